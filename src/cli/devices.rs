@@ -1,0 +1,8 @@
+//! `translucent devices`.
+
+#[derive(clap::Args, Debug)]
+pub struct Args {}
+
+pub fn run(_gpu: &super::GpuArgs, _args: &Args) -> anyhow::Result<()> {
+    anyhow::bail!("not built yet")
+}

@@ -1,0 +1,46 @@
+//! The `translucent` command line. Each subcommand lives in `src/cli/`.
+
+mod cli;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "translucent", version, about = "Render translucent materials (dipole BSSRDF) on Vulkan", long_about = None)]
+struct Cli {
+    #[command(flatten)]
+    gpu: cli::GpuArgs,
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List Vulkan devices (name, type, driver, Vulkan version)
+    Devices(cli::devices::Args),
+    /// Render a scene (default: the built-in scene)
+    Render(cli::render::Args),
+    /// Show a material's derived dipole quantities, or list the measured presets
+    Material(cli::material::Args),
+    /// Place sample points on a mesh and print their statistics
+    Sample(cli::sample::Args),
+}
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = Cli::parse();
+    let result = match cli.command {
+        None => cli::render::run(&cli.gpu, &cli::render::Args::default()),
+        Some(Command::Render(args)) => cli::render::run(&cli.gpu, &args),
+        Some(Command::Devices(args)) => cli::devices::run(&cli.gpu, &args),
+        Some(Command::Material(args)) => cli::material::run(&args),
+        Some(Command::Sample(args)) => cli::sample::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! Triangle meshes: OBJ loading, validation and derived geometry.

@@ -1,0 +1,1 @@
+//! Smoke pass: a tiny compute dispatch that proves the device works.
