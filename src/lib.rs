@@ -9,3 +9,4 @@ pub mod mesh;
 pub mod optics;
 pub mod render;
 pub mod sampling;
+pub mod scene;
