@@ -222,7 +222,7 @@ fn graphics_pipeline_draws_a_triangle() {
                 .depth_attachment(&depth_attachment);
             unsafe {
                 device.cmd_begin_rendering(cmd, &rendering);
-                pipeline.bind(cmd, &set, bytemuck::bytes_of(&0.5f32), color.extent());
+                pipeline.bind(cmd, Some(&set), bytemuck::bytes_of(&0.5f32), color.extent());
                 device.cmd_bind_vertex_buffers(cmd, 0, &[vbuf.raw()], &[0]);
                 device.cmd_draw(cmd, 3, 1, 0, 0);
                 device.cmd_end_rendering(cmd);

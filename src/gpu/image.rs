@@ -47,6 +47,8 @@ pub struct Image {
     gpu: Arc<Gpu>,
     raw: vk::Image,
     view: vk::ImageView,
+    /// One 2D view per layer, for rendering into a single layer (only when `layers > 1`).
+    layer_views: Vec<vk::ImageView>,
     allocation: Option<Allocation>,
     desc: ImageDesc,
 }
@@ -111,6 +113,7 @@ impl Image {
             gpu: gpu.clone(),
             raw,
             view: vk::ImageView::null(),
+            layer_views: Vec::new(),
             allocation: Some(allocation),
             desc: desc.clone(),
         };
@@ -142,6 +145,14 @@ impl Image {
     }
     pub fn view(&self) -> vk::ImageView {
         self.view
+    }
+    /// A 2D view of one layer (the whole-image view when there is only one layer).
+    pub fn layer_view(&self, layer: u32) -> vk::ImageView {
+        if self.layer_views.is_empty() {
+            self.view
+        } else {
+            self.layer_views[layer as usize]
+        }
     }
     pub fn desc(&self) -> &ImageDesc {
         &self.desc
@@ -218,6 +229,9 @@ impl Drop for Image {
     fn drop(&mut self) {
         // SAFETY: all submissions wait on their fence, so the image is idle.
         unsafe {
+            for view in self.layer_views.drain(..) {
+                self.gpu.device().destroy_image_view(view, None);
+            }
             if self.view != vk::ImageView::null() {
                 self.gpu.device().destroy_image_view(self.view, None);
             }

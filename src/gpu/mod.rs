@@ -1,6 +1,6 @@
 //! The Vulkan core (ash), one Vulkan concept per file: instance (loader, validation), debug
 //! (messenger and message counts), device (choice and logical device), context (`Gpu`),
-//! buffer, image, descriptor, pipeline, command (one-shot submission), barrier, timer, shaders.
+//! buffer, image, sampler, descriptor, pipeline, command (one-shot submission), barrier, timer, shaders.
 //!
 //! Every Vulkan object is owned by a Rust value that destroys it on Drop and holds an
 //! `Arc<Gpu>`, so the device always outlives what was made from it.
@@ -16,6 +16,7 @@ mod error;
 mod image;
 mod instance;
 mod pipeline;
+mod sampler;
 pub mod shaders;
 mod timer;
 
@@ -29,6 +30,7 @@ pub use error::{GpuError, GpuResult};
 pub use gpu_allocator::MemoryLocation;
 pub use image::{Image, ImageDesc, aspect_of};
 pub use pipeline::{ComputePipeline, GraphicsDesc, GraphicsPipeline};
+pub use sampler::Sampler;
 pub use timer::{GpuTimer, median};
 
 use std::time::Duration;

@@ -61,13 +61,22 @@ impl Layout {
         &self,
         cmd: vk::CommandBuffer,
         point: vk::PipelineBindPoint,
-        set: &DescriptorSet,
+        set: Option<&DescriptorSet>,
         push: &[u8],
     ) {
         let device = self.gpu.device();
         // SAFETY: `cmd` is recording; set and push block match this layout (push length checked).
         unsafe {
-            device.cmd_bind_descriptor_sets(cmd, point, self.pipeline_layout, 0, &[set.raw()], &[]);
+            if let Some(set) = set {
+                device.cmd_bind_descriptor_sets(
+                    cmd,
+                    point,
+                    self.pipeline_layout,
+                    0,
+                    &[set.raw()],
+                    &[],
+                );
+            }
             if !push.is_empty() {
                 device.cmd_push_constants(cmd, self.pipeline_layout, self.stages, 0, push);
             }
@@ -183,7 +192,7 @@ impl ComputePipeline {
         // SAFETY: `cmd` is recording, outside a render pass.
         unsafe { device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline) };
         self.layout
-            .bind(cmd, vk::PipelineBindPoint::COMPUTE, set, push);
+            .bind(cmd, vk::PipelineBindPoint::COMPUTE, Some(set), push);
         unsafe { device.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
     }
 
@@ -344,7 +353,7 @@ impl GraphicsPipeline {
     pub fn bind(
         &self,
         cmd: vk::CommandBuffer,
-        set: &DescriptorSet,
+        set: Option<&DescriptorSet>,
         push: &[u8],
         extent: vk::Extent2D,
     ) {

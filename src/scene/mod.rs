@@ -1,7 +1,9 @@
 //! Scenes: the TOML format (`format`), loading with errors that name the file, key path and
 //! line, value checks, and the built-in default scene.
 
+mod camera;
 pub mod format;
+pub mod lights;
 
 pub use format::*;
 use std::path::{Path, PathBuf};
