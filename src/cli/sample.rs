@@ -54,7 +54,7 @@ pub struct Args {
     /// Scale applied to the mesh positions on loading
     #[arg(long, default_value_t = 1.0)]
     pub scale: f32,
-    /// Repulsion iterations for turk and feature (default 40)
+    /// Repulsion iterations (default 40 for turk, 80 for feature)
     #[arg(long)]
     pub iterations: Option<usize>,
 }

@@ -100,8 +100,13 @@ pub fn relax(mesh: &Mesh, points: &mut Vec<SurfacePoint>, radius: Radius<'_>, pa
                         return;
                     }
                     let d = d2.sqrt();
-                    let dir = if d > 1e-9 * rij {
-                        (p - positions[j]) / d
+                    // The neighbour is laid into this point's tangent plane at its distance d, so
+                    // a neighbour around a bend pushes with the full (r - d), not the smaller
+                    // in-plane part of its offset.
+                    let offset = p - positions[j];
+                    let in_plane = offset - offset.dot(n) * n;
+                    let dir = if d > 1e-9 * rij && in_plane.length_squared() > 1e-18 * d2 {
+                        in_plane.normalize()
                     } else {
                         // Coincident points: push apart along a fixed edge of the triangle, in
                         // opposite senses for the two, so they separate deterministically.
@@ -111,8 +116,7 @@ pub fn relax(mesh: &Mesh, points: &mut Vec<SurfacePoint>, radius: Radius<'_>, pa
                     };
                     force += (rij - d) * dir;
                 });
-                let tangential = force - force.dot(n) * n;
-                let mut disp = step * tangential;
+                let mut disp = step * force;
                 // No single step longer than half a radius: keeps crowded starts from flinging
                 // points across the model.
                 let len = disp.length();
