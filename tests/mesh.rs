@@ -227,7 +227,9 @@ fn torus_curvature_follows_the_analytic_range() {
         worst_k = worst_k.max((k[i] - k_exact(v[i])).abs());
         worst_h = worst_h.max((h[i] - h_exact(v[i])).abs());
     }
-    eprintln!("torus: worst |K error| {worst_k:.2e} (range {k_lo:.3}..{k_hi:.3}), worst |H error| {worst_h:.2e} (range {h_lo:.3}..{h_hi:.3})");
+    eprintln!(
+        "torus: worst |K error| {worst_k:.2e} (range {k_lo:.3}..{k_hi:.3}), worst |H error| {worst_h:.2e} (range {h_lo:.3}..{h_hi:.3})"
+    );
     // Errors measured against the spread of each quantity over the torus.
     assert!(worst_k < 0.02 * (k_hi - k_lo), "worst |K error| = {worst_k}, range {k_lo}..{k_hi}");
     assert!(worst_h < 0.02 * (h_hi - h_lo), "worst |H error| = {worst_h}, range {h_lo}..{h_hi}");

@@ -13,8 +13,7 @@ use translucent::sampling::feature::{feature_point_count, feature_points};
 use translucent::sampling::walk::walk;
 use translucent::sampling::weights::{WeightParams, area_weights};
 use translucent::sampling::{
-    GpuSample, MAX_COUNT, Method, SampleOptions, SampleSet, SamplingError, SpatialHash, SurfacePoint, nearest_neighbour_distances,
-    sample,
+    GpuSample, MAX_COUNT, Method, SampleOptions, SampleSet, SamplingError, SpatialHash, SurfacePoint, nearest_neighbour_distances, sample,
 };
 
 fn asset(name: &str) -> PathBuf {
@@ -85,7 +84,12 @@ fn check_set(mesh: &Mesh, set: &SampleSet, n: usize) {
         assert!(p.area >= 0.0 && p.area.is_finite());
     }
     let total = set.total_area();
-    assert!((total - mesh.total_area()).abs() <= 1e-6 * mesh.total_area(), "{}: weights sum to {total}, area {}", set.method, mesh.total_area());
+    assert!(
+        (total - mesh.total_area()).abs() <= 1e-6 * mesh.total_area(),
+        "{}: weights sum to {total}, area {}",
+        set.method,
+        mesh.total_area()
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -218,11 +222,7 @@ fn unit_square() -> Mesh {
 /// The surface point of the unit square at (x, y).
 fn on_square(x: f64, y: f64) -> SurfacePoint {
     // Triangle 0 is (0,0) (1,0) (1,1), below the diagonal; triangle 1 is (0,0) (1,1) (0,1).
-    if y <= x {
-        SurfacePoint { triangle: 0, bary: [1.0 - x, x - y, y] }
-    } else {
-        SurfacePoint { triangle: 1, bary: [1.0 - y, x, y - x] }
-    }
+    if y <= x { SurfacePoint { triangle: 0, bary: [1.0 - x, x - y, y] } } else { SurfacePoint { triangle: 1, bary: [1.0 - y, x, y - x] } }
 }
 
 #[test]
@@ -343,8 +343,8 @@ fn algorithm_1_places_2n_points_in_distinct_top_triangles() {
         // Eq. 12 with |H| weights, blended with 5% of the centroid: inside the triangle.
         let w = mesh.triangles()[p.triangle as usize].map(|v| h[v as usize]);
         let s: f64 = w.iter().sum();
-        for k in 0..3 {
-            let want = 0.95 * w[k] / s + 0.05 / 3.0;
+        for (k, wk) in w.iter().enumerate() {
+            let want = 0.95 * wk / s + 0.05 / 3.0;
             assert!((p.bary[k] - want).abs() < 1e-12);
             assert!(p.bary[k] > 0.0);
         }

@@ -99,7 +99,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let stats = SampleStats::compute(&points, mesh.total_area());
     if let Some(path) = &args.output {
         spinner.set_message(format!("writing {}", path.display()));
-        let comment = format!("translucent sample: {} points, method {}, seed {}, mesh {}", points.len(), options.method, args.seed, args.mesh.display());
+        let comment = format!(
+            "translucent sample: {} points, method {}, seed {}, mesh {}",
+            points.len(),
+            options.method,
+            args.seed,
+            args.mesh.display()
+        );
         write_ply_atomic(path, &points, &comment)?;
     }
     spinner.finish_and_clear();
@@ -169,9 +175,8 @@ fn write_ply_atomic(path: &Path, points: &[SamplePoint], comment: &str) -> anyho
     };
     let name = path.file_name().with_context(|| format!("output path {} has no file name", path.display()))?;
     let tmp = dir.join(format!(".{}.tmp{}", name.to_string_lossy(), std::process::id()));
-    let result = write_ply(&tmp, points, comment).and_then(|()| {
-        std::fs::rename(&tmp, path).with_context(|| format!("cannot move {} to {}", tmp.display(), path.display()))
-    });
+    let result = write_ply(&tmp, points, comment)
+        .and_then(|()| std::fs::rename(&tmp, path).with_context(|| format!("cannot move {} to {}", tmp.display(), path.display())));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }

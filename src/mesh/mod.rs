@@ -272,11 +272,7 @@ impl Mesh {
     #[inline]
     pub fn corners(&self, t: usize) -> [DVec3; 3] {
         let [a, b, c] = self.triangles[t];
-        [
-            self.positions[a as usize].as_dvec3(),
-            self.positions[b as usize].as_dvec3(),
-            self.positions[c as usize].as_dvec3(),
-        ]
+        [self.positions[a as usize].as_dvec3(), self.positions[b as usize].as_dvec3(), self.positions[c as usize].as_dvec3()]
     }
 
     /// The point of triangle `t` at barycentric coordinates `bary` (weights of its corners).
@@ -319,7 +315,8 @@ fn is_degenerate(positions: &[Vec3], t: &[u32; 3]) -> bool {
     }
     let p = t.map(|i| positions[i as usize].as_dvec3());
     let (area, longest) = area_and_longest_edge(p);
-    !(area > DEGENERATE_AREA_RATIO * longest)
+    // Written so that a NaN area also counts as degenerate.
+    area.is_nan() || area <= DEGENERATE_AREA_RATIO * longest
 }
 
 /// Merge vertices whose positions are bit-identical (after folding -0.0 into 0.0). Returns the

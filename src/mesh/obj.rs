@@ -62,17 +62,11 @@ pub(super) fn load(path: &Path, options: &LoadOptions) -> Result<Loaded, MeshErr
     let source_name = path.display().to_string();
     prescan(&text, &source_name)?;
 
-    let tobj_options = tobj::LoadOptions {
-        single_index: true,
-        triangulate: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
+    let tobj_options = tobj::LoadOptions { single_index: true, triangulate: true, ignore_points: true, ignore_lines: true };
     // Materials are not used: refuse to open .mtl files instead of reading them.
-    let (models, _materials) = tobj::load_obj_buf(&mut Cursor::new(text.as_bytes()), &tobj_options, |_| {
-        Err(tobj::LoadError::GenericFailure)
-    })
-    .map_err(|error| MeshError::Obj { source_name: source_name.clone(), error })?;
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut Cursor::new(text.as_bytes()), &tobj_options, |_| Err(tobj::LoadError::GenericFailure))
+            .map_err(|error| MeshError::Obj { source_name: source_name.clone(), error })?;
 
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
@@ -130,7 +124,12 @@ fn prescan(text: &str, source_name: &str) -> Result<(), MeshError> {
                     vertices += 1;
                     for (kind, part) in word.split('/').enumerate() {
                         if kind >= 3 {
-                            return Err(parse_error(source_name, line_no, format!("face vertex `{word}` has more than three indices"), line));
+                            return Err(parse_error(
+                                source_name,
+                                line_no,
+                                format!("face vertex `{word}` has more than three indices"),
+                                line,
+                            ));
                         }
                         if part.is_empty() {
                             if kind == 0 {
@@ -138,9 +137,9 @@ fn prescan(text: &str, source_name: &str) -> Result<(), MeshError> {
                             }
                             continue;
                         }
-                        let index: i64 = part.parse().map_err(|_| {
-                            parse_error(source_name, line_no, format!("face index `{part}` is not an integer"), line)
-                        })?;
+                        let index: i64 = part
+                            .parse()
+                            .map_err(|_| parse_error(source_name, line_no, format!("face index `{part}` is not an integer"), line))?;
                         if index == 0 {
                             return Err(parse_error(source_name, line_no, "face index 0 is invalid (OBJ indices start at 1)".into(), line));
                         }
@@ -148,7 +147,10 @@ fn prescan(text: &str, source_name: &str) -> Result<(), MeshError> {
                             return Err(parse_error(
                                 source_name,
                                 line_no,
-                                format!("relative {} index {index} reaches before the first of the {} defined so far", KINDS[kind], counts[kind]),
+                                format!(
+                                    "relative {} index {index} reaches before the first of the {} defined so far",
+                                    KINDS[kind], counts[kind]
+                                ),
                                 line,
                             ));
                         }
@@ -158,7 +160,12 @@ fn prescan(text: &str, source_name: &str) -> Result<(), MeshError> {
                     }
                 }
                 if keyword == "f" && vertices < 3 {
-                    return Err(parse_error(source_name, line_no, format!("a face needs at least 3 vertices, this one has {vertices}"), line));
+                    return Err(parse_error(
+                        source_name,
+                        line_no,
+                        format!("a face needs at least 3 vertices, this one has {vertices}"),
+                        line,
+                    ));
                 }
                 continue;
             }
@@ -166,9 +173,7 @@ fn prescan(text: &str, source_name: &str) -> Result<(), MeshError> {
         };
         let mut values = 0;
         for word in words.by_ref().take(needed) {
-            let value: f32 = word.parse().map_err(|_| {
-                parse_error(source_name, line_no, format!("`{word}` is not a number"), line)
-            })?;
+            let value: f32 = word.parse().map_err(|_| parse_error(source_name, line_no, format!("`{word}` is not a number"), line))?;
             if !value.is_finite() {
                 return Err(parse_error(source_name, line_no, format!("coordinate `{word}` is not a finite f32 number"), line));
             }
@@ -184,11 +189,16 @@ fn prescan(text: &str, source_name: &str) -> Result<(), MeshError> {
             match rest.len() {
                 0 | 3 => {}
                 1 => {
-                    let w: f32 = rest[0].parse().map_err(|_| {
-                        parse_error(source_name, line_no, format!("weight `{}` is not a number", rest[0]), line)
-                    })?;
+                    let w: f32 = rest[0]
+                        .parse()
+                        .map_err(|_| parse_error(source_name, line_no, format!("weight `{}` is not a number", rest[0]), line))?;
                     if !w.is_finite() || w == 0.0 {
-                        return Err(parse_error(source_name, line_no, format!("weight w = `{}` must be finite and non-zero", rest[0]), line));
+                        return Err(parse_error(
+                            source_name,
+                            line_no,
+                            format!("weight w = `{}` must be finite and non-zero", rest[0]),
+                            line,
+                        ));
                     }
                 }
                 k => {

@@ -89,7 +89,7 @@ pub fn curvature_density(mesh: &Mesh, contrast: f64, cap: f64) -> Vec<f64> {
     let area = mesh.mixed_areas();
     let total: f64 = area.iter().sum();
     let mean = h.iter().zip(area).map(|(h, a)| h * a).sum::<f64>() / total;
-    if !(mean > 0.0) || !mean.is_finite() {
+    if mean.is_nan() || mean <= 0.0 || !mean.is_finite() {
         return vec![1.0; h.len()];
     }
     h.iter().map(|&x| 1.0 + (contrast * x / mean).min(cap)).collect()
@@ -128,11 +128,7 @@ pub fn feature_points(mesh: &Mesh, two_n: usize) -> Vec<SurfacePoint> {
         .map(|&t| {
             let w = tris[t as usize].map(|v| abs_h[v as usize]);
             let sum = w[0] + w[1] + w[2];
-            let eq12 = if sum.is_finite() && sum > NEGLIGIBLE * mean_h && sum > 0.0 {
-                w.map(|x| x / sum)
-            } else {
-                [1.0 / 3.0; 3]
-            };
+            let eq12 = if sum.is_finite() && sum > NEGLIGIBLE * mean_h && sum > 0.0 { w.map(|x| x / sum) } else { [1.0 / 3.0; 3] };
             let bary = eq12.map(|x| (1.0 - CENTROID_BLEND) * x + CENTROID_BLEND / 3.0);
             SurfacePoint { triangle: t, bary }
         })
@@ -165,4 +161,3 @@ pub fn relax_by_curvature(mesh: &Mesh, points: &mut Vec<SurfacePoint>, params: &
     let base = 2.0 * (integral / points.len().max(1) as f64).sqrt();
     relax(mesh, points, Radius::Density { base, vertex_density: &density }, &params.turk);
 }
-

@@ -48,9 +48,9 @@ impl SpatialHash {
         self.hi = [i32::MIN; 3];
         for p in positions {
             let c = self.cell_of(*p);
-            for a in 0..3 {
-                self.lo[a] = self.lo[a].min(c[a]);
-                self.hi[a] = self.hi[a].max(c[a]);
+            for (a, &ca) in c.iter().enumerate() {
+                self.lo[a] = self.lo[a].min(ca);
+                self.hi[a] = self.hi[a].max(ca);
             }
             self.cells.push(c);
             self.buckets.push(self.bucket(c));
@@ -159,8 +159,8 @@ impl SpatialHash {
         }
         let c = self.cell_of(p);
         let mut max_ring = 0;
-        for a in 0..3 {
-            max_ring = max_ring.max((c[a] - self.lo[a]).abs()).max((self.hi[a] - c[a]).abs());
+        for (a, &ca) in c.iter().enumerate() {
+            max_ring = max_ring.max((ca - self.lo[a]).abs()).max((self.hi[a] - ca).abs());
         }
         for k in 0..=max_ring {
             for dz in -k..=k {
@@ -204,8 +204,8 @@ impl SpatialHash {
     /// the nearest point of all, in which case that one. Used to keep the two sides of a thin
     /// sheet apart: a point on one face prefers samples whose normals face the same way.
     pub fn nearest_preferring(&self, p: DVec3, slack: f64, prefer: impl Fn(u32) -> bool) -> Option<u32> {
-        // (nearest of all, nearest preferred), each as (index, squared distance).
-        let mut state: (Option<(u32, f64)>, Option<(u32, f64)>) = (None, None);
+        // (nearest of all, nearest preferred).
+        let mut state: (Option<Hit>, Option<Hit>) = (None, None);
         self.ring_search(
             p,
             &mut state,
@@ -232,8 +232,11 @@ impl SpatialHash {
     }
 }
 
+/// A point index and its squared distance to the query.
+type Hit = (u32, f64);
+
 /// Strictly nearer, or as near with a lower index (so ties resolve the same way every run).
 #[inline]
-fn better(i: u32, d2: f64, current: Option<(u32, f64)>) -> bool {
+fn better(i: u32, d2: f64, current: Option<Hit>) -> bool {
     current.is_none_or(|(bi, bd)| d2 < bd || (d2 == bd && i < bi))
 }

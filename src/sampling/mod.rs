@@ -193,7 +193,7 @@ fn check(mesh: &Mesh, count: usize) -> Result<(), SamplingError> {
         return Err(SamplingError::TooMany { count, max: MAX_COUNT });
     }
     let area = mesh.total_area();
-    if !(area > 0.0) || !area.is_finite() {
+    if area.is_nan() || area <= 0.0 || !area.is_finite() {
         return Err(SamplingError::NoArea { area });
     }
     Ok(())

@@ -74,8 +74,10 @@ pub fn eliminate(mesh: &Mesh, candidates: &[SurfacePoint], n: usize) -> Vec<Surf
     let hash = SpatialHash::new(&positions, reach);
     let weight = |d: f64| (1.0 - d.max(r_min) / reach).max(0.0).powi(ALPHA);
 
-    // Neighbour lists (index, weight) in CSR form, built block by block.
-    let blocks: Vec<(Vec<u32>, Vec<(u32, f64)>)> = (0..m.div_ceil(BLOCK))
+    // Neighbour lists (index, weight) in CSR form, built block by block: each block gives its
+    // per-candidate counts and its concatenated lists.
+    type Block = (Vec<u32>, Vec<(u32, f64)>);
+    let blocks: Vec<Block> = (0..m.div_ceil(BLOCK))
         .into_par_iter()
         .map(|blk| {
             let range = blk * BLOCK..((blk + 1) * BLOCK).min(m);

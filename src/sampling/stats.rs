@@ -19,10 +19,7 @@ pub fn nearest_neighbour_distances(positions: &[Vec3]) -> Vec<f64> {
     let box_area = 2.0 * (ext.x * ext.y + ext.y * ext.z + ext.z * ext.x);
     let cell = (box_area / pts.len() as f64).sqrt().max(1e-12);
     let hash = SpatialHash::new(&pts, cell);
-    pts.par_iter()
-        .enumerate()
-        .map(|(i, p)| hash.nearest(*p, Some(i as u32)).map_or(0.0, |(_, d)| d))
-        .collect()
+    pts.par_iter().enumerate().map(|(i, p)| hash.nearest(*p, Some(i as u32)).map_or(0.0, |(_, d)| d)).collect()
 }
 
 /// Summary printed by `translucent sample`.
