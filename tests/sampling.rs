@@ -254,13 +254,15 @@ fn spatial_hash_agrees_with_brute_force() {
     pts.push(DVec3::new(50.0, -30.0, 7.0));
     let hash = SpatialHash::new(&pts, 0.05);
     for q in (0..60).map(|i| pts[i * 11] + DVec3::new(0.01, -0.02, 0.005)) {
-        let radius = 0.3;
-        let mut got = BTreeSet::new();
-        hash.for_each_within(q, radius, |i, _| {
-            got.insert(i);
-        });
-        let want: BTreeSet<u32> = (0..pts.len() as u32).filter(|&i| pts[i as usize].distance(q) <= radius).collect();
-        assert_eq!(got, want);
+        // A radius near the cell size walks the cells; a large one falls back to a scan.
+        for radius in [0.06, 0.3] {
+            let mut got = BTreeSet::new();
+            hash.for_each_within(q, radius, |i, _| {
+                assert!(got.insert(i), "point {i} visited twice");
+            });
+            let want: BTreeSet<u32> = (0..pts.len() as u32).filter(|&i| pts[i as usize].distance(q) <= radius).collect();
+            assert_eq!(got, want);
+        }
         let (near, d) = hash.nearest(q, None).unwrap();
         let brute = pts.iter().map(|p| p.distance(q)).fold(f64::INFINITY, f64::min);
         assert!((d - brute).abs() < 1e-12 && (pts[near as usize].distance(q) - brute).abs() < 1e-12);

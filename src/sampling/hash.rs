@@ -21,8 +21,9 @@ pub struct SpatialHash {
     hi: [i32; 3],
 }
 
-/// Cell coordinates are clamped so that absurd coordinate-to-cell ratios cannot overflow i32.
-const CELL_LIMIT: f64 = (1i64 << 30) as f64;
+/// Cell coordinates are clamped so that absurd coordinate-to-cell ratios cannot overflow i32,
+/// differences of two cell coordinates included.
+const CELL_LIMIT: f64 = (1i64 << 29) as f64;
 
 impl SpatialHash {
     /// A hash over `positions` with cubic cells of side `cell` (which must be positive).
@@ -94,6 +95,12 @@ impl SpatialHash {
         self.positions[i as usize]
     }
 
+    /// Cell visits beyond which a query scans all points instead.
+    #[inline]
+    fn brute_force_threshold(&self) -> i64 {
+        2 * self.positions.len() as i64 + 64
+    }
+
     #[inline]
     fn cell_of(&self, p: DVec3) -> [i32; 3] {
         let c = (p * self.inv_cell).floor().clamp(DVec3::splat(-CELL_LIMIT), DVec3::splat(CELL_LIMIT));
@@ -135,6 +142,18 @@ impl SpatialHash {
             [a[0].max(self.lo[0]), a[1].max(self.lo[1]), a[2].max(self.lo[2])],
             [b[0].min(self.hi[0]), b[1].min(self.hi[1]), b[2].min(self.hi[2])],
         );
+        // A radius much larger than the cells would visit more (mostly empty) cells than there
+        // are points: then a plain scan is cheaper.
+        let cells: i64 = (0..3).map(|k| (b[k] as i64 - a[k] as i64 + 1).max(0)).product();
+        if cells > self.brute_force_threshold() {
+            for (i, q) in self.positions.iter().enumerate() {
+                let d2 = q.distance_squared(p);
+                if d2 <= r2 {
+                    f(i as u32, d2);
+                }
+            }
+            return;
+        }
         for z in a[2]..=b[2] {
             for y in a[1]..=b[1] {
                 for x in a[0]..=b[0] {
@@ -162,16 +181,31 @@ impl SpatialHash {
         for (a, &ca) in c.iter().enumerate() {
             max_ring = max_ring.max((ca - self.lo[a]).abs()).max((self.hi[a] - ca).abs());
         }
+        let mut cells_seen: i64 = 0;
         for k in 0..=max_ring {
-            for dz in -k..=k {
-                for dy in -k..=k {
+            // An isolated query far from every point would sweep ever larger empty shells; once
+            // the shells cost more than all the points, scan the points instead (visiting one
+            // twice changes nothing for the searches here).
+            cells_seen += if k == 0 { 1 } else { 24 * (k as i64) * (k as i64) + 2 };
+            if cells_seen > self.brute_force_threshold() {
+                for (i, q) in self.positions.iter().enumerate() {
+                    visit(state, i as u32, q.distance_squared(p));
+                }
+                return;
+            }
+            // Rows outside the occupied box are skipped whole.
+            let (z0, z1) = ((-k).max(self.lo[2] - c[2]), k.min(self.hi[2] - c[2]));
+            let (y0, y1) = ((-k).max(self.lo[1] - c[1]), k.min(self.hi[1] - c[1]));
+            for dz in z0..=z1 {
+                for dy in y0..=y1 {
                     let inner = dz.abs() < k && dy.abs() < k;
                     // Inside the shell only the two x faces belong to ring k.
                     let step = if inner { (2 * k).max(1) } else { 1 };
                     let mut dx = -k;
                     while dx <= k {
-                        let cell = [c[0] + dx, c[1] + dy, c[2] + dz];
-                        if (0..3).all(|a| cell[a] >= self.lo[a] && cell[a] <= self.hi[a]) {
+                        let x = c[0] + dx;
+                        if x >= self.lo[0] && x <= self.hi[0] {
+                            let cell = [x, c[1] + dy, c[2] + dz];
                             self.visit_cell(cell, |i| visit(state, i, self.positions[i as usize].distance_squared(p)));
                         }
                         dx += step;
