@@ -3,14 +3,14 @@
 //!
 //! # How the paper is read here
 //!
-//! The paper starts from random points, then "select[s] triangles with larger curvature and area
-//! to distribute new points on the center of gravity", weighting the three corners by their
-//! curvature (Eq. 12: newCoord = sum_i Curvature[i] Coord[i] / sum_i Curvature[i]). Algorithm 1
+//! The paper begins with random points, then adds points at curvature-weighted centres of the
+//! triangles that rank high on curvature and on area (Eq. 12:
+//! `newCoord = sum_i Curvature[i] * Coord[i] / sum_i Curvature[i]` over the three corners). Algorithm 1
 //! takes the n triangles with the largest curvature and the n with the largest area, 2n new
 //! points in all. It leaves open which curvature, how n relates to the budget, and what happens
 //! when the weights cancel. The exact procedure implemented:
 //!
-//! 1. Curvature[i] is |H_i|, the magnitude of the mean curvature at vertex i (cotangent
+//! 1. `Curvature[i]` is |H_i|, the magnitude of the mean curvature at vertex i (cotangent
 //!    Laplace-Beltrami, Meyer et al. 2003). A triangle's curvature is the mean of its three
 //!    corners' |H|; its area is its own area.
 //! 2. The budget is N in total: n = floor(N * feature_fraction / 2), at most half the triangle
@@ -30,6 +30,9 @@
 //!    2 sqrt(integral(rho) / (N rho_i)), which reduces to Turk's 2 sqrt(A / N) where rho is
 //!    constant. Regions of high |H| therefore end up with up to (1 + cap) times more points
 //!    per unit area than flat ones.
+//!
+//! Defaults ([`FeatureParams::default`]): feature_fraction 0.5 (so 2n = 2 floor(N / 4)), c = 1,
+//! cap = 3, 80 repulsion iterations with step 0.1.
 
 use super::turk::{Radius, TurkParams, relax};
 use super::walk::SurfacePoint;
