@@ -130,14 +130,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for warning in mesh_warnings(report) {
         eprintln!("warning: {}: {warning}", report.source);
     }
-    let fmt_opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.6}"));
+    let fmt_opt = |v: Option<f64>| v.map_or("-".to_string(), num);
     println!("mesh         {} ({} vertices, {} triangles)", report.source, mesh.positions().len(), mesh.triangles().len());
     println!("method       {} (seed {})", options.method, args.seed);
     println!("count        {}", stats.count);
     println!(
-        "total area   {:.6} (weights sum to {:.6}, relative difference {:.1e})",
-        stats.mesh_area,
-        stats.total_weight,
+        "total area   {} (weights sum to {}, relative difference {:.1e})",
+        num(stats.mesh_area),
+        num(stats.total_weight),
         (stats.total_weight - stats.mesh_area).abs() / stats.mesh_area
     );
     println!("nn distance  min {}  mean {}  max {}", fmt_opt(stats.nn_min), fmt_opt(stats.nn_mean), fmt_opt(stats.nn_max));
@@ -147,6 +147,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         println!("written      {}", path.display());
     }
     Ok(())
+}
+
+/// Six significant digits, in fixed notation for everyday magnitudes and scientific otherwise
+/// (meshes may be in micrometres or kilometres).
+fn num(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e6).contains(&v.abs()) {
+        let decimals = (5 - v.abs().log10().floor() as i32).clamp(0, 8) as usize;
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.5e}")
+    }
 }
 
 fn mesh_warnings(r: &translucent::mesh::MeshReport) -> Vec<String> {
@@ -176,30 +187,28 @@ fn write_ply_atomic(path: &Path, points: &[SamplePoint], comment: &str) -> anyho
     let name = path.file_name().with_context(|| format!("output path {} has no file name", path.display()))?;
     let tmp = dir.join(format!(".{}.tmp{}", name.to_string_lossy(), std::process::id()));
     let result = write_ply(&tmp, points, comment)
-        .and_then(|()| std::fs::rename(&tmp, path).with_context(|| format!("cannot move {} to {}", tmp.display(), path.display())));
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .with_context(|| format!("cannot write {} (through the temporary file {})", path.display(), tmp.display()));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
     result
 }
 
-fn write_ply(path: &Path, points: &[SamplePoint], comment: &str) -> anyhow::Result<()> {
-    let write = || -> std::io::Result<()> {
-        let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
-        let comment = comment.replace(['\n', '\r'], " ");
-        write!(
-            w,
-            "ply\nformat ascii 1.0\ncomment {comment}\nelement vertex {}\n\
-             property float x\nproperty float y\nproperty float z\n\
-             property float nx\nproperty float ny\nproperty float nz\n\
-             property float area\nend_header\n",
-            points.len()
-        )?;
-        for p in points {
-            let (x, n) = (p.position, p.normal);
-            writeln!(w, "{} {} {} {} {} {} {}", x.x, x.y, x.z, n.x, n.y, n.z, p.area as f32)?;
-        }
-        w.into_inner().map_err(|e| e.into_error())?.sync_all()
-    };
-    write().with_context(|| format!("cannot write {}", path.display()))
+fn write_ply(path: &Path, points: &[SamplePoint], comment: &str) -> std::io::Result<()> {
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let comment = comment.replace(['\n', '\r'], " ");
+    write!(
+        w,
+        "ply\nformat ascii 1.0\ncomment {comment}\nelement vertex {}\n\
+         property float x\nproperty float y\nproperty float z\n\
+         property float nx\nproperty float ny\nproperty float nz\n\
+         property float area\nend_header\n",
+        points.len()
+    )?;
+    for p in points {
+        let (x, n) = (p.position, p.normal);
+        writeln!(w, "{} {} {} {} {} {} {}", x.x, x.y, x.z, n.x, n.y, n.z, p.area as f32)?;
+    }
+    w.into_inner().map_err(|e| e.into_error())?.sync_all()
 }

@@ -30,7 +30,8 @@ pub const DEGENERATE_AREA_RATIO: f64 = 1e-10;
 /// (or `<memory>`), and the line, vertex or triangle at fault.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
-    #[error("cannot read mesh file {}: {source}", path.display())]
+    // The io::Error is the source (shown by `{:#}` and error reporters), not repeated here.
+    #[error("cannot read mesh file {}", path.display())]
     Io { path: PathBuf, source: std::io::Error },
     #[error("{source_name}:{line}: {message} (line: `{text}`)")]
     Parse { source_name: String, line: usize, message: String, text: String },
