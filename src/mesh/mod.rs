@@ -113,6 +113,13 @@ impl Mesh {
         Mesh::build(path.display().to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
     }
 
+    /// Parse OBJ text in memory (e.g. an asset embedded in the binary), with the same
+    /// validation as [`Mesh::load`]; `source_name` names it in errors.
+    pub fn from_obj_text(text: &str, source_name: &str, options: &LoadOptions) -> Result<Mesh, MeshError> {
+        let loaded = obj::parse(text, source_name, options)?;
+        Mesh::build(source_name.to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
+    }
+
     /// Build a mesh from positions and triangles in memory, with the same validation and
     /// clean-up as [`Mesh::load`].
     pub fn from_triangles(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Mesh, MeshError> {

@@ -58,9 +58,14 @@ pub(super) struct Loaded {
 pub(super) fn load(path: &Path, options: &LoadOptions) -> Result<Loaded, MeshError> {
     options.validate()?;
     let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_path_buf(), source })?;
-    let text = String::from_utf8_lossy(&bytes);
-    let source_name = path.display().to_string();
-    prescan(&text, &source_name)?;
+    parse(&String::from_utf8_lossy(&bytes), &path.display().to_string(), options)
+}
+
+/// Parse OBJ text already in memory; `source_name` names it in errors.
+pub(super) fn parse(text: &str, source_name: &str, options: &LoadOptions) -> Result<Loaded, MeshError> {
+    options.validate()?;
+    let source_name = source_name.to_string();
+    prescan(text, &source_name)?;
 
     let tobj_options = tobj::LoadOptions { single_index: true, triangulate: true, ignore_points: true, ignore_lines: true };
     // Materials are not used: refuse to open .mtl files instead of reading them.
