@@ -161,7 +161,11 @@ impl Dipole {
         let mut lo = 0.0;
         for _ in 0..200 {
             let mid = 0.5 * (lo + hi);
-            if self.r_d_outside(mid) > target { lo = mid } else { hi = mid }
+            if self.r_d_outside(mid) > target {
+                lo = mid
+            } else {
+                hi = mid
+            }
             if hi - lo <= 1e-12 * hi {
                 break;
             }
@@ -208,11 +212,19 @@ pub fn ring_term(z: f64, s: f64, r1_sq: f64, delta_sq: f64) -> f64 {
     (z / d1) * (-s * d1).exp() * (gap / d2 + (d1 / d2) * -(-s * gap).exp_m1())
 }
 
-pub(crate) fn check_coefficient(name: &'static str, channel: usize, value: f64) -> Result<(), OpticsError> {
+pub(crate) fn check_coefficient(
+    name: &'static str,
+    channel: usize,
+    value: f64,
+) -> Result<(), OpticsError> {
     if value.is_finite() && value >= 0.0 {
         Ok(())
     } else {
-        Err(OpticsError::BadCoefficient { name, channel, value })
+        Err(OpticsError::BadCoefficient {
+            name,
+            channel,
+            value,
+        })
     }
 }
 

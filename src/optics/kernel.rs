@@ -122,7 +122,12 @@ pub fn second_difference(z: f64, s: f64, beta: f64) -> f64 {
             let q_sq = z * z + y;
             let q = q_sq.sqrt();
             let sq = s * q;
-            (weight / q_sq) * (beta / q_sq) * (z / q) * (-sq).exp() * (sq * sq + 3.0 * sq + 3.0) * 0.25
+            (weight / q_sq)
+                * (beta / q_sq)
+                * (z / q)
+                * (-sq).exp()
+                * (sq * sq + 3.0 * sq + 3.0)
+                * 0.25
         };
         let mut sum = 0.0;
         for k in 0..3 {
@@ -132,7 +137,8 @@ pub fn second_difference(z: f64, s: f64, beta: f64) -> f64 {
         0.5 * sum
     } else {
         // Gaps between the square roots as beta / (sum), not by subtraction.
-        first_difference(z, s, z, d1, beta / (z + d1)) - first_difference(z, s, d1, d2, beta / (d1 + d2))
+        first_difference(z, s, z, d1, beta / (z + d1))
+            - first_difference(z, s, d1, d2, beta / (d1 + d2))
     }
 }
 

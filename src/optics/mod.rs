@@ -31,18 +31,23 @@ pub use presets::{MeasuredMaterial, Source};
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum OpticsError {
     /// A coefficient that is NaN, infinite or negative.
-    #[error("{name} = {value} in channel {channel} is not a finite number >= 0 (1/mm)")]
-    BadCoefficient { name: &'static str, channel: usize, value: f64 },
+    #[error("{name} = {value} in channel {} is not a finite number >= 0 (1/mm)", channel_name(*channel))]
+    BadCoefficient {
+        name: &'static str,
+        channel: usize,
+        value: f64,
+    },
     /// Neither absorption nor scattering: there is no medium to diffuse in.
     #[error(
-        "sigma_a = 0 and sigma_s' = 0 in channel {channel}: the medium neither absorbs nor \
-         scatters, so the dipole model has nothing to describe"
+        "sigma_a = 0 and sigma_s' = 0 in channel {}: the medium neither absorbs nor \
+         scatters, so the dipole model has nothing to describe",
+        channel_name(*channel)
     )]
     NoExtinction { channel: usize },
     /// The relative index of refraction is not in the range where the `F_dr` fits hold.
     #[error(
         "eta = {0} is not supported: the relative index of refraction must lie in \
-         [{min}, {max}], where the F_dr fits stay below 1",
+         [{min:.4}, {max}], where the F_dr fits stay below 1",
         min = fresnel::ETA_MIN,
         max = fresnel::ETA_MAX
     )]
@@ -55,8 +60,9 @@ pub enum OpticsError {
     BadScale(f64),
     /// A coefficient converted to scene units falls outside the range the f32 twin handles.
     #[error(
-        "sigma_t' = {value} per scene unit in channel {channel} (sigma_t' in 1/mm times the scale) \
+        "sigma_t' = {value:e} per scene unit in channel {} (sigma_t' in 1/mm times the scale) \
          is outside [{min:e}, {max:e}], the range the f32 GPU twin represents safely",
+        channel_name(*channel),
         min = material::SIGMA_T_PRIME_MIN,
         max = material::SIGMA_T_PRIME_MAX
     )]
@@ -64,4 +70,9 @@ pub enum OpticsError {
     /// No measured material has this name.
     #[error("unknown material preset {0:?}: `translucent material --list` shows the presets")]
     UnknownPreset(String),
+}
+
+/// "R", "G", "B" for channel 0, 1, 2 (error messages).
+fn channel_name(channel: usize) -> &'static str {
+    ["R", "G", "B"].get(channel).copied().unwrap_or("?")
 }
