@@ -33,11 +33,18 @@ fn main() {
             Some("frag") => shaderc::ShaderKind::Fragment,
             _ => continue, // headers (.glsl) are compiled through the shaders that include them
         };
-        let rel = path.strip_prefix(&root).unwrap().to_string_lossy().replace('\\', "/");
+        let rel = path
+            .strip_prefix(&root)
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
         let source = fs::read_to_string(path).unwrap_or_else(|e| panic!("{rel}: {e}"));
 
         let mut options = shaderc::CompileOptions::new().unwrap();
-        options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
+        options.set_target_env(
+            shaderc::TargetEnv::Vulkan,
+            shaderc::EnvVersion::Vulkan1_2 as u32,
+        );
         options.set_target_spirv(shaderc::SpirvVersion::V1_5);
         options.set_warnings_as_errors();
         if release {
@@ -47,7 +54,10 @@ fn main() {
         }
         let common = root.join("common");
         options.set_include_callback(move |name, _ty, from, _depth| {
-            let from_dir = Path::new(from).parent().map(Path::to_path_buf).unwrap_or_default();
+            let from_dir = Path::new(from)
+                .parent()
+                .map(Path::to_path_buf)
+                .unwrap_or_default();
             for dir in [from_dir, common.clone()] {
                 let candidate = dir.join(name);
                 if let Ok(content) = fs::read_to_string(&candidate) {
@@ -58,7 +68,9 @@ fn main() {
                     });
                 }
             }
-            Err(format!("cannot find include \"{name}\" (looked beside {from} and in glsl/common/)"))
+            Err(format!(
+                "cannot find include \"{name}\" (looked beside {from} and in glsl/common/)"
+            ))
         });
 
         let display = path.to_string_lossy();
@@ -69,8 +81,12 @@ fn main() {
                 }
                 let spv = out.join(format!("{}.spv", rel.replace('/', "__")));
                 fs::write(&spv, artifact.as_binary_u8()).unwrap();
-                writeln!(table, "    ({rel:?}, include_bytes!({:?})),", spv.display().to_string())
-                    .unwrap();
+                writeln!(
+                    table,
+                    "    ({rel:?}, include_bytes!({:?})),",
+                    spv.display().to_string()
+                )
+                .unwrap();
             }
             Err(e) => errors.push(e.to_string()),
         }
@@ -83,7 +99,9 @@ fn main() {
 }
 
 fn walk(dir: &Path, files: &mut Vec<PathBuf>) {
-    let Ok(entries) = fs::read_dir(dir) else { return };
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
     for entry in entries.flatten() {
         let path = entry.path();
         if path.is_dir() {

@@ -23,6 +23,10 @@ impl GpuArgs {
         let env_validation = std::env::var("TRANSLUCENT_VALIDATION")
             .map(|v| !v.is_empty() && v != "0")
             .unwrap_or(false);
-        GpuOptions { device: self.device.clone(), validation: self.validation || env_validation, ..GpuOptions::default() }
+        GpuOptions {
+            device: self.device.clone(),
+            validation: self.validation || env_validation,
+            ..GpuOptions::default()
+        }
     }
 }

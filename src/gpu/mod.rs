@@ -1,10 +1,68 @@
-//! The Vulkan core (ash): one Vulkan concept per file.
+//! The Vulkan core (ash), one Vulkan concept per file: instance (loader, validation), debug
+//! (messenger and message counts), device (choice and logical device), context (`Gpu`),
+//! buffer, image, sampler, descriptor, pipeline, command (one-shot submission), barrier, timer, shaders.
+//!
+//! Every Vulkan object is owned by a Rust value that destroys it on Drop and holds an
+//! `Arc<Gpu>`, so the device always outlives what was made from it.
 
-/// How to build a GPU context.
-#[derive(Clone, Debug, Default)]
+mod barrier;
+mod buffer;
+mod command;
+mod context;
+mod debug;
+mod descriptor;
+mod device;
+mod error;
+mod image;
+mod instance;
+mod pipeline;
+mod sampler;
+pub mod shaders;
+mod timer;
+
+pub use barrier::{image_barrier, memory_barrier};
+pub use buffer::{Buffer, BufferDesc};
+pub use context::{Gpu, HostVulkan};
+pub use debug::ValidationCounters;
+pub use descriptor::{Binding, BindingKind, DescriptorSet};
+pub use device::DeviceInfo;
+pub use error::{GpuError, GpuResult};
+pub use gpu_allocator::MemoryLocation;
+pub use image::{Image, ImageDesc, aspect_of};
+pub use pipeline::{ComputePipeline, GraphicsDesc, GraphicsPipeline};
+pub use sampler::Sampler;
+pub use timer::{GpuTimer, median};
+
+use std::time::Duration;
+
+/// How to build a `Gpu`.
+#[derive(Clone, Debug)]
 pub struct GpuOptions {
     /// Device index or part of its name; `None` picks a discrete/integrated GPU, else the CPU device.
     pub device: Option<String>,
     /// Enable the Khronos validation layer and count its messages.
     pub validation: bool,
+    /// How long one submission may run before it is reported as hung.
+    pub timeout: Duration,
+}
+
+impl Default for GpuOptions {
+    fn default() -> Self {
+        Self {
+            device: None,
+            validation: false,
+            timeout: Duration::from_secs(120),
+        }
+    }
+}
+
+/// Every Vulkan device visible to the loader, without creating a logical device.
+pub fn list_devices() -> GpuResult<Vec<DeviceInfo>> {
+    let entry = instance::load_entry()?;
+    let counters = std::sync::Arc::new(ValidationCounters::default());
+    let mut owned = instance::create_instance(&entry, false, &counters)?;
+    let devices = device::enumerate(&owned.instance);
+    // SAFETY: nothing was created from this instance.
+    unsafe { owned.destroy() };
+    devices
 }

@@ -1,3 +1,6 @@
 //! GPU passes: each is one module here and one GLSL file of the same name in `glsl/`.
 
+pub mod records;
+pub mod shadow;
 pub mod smoke;
+pub mod tonemap;

@@ -1,0 +1,60 @@
+// Light records (std430), mirrored by `LightGpu` in src/scene/lights.rs (a test pins the layout),
+// and the shadow lookup shared by the splat (compute) and shading (fragment) passes.
+#ifndef LIGHTS_GLSL
+#define LIGHTS_GLSL
+
+const uint LIGHT_DIRECTIONAL = 0u;
+const uint LIGHT_POINT = 1u;
+const uint LIGHT_SPOT = 2u;
+
+struct Light {
+    vec4 position_kind;    // xyz: position (point, spot); w: kind (LIGHT_*)
+    vec4 direction_cos;    // xyz: unit vector towards the light (directional) or the spot axis
+                           //      pointing away from the light; w: cos of the spot's outer angle
+    vec4 power_layer;      // rgb: irradiance W/m^2 (directional) or intensity W/sr (point, spot);
+                           //      w: shadow-map layer, negative when the light casts no shadow
+    vec4 spot_texel;       // x: cos of the spot's inner angle; y: shadow-map texel size in uv
+    mat4 shadow_matrix;    // world -> shadow clip space (depth 0..1)
+};
+
+// Unit direction towards the light from `p`, and the irradiance it delivers to a surface facing
+// it (inverse-square falloff and spot cone for local lights), before visibility and cosine.
+void light_incidence(Light l, vec3 p, out vec3 wi, out vec3 irradiance) {
+    uint kind = uint(l.position_kind.w);
+    if (kind == LIGHT_DIRECTIONAL) {
+        wi = l.direction_cos.xyz;
+        irradiance = l.power_layer.rgb;
+        return;
+    }
+    vec3 d = l.position_kind.xyz - p;
+    float dist2 = max(dot(d, d), 1e-12);
+    wi = d * inversesqrt(dist2);
+    irradiance = l.power_layer.rgb / dist2;
+    if (kind == LIGHT_SPOT) {
+        float c = dot(-wi, l.direction_cos.xyz);
+        irradiance *= smoothstep(l.direction_cos.w, l.spot_texel.x, c);
+    }
+}
+
+// Fraction of `l` that reaches world point `p` (1 = lit), by a 3x3 percentage-closer filter
+// over the light's shadow map; each tap of the compare sampler is itself bilinear when the
+// format allows. Points outside the map are lit (border colour white).
+float light_visibility(Light l, sampler2DArrayShadow maps, vec3 p) {
+    float layer = l.power_layer.w;
+    if (layer < 0.0) return 1.0;
+    vec4 clip = l.shadow_matrix * vec4(p, 1.0);
+    if (clip.w <= 0.0) return 1.0;
+    vec3 ndc = clip.xyz / clip.w;
+    if (ndc.z >= 1.0) return 1.0;
+    vec2 uv = ndc.xy * 0.5 + 0.5;
+    float texel = l.spot_texel.y;
+    float lit = 0.0;
+    for (int y = -1; y <= 1; ++y) {
+        for (int x = -1; x <= 1; ++x) {
+            lit += texture(maps, vec4(uv + vec2(x, y) * texel, layer, ndc.z));
+        }
+    }
+    return lit / 9.0;
+}
+
+#endif

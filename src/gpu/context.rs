@@ -1,0 +1,256 @@
+//! `Gpu`: the instance, device, queue and memory allocator every pass works through.
+//!
+//! Nothing global: a `Gpu` is either built here (and destroys what it built) or wrapped around
+//! the instance, device and queue of a host engine (`Gpu::from_host`), which it never destroys.
+
+use super::GpuOptions;
+use super::debug::ValidationCounters;
+use super::device::{self, DeviceInfo};
+use super::error::{GpuError, GpuResult};
+use super::instance::{self, OwnedInstance};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use std::mem::ManuallyDrop;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+pub struct Gpu {
+    entry: ash::Entry,
+    instance: ash::Instance,
+    /// `Some` when this `Gpu` created the instance and must destroy it.
+    owned_instance: Option<OwnedInstance>,
+    device: ash::Device,
+    owns_device: bool,
+    info: DeviceInfo,
+    queue: Mutex<vk::Queue>,
+    queue_family: u32,
+    timestamp_valid_bits: u32,
+    timestamp_period_ns: f64,
+    properties: vk::PhysicalDeviceProperties,
+    allocator: ManuallyDrop<Mutex<Allocator>>,
+    counters: Arc<ValidationCounters>,
+    timeout: Duration,
+}
+
+/// Vulkan objects owned by a host engine, for `Gpu::from_host`.
+pub struct HostVulkan {
+    pub entry: ash::Entry,
+    pub instance: ash::Instance,
+    pub physical_device: vk::PhysicalDevice,
+    /// Must have been created with Vulkan 1.3 `dynamicRendering` and `synchronization2` enabled.
+    pub device: ash::Device,
+    /// A queue that supports graphics and compute. Submissions from `Gpu` lock an internal mutex;
+    /// the host must not submit to the same queue concurrently.
+    pub queue: vk::Queue,
+    pub queue_family: u32,
+}
+
+impl Gpu {
+    /// Load Vulkan, create an instance (with validation if asked), choose a device, and create
+    /// a logical device with one graphics+compute queue.
+    pub fn new(options: &GpuOptions) -> GpuResult<Arc<Gpu>> {
+        let entry = instance::load_entry()?;
+        let counters = Arc::new(ValidationCounters::default());
+        let mut owned = instance::create_instance(&entry, options.validation, &counters)?;
+        // From here on, destroy the instance if anything fails.
+        let built = (|| {
+            let devices = device::enumerate(&owned.instance)?;
+            let info = device::select(&devices, options.device.as_deref())?;
+            let (family, _) = device::queue_family(&owned.instance, &info)?;
+            let device = device::create_logical(&owned.instance, &info, family)?;
+            Ok::<_, GpuError>((info, family, device))
+        })();
+        let (info, family, device) = match built {
+            Ok(v) => v,
+            Err(e) => {
+                // SAFETY: nothing created from the instance survives the closure above.
+                unsafe { owned.destroy() };
+                return Err(e);
+            }
+        };
+        // SAFETY: queue 0 of `family` was requested in create_logical.
+        let queue = unsafe { device.get_device_queue(family, 0) };
+        let instance = owned.instance.clone();
+        Self::assemble(
+            entry,
+            instance,
+            Some(owned),
+            info.handle,
+            device,
+            true,
+            queue,
+            family,
+            counters,
+            options,
+        )
+    }
+
+    /// Wrap Vulkan objects a host engine owns. Nothing of theirs is destroyed on Drop; only what
+    /// this `Gpu` allocates (memory, buffers, pipelines) is freed.
+    ///
+    /// # Safety
+    /// The host's instance, device and queue must outlive the returned `Gpu` and everything made
+    /// from it, and the device must have the features listed on `HostVulkan::device`.
+    pub unsafe fn from_host(host: HostVulkan, options: &GpuOptions) -> GpuResult<Arc<Gpu>> {
+        let devices = device::enumerate(&host.instance)?;
+        let info = devices
+            .into_iter()
+            .find(|d| d.handle == host.physical_device)
+            .ok_or_else(|| {
+                GpuError::Invalid("the host's physical device is not one of its instance's".into())
+            })?;
+        let counters = Arc::new(ValidationCounters::default());
+        Self::assemble(
+            host.entry,
+            host.instance,
+            None,
+            info.handle,
+            host.device,
+            false,
+            host.queue,
+            host.queue_family,
+            counters,
+            options,
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn assemble(
+        entry: ash::Entry,
+        instance: ash::Instance,
+        owned_instance: Option<OwnedInstance>,
+        physical: vk::PhysicalDevice,
+        device: ash::Device,
+        owns_device: bool,
+        queue: vk::Queue,
+        queue_family: u32,
+        counters: Arc<ValidationCounters>,
+        options: &GpuOptions,
+    ) -> GpuResult<Arc<Gpu>> {
+        let info = device::enumerate(&instance)?
+            .into_iter()
+            .find(|d| d.handle == physical)
+            .unwrap();
+        // SAFETY: plain queries.
+        let properties = unsafe { instance.get_physical_device_properties(physical) };
+        let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
+        let timestamp_valid_bits = families
+            .get(queue_family as usize)
+            .map(|f| f.timestamp_valid_bits)
+            .unwrap_or(0);
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        });
+        let allocator = match allocator {
+            Ok(a) => a,
+            Err(source) => {
+                let mut owned_instance = owned_instance;
+                // SAFETY: nothing else was created from this device or instance.
+                unsafe {
+                    if owns_device {
+                        device.destroy_device(None);
+                    }
+                    if let Some(o) = owned_instance.as_mut() {
+                        o.destroy();
+                    }
+                }
+                return Err(GpuError::Alloc {
+                    what: "allocator".into(),
+                    source,
+                });
+            }
+        };
+        Ok(Arc::new(Gpu {
+            entry,
+            instance,
+            owned_instance,
+            device,
+            owns_device,
+            info,
+            queue: Mutex::new(queue),
+            queue_family,
+            timestamp_valid_bits,
+            timestamp_period_ns: properties.limits.timestamp_period as f64,
+            properties,
+            allocator: ManuallyDrop::new(Mutex::new(allocator)),
+            counters,
+            timeout: options.timeout,
+        }))
+    }
+
+    pub fn entry(&self) -> &ash::Entry {
+        &self.entry
+    }
+    pub fn instance(&self) -> &ash::Instance {
+        &self.instance
+    }
+    pub fn device(&self) -> &ash::Device {
+        &self.device
+    }
+    pub fn physical_device(&self) -> vk::PhysicalDevice {
+        self.info.handle
+    }
+    /// Name, type, driver and Vulkan version of the device in use.
+    pub fn info(&self) -> &DeviceInfo {
+        &self.info
+    }
+    pub fn properties(&self) -> &vk::PhysicalDeviceProperties {
+        &self.properties
+    }
+    pub fn queue_family(&self) -> u32 {
+        self.queue_family
+    }
+    /// The queue, locked: Vulkan requires external synchronisation of vkQueueSubmit.
+    pub(crate) fn queue(&self) -> MutexGuard<'_, vk::Queue> {
+        self.queue.lock().unwrap_or_else(|p| p.into_inner())
+    }
+    pub(crate) fn allocator(&self) -> MutexGuard<'_, Allocator> {
+        self.allocator.lock().unwrap_or_else(|p| p.into_inner())
+    }
+    /// Validation messages counted so far (all zero when validation is off). The counters
+    /// outlive the `Gpu`, so messages sent while the device is destroyed (leaks) are counted.
+    pub fn validation(&self) -> Arc<ValidationCounters> {
+        self.counters.clone()
+    }
+    pub fn validation_enabled(&self) -> bool {
+        self.owned_instance
+            .as_ref()
+            .is_some_and(|o| o.debug.is_some())
+    }
+    /// Nanoseconds per timestamp tick, and how many low bits of a timestamp are valid.
+    pub fn timestamp_info(&self) -> (f64, u32) {
+        (self.timestamp_period_ns, self.timestamp_valid_bits)
+    }
+    /// How long a submission may run before `one_shot` gives up.
+    pub fn timeout(&self) -> Duration {
+        self.timeout
+    }
+    /// Bytes of device memory in use and reserved by the allocator.
+    pub fn memory_usage(&self) -> (u64, u64) {
+        let report = self.allocator().generate_report();
+        (report.total_allocated_bytes, report.total_capacity_bytes)
+    }
+}
+
+impl Drop for Gpu {
+    fn drop(&mut self) {
+        // SAFETY: every Buffer/Image/Pipeline holds an Arc<Gpu>, so all of them are gone; the
+        // allocator frees its memory blocks before the device that owns them is destroyed, and
+        // the messenger goes just before the instance (OwnedInstance::destroy).
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            ManuallyDrop::drop(&mut self.allocator);
+            if self.owns_device {
+                self.device.destroy_device(None);
+            }
+            if let Some(owned) = self.owned_instance.as_mut() {
+                owned.destroy();
+            }
+        }
+    }
+}

@@ -1,0 +1,181 @@
+//! Descriptor-set layouts and sets. Each set owns a small pool sized for exactly its bindings:
+//! passes create their sets once and reuse them across frames.
+
+use super::buffer::Buffer;
+use super::context::Gpu;
+use super::error::{GpuError, GpuResult, VkContext};
+use ash::vk;
+use std::sync::Arc;
+
+/// The kind of one binding, in binding order (binding i is the i-th entry).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BindingKind {
+    StorageBuffer,
+    UniformBuffer,
+    CombinedImageSampler,
+}
+
+impl BindingKind {
+    fn vk(self) -> vk::DescriptorType {
+        match self {
+            BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
+            BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
+            BindingKind::CombinedImageSampler => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+        }
+    }
+}
+
+/// What to bind at one binding.
+pub enum Binding<'a> {
+    Buffer(&'a Buffer),
+    Image {
+        view: vk::ImageView,
+        layout: vk::ImageLayout,
+        sampler: vk::Sampler,
+    },
+}
+
+pub(crate) fn create_set_layout(
+    gpu: &Gpu,
+    kinds: &[BindingKind],
+    stages: vk::ShaderStageFlags,
+) -> GpuResult<vk::DescriptorSetLayout> {
+    let bindings: Vec<_> = kinds
+        .iter()
+        .enumerate()
+        .map(|(i, k)| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(i as u32)
+                .descriptor_type(k.vk())
+                .descriptor_count(1)
+                .stage_flags(stages)
+        })
+        .collect();
+    let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
+    // SAFETY: valid create info; the owner destroys the layout.
+    unsafe { gpu.device().create_descriptor_set_layout(&info, None) }
+        .vk("vkCreateDescriptorSetLayout")
+}
+
+pub struct DescriptorSet {
+    gpu: Arc<Gpu>,
+    pool: vk::DescriptorPool,
+    set: vk::DescriptorSet,
+}
+
+impl DescriptorSet {
+    pub(crate) fn new(
+        gpu: &Arc<Gpu>,
+        layout: vk::DescriptorSetLayout,
+        kinds: &[BindingKind],
+        bindings: &[Binding<'_>],
+    ) -> GpuResult<DescriptorSet> {
+        if kinds.len() != bindings.len() {
+            return Err(GpuError::Invalid(format!(
+                "descriptor set needs {} bindings, {} given",
+                kinds.len(),
+                bindings.len()
+            )));
+        }
+        let device = gpu.device();
+        let sizes: Vec<_> = kinds
+            .iter()
+            .map(|k| vk::DescriptorPoolSize {
+                ty: k.vk(),
+                descriptor_count: 1,
+            })
+            .collect();
+        let info = vk::DescriptorPoolCreateInfo::default()
+            .max_sets(1)
+            .pool_sizes(&sizes);
+        // SAFETY: valid create info; destroyed in Drop.
+        let pool =
+            unsafe { device.create_descriptor_pool(&info, None) }.vk("vkCreateDescriptorPool")?;
+        let mut out = DescriptorSet {
+            gpu: gpu.clone(),
+            pool,
+            set: vk::DescriptorSet::null(),
+        };
+        let layouts = [layout];
+        let alloc = vk::DescriptorSetAllocateInfo::default()
+            .descriptor_pool(pool)
+            .set_layouts(&layouts);
+        out.set =
+            unsafe { device.allocate_descriptor_sets(&alloc) }.vk("vkAllocateDescriptorSets")?[0];
+        out.update(kinds, bindings)?;
+        Ok(out)
+    }
+
+    /// Point the bindings at other resources (same kinds). Not while the set is in use by the GPU.
+    pub(crate) fn update(
+        &mut self,
+        kinds: &[BindingKind],
+        bindings: &[Binding<'_>],
+    ) -> GpuResult<()> {
+        let mut buffer_infos = Vec::new();
+        let mut image_infos = Vec::new();
+        for (i, (kind, binding)) in kinds.iter().zip(bindings).enumerate() {
+            match (kind, binding) {
+                (BindingKind::StorageBuffer | BindingKind::UniformBuffer, Binding::Buffer(b)) => {
+                    buffer_infos.push((
+                        i,
+                        [vk::DescriptorBufferInfo {
+                            buffer: b.raw(),
+                            offset: 0,
+                            range: vk::WHOLE_SIZE,
+                        }],
+                    ))
+                }
+                (
+                    BindingKind::CombinedImageSampler,
+                    Binding::Image {
+                        view,
+                        layout,
+                        sampler,
+                    },
+                ) => image_infos.push((
+                    i,
+                    [vk::DescriptorImageInfo {
+                        sampler: *sampler,
+                        image_view: *view,
+                        image_layout: *layout,
+                    }],
+                )),
+                _ => return Err(GpuError::Invalid(format!("binding {i}: expected {kind:?}"))),
+            }
+        }
+        let mut writes = Vec::new();
+        for (i, info) in &buffer_infos {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(self.set)
+                    .dst_binding(*i as u32)
+                    .descriptor_type(kinds[*i].vk())
+                    .buffer_info(info),
+            );
+        }
+        for (i, info) in &image_infos {
+            writes.push(
+                vk::WriteDescriptorSet::default()
+                    .dst_set(self.set)
+                    .dst_binding(*i as u32)
+                    .descriptor_type(kinds[*i].vk())
+                    .image_info(info),
+            );
+        }
+        // SAFETY: every write points at live resources of the declared type.
+        unsafe { self.gpu.device().update_descriptor_sets(&writes, &[]) };
+        Ok(())
+    }
+
+    pub fn raw(&self) -> vk::DescriptorSet {
+        self.set
+    }
+}
+
+impl Drop for DescriptorSet {
+    fn drop(&mut self) {
+        // SAFETY: destroying the pool frees its set; no submission using it is pending.
+        unsafe { self.gpu.device().destroy_descriptor_pool(self.pool, None) };
+    }
+}

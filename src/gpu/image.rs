@@ -1,0 +1,246 @@
+//! `Image`: a 2D VkImage with its memory and a view, freed on Drop.
+
+use super::barrier::{image_barrier, memory_barrier};
+use super::buffer::{Buffer, BufferDesc};
+use super::context::Gpu;
+use super::error::{GpuError, GpuResult, VkContext};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
+use std::sync::Arc;
+
+#[derive(Clone, Debug)]
+pub struct ImageDesc {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub format: vk::Format,
+    pub usage: vk::ImageUsageFlags,
+    /// Layers (e.g. one per shadow-casting light); the view is a 2D array when above 1.
+    pub layers: u32,
+}
+
+impl ImageDesc {
+    pub fn new(
+        name: &str,
+        width: u32,
+        height: u32,
+        format: vk::Format,
+        usage: vk::ImageUsageFlags,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            width,
+            height,
+            format,
+            usage,
+            layers: 1,
+        }
+    }
+    pub fn layers(mut self, layers: u32) -> Self {
+        self.layers = layers;
+        self
+    }
+}
+
+pub struct Image {
+    gpu: Arc<Gpu>,
+    raw: vk::Image,
+    view: vk::ImageView,
+    /// One 2D view per layer, for rendering into a single layer (only when `layers > 1`).
+    layer_views: Vec<vk::ImageView>,
+    allocation: Option<Allocation>,
+    desc: ImageDesc,
+}
+
+/// Depth formats get the depth aspect, everything else colour.
+pub fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
+    match format {
+        vk::Format::D16_UNORM | vk::Format::D32_SFLOAT | vk::Format::X8_D24_UNORM_PACK32 => {
+            vk::ImageAspectFlags::DEPTH
+        }
+        vk::Format::D24_UNORM_S8_UINT
+        | vk::Format::D32_SFLOAT_S8_UINT
+        | vk::Format::D16_UNORM_S8_UINT => vk::ImageAspectFlags::DEPTH,
+        _ => vk::ImageAspectFlags::COLOR,
+    }
+}
+
+impl Image {
+    pub fn new(gpu: &Arc<Gpu>, desc: &ImageDesc) -> GpuResult<Image> {
+        if desc.width == 0 || desc.height == 0 || desc.layers == 0 {
+            return Err(GpuError::Invalid(format!(
+                "image {:?} has an empty extent {}x{}x{}",
+                desc.name, desc.width, desc.height, desc.layers
+            )));
+        }
+        let device = gpu.device();
+        let info = vk::ImageCreateInfo::default()
+            .image_type(vk::ImageType::TYPE_2D)
+            .format(desc.format)
+            .extent(vk::Extent3D {
+                width: desc.width,
+                height: desc.height,
+                depth: 1,
+            })
+            .mip_levels(1)
+            .array_layers(desc.layers)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .tiling(vk::ImageTiling::OPTIMAL)
+            .usage(desc.usage | vk::ImageUsageFlags::TRANSFER_SRC)
+            .sharing_mode(vk::SharingMode::EXCLUSIVE)
+            .initial_layout(vk::ImageLayout::UNDEFINED);
+        // SAFETY: valid create info; destroyed in Drop or below on failure.
+        let raw = unsafe { device.create_image(&info, None) }.vk("vkCreateImage")?;
+        let requirements = unsafe { device.get_image_memory_requirements(raw) };
+        let allocation = match gpu.allocator().allocate(&AllocationCreateDesc {
+            name: &desc.name,
+            requirements,
+            location: MemoryLocation::GpuOnly,
+            linear: false,
+            allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        }) {
+            Ok(a) => a,
+            Err(source) => {
+                unsafe { device.destroy_image(raw, None) };
+                return Err(GpuError::Alloc {
+                    what: desc.name.clone(),
+                    source,
+                });
+            }
+        };
+        let mut image = Image {
+            gpu: gpu.clone(),
+            raw,
+            view: vk::ImageView::null(),
+            layer_views: Vec::new(),
+            allocation: Some(allocation),
+            desc: desc.clone(),
+        };
+        let a = image.allocation.as_ref().unwrap();
+        // SAFETY: the allocation satisfies the image's requirements; on error Drop cleans up.
+        unsafe { device.bind_image_memory(raw, a.memory(), a.offset()) }.vk("vkBindImageMemory")?;
+        let view_type = if desc.layers > 1 {
+            vk::ImageViewType::TYPE_2D_ARRAY
+        } else {
+            vk::ImageViewType::TYPE_2D
+        };
+        let view_info = vk::ImageViewCreateInfo::default()
+            .image(raw)
+            .view_type(view_type)
+            .format(desc.format)
+            .subresource_range(
+                vk::ImageSubresourceRange::default()
+                    .aspect_mask(aspect_of(desc.format))
+                    .level_count(1)
+                    .layer_count(desc.layers),
+            );
+        image.view =
+            unsafe { device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
+        Ok(image)
+    }
+
+    pub fn raw(&self) -> vk::Image {
+        self.raw
+    }
+    pub fn view(&self) -> vk::ImageView {
+        self.view
+    }
+    /// A 2D view of one layer (the whole-image view when there is only one layer).
+    pub fn layer_view(&self, layer: u32) -> vk::ImageView {
+        if self.layer_views.is_empty() {
+            self.view
+        } else {
+            self.layer_views[layer as usize]
+        }
+    }
+    pub fn desc(&self) -> &ImageDesc {
+        &self.desc
+    }
+    pub fn extent(&self) -> vk::Extent2D {
+        vk::Extent2D {
+            width: self.desc.width,
+            height: self.desc.height,
+        }
+    }
+
+    /// Copy layer 0 into host memory: tightly packed rows, `bytes_per_texel` each texel.
+    /// `layout` is the image's current layout; it is left in TRANSFER_SRC_OPTIMAL.
+    pub fn read(&self, layout: vk::ImageLayout, bytes_per_texel: u64) -> GpuResult<Vec<u8>> {
+        let size = self.desc.width as u64 * self.desc.height as u64 * bytes_per_texel;
+        let staging = Buffer::new(
+            &self.gpu,
+            &BufferDesc::readback("image readback", size, vk::BufferUsageFlags::TRANSFER_DST),
+        )?;
+        let device = self.gpu.device();
+        let aspect = aspect_of(self.desc.format);
+        self.gpu.one_shot("image readback", |cmd| {
+            image_barrier(
+                device,
+                cmd,
+                self.raw,
+                aspect,
+                (layout, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
+                (
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    vk::AccessFlags2::MEMORY_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_READ,
+                ),
+            );
+            let region = [vk::BufferImageCopy::default()
+                .image_subresource(
+                    vk::ImageSubresourceLayers::default()
+                        .aspect_mask(aspect)
+                        .layer_count(1),
+                )
+                .image_extent(vk::Extent3D {
+                    width: self.desc.width,
+                    height: self.desc.height,
+                    depth: 1,
+                })];
+            // SAFETY: the staging buffer holds exactly one tightly packed layer.
+            unsafe {
+                device.cmd_copy_image_to_buffer(
+                    cmd,
+                    self.raw,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    staging.raw(),
+                    &region,
+                )
+            };
+            memory_barrier(
+                device,
+                cmd,
+                (
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                ),
+                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+            );
+        })?;
+        staging.read::<u8>()
+    }
+}
+
+impl Drop for Image {
+    fn drop(&mut self) {
+        // SAFETY: all submissions wait on their fence, so the image is idle.
+        unsafe {
+            for view in self.layer_views.drain(..) {
+                self.gpu.device().destroy_image_view(view, None);
+            }
+            if self.view != vk::ImageView::null() {
+                self.gpu.device().destroy_image_view(self.view, None);
+            }
+            self.gpu.device().destroy_image(self.raw, None);
+        }
+        if let Some(a) = self.allocation.take()
+            && let Err(e) = self.gpu.allocator().free(a)
+        {
+            log::error!("freeing image {:?}: {e}", self.desc.name);
+        }
+    }
+}

@@ -1,0 +1,216 @@
+//! A bounding-volume hierarchy over triangles for the CPU reference's shadow rays (any-hit).
+//! Built by median split on the longest axis of the centroid bounds; f64 throughout, so the
+//! reference's visibility is limited by geometry, not by rounding.
+
+use glam::DVec3;
+
+#[derive(Clone, Copy, Debug)]
+struct Aabb {
+    min: DVec3,
+    max: DVec3,
+}
+
+impl Aabb {
+    fn empty() -> Self {
+        Aabb {
+            min: DVec3::splat(f64::INFINITY),
+            max: DVec3::splat(f64::NEG_INFINITY),
+        }
+    }
+    fn grow(&mut self, p: DVec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+    /// Slab test: does the ray origin + t dir, t in (0, t_max), touch the box?
+    fn hit(&self, origin: DVec3, inv_dir: DVec3, t_max: f64) -> bool {
+        let t0 = (self.min - origin) * inv_dir;
+        let t1 = (self.max - origin) * inv_dir;
+        let near = t0.min(t1).max_element().max(0.0);
+        let far = t0.max(t1).min_element().min(t_max);
+        near <= far
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    bounds: Aabb,
+    /// Leaf: first triangle in `order`, count > 0. Inner: index of the left child (right = +1), count 0.
+    first: u32,
+    count: u32,
+}
+
+/// Triangles of a whole scene (world space) with a BVH for occlusion queries.
+pub struct Bvh {
+    triangles: Vec<[DVec3; 3]>,
+    nodes: Vec<Node>,
+    order: Vec<u32>,
+}
+
+const LEAF_SIZE: usize = 4;
+
+impl Bvh {
+    pub fn new(triangles: Vec<[DVec3; 3]>) -> Bvh {
+        let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
+        let centroids: Vec<DVec3> = triangles
+            .iter()
+            .map(|t| (t[0] + t[1] + t[2]) / 3.0)
+            .collect();
+        let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
+        nodes.push(Node {
+            bounds: Aabb::empty(),
+            first: 0,
+            count: 0,
+        });
+        if !triangles.is_empty() {
+            // Explicit stack: (node index, start, end) over `order`.
+            let mut stack = vec![(0usize, 0usize, triangles.len())];
+            while let Some((node, start, end)) = stack.pop() {
+                let mut bounds = Aabb::empty();
+                let mut cbounds = Aabb::empty();
+                for &t in &order[start..end] {
+                    for p in triangles[t as usize] {
+                        bounds.grow(p);
+                    }
+                    cbounds.grow(centroids[t as usize]);
+                }
+                nodes[node].bounds = bounds;
+                let extent = cbounds.max - cbounds.min;
+                if end - start <= LEAF_SIZE || extent.max_element() <= 0.0 {
+                    nodes[node].first = start as u32;
+                    nodes[node].count = (end - start) as u32;
+                    continue;
+                }
+                let axis = if extent.x >= extent.y && extent.x >= extent.z {
+                    0
+                } else if extent.y >= extent.z {
+                    1
+                } else {
+                    2
+                };
+                let mid = (start + end) / 2;
+                order[start..end].select_nth_unstable_by(mid - start, |a, b| {
+                    centroids[*a as usize][axis].total_cmp(&centroids[*b as usize][axis])
+                });
+                let left = nodes.len();
+                nodes.push(Node {
+                    bounds: Aabb::empty(),
+                    first: 0,
+                    count: 0,
+                });
+                nodes.push(Node {
+                    bounds: Aabb::empty(),
+                    first: 0,
+                    count: 0,
+                });
+                nodes[node].first = left as u32;
+                nodes[node].count = 0;
+                stack.push((left, start, mid));
+                stack.push((left + 1, mid, end));
+            }
+        }
+        Bvh {
+            triangles,
+            nodes,
+            order,
+        }
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Is anything hit along origin + t dir for t in (t_min, t_max)? `dir` need not be unit.
+    pub fn occluded(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> bool {
+        if self.triangles.is_empty() {
+            return false;
+        }
+        let inv = DVec3::ONE / dir;
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            if !node.bounds.hit(origin, inv, t_max) {
+                continue;
+            }
+            if node.count > 0 {
+                for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
+                    if let Some(t_hit) = intersect(&self.triangles[t as usize], origin, dir)
+                        && t_hit > t_min
+                        && t_hit < t_max
+                    {
+                        return true;
+                    }
+                }
+            } else if top + 2 <= stack.len() {
+                stack[top] = node.first;
+                stack[top + 1] = node.first + 1;
+                top += 2;
+            }
+        }
+        false
+    }
+}
+
+/// Möller-Trumbore ray-triangle intersection (Möller and Trumbore 1997): the ray parameter t.
+fn intersect(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> Option<f64> {
+    let e1 = tri[1] - tri[0];
+    let e2 = tri[2] - tri[0];
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < 1e-300 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = origin - tri[0];
+    let u = s.dot(p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = dir.dot(q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    Some(e2.dot(q) * inv)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn occlusion_matches_brute_force() {
+        // A grid of small triangles; rays from random points must agree with a linear scan.
+        let mut tris = Vec::new();
+        for i in 0..20 {
+            for j in 0..20 {
+                let o = DVec3::new(i as f64, (i * j % 7) as f64 * 0.3, j as f64);
+                tris.push([
+                    o,
+                    o + DVec3::new(0.9, 0.1, 0.0),
+                    o + DVec3::new(0.0, 0.2, 0.9),
+                ]);
+            }
+        }
+        let bvh = Bvh::new(tris.clone());
+        let mut state = 12345u64;
+        let mut rnd = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let origin = DVec3::new(rnd() * 22.0 - 1.0, rnd() * 4.0 - 1.0, rnd() * 22.0 - 1.0);
+            let dir = DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);
+            let brute = tris
+                .iter()
+                .any(|t| intersect(t, origin, dir).is_some_and(|t| t > 1e-9 && t < 5.0));
+            assert_eq!(bvh.occluded(origin, dir, 1e-9, 5.0), brute);
+            hits += brute as u32;
+        }
+        assert!(hits > 50, "the test must exercise hits too ({hits})");
+    }
+}

@@ -1,0 +1,165 @@
+//! Shadow-map pass (`glsl/shadow.vert`): depth of the shadow casters from each shadow-casting
+//! light into one layer of a D32 array image, which the splat and shade passes sample with a
+//! compare sampler (percentage-closer filtering, `glsl/common/lights.glsl`).
+//!
+//! Vertex input: binding 0 = `records::Vertex`. Push: the light's world -> clip matrix.
+
+use super::records::Vertex;
+use crate::gpu::{
+    Buffer, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler,
+    image_barrier,
+};
+use ash::vk;
+use std::sync::Arc;
+
+pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+/// A draw of one caster: index range and vertex offset in the shared buffers.
+#[derive(Clone, Copy, Debug)]
+pub struct DrawRange {
+    pub first_index: u32,
+    pub index_count: u32,
+    pub vertex_offset: i32,
+}
+
+pub struct ShadowPass {
+    pipeline: GraphicsPipeline,
+    maps: Image,
+    sampler: Sampler,
+    layers: u32,
+}
+
+impl ShadowPass {
+    /// `layers` shadow maps of `size`^2 texels (at least one layer, so the array can always be
+    /// bound even when nothing casts a shadow).
+    pub fn new(gpu: &Arc<Gpu>, size: u32, layers: u32) -> GpuResult<ShadowPass> {
+        let mut desc = GraphicsDesc::new("shadow.vert", None);
+        desc.push_bytes = 64;
+        desc.vertex_bindings = vec![Vertex::binding()];
+        desc.vertex_attributes = vec![Vertex::position_attribute()];
+        desc.depth_format = Some(DEPTH_FORMAT);
+        // Slope-scaled bias against acne on surfaces grazing the light.
+        desc.depth_bias = Some((1.0, 1.75));
+        let pipeline = GraphicsPipeline::new(gpu, &desc)?;
+        let maps = Image::new(
+            gpu,
+            &ImageDesc::new(
+                "shadow maps",
+                size,
+                size,
+                DEPTH_FORMAT,
+                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+            )
+            .layers(layers.max(1)),
+        )?;
+        let sampler = Sampler::shadow(gpu, DEPTH_FORMAT)?;
+        Ok(ShadowPass {
+            pipeline,
+            maps,
+            sampler,
+            layers,
+        })
+    }
+
+    pub fn maps(&self) -> &Image {
+        &self.maps
+    }
+    pub fn sampler(&self) -> &Sampler {
+        &self.sampler
+    }
+
+    /// Record: render every layer (`matrices[i]` into layer i), then leave the maps in
+    /// SHADER_READ_ONLY_OPTIMAL for compute and fragment shaders. With no layers, the single
+    /// placeholder layer is cleared to 1 (everything lit).
+    pub fn record(
+        &self,
+        gpu: &Gpu,
+        cmd: vk::CommandBuffer,
+        vertices: &Buffer,
+        indices: &Buffer,
+        casters: &[DrawRange],
+        matrices: &[[[f32; 4]; 4]],
+    ) {
+        let device = gpu.device();
+        image_barrier(
+            device,
+            cmd,
+            self.maps.raw(),
+            vk::ImageAspectFlags::DEPTH,
+            (
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+            ),
+            (
+                vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_SAMPLED_READ,
+            ),
+            (
+                vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
+                    | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
+                    | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
+            ),
+        );
+        let extent = self.maps.extent();
+        for layer in 0..self.layers.max(1) {
+            let attachment = vk::RenderingAttachmentInfo::default()
+                .image_view(self.maps.layer_view(layer))
+                .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    depth_stencil: vk::ClearDepthStencilValue {
+                        depth: 1.0,
+                        stencil: 0,
+                    },
+                });
+            let info = vk::RenderingInfo::default()
+                .render_area(vk::Rect2D {
+                    offset: vk::Offset2D::default(),
+                    extent,
+                })
+                .layer_count(1)
+                .depth_attachment(&attachment);
+            // SAFETY: `cmd` is recording; the layer view is a depth attachment in the right layout.
+            unsafe { device.cmd_begin_rendering(cmd, &info) };
+            if let Some(matrix) = matrices.get(layer as usize).filter(|_| layer < self.layers) {
+                self.pipeline
+                    .bind(cmd, None, bytemuck::bytes_of(matrix), extent);
+                unsafe {
+                    device.cmd_bind_vertex_buffers(cmd, 0, &[vertices.raw()], &[0]);
+                    device.cmd_bind_index_buffer(cmd, indices.raw(), 0, vk::IndexType::UINT32);
+                    for d in casters {
+                        device.cmd_draw_indexed(
+                            cmd,
+                            d.index_count,
+                            1,
+                            d.first_index,
+                            d.vertex_offset,
+                            0,
+                        );
+                    }
+                }
+            }
+            unsafe { device.cmd_end_rendering(cmd) };
+        }
+        image_barrier(
+            device,
+            cmd,
+            self.maps.raw(),
+            vk::ImageAspectFlags::DEPTH,
+            (
+                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            ),
+            (
+                vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
+            ),
+            (
+                vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COMPUTE_SHADER,
+                vk::AccessFlags2::SHADER_SAMPLED_READ,
+            ),
+        );
+    }
+}

@@ -1,0 +1,25 @@
+//! The camera's matrices, in Vulkan conventions (depth 0..1, framebuffer y down).
+
+use super::format::Camera;
+use glam::camera::rh::{proj::vulkan, view::look_at_mat4};
+use glam::{Mat4, Vec3};
+
+impl Camera {
+    pub fn view(&self) -> Mat4 {
+        look_at_mat4(
+            Vec3::from(self.eye),
+            Vec3::from(self.target),
+            Vec3::from(self.up).normalize(),
+        )
+    }
+
+    /// Perspective projection with near and far planes fitted around a scene bounding sphere.
+    pub fn projection(&self, scene_center: Vec3, scene_radius: f32) -> Mat4 {
+        let aspect = self.resolution[0] as f32 / self.resolution[1] as f32;
+        let distance = (Vec3::from(self.eye) - scene_center).length();
+        let far = (distance + scene_radius) * 1.05;
+        let near = (distance - scene_radius).max(far * 1e-4);
+        // The Vulkan variant outputs y down, as the framebuffer is, so +y is up in the image.
+        vulkan::perspective(self.fov_y.to_radians(), aspect, near, far)
+    }
+}

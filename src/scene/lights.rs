@@ -1,0 +1,360 @@
+//! Scene lights turned into GPU records, with shadow matrices, and the environment light
+//! reduced to directional lights by median cut (Debevec 2006, "A median cut algorithm for light
+//! probe sampling"): regions of equal energy on the equirectangular map, each replaced by one
+//! directional light carrying the region's irradiance, each with its own shadow map. Together
+//! they give the soft environment shadows of the seed paper's Figure 6.
+
+use super::format::Light;
+use glam::Vec3;
+use glam::camera::rh::{proj::vulkan, view::look_at_mat4};
+
+/// std430 mirror of `struct Light` in glsl/common/lights.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LightGpu {
+    pub position_kind: [f32; 4],
+    pub direction_cos: [f32; 4],
+    pub power_layer: [f32; 4],
+    pub spot_texel: [f32; 4],
+    pub shadow_matrix: [[f32; 4]; 4],
+}
+
+pub const LIGHT_DIRECTIONAL: f32 = 0.0;
+pub const LIGHT_POINT: f32 = 1.0;
+pub const LIGHT_SPOT: f32 = 2.0;
+
+/// An environment as an equirectangular grid of linear radiance (W/m^2/sr). Row 0 looks at
+/// +y (up); column u covers azimuth phi = 2 pi (u + 0.5) / width, direction
+/// (sin theta cos phi, cos theta, sin theta sin phi).
+#[derive(Clone, Debug)]
+pub struct Environment {
+    pub width: usize,
+    pub height: usize,
+    pub radiance: Vec<Vec3>,
+}
+
+impl Environment {
+    /// The built-in sky: a blue zenith fading to a bright horizon, and a dim ground below.
+    pub fn procedural_sky(width: usize, height: usize) -> Environment {
+        let zenith = Vec3::new(0.30, 0.45, 0.85);
+        let horizon = Vec3::new(0.85, 0.88, 0.95);
+        let ground = Vec3::new(0.12, 0.11, 0.10);
+        let mut radiance = Vec::with_capacity(width * height);
+        for y in 0..height {
+            for x in 0..width {
+                let d = Self::direction_of(width, height, x as f32 + 0.5, y as f32 + 0.5);
+                radiance.push(if d.y >= 0.0 {
+                    horizon.lerp(zenith, d.y.sqrt())
+                } else {
+                    ground
+                });
+            }
+        }
+        Environment {
+            width,
+            height,
+            radiance,
+        }
+    }
+
+    /// Load an equirectangular .hdr or .exr map (through the `image` crate).
+    pub fn load(path: &std::path::Path) -> Result<Environment, String> {
+        let img = image::open(path)
+            .map_err(|e| format!("cannot read environment map {}: {e}", path.display()))?;
+        let rgb = img.to_rgb32f();
+        let (width, height) = (rgb.width() as usize, rgb.height() as usize);
+        if width < 2 || height < 2 {
+            return Err(format!(
+                "environment map {} is only {width}x{height}",
+                path.display()
+            ));
+        }
+        let mut radiance = Vec::with_capacity(width * height);
+        for p in rgb.pixels() {
+            let v = Vec3::new(p[0], p[1], p[2]);
+            if !v.is_finite() || v.min_element() < 0.0 {
+                return Err(format!(
+                    "environment map {} has a negative or non-finite texel",
+                    path.display()
+                ));
+            }
+            radiance.push(v);
+        }
+        Ok(Environment {
+            width,
+            height,
+            radiance,
+        })
+    }
+
+    fn direction_of(width: usize, height: usize, u: f32, v: f32) -> Vec3 {
+        let theta = std::f32::consts::PI * v / height as f32;
+        let phi = 2.0 * std::f32::consts::PI * u / width as f32;
+        Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.cos(),
+            theta.sin() * phi.sin(),
+        )
+    }
+
+    /// Solid angle of one texel in row `y`.
+    fn texel_solid_angle(&self, y: usize) -> f32 {
+        let theta = std::f32::consts::PI * (y as f32 + 0.5) / self.height as f32;
+        (2.0 * std::f32::consts::PI / self.width as f32)
+            * (std::f32::consts::PI / self.height as f32)
+            * theta.sin()
+    }
+
+    /// Irradiance on a surface with normal `n`, by direct integration over the map (reference).
+    pub fn irradiance(&self, n: Vec3) -> Vec3 {
+        let mut e = Vec3::ZERO;
+        for y in 0..self.height {
+            let dw = self.texel_solid_angle(y);
+            for x in 0..self.width {
+                let d = Self::direction_of(self.width, self.height, x as f32 + 0.5, y as f32 + 0.5);
+                e += self.radiance[y * self.width + x] * dw * n.dot(d).max(0.0);
+            }
+        }
+        e
+    }
+
+    /// Up to `k` directional lights (unit direction towards the light, irradiance on a surface
+    /// facing it) by median cut: repeatedly split the region of most energy across its longer
+    /// angular side at its energy median. Each light sits at its region's energy-weighted mean
+    /// direction and carries the sum of L dw over the region, so the total power is kept exactly.
+    pub fn median_cut(&self, k: usize) -> Vec<(Vec3, Vec3)> {
+        let energy = |x: usize, y: usize| {
+            let l = self.radiance[y * self.width + x];
+            (0.2126 * l.x + 0.7152 * l.y + 0.0722 * l.z) * self.texel_solid_angle(y)
+        };
+        let region_energy = |r: &[usize; 4]| -> f32 {
+            (r[2]..r[3])
+                .map(|y| (r[0]..r[1]).map(|x| energy(x, y)).sum::<f32>())
+                .sum()
+        };
+        // Regions are [x0, x1, y0, y1).
+        let mut regions = vec![[0, self.width, 0, self.height]];
+        while regions.len() < k {
+            let (i, _) = regions
+                .iter()
+                .enumerate()
+                .filter(|(_, r)| r[1] - r[0] > 1 || r[3] - r[2] > 1)
+                .map(|(i, r)| (i, region_energy(r)))
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap_or((usize::MAX, 0.0));
+            if i == usize::MAX {
+                break;
+            }
+            let r = regions[i];
+            let mid_theta =
+                std::f32::consts::PI * ((r[2] + r[3]) as f32 * 0.5) / self.height as f32;
+            let angular_w =
+                (r[1] - r[0]) as f32 / self.width as f32 * 2.0 * mid_theta.sin().max(1e-3);
+            let angular_h = (r[3] - r[2]) as f32 / self.height as f32;
+            let split_x = (angular_w >= angular_h && r[1] - r[0] > 1) || r[3] - r[2] <= 1;
+            let total = region_energy(&r);
+            let (lo, hi) = if split_x { (r[0], r[1]) } else { (r[2], r[3]) };
+            let mut acc = 0.0;
+            let mut cut = lo + 1;
+            for c in lo..hi - 1 {
+                acc += if split_x {
+                    (r[2]..r[3]).map(|y| energy(c, y)).sum::<f32>()
+                } else {
+                    (r[0]..r[1]).map(|x| energy(x, c)).sum::<f32>()
+                };
+                cut = c + 1;
+                if acc >= 0.5 * total {
+                    break;
+                }
+            }
+            let (a, b) = if split_x {
+                ([r[0], cut, r[2], r[3]], [cut, r[1], r[2], r[3]])
+            } else {
+                ([r[0], r[1], r[2], cut], [r[0], r[1], cut, r[3]])
+            };
+            regions[i] = a;
+            regions.push(b);
+        }
+        regions
+            .iter()
+            .filter_map(|r| {
+                let mut power = Vec3::ZERO;
+                let mut mean = Vec3::ZERO;
+                for y in r[2]..r[3] {
+                    let dw = self.texel_solid_angle(y);
+                    for x in r[0]..r[1] {
+                        let d = Self::direction_of(
+                            self.width,
+                            self.height,
+                            x as f32 + 0.5,
+                            y as f32 + 0.5,
+                        );
+                        power += self.radiance[y * self.width + x] * dw;
+                        mean += d * energy(x, y);
+                    }
+                }
+                let dir = if mean.length() > 1e-12 {
+                    mean.normalize()
+                } else {
+                    Self::direction_of(
+                        self.width,
+                        self.height,
+                        (r[0] + r[1]) as f32 * 0.5,
+                        (r[2] + r[3]) as f32 * 0.5,
+                    )
+                };
+                (power.max_element() > 0.0).then_some((dir, power))
+            })
+            .collect()
+    }
+}
+
+/// A light ready for the GPU, before shadow layers are assigned.
+#[derive(Clone, Debug)]
+pub struct PreparedLight {
+    pub record: LightGpu,
+    pub casts_shadow: bool,
+    /// Which scene light it came from (several for an environment).
+    pub source: usize,
+}
+
+/// Turn scene lights into GPU records. `bounds` is the bounding sphere (centre, radius) of the
+/// shadow casters, which every shadow frustum must cover; `environment` is the loaded map or sky.
+pub fn prepare(
+    lights: &[Light],
+    environment: Option<&Environment>,
+    bounds: (Vec3, f32),
+    shadow_map_size: u32,
+) -> Vec<PreparedLight> {
+    let (center, radius) = (bounds.0, bounds.1.max(1e-6));
+    let texel = 1.0 / shadow_map_size as f32;
+    let mut out = Vec::new();
+    let directional = |dir: Vec3, irradiance: Vec3| {
+        let dir = dir.normalize();
+        let eye = center + dir * (2.0 * radius);
+        let view = look_at_mat4(eye, center, any_up(dir));
+        let proj = vulkan::orthographic(-radius, radius, -radius, radius, 0.0, 4.0 * radius);
+        LightGpu {
+            position_kind: [0.0, 0.0, 0.0, LIGHT_DIRECTIONAL],
+            direction_cos: [dir.x, dir.y, dir.z, 0.0],
+            power_layer: [irradiance.x, irradiance.y, irradiance.z, -1.0],
+            spot_texel: [0.0, texel, 0.0, 0.0],
+            shadow_matrix: (proj * view).to_cols_array_2d(),
+        }
+    };
+    let local = |position: Vec3, axis: Option<(Vec3, f32)>| {
+        let to_center = center - position;
+        let dist = to_center.length().max(1e-6);
+        let (forward, half_angle) = match axis {
+            Some((a, angle)) => (a.normalize(), angle),
+            None => {
+                // Cover the casters' bounding sphere; a light inside it gets a wide frustum.
+                let half = if dist > radius {
+                    (radius / dist).asin() * 1.05
+                } else {
+                    80f32.to_radians()
+                };
+                (to_center / dist, half.min(80f32.to_radians()))
+            }
+        };
+        let near = (dist - radius).max(dist * 1e-3).max(1e-5);
+        let far = dist + radius;
+        let view = look_at_mat4(position, position + forward, any_up(forward));
+        let proj = vulkan::perspective(2.0 * half_angle, 1.0, near, far);
+        proj * view
+    };
+    for (source, light) in lights.iter().enumerate() {
+        match light {
+            Light::Directional {
+                direction,
+                irradiance,
+                shadows,
+            } => out.push(PreparedLight {
+                record: directional(Vec3::from(*direction), Vec3::from(*irradiance)),
+                casts_shadow: *shadows,
+                source,
+            }),
+            Light::Point {
+                position,
+                intensity,
+                shadows,
+            } => {
+                let p = Vec3::from(*position);
+                out.push(PreparedLight {
+                    record: LightGpu {
+                        position_kind: [p.x, p.y, p.z, LIGHT_POINT],
+                        direction_cos: [0.0; 4],
+                        power_layer: [intensity[0], intensity[1], intensity[2], -1.0],
+                        spot_texel: [0.0, texel, 0.0, 0.0],
+                        shadow_matrix: local(p, None).to_cols_array_2d(),
+                    },
+                    casts_shadow: *shadows,
+                    source,
+                })
+            }
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                angle,
+                softness,
+                shadows,
+            } => {
+                let p = Vec3::from(*position);
+                let axis = Vec3::from(*direction).normalize();
+                let outer = angle.to_radians();
+                let inner = outer * (1.0 - softness);
+                out.push(PreparedLight {
+                    record: LightGpu {
+                        position_kind: [p.x, p.y, p.z, LIGHT_SPOT],
+                        direction_cos: [axis.x, axis.y, axis.z, outer.cos()],
+                        power_layer: [intensity[0], intensity[1], intensity[2], -1.0],
+                        spot_texel: [inner.cos(), texel, 0.0, 0.0],
+                        shadow_matrix: local(
+                            p,
+                            Some((axis, (outer * 1.05).min(85f32.to_radians()))),
+                        )
+                        .to_cols_array_2d(),
+                    },
+                    casts_shadow: *shadows,
+                    source,
+                })
+            }
+            Light::Environment {
+                scale,
+                directions,
+                shadows,
+                ..
+            } => {
+                if let Some(env) = environment {
+                    for (dir, irradiance) in env.median_cut(*directions as usize) {
+                        out.push(PreparedLight {
+                            record: directional(dir, irradiance * *scale),
+                            casts_shadow: *shadows,
+                            source,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Assign shadow-map layers to the lights that cast shadows; returns the layer count.
+pub fn assign_shadow_layers(lights: &mut [PreparedLight], any_caster: bool) -> u32 {
+    let mut layers = 0;
+    for l in lights.iter_mut() {
+        l.record.power_layer[3] = if l.casts_shadow && any_caster {
+            layers += 1;
+            (layers - 1) as f32
+        } else {
+            -1.0
+        };
+    }
+    layers
+}
+
+fn any_up(dir: Vec3) -> Vec3 {
+    if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y }
+}
