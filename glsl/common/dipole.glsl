@@ -41,11 +41,16 @@ float dipole_fresnel_transmittance(float cos_theta_i, float eta) {
     return 1.0 - dipole_fresnel_reflectance(cos_theta_i, eta);
 }
 
-// Diffuse Fresnel reflectance fits (Jensen et al. 2001 after Egan & Hilgeman; DESIGN.md).
+// Diffuse Fresnel reflectance fits (Jensen et al. 2001 after Egan & Hilgeman; DESIGN.md),
+// the same polynomials expanded about eta = 1, where their terms cancel to 0.0016 (see F_dr in
+// fresnel.rs).
 float dipole_F_dr(float eta) {
-    if (eta >= 1.0) return -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta;
-    float inv = 1.0 / eta;
-    return -0.4399 + inv * (0.7099 + inv * (-0.3319 + inv * 0.0636));
+    if (eta >= 1.0) {
+        float u = eta - 1.0;
+        return (0.0016 + u * (2.2368 + u * (0.8588 + u * 0.0636))) / (eta * eta);
+    }
+    float w = 1.0 / eta - 1.0;
+    return 0.0017 + w * (0.2369 + w * (-0.1411 + w * 0.0636));
 }
 
 float dipole_A(float eta) {
@@ -188,10 +193,12 @@ float dipole_near_energy(DipoleChannel ch, float b) {
          + dipole_second_difference(ch.z_v, ch.sigma_tr, beta));
 }
 
-// Footprint weight w(r / rho): 1 inside, smoothstep edge, integral w 2 pi r dr = dA.
+// Footprint weight w(r / rho): 1 inside, smoothstep edge, integral w 2 pi r dr = dA. Computed
+// as S(1 - t), not 1 - S(t), so the tiny values near the outer edge keep their digits.
 float dipole_footprint_weight(float x) {
     float c = sqrt(1.0 - DIPOLE_BUMP_DELTA * DIPOLE_BUMP_DELTA / 5.0);
-    return 1.0 - smoothstep(c - DIPOLE_BUMP_DELTA, c + DIPOLE_BUMP_DELTA, x);
+    float t = clamp((c + DIPOLE_BUMP_DELTA - x) / (2.0 * DIPOLE_BUMP_DELTA), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
 }
 
 float dipole_point_kernel(DipoleChannel ch, float r, float area) {

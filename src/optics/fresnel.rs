@@ -47,13 +47,31 @@ pub fn fresnel_transmittance(cos_theta_i: f64, eta: f64) -> f64 {
 /// `eta < 1`: `-0.4399 + 0.7099/eta - 0.3319/eta^2 + 0.0636/eta^3`.
 /// `eta` is the relative index of the material (inside over outside). The fits are not exactly
 /// 0 at `eta = 1` (they give 0.0016 and 0.0017): that is the fit, not a bug.
+///
+/// Near `eta = 1` the terms of either fit cancel to those small values, which costs f32 about
+/// three digits. So both are evaluated expanded about `eta = 1` (the same polynomials, the
+/// coefficients worked out exactly in decimal; [`F_dr_as_published`] is the form above, and a
+/// test checks that the two agree):
+/// `eta >= 1`, `u = eta - 1`: `(0.0016 + 2.2368 u + 0.8588 u^2 + 0.0636 u^3) / eta^2`;
+/// `eta < 1`, `w = 1/eta - 1`: `0.0017 + 0.2369 w - 0.1411 w^2 + 0.0636 w^3`.
 #[allow(non_snake_case)]
 pub fn F_dr(eta: f64) -> f64 {
     if eta >= 1.0 {
+        let u = eta - 1.0;
+        (0.0016 + u * (2.2368 + u * (0.8588 + u * 0.0636))) / (eta * eta)
+    } else {
+        let w = 1.0 / eta - 1.0;
+        0.0017 + w * (0.2369 + w * (-0.1411 + w * 0.0636))
+    }
+}
+
+/// The `F_dr` fits in their published form (see [`F_dr`]).
+#[allow(non_snake_case)]
+pub fn F_dr_as_published(eta: f64) -> f64 {
+    if eta >= 1.0 {
         -1.440 / (eta * eta) + 0.710 / eta + 0.668 + 0.0636 * eta
     } else {
-        let inv = 1.0 / eta;
-        -0.4399 + inv * (0.7099 + inv * (-0.3319 + inv * 0.0636))
+        -0.4399 + 0.7099 / eta - 0.3319 / (eta * eta) + 0.0636 / (eta * eta * eta)
     }
 }
 

@@ -152,9 +152,13 @@ fn first_difference(z: f64, s: f64, da: f64, db: f64, gap: f64) -> f64 {
 /// The footprint weight `w(x)`, `x = r / rho`: 1 inside, a smoothstep edge of half-width
 /// [`BUMP_DELTA`] centred at `c = sqrt(1 - delta^2 / 5)`, so that `integral w(x) 2x dx = 1`
 /// (the edge's derivative is a Beta(2,2) bump of variance `delta^2 / 5`).
+///
+/// Written as `S((c + delta - x) / (2 delta))` rather than `1 - S(...)` (equal, since
+/// `S(t) + S(1 - t) = 1`) so that near the outer edge, where `w` is tiny and multiplies the
+/// whole near energy, f32 keeps its relative precision.
 pub fn footprint_weight(x: f64) -> f64 {
     let c = (1.0 - BUMP_DELTA * BUMP_DELTA / 5.0).sqrt();
-    1.0 - smoothstep((x - (c - BUMP_DELTA)) / (2.0 * BUMP_DELTA))
+    smoothstep((c + BUMP_DELTA - x) / (2.0 * BUMP_DELTA))
 }
 
 /// The kernel of the discrete dipole sum: what a sample of area `area` (scene units squared)
