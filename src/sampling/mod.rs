@@ -1,1 +1,251 @@
 //! Sample points on a mesh surface, each with an area weight (seed paper section 3).
+//!
+//! Four placements, all giving exactly N points for a budget N and the same points for the same
+//! seed:
+//! - [`Method::Random`]: uniform by area.
+//! - [`Method::Turk`]: Turk's point repulsion (1992) from a random start ([`turk`]).
+//! - [`Method::Feature`]: the seed paper's Algorithm 1 and Eq. 12, then repulsion with a density
+//!   that follows curvature ([`feature`], whose documentation states how the paper is read).
+//! - [`Method::Poisson`]: blue noise by weighted sample elimination (Yuksel 2015, [`poisson`]).
+//!
+//! Every point then gets the area of the surface nearer to it than to any other sample
+//! ([`weights`]), so the weights sum to the mesh area and follow the local density.
+//!
+//! For the GPU, [`SampleSet::gpu_records`] packs points as [`GpuSample`] (std430-compatible).
+
+pub mod feature;
+pub mod hash;
+pub mod poisson;
+pub mod random;
+pub mod stats;
+pub mod turk;
+pub mod walk;
+pub mod weights;
+
+use std::fmt;
+use std::str::FromStr;
+
+use glam::Vec3;
+use rand::SeedableRng;
+use rand_pcg::Pcg64;
+
+pub use feature::FeatureParams;
+pub use hash::SpatialHash;
+pub use poisson::PoissonParams;
+pub use stats::{SampleStats, nearest_neighbour_distances};
+pub use turk::TurkParams;
+pub use walk::SurfacePoint;
+pub use weights::WeightParams;
+
+use crate::mesh::Mesh;
+
+/// Largest sample count accepted; far above what a dipole gather can use, low enough that a
+/// typo cannot exhaust memory.
+pub const MAX_COUNT: usize = 1 << 24;
+
+/// How sample points are placed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    Random,
+    Turk,
+    Feature,
+    Poisson,
+}
+
+impl Method {
+    pub const ALL: [Method; 4] = [Method::Random, Method::Turk, Method::Feature, Method::Poisson];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Random => "random",
+            Method::Turk => "turk",
+            Method::Feature => "feature",
+            Method::Poisson => "poisson",
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Method {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name().eq_ignore_ascii_case(s))
+            .ok_or_else(|| format!("unknown sampling method `{s}` (expected random, turk, feature or poisson)"))
+    }
+}
+
+/// Errors of the samplers.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum SamplingError {
+    #[error("the sample count must be at least 1, got 0")]
+    ZeroCount,
+    #[error("the sample count {count} is above the limit of {max}")]
+    TooMany { count: usize, max: usize },
+    #[error("the mesh has no surface area to sample (total area {area})")]
+    NoArea { area: f64 },
+}
+
+/// Everything a sampler needs; [`SampleOptions::new`] fills in the defaults.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampleOptions {
+    pub method: Method,
+    pub count: usize,
+    pub seed: u64,
+    pub turk: TurkParams,
+    pub feature: FeatureParams,
+    pub poisson: PoissonParams,
+    pub weights: WeightParams,
+}
+
+impl SampleOptions {
+    pub fn new(method: Method, count: usize) -> SampleOptions {
+        SampleOptions {
+            method,
+            count,
+            seed: 0,
+            turk: TurkParams::default(),
+            feature: FeatureParams::default(),
+            poisson: PoissonParams::default(),
+            weights: WeightParams::default(),
+        }
+    }
+
+    pub fn with_seed(mut self, seed: u64) -> SampleOptions {
+        self.seed = seed;
+        self
+    }
+}
+
+/// One sample point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SamplePoint {
+    pub position: Vec3,
+    /// Unit shading normal (interpolated vertex normals).
+    pub normal: Vec3,
+    pub triangle: u32,
+    /// Weights of the triangle's three corners, non-negative, summing to one.
+    pub barycentric: [f32; 3],
+    /// The surface area this sample stands for.
+    pub area: f64,
+}
+
+/// A sample as the GPU reads it: std430 `struct Sample { vec4 position_area; vec4 normal_pad; }`,
+/// 32 bytes, the area in the w of the first vec4.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuSample {
+    pub position: [f32; 3],
+    pub area: f32,
+    pub normal: [f32; 3],
+    pub pad: f32,
+}
+
+impl SamplePoint {
+    pub fn gpu(&self) -> GpuSample {
+        GpuSample { position: self.position.to_array(), area: self.area as f32, normal: self.normal.to_array(), pad: 0.0 }
+    }
+}
+
+/// The result of a sampler.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampleSet {
+    pub method: Method,
+    pub seed: u64,
+    pub points: Vec<SamplePoint>,
+}
+
+impl SampleSet {
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// Sum of the area weights (the mesh area, up to rounding).
+    pub fn total_area(&self) -> f64 {
+        self.points.iter().map(|p| p.area).sum()
+    }
+
+    pub fn positions(&self) -> Vec<Vec3> {
+        self.points.iter().map(|p| p.position).collect()
+    }
+
+    /// The points packed for a GPU storage buffer.
+    pub fn gpu_records(&self) -> Vec<GpuSample> {
+        self.points.iter().map(SamplePoint::gpu).collect()
+    }
+}
+
+fn check(mesh: &Mesh, count: usize) -> Result<(), SamplingError> {
+    if count == 0 {
+        return Err(SamplingError::ZeroCount);
+    }
+    if count > MAX_COUNT {
+        return Err(SamplingError::TooMany { count, max: MAX_COUNT });
+    }
+    let area = mesh.total_area();
+    if area.is_nan() || area <= 0.0 || !area.is_finite() {
+        return Err(SamplingError::NoArea { area });
+    }
+    Ok(())
+}
+
+/// Place `options.count` points by `options.method`, without weights.
+pub fn place(mesh: &Mesh, options: &SampleOptions) -> Result<Vec<SurfacePoint>, SamplingError> {
+    let n = options.count;
+    check(mesh, n)?;
+    let mut rng = Pcg64::seed_from_u64(options.seed);
+    let points = match options.method {
+        Method::Random => random::random_points(mesh, n, &mut rng),
+        Method::Turk => {
+            let mut pts = random::random_points(mesh, n, &mut rng);
+            turk::relax(mesh, &mut pts, turk::Radius::Uniform(turk::turk_radius(mesh.total_area(), n)), &options.turk);
+            pts
+        }
+        Method::Feature => {
+            let two_n = feature::feature_point_count(mesh, n, options.feature.feature_fraction);
+            let mut pts = feature::feature_points(mesh, two_n);
+            pts.extend(random::random_points(mesh, n - two_n, &mut rng));
+            feature::relax_by_curvature(mesh, &mut pts, &options.feature);
+            pts
+        }
+        Method::Poisson => {
+            let m = n.saturating_mul(options.poisson.candidate_factor.max(1));
+            let candidates = random::random_points(mesh, m, &mut rng);
+            poisson::eliminate(mesh, &candidates, n)
+        }
+    };
+    debug_assert_eq!(points.len(), n);
+    Ok(points)
+}
+
+/// Turn placed points into samples with positions, normals and the given area weights.
+pub fn finish(mesh: &Mesh, points: &[SurfacePoint], areas: &[f64]) -> Vec<SamplePoint> {
+    points
+        .iter()
+        .zip(areas)
+        .map(|(p, &area)| SamplePoint {
+            position: p.position(mesh).as_vec3(),
+            normal: mesh.normal_at(p.triangle as usize, p.bary),
+            triangle: p.triangle,
+            barycentric: p.bary.map(|b| b as f32),
+            area,
+        })
+        .collect()
+}
+
+/// Place points and weigh them: the whole pipeline behind `translucent sample`.
+pub fn sample(mesh: &Mesh, options: &SampleOptions) -> Result<SampleSet, SamplingError> {
+    let points = place(mesh, options)?;
+    let areas = weights::area_weights(mesh, &points, &options.weights);
+    Ok(SampleSet { method: options.method, seed: options.seed, points: finish(mesh, &points, &areas) })
+}
