@@ -1,0 +1,229 @@
+// dipole.glsl: the dipole diffusion model in f32, twin of the f64 reference in src/optics/
+// (dipole.rs, fresnel.rs, kernel.rs; the doc comments there give the derivations). Every function
+// here has a same-named counterpart there, and tests/optics_gpu.rs compares them.
+//
+// Written to stay finite for everything a validated Material yields (sigma_t' per scene unit in
+// [1e-12, 1e12], eta in [1/3, 3]) and distances up to 1e18 scene units:
+// - sigma_a = 0 gives sigma_tr = 0, alpha' = 1 and exp(0) terms, no division by sigma_tr;
+// - products are ordered as ratios <= 1 ((z/d) before 1/d) so nothing overflows;
+// - 1 - e^-x uses a series for small x, differences of nearly equal terms are rewritten as sums
+//   of non-negative terms (ring integrals, second differences), so no catastrophic cancellation;
+// - exp of large negatives underflows to 0, which is the right answer.
+#ifndef TRANSLUCENT_DIPOLE_GLSL
+#define TRANSLUCENT_DIPOLE_GLSL
+
+const float DIPOLE_PI = 3.14159265358979;
+
+// One colour channel's dipole constants, lengths in scene units (Rust: DipoleChannelGpu).
+struct DipoleChannel {
+    float alpha_prime; // reduced albedo sigma_s' / sigma_t'
+    float sigma_tr;    // effective transport coefficient sqrt(3 sigma_a sigma_t')
+    float z_r;         // real source depth 1 / sigma_t'
+    float z_v;         // virtual source height z_r + 4 A D
+};
+
+// ---- Fresnel (src/optics/fresnel.rs) ----
+
+// Exact unpolarized dielectric reflectance; eta = n_t / n_i. TIR gives 1, eta = 1 gives 0.
+float dipole_fresnel_reflectance(float cos_theta_i, float eta) {
+    if (eta == 1.0) return 0.0;
+    float cos_i = min(abs(cos_theta_i), 1.0);
+    // cos^2 theta_t without the 1 - sin^2 cancellation at grazing incidence.
+    float cos_t_sq = (cos_i * cos_i + (eta - 1.0) * (eta + 1.0)) / (eta * eta);
+    if (cos_t_sq <= 0.0) return 1.0;
+    float cos_t = sqrt(cos_t_sq);
+    float r_s = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    float r_p = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    return 0.5 * (r_s * r_s + r_p * r_p);
+}
+
+float dipole_fresnel_transmittance(float cos_theta_i, float eta) {
+    return 1.0 - dipole_fresnel_reflectance(cos_theta_i, eta);
+}
+
+// Diffuse Fresnel reflectance fits (Jensen et al. 2001 after Egan & Hilgeman; DESIGN.md),
+// the same polynomials expanded about eta = 1, where their terms cancel to 0.0016 (see F_dr in
+// fresnel.rs).
+float dipole_F_dr(float eta) {
+    if (eta >= 1.0) {
+        float u = eta - 1.0;
+        return (0.0016 + u * (2.2368 + u * (0.8588 + u * 0.0636))) / (eta * eta);
+    }
+    float w = 1.0 / eta - 1.0;
+    return 0.0017 + w * (0.2369 + w * (-0.1411 + w * 0.0636));
+}
+
+float dipole_A(float eta) {
+    float f = dipole_F_dr(eta);
+    return (1.0 + f) / (1.0 - f);
+}
+
+// ---- The dipole (src/optics/dipole.rs) ----
+
+// 1 - e^-x for x >= 0, accurate to a few ulp also for small x (GLSL has no expm1).
+float dipole_one_minus_exp(float x) {
+    if (x < 0.1) {
+        return x * (1.0 - x / 2.0 * (1.0 - x / 3.0 * (1.0 - x / 4.0 * (1.0 - x / 5.0 * (1.0 - x / 6.0)))));
+    }
+    return 1.0 - exp(-x);
+}
+
+// The channel from coefficients per scene unit. sigma_t' = 0 (no medium) yields zeros, so every
+// function below returns 0 for it instead of dividing by zero.
+DipoleChannel dipole_channel(float sigma_a, float sigma_s_prime, float eta) {
+    float sigma_t_prime = sigma_a + sigma_s_prime;
+    if (!(sigma_t_prime > 0.0)) return DipoleChannel(0.0, 0.0, 1.0, 1.0);
+    float one_minus_alpha_prime = sigma_a / sigma_t_prime;
+    float z_r = 1.0 / sigma_t_prime;
+    // eta outside the fits' range is refused on the CPU; clamp so a stray value stays finite.
+    float a = dipole_A(clamp(eta, 1.0 / 3.0, 3.0));
+    return DipoleChannel(sigma_s_prime / sigma_t_prime,
+                         sigma_t_prime * sqrt(3.0 * one_minus_alpha_prime),
+                         z_r,
+                         z_r * (1.0 + 4.0 * a / 3.0));
+}
+
+// One pole of seed Eq. 8 at squared distance d_sq: z (sigma_tr + 1/d) e^(-sigma_tr d) / d^2.
+float dipole_pole(float z, float s, float d_sq) {
+    float d = sqrt(d_sq);
+    float inv_d = 1.0 / d;
+    return (z * inv_d) * (s + inv_d) * inv_d * exp(-s * d);
+}
+
+// Diffuse reflectance profile R_d(r), seed Eq. 8.
+float dipole_r_d(DipoleChannel ch, float r) {
+    float r_sq = r * r;
+    return ch.alpha_prime / (4.0 * DIPOLE_PI)
+        * (dipole_pole(ch.z_r, ch.sigma_tr, r_sq + ch.z_r * ch.z_r)
+         + dipole_pole(ch.z_v, ch.sigma_tr, r_sq + ch.z_v * ch.z_v));
+}
+
+// Total diffuse reflectance (alpha'/2)(e^(-sigma_tr z_r) + e^(-sigma_tr z_v)), which is the closed
+// form of DESIGN.md since sigma_tr z_r = sqrt(3(1 - alpha')) and z_v = z_r (1 + 4A/3).
+float dipole_r_d_total(DipoleChannel ch) {
+    return 0.5 * ch.alpha_prime * (exp(-ch.sigma_tr * ch.z_r) + exp(-ch.sigma_tr * ch.z_v));
+}
+
+// One pole's ring integral z [e^(-s d1)/d1 - e^(-s d2)/d2], rewritten without cancellation.
+float dipole_ring_term(float z, float s, float r1_sq, float delta_sq) {
+    float d1 = sqrt(r1_sq + z * z);
+    float d2 = sqrt(r1_sq + delta_sq + z * z);
+    float gap = delta_sq / (d1 + d2);
+    return (z / d1) * exp(-s * d1) * (gap / d2 + (d1 / d2) * dipole_one_minus_exp(s * gap));
+}
+
+// Integral of R_d 2 pi r dr between radii sqrt(r1_sq) and sqrt(r1_sq + delta_sq).
+float dipole_r_d_ring_sq(DipoleChannel ch, float r1_sq, float delta_sq) {
+    return 0.5 * ch.alpha_prime
+        * (dipole_ring_term(ch.z_r, ch.sigma_tr, r1_sq, delta_sq)
+         + dipole_ring_term(ch.z_v, ch.sigma_tr, r1_sq, delta_sq));
+}
+
+// Exact disk integral P(R) of R_d (DESIGN.md).
+float dipole_r_d_disk(DipoleChannel ch, float radius) {
+    return dipole_r_d_ring_sq(ch, 0.0, radius * radius);
+}
+
+// BSSRDF S_d (seed Eq. 9), normalized by t_eta = 1 - 2 FM1(eta) (computed on the CPU) so that
+// the outgoing radiance integrates to the exitance; see Dipole::s_d.
+float dipole_s_d(DipoleChannel ch, float eta, float r, float cos_theta_i, float cos_theta_o, float t_eta) {
+    return dipole_fresnel_transmittance(cos_theta_i, eta) * dipole_r_d(ch, r)
+        * dipole_fresnel_transmittance(cos_theta_o, eta) / (DIPOLE_PI * t_eta);
+}
+
+// ---- The near-field kernel (src/optics/kernel.rs, whose module doc explains the design) ----
+
+const float DIPOLE_B_PER_SQRT_AREA = 1.5;
+const float DIPOLE_BUMP_DELTA = 0.25;
+const float DIPOLE_FAR_BLEND_START = 8.0;
+const float DIPOLE_FAR_BLEND_END = 16.0;
+
+// R_b(r): seed Eq. 8 with d^2 = r^2 + z^2 + b^2; takes rb_sq = r^2 + b^2.
+float dipole_r_d_regularized_sq(DipoleChannel ch, float rb_sq) {
+    return ch.alpha_prime / (4.0 * DIPOLE_PI)
+        * (dipole_pole(ch.z_r, ch.sigma_tr, rb_sq + ch.z_r * ch.z_r)
+         + dipole_pole(ch.z_v, ch.sigma_tr, rb_sq + ch.z_v * ch.z_v));
+}
+
+// R_far(r) = 2 R_b(r) - R_{sqrt2 b}(r).
+float dipole_r_d_far(DipoleChannel ch, float r, float b) {
+    float r_sq = r * r, b_sq = b * b;
+    return 2.0 * dipole_r_d_regularized_sq(ch, r_sq + b_sq) - dipole_r_d_regularized_sq(ch, r_sq + 2.0 * b_sq);
+}
+
+// z [e^(-s da)/da - e^(-s db)/db], db = da + gap, without cancellation.
+float dipole_first_difference(float z, float s, float da, float db, float gap) {
+    return (z / da) * exp(-s * da) * (gap / db + (da / db) * dipole_one_minus_exp(s * gap));
+}
+
+// z (beta / q^2)(y / q^2) ... : one node of the second-difference quadrature, weight applied.
+float dipole_second_difference_node(float z, float s, float beta, float y, float weight) {
+    float q_sq = z * z + y;
+    float q = sqrt(q_sq);
+    float sq = s * q;
+    return (weight / q_sq) * (beta / q_sq) * (z / q) * exp(-sq) * (sq * sq + 3.0 * sq + 3.0) * 0.25;
+}
+
+// z [g(z^2) - 2 g(z^2 + beta) + g(z^2 + 2 beta)], g(D) = e^(-s sqrt(D)) / sqrt(D).
+float dipole_second_difference(float z, float s, float beta) {
+    float d1 = sqrt(z * z + beta);
+    float d2 = sqrt(z * z + 2.0 * beta);
+    float spread = 2.0 * beta / (z + d2);
+    if (spread <= 0.1 * z && s * spread <= 0.5) {
+        const float X[3] = float[3](-0.7745966692414834, 0.0, 0.7745966692414834);
+        const float W[3] = float[3](5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0);
+        float sum = 0.0;
+        for (int k = 0; k < 3; ++k) {
+            float y = 0.5 * beta * (1.0 + X[k]);
+            sum += W[k] * (dipole_second_difference_node(z, s, beta, y, y)
+                         + dipole_second_difference_node(z, s, beta, beta + y, beta - y));
+        }
+        return 0.5 * sum;
+    }
+    return dipole_first_difference(z, s, z, d1, beta / (z + d1))
+         - dipole_first_difference(z, s, d1, d2, beta / (d1 + d2));
+}
+
+// E_near(b) = R_d,total - integral R_far 2 pi r dr: the light a sample keeps on its footprint.
+// Depends only on the channel and the sample's area: a splat pass can compute it once per sample.
+float dipole_near_energy(DipoleChannel ch, float b) {
+    float beta = b * b;
+    return 0.5 * ch.alpha_prime
+        * (dipole_second_difference(ch.z_r, ch.sigma_tr, beta)
+         + dipole_second_difference(ch.z_v, ch.sigma_tr, beta));
+}
+
+// Footprint weight w(r / rho): 1 inside, smoothstep edge, integral w 2 pi r dr = dA. Computed
+// as S(1 - t), not 1 - S(t), so the tiny values near the outer edge keep their digits.
+float dipole_footprint_weight(float x) {
+    float c = sqrt(1.0 - DIPOLE_BUMP_DELTA * DIPOLE_BUMP_DELTA / 5.0);
+    float t = clamp((c + DIPOLE_BUMP_DELTA - x) / (2.0 * DIPOLE_BUMP_DELTA), 0.0, 1.0);
+    return t * t * (3.0 - 2.0 * t);
+}
+
+float dipole_point_kernel(DipoleChannel ch, float r, float area) {
+    return dipole_r_d(ch, r) * area;
+}
+
+// The kernel with the sample's near energy e_near = dipole_near_energy(ch, 1.5 sqrt(area))
+// computed beforehand.
+float dipole_kernel_with_near_energy(DipoleChannel ch, float r, float area, float e_near) {
+    if (!(area > 0.0)) return 0.0;
+    float b = DIPOLE_B_PER_SQRT_AREA * sqrt(area);
+    float start = DIPOLE_FAR_BLEND_START * b, end = DIPOLE_FAR_BLEND_END * b;
+    if (r >= end) return dipole_point_kernel(ch, r, area);
+    float rho = sqrt(area / DIPOLE_PI);
+    float near = area * dipole_r_d_far(ch, r, b) + e_near * dipole_footprint_weight(r / rho);
+    if (r <= start) return near;
+    float w = smoothstep(start, end, r);
+    return near + w * (dipole_point_kernel(ch, r, area) - near);
+}
+
+// What a sample of area `area` contributes to the exitance of a receiver at distance r, per unit
+// flux density at the sample (dimensionless).
+float dipole_kernel(DipoleChannel ch, float r, float area) {
+    if (!(area > 0.0)) return 0.0;
+    return dipole_kernel_with_near_energy(ch, r, area, dipole_near_energy(ch, DIPOLE_B_PER_SQRT_AREA * sqrt(area)));
+}
+
+#endif // TRANSLUCENT_DIPOLE_GLSL

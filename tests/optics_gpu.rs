@@ -1,0 +1,340 @@
+//! The GPU twin: `glsl/dipole_eval.comp` evaluates every function of `glsl/common/dipole.glsl`
+//! in f32 over a grid of parameters (every preset, the hard cases, r from 0 to 1e3 diffusion
+//! lengths, scales from micrometres to metres) on the validated test device (lavapipe), and each
+//! value is compared with the f64 reference in `src/optics`.
+//!
+//! Criteria: every value finite; relative error <= 1e-4 wherever the reference is above 1e-30
+//! of its peak over the same sweep (same material, scale and sample area; over r and angles)
+//! and large enough to carry four digits in f32 (>= 1e-35, a thousand times f32's smallest
+//! normal number); elsewhere the absolute error must stay below 1e-4 of that floor or of the
+//! sweep's peak.
+
+mod common;
+
+use ash::vk;
+use common::with_gpu;
+use std::collections::HashMap;
+use translucent::gpu::{Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, memory_barrier};
+use translucent::optics::fresnel::{self, fresnel_reflectance, fresnel_transmittance};
+use translucent::optics::gpu::{DipoleEvalInput, DipoleEvalOutput};
+use translucent::optics::kernel::{self, footprint_kernel, near_energy, r_d_far};
+use translucent::optics::{Dipole, Material, presets};
+
+const LOCAL_SIZE: u32 = 64;
+const REL_TOLERANCE: f64 = 1e-4;
+const PEAK_FRACTION: f64 = 1e-30;
+const F32_FLOOR: f64 = 1e-35;
+
+/// One material channel at one scale: the f32 inputs it is evaluated with.
+struct Case {
+    label: String,
+    sigma_a: f32,
+    sigma_s_prime: f32,
+    eta: f32,
+    mm_per_unit: f32,
+}
+
+fn cases() -> Vec<Case> {
+    let mut out = Vec::new();
+    // Every preset, every channel, at 1 mm per unit (its own eta).
+    for m in presets::all() {
+        for c in 0..3 {
+            out.push(Case {
+                label: format!("{} [{c}]", m.name),
+                sigma_a: m.sigma_a[c] as f32,
+                sigma_s_prime: m.sigma_s_prime[c] as f32,
+                eta: m.eta as f32,
+                mm_per_unit: 1.0,
+            });
+        }
+    }
+    // Hard cases: no absorption, sigma_s' from 1e-6 to 1e4 per mm, eta = 1 and eta < 1,
+    // scales from micrometres to metres.
+    for sigma_a in [0.0f32, 1e-4, 1e-2, 1.0, 1e2] {
+        for sigma_s_prime in [1e-6f32, 1e-4, 1e-2, 1.0, 1e2, 1e4] {
+            for eta in [
+                fresnel::ETA_MIN as f32,
+                0.75,
+                1.0,
+                1.3,
+                1.5,
+                fresnel::ETA_MAX as f32,
+            ] {
+                for mm_per_unit in [1e-3f32, 1.0, 1e3] {
+                    out.push(Case {
+                        label: format!("sigma_a {sigma_a:e} sigma_s' {sigma_s_prime:e} eta {eta} scale {mm_per_unit:e}"),
+                        sigma_a,
+                        sigma_s_prime,
+                        eta,
+                        mm_per_unit,
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The reference dipole for a case, from the very f32 inputs the GPU sees.
+fn dipole(case: &Case) -> Dipole {
+    let scale = case.mm_per_unit as f64;
+    Dipole::new(
+        case.sigma_a as f64 * scale,
+        case.sigma_s_prime as f64 * scale,
+        case.eta as f64,
+        0,
+    )
+    .unwrap_or_else(|e| panic!("{}: {e}", case.label))
+}
+
+/// The records for one case: sample areas from far below to far above z_r^2 and the diffusion
+/// length squared; distances 0, fractions of z_r, and up to 1e3 diffusion lengths (1e3 z_v when
+/// there is no absorption); a few angle pairs. Returns (records, sweep id per record).
+fn records(case: &Case, d: &Dipole, t_eta: f32) -> Vec<(DipoleEvalInput, usize)> {
+    let length = if d.sigma_tr > 0.0 {
+        d.diffusion_length()
+    } else {
+        d.z_v
+    };
+    let mut distances = vec![0.0];
+    distances.extend([1e-4, 1e-2, 0.1, 0.5, 1.0, 3.0, 10.0].map(|f| f * d.z_r));
+    distances.extend([1e-2, 0.3, 1.0, 2.0, 5.0, 10.0, 30.0, 100.0, 300.0, 1e3].map(|f| f * length));
+    let mut areas: Vec<f64> = [1e-6, 1e-2, 1.0, 1e2, 1e6]
+        .map(|f| f * d.z_r * d.z_r)
+        .to_vec();
+    areas.extend([1e-2, 1.0, 1e2].map(|f| f * length * length));
+    let angles = [(1.0f32, 1.0f32), (0.7, 0.2), (0.05, 0.0)];
+    let mut out = Vec::new();
+    for (a, &area) in areas.iter().enumerate() {
+        for &r in &distances {
+            for &(cos_theta_i, cos_theta_o) in &angles {
+                let input = DipoleEvalInput {
+                    sigma_a: case.sigma_a,
+                    sigma_s_prime: case.sigma_s_prime,
+                    eta: case.eta,
+                    mm_per_unit: case.mm_per_unit,
+                    r: r as f32,
+                    area: area as f32,
+                    cos_theta_i,
+                    cos_theta_o,
+                    t_eta,
+                    _pad: [0.0; 3],
+                };
+                out.push((input, a));
+            }
+        }
+    }
+    out
+}
+
+/// The f64 reference of every output field, from the f32 input widened to f64.
+fn reference(d: &Dipole, p: &DipoleEvalInput) -> [f64; 16] {
+    let (r, area) = (p.r as f64, p.area as f64);
+    let b = kernel::B_PER_SQRT_AREA * area.sqrt();
+    let (cos_i, cos_o) = (p.cos_theta_i as f64, p.cos_theta_o as f64);
+    [
+        d.sigma_t_prime,
+        d.alpha_prime,
+        d.sigma_tr,
+        d.F_dr,
+        d.A,
+        d.z_r,
+        d.z_v,
+        d.r_d(r),
+        d.r_d_total(),
+        d.r_d_disk(r),
+        footprint_kernel(d, r, area),
+        near_energy(d, b),
+        r_d_far(d, r, b),
+        fresnel_reflectance(cos_i, d.eta),
+        fresnel_transmittance(cos_o, d.eta),
+        d.s_d(r, cos_i, cos_o, p.t_eta as f64),
+    ]
+}
+
+fn fields(o: &DipoleEvalOutput) -> [f32; 16] {
+    [
+        o.sigma_t_prime,
+        o.alpha_prime,
+        o.sigma_tr,
+        o.F_dr,
+        o.A,
+        o.z_r,
+        o.z_v,
+        o.r_d,
+        o.r_d_total,
+        o.r_d_disk,
+        o.kernel,
+        o.near_energy,
+        o.r_d_far,
+        o.fresnel_r,
+        o.fresnel_t,
+        o.s_d,
+    ]
+}
+
+const NAMES: [&str; 16] = [
+    "sigma_t'",
+    "alpha'",
+    "sigma_tr",
+    "F_dr",
+    "A",
+    "z_r",
+    "z_v",
+    "R_d",
+    "R_d,total",
+    "disk P(r)",
+    "kernel",
+    "E_near",
+    "R_far",
+    "F_r",
+    "F_t",
+    "S_d",
+];
+
+fn run_on_gpu(inputs: &[DipoleEvalInput]) -> Vec<DipoleEvalOutput> {
+    with_gpu(|gpu| {
+        let count = inputs.len() as u32;
+        let pipeline = ComputePipeline::new(
+            gpu,
+            "dipole_eval.comp",
+            &[BindingKind::StorageBuffer, BindingKind::StorageBuffer],
+            4,
+        )
+        .expect("dipole_eval pipeline");
+        let src = Buffer::from_slice(
+            gpu,
+            "dipole_eval inputs",
+            inputs,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        )
+        .expect("input buffer");
+        let bytes = (inputs.len() * std::mem::size_of::<DipoleEvalOutput>()) as u64;
+        let dst = Buffer::new(
+            gpu,
+            &BufferDesc::readback(
+                "dipole_eval outputs",
+                bytes,
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+            ),
+        )
+        .expect("output buffer");
+        let set = pipeline
+            .descriptor_set(&[Binding::Buffer(&src), Binding::Buffer(&dst)])
+            .expect("descriptor set");
+        gpu.one_shot("dipole_eval", |cmd| {
+            pipeline.dispatch(
+                cmd,
+                &set,
+                bytemuck::bytes_of(&count),
+                [count.div_ceil(LOCAL_SIZE), 1, 1],
+            );
+            memory_barrier(
+                gpu.device(),
+                cmd,
+                (
+                    vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    vk::AccessFlags2::SHADER_WRITE,
+                ),
+                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+            );
+        })
+        .expect("dispatch");
+        dst.read().expect("readback")
+    })
+}
+
+#[test]
+fn glsl_twin_matches_f64_reference() {
+    // Build the records and their references.
+    let mut inputs = Vec::new();
+    let mut refs = Vec::new();
+    let mut sweep = Vec::new(); // (case index, area index) per record
+    let cases = cases();
+    for (ci, case) in cases.iter().enumerate() {
+        let d = dipole(case);
+        let t_eta = Material::new("t", [0.0; 3], [1.0; 3], case.eta as f64)
+            .unwrap()
+            .diffuse_transmittance() as f32;
+        for (input, a) in records(case, &d, t_eta) {
+            refs.push(reference(&d, &input));
+            inputs.push(input);
+            sweep.push((ci, a));
+        }
+    }
+    let outputs = run_on_gpu(&inputs);
+    assert_eq!(outputs.len(), inputs.len());
+
+    // Peak of each field over its sweep.
+    let mut peaks: HashMap<(usize, usize, usize), f64> = HashMap::new();
+    for (i, r) in refs.iter().enumerate() {
+        for (f, &v) in r.iter().enumerate() {
+            let peak = peaks.entry((sweep[i].0, sweep[i].1, f)).or_insert(0.0);
+            *peak = peak.max(v.abs());
+        }
+    }
+
+    let mut worst: Vec<(f64, String)> = vec![(0.0, String::new()); 16];
+    let (mut compared, mut floor_only, mut failures) = (0usize, 0usize, Vec::new());
+    for (i, (out, r)) in outputs.iter().zip(&refs).enumerate() {
+        let p = &inputs[i];
+        let case = &cases[sweep[i].0];
+        for (f, (&g, &want)) in fields(out).iter().zip(r).enumerate() {
+            let at = format!(
+                "{} {} at r = {:e}, dA = {:e}, cos {}/{}",
+                NAMES[f], case.label, p.r, p.area, p.cos_theta_i, p.cos_theta_o
+            );
+            assert!(g.is_finite(), "{at}: GPU gave {g}");
+            assert!(want.is_finite(), "{at}: reference gave {want}");
+            let g = g as f64;
+            let peak = peaks[&(sweep[i].0, sweep[i].1, f)];
+            if want.abs() > PEAK_FRACTION * peak && want.abs() >= F32_FLOOR {
+                let e = (g - want).abs() / want.abs();
+                compared += 1;
+                if e > worst[f].0 {
+                    worst[f] = (e, at.clone());
+                }
+                if e > REL_TOLERANCE {
+                    failures.push(format!(
+                        "{at}: GPU {g:e} vs f64 {want:e} (relative {e:.2e})"
+                    ));
+                }
+            } else {
+                floor_only += 1;
+                let allowed = REL_TOLERANCE * F32_FLOOR.max(PEAK_FRACTION * peak);
+                if (g - want).abs() > allowed {
+                    failures.push(format!(
+                        "{at}: GPU {g:e} vs f64 {want:e} below the comparison floor"
+                    ));
+                }
+            }
+        }
+    }
+    println!(
+        "{} records ({} cases): {compared} values compared relatively, {floor_only} below the floor",
+        inputs.len(),
+        cases.len()
+    );
+    println!("worst relative error per function:");
+    for (f, (e, at)) in worst.iter().enumerate() {
+        println!("  {:<10} {e:9.2e}  {at}", NAMES[f]);
+    }
+    // Not vacuous: the bulk of the grid is compared relatively.
+    assert!(
+        compared > 8 * floor_only,
+        "only {compared} of {} values were compared",
+        compared + floor_only
+    );
+    let mut by_field: HashMap<&str, usize> = HashMap::new();
+    for f in &failures {
+        *by_field
+            .entry(NAMES.iter().find(|n| f.starts_with(*n)).unwrap())
+            .or_default() += 1;
+    }
+    assert!(
+        failures.is_empty(),
+        "{} mismatches ({by_field:?}), first ones:\n{}",
+        failures.len(),
+        failures[..failures.len().min(30)].join("\n")
+    );
+}
