@@ -7,6 +7,7 @@
 pub mod gpu;
 pub mod mesh;
 pub mod optics;
+pub mod output;
 pub mod reference;
 pub mod render;
 pub mod sampling;

@@ -226,4 +226,21 @@ float dipole_kernel(DipoleChannel ch, float r, float area) {
     return dipole_kernel_with_near_energy(ch, r, area, dipole_near_energy(ch, DIPOLE_B_PER_SQRT_AREA * sqrt(area)));
 }
 
+// The far part alone (kernel::far_kernel): the gather adds the near energy through a blend
+// over neighbouring samples instead of each sample's own disk (see far_kernel's doc).
+float dipole_far_kernel(DipoleChannel ch, float r, float area) {
+    return dipole_kernel_with_near_energy(ch, r, area, 0.0);
+}
+
+const float DIPOLE_NEAR_BLEND_RADIUS = 2.0;
+
+// Shepard weight (1 - (r/R)^2)^3 inside R = 2 sqrt(area) (kernel::near_blend_weight).
+float dipole_near_blend_weight(float r, float area) {
+    float radius = DIPOLE_NEAR_BLEND_RADIUS * sqrt(max(area, 0.0));
+    if (!(r < radius)) return 0.0;
+    float x = r / radius;
+    float t = 1.0 - x * x;
+    return t * t * t;
+}
+
 #endif // TRANSLUCENT_DIPOLE_GLSL

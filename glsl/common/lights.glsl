@@ -13,7 +13,8 @@ struct Light {
                            //      pointing away from the light; w: cos of the spot's outer angle
     vec4 power_layer;      // rgb: irradiance W/m^2 (directional) or intensity W/sr (point, spot);
                            //      w: shadow-map layer, negative when the light casts no shadow
-    vec4 spot_texel;       // x: cos of the spot's inner angle; y: shadow-map texel size in uv
+    vec4 spot_texel;       // x: cos of the spot's inner angle; y: shadow-map texel size in uv;
+                           // z: normal offset (world units) against self-shadowing
     mat4 shadow_matrix;    // world -> shadow clip space (depth 0..1)
 };
 
@@ -36,13 +37,15 @@ void light_incidence(Light l, vec3 p, out vec3 wi, out vec3 irradiance) {
     }
 }
 
-// Fraction of `l` that reaches world point `p` (1 = lit), by a 3x3 percentage-closer filter
-// over the light's shadow map; each tap of the compare sampler is itself bilinear when the
-// format allows. Points outside the map are lit (border colour white).
-float light_visibility(Light l, sampler2DArrayShadow maps, vec3 p) {
+// Fraction of `l` that reaches world point `p` with unit normal `n` (1 = lit), by a 3x3
+// percentage-closer filter over the light's shadow map; each tap of the compare sampler is itself
+// bilinear when the format allows. Points outside the map are lit (border colour white). The
+// lookup moves off the surface along the normal by about two texels, so a curved surface does
+// not shadow itself through the filter's neighbouring texels.
+float light_visibility(Light l, sampler2DArrayShadow maps, vec3 p, vec3 n) {
     float layer = l.power_layer.w;
     if (layer < 0.0) return 1.0;
-    vec4 clip = l.shadow_matrix * vec4(p, 1.0);
+    vec4 clip = l.shadow_matrix * vec4(p + n * l.spot_texel.z, 1.0);
     if (clip.w <= 0.0) return 1.0;
     vec3 ndc = clip.xyz / clip.w;
     if (ndc.z >= 1.0) return 1.0;

@@ -1,46 +1,184 @@
-//! `translucent render`. Until the renderer lands this runs the smoke pass: it proves the device
-//! works end to end and prints the device and the GPU time.
+//! `translucent render [SCENE]`: render a scene (the built-in one without arguments) to PNG.
 
-use anyhow::Context;
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
 use std::sync::Arc;
-use translucent::gpu::Gpu;
-use translucent::render::smoke;
+use translucent::gpu::{Gpu, median};
+use translucent::output;
+use translucent::render::plan::Change;
+use translucent::render::renderer::Renderer;
+use translucent::scene::Scene;
+use translucent::scene::build::{Overrides, PreparedScene};
 
-#[derive(clap::Args, Debug, Default)]
+#[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Elements in the smoke dispatch
-    #[arg(long, default_value_t = 1 << 20)]
-    pub count: u32,
+    /// Scene file (TOML); the built-in marble bunny when omitted
+    pub scene: Option<PathBuf>,
+    /// Output PNG (tone-mapped sRGB)
+    #[arg(short, long, default_value = "translucent.png")]
+    pub output: PathBuf,
+    /// Also write the linear HDR image as OpenEXR
+    #[arg(long)]
+    pub exr: Option<PathBuf>,
+    /// Sample points per translucent object (overrides the scene)
+    #[arg(long)]
+    pub samples: Option<usize>,
+    /// Sampler: random, turk, feature or poisson (overrides the scene)
+    #[arg(long)]
+    pub sampler: Option<String>,
+    /// Where exitance is gathered: vertex or pixel (overrides the scene)
+    #[arg(long)]
+    pub gather: Option<String>,
+    /// Image size WIDTHxHEIGHT (overrides the scene)
+    #[arg(long, value_parser = parse_resolution)]
+    pub resolution: Option<[u32; 2]>,
+    /// Frames to render; after the first, each frame recomputes what `--moving` invalidates
+    #[arg(long, default_value_t = 1)]
+    pub frames: u32,
+    /// What changes between frames: lights (splat, gather, shade) or camera (shade only)
+    #[arg(long, default_value = "lights")]
+    pub moving: String,
+    /// Print per-pass GPU milliseconds (median over the frames after the first)
+    #[arg(long)]
+    pub timings: bool,
+    /// Print which passes run and why
+    #[arg(long)]
+    pub plan: bool,
+    /// Write each translucent vertex's world position and RGB radiant exitance to a PLY
+    #[arg(long)]
+    pub export_exitance: Option<PathBuf>,
 }
 
-pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> anyhow::Result<()> {
-    let count = if args.count == 0 { 1 << 20 } else { args.count };
+impl Default for Args {
+    fn default() -> Self {
+        Args {
+            scene: None,
+            output: PathBuf::from("translucent.png"),
+            exr: None,
+            samples: None,
+            sampler: None,
+            gather: None,
+            resolution: None,
+            frames: 1,
+            moving: "lights".into(),
+            timings: false,
+            plan: false,
+            export_exitance: None,
+        }
+    }
+}
+
+fn parse_resolution(s: &str) -> Result<[u32; 2], String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("{s:?} is not WIDTHxHEIGHT"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|v| (1..=16384).contains(v));
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok([w, h]),
+        _ => Err(format!("{s:?}: width and height must be 1 to 16384")),
+    }
+}
+
+pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
+    let moving = match args.moving.as_str() {
+        "lights" => Change::Lights,
+        "camera" => Change::Camera,
+        other => bail!("--moving {other:?} is not lights or camera"),
+    };
+    if args.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    let scene = match &args.scene {
+        Some(path) => Scene::load(path)?,
+        None => Scene::builtin(),
+    };
+    let overrides = Overrides {
+        samples: args.samples,
+        sampler: args.sampler.clone(),
+        gather: args.gather.clone(),
+        resolution: args.resolution,
+    };
+    let spinner = ProgressBar::new_spinner().with_message(format!("preparing {} (meshes, sample points)", scene.name));
+    spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+    let prepared = PreparedScene::new(&scene, &overrides);
+    spinner.finish_and_clear();
+    let prepared = prepared?;
+    if prepared.scene.file.render.gather == "pixel" {
+        bail!("{}: `render.gather = \"pixel\"` is not implemented yet; use \"vertex\"", prepared.scene.name);
+    }
     let gpu: Arc<Gpu> = Gpu::new(&gpu_args.options())?;
-    println!("device: {}", gpu.info());
-    let input: Vec<f32> = (0..count).map(|i| (i % 1000) as f32 * 0.5).collect();
-    let result = smoke::run(&gpu, &input).context("smoke dispatch")?;
-    let expected = smoke::expected(&input);
-    let wrong = result
-        .output
-        .iter()
-        .zip(&expected)
-        .filter(|(a, b)| a != b)
-        .count();
-    anyhow::ensure!(
-        wrong == 0,
-        "smoke dispatch: {wrong} of {count} values are wrong"
+    eprintln!(
+        "device: {} | {} vertices, {} samples ({}), {} lights ({} shadow maps)",
+        gpu.info().name,
+        prepared.vertex_count(),
+        prepared.sample_count(),
+        prepared.scene.file.sampling.method,
+        prepared.lights.len(),
+        prepared.shadow_layers
     );
-    println!(
-        "smoke compute: {count} values correct, GPU time {:.3} ms",
-        result.gpu_ms
-    );
-    let counters = gpu.validation();
-    drop(gpu);
-    anyhow::ensure!(
-        counters.total() == 0,
-        "{} Vulkan validation messages:\n{}",
-        counters.total(),
-        counters.messages().join("\n")
-    );
+    let [width, height] = prepared.scene.file.camera.resolution;
+    let mut renderer = Renderer::new(&gpu, prepared).context("creating GPU resources")?;
+
+    let progress = if args.frames > 1 {
+        ProgressBar::new(args.frames as u64)
+            .with_style(ProgressStyle::with_template("frames {bar:30} {pos}/{len} {elapsed}").unwrap())
+    } else {
+        ProgressBar::hidden()
+    };
+    let mut per_pass: Vec<(String, Vec<f64>)> = Vec::new();
+    let mut totals = Vec::new();
+    for frame in 0..args.frames {
+        let change = if frame == 0 { Change::Everything } else { moving };
+        let plan = renderer.plan(change);
+        if args.plan && frame < 2 {
+            eprintln!("frame {frame} ({change:?}):\n{plan}");
+        }
+        let timings = renderer.frame(&plan)?;
+        // The first frame builds everything and warms caches: it is not counted.
+        if frame > 0 || args.frames == 1 {
+            totals.push(timings.total());
+            for (name, ms) in timings.passes {
+                match per_pass.iter_mut().find(|(n, _)| *n == name) {
+                    Some((_, v)) => v.push(ms),
+                    None => per_pass.push((name, vec![ms])),
+                }
+            }
+        }
+        progress.inc(1);
+    }
+    progress.finish_and_clear();
+
+    let (rgba8, non_finite) = renderer.image()?;
+    if non_finite > 0 {
+        bail!("{non_finite} pixels were NaN or infinite before tone mapping; no image written");
+    }
+    output::write_png(&args.output, width, height, &rgba8)?;
+    eprintln!("wrote {}", args.output.display());
+    if let Some(exr) = &args.exr {
+        output::write_exr(exr, width, height, &renderer.hdr_image()?)?;
+        eprintln!("wrote {}", exr.display());
+    }
+    if let Some(ply) = &args.export_exitance {
+        let mut points = Vec::new();
+        for (i, o) in renderer.scene().objects.iter().enumerate() {
+            if o.samples.is_empty() {
+                continue;
+            }
+            for (p, e) in o.mesh.positions().iter().zip(renderer.exitance(i)?) {
+                points.push((p.to_array(), e));
+            }
+        }
+        output::write_exitance_ply(ply, &points)?;
+        eprintln!("wrote {} ({} vertices)", ply.display(), points.len());
+    }
+    if args.timings {
+        let frames = totals.len();
+        println!("GPU time per pass on {} (median of {frames} frame(s){}):", gpu.info().name, if args.frames > 1 { " after the first" } else { "" });
+        for (name, mut v) in per_pass {
+            println!("  {name:<8} {:>9.3} ms", median(&mut v));
+        }
+        let total = median(&mut totals);
+        println!("  {:<8} {:>9.3} ms  ({:.1} frames/s)", "total", total, 1000.0 / total);
+        println!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
+    }
     Ok(())
 }

@@ -18,6 +18,8 @@ pub struct ImageDesc {
     pub usage: vk::ImageUsageFlags,
     /// Layers (e.g. one per shadow-casting light); the view is a 2D array when above 1.
     pub layers: u32,
+    /// Make the whole-image view a 2D array even with one layer (for `sampler2DArray*`).
+    pub array_view: bool,
 }
 
 impl ImageDesc {
@@ -35,10 +37,16 @@ impl ImageDesc {
             format,
             usage,
             layers: 1,
+            array_view: false,
         }
     }
     pub fn layers(mut self, layers: u32) -> Self {
         self.layers = layers;
+        self
+    }
+    /// A 2D-array view whatever the layer count.
+    pub fn array_view(mut self) -> Self {
+        self.array_view = true;
         self
     }
 }
@@ -120,7 +128,7 @@ impl Image {
         let a = image.allocation.as_ref().unwrap();
         // SAFETY: the allocation satisfies the image's requirements; on error Drop cleans up.
         unsafe { device.bind_image_memory(raw, a.memory(), a.offset()) }.vk("vkBindImageMemory")?;
-        let view_type = if desc.layers > 1 {
+        let view_type = if desc.layers > 1 || desc.array_view {
             vk::ImageViewType::TYPE_2D_ARRAY
         } else {
             vk::ImageViewType::TYPE_2D

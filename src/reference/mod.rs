@@ -1,3 +1,134 @@
-//! The CPU reference (f64): splat with ray-cast visibility and the dipole gather, the ground truth for tests and the accuracy study.
+//! The CPU reference (f64): splat with ray-cast visibility through a BVH and the dipole gather
+//! with the f64 kernel of `optics::kernel`. The ground truth for the GPU passes' tests and for
+//! the accuracy study.
 
 pub mod bvh;
+
+use crate::optics::{fresnel, kernel};
+use crate::scene::build::{PreparedScene, ResolvedMaterial};
+use crate::scene::lights::{LIGHT_DIRECTIONAL, LIGHT_SPOT, LightGpu};
+use bvh::Bvh;
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Occluders of a prepared scene: every triangle of every shadow-casting object.
+pub fn occluders(scene: &PreparedScene) -> Bvh {
+    let mut triangles = Vec::new();
+    for o in scene.objects.iter().filter(|o| o.casts_shadow) {
+        for t in 0..o.mesh.triangles().len() {
+            triangles.push(o.mesh.corners(t));
+        }
+    }
+    Bvh::new(triangles)
+}
+
+/// Direction towards the light and the irradiance it brings to a surface facing it, in f64:
+/// the twin of `light_incidence` in glsl/common/lights.glsl.
+pub fn light_incidence(l: &LightGpu, p: DVec3) -> (DVec3, DVec3, f64) {
+    let kind = l.position_kind[3];
+    let power = DVec3::new(l.power_layer[0] as f64, l.power_layer[1] as f64, l.power_layer[2] as f64);
+    if kind == LIGHT_DIRECTIONAL {
+        let d = DVec3::new(l.direction_cos[0] as f64, l.direction_cos[1] as f64, l.direction_cos[2] as f64);
+        return (d, power, f64::INFINITY);
+    }
+    let pos = DVec3::new(l.position_kind[0] as f64, l.position_kind[1] as f64, l.position_kind[2] as f64);
+    let d = pos - p;
+    let dist2 = d.length_squared().max(1e-24);
+    let dist = dist2.sqrt();
+    let wi = d / dist;
+    let mut irradiance = power / dist2;
+    if kind == LIGHT_SPOT {
+        let axis = DVec3::new(l.direction_cos[0] as f64, l.direction_cos[1] as f64, l.direction_cos[2] as f64);
+        let c = (-wi).dot(axis);
+        let (outer, inner) = (l.direction_cos[3] as f64, l.spot_texel[0] as f64);
+        let t = ((c - outer) / (inner - outer)).clamp(0.0, 1.0);
+        irradiance *= t * t * (3.0 - 2.0 * t);
+    }
+    (wi, irradiance, dist)
+}
+
+/// Transmitted irradiance at every sample of the scene (scene order), with exact ray-cast
+/// visibility for the lights that cast shadows.
+pub fn splat(scene: &PreparedScene, occluders: &Bvh) -> Vec<[f64; 3]> {
+    let mut jobs = Vec::new();
+    for o in &scene.objects {
+        if let ResolvedMaterial::Translucent { material, .. } = &o.material {
+            for s in &o.samples {
+                jobs.push((s, material.eta));
+            }
+        }
+    }
+    let eps = 1e-5 * scene.bounds.1 as f64;
+    jobs.par_iter()
+        .map(|(s, eta)| {
+            let p = s.position.as_dvec3();
+            let n = s.normal.as_dvec3().normalize();
+            let mut e = DVec3::ZERO;
+            for l in &scene.lights {
+                let (wi, irradiance, dist) = light_incidence(&l.record, p);
+                let cos_i = n.dot(wi);
+                if cos_i <= 0.0 {
+                    continue;
+                }
+                if l.record.power_layer[3] >= 0.0 && occluders.occluded(p + n * eps, wi, eps, dist) {
+                    continue;
+                }
+                e += irradiance * (cos_i * fresnel::fresnel_transmittance(cos_i, *eta));
+            }
+            e.to_array()
+        })
+        .collect()
+}
+
+/// Radiant exitance at every vertex of every object (zero for opaque ones), from per-sample
+/// transmitted irradiance in scene order: the far kernel summed plus the near field blended
+/// over neighbouring samples (`optics::kernel::far_kernel` explains the split).
+pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3]>> {
+    let mut offset = 0;
+    scene
+        .objects
+        .iter()
+        .map(|o| {
+            let first = offset;
+            offset += o.samples.len();
+            let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else {
+                return vec![[0.0; 3]; o.mesh.positions().len()];
+            };
+            let samples: Vec<(DVec3, f64, [f64; 3], [f64; 3])> = o
+                .samples
+                .iter()
+                .enumerate()
+                .map(|(k, s)| {
+                    let e = irradiance[first + k];
+                    let b = kernel::B_PER_SQRT_AREA * s.area.sqrt();
+                    let near = [0, 1, 2].map(|c| e[c] * kernel::near_energy(&dipoles[c], b));
+                    (s.position.as_dvec3(), s.area, e, near)
+                })
+                .collect();
+            o.mesh
+                .positions()
+                .par_iter()
+                .map(|x| {
+                    let x = x.as_dvec3();
+                    let mut far = [0.0; 3];
+                    let (mut near_sum, mut weight_sum) = ([0.0; 3], 0.0);
+                    let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; 3]);
+                    for (p, area, e, near) in &samples {
+                        let r = x.distance(*p);
+                        let w = kernel::near_blend_weight(r, *area);
+                        for c in 0..3 {
+                            far[c] += e[c] * kernel::far_kernel(&dipoles[c], r, *area);
+                            near_sum[c] += w * near[c];
+                        }
+                        weight_sum += w;
+                        if r < nearest_r {
+                            (nearest_r, nearest) = (r, *near);
+                        }
+                    }
+                    let near = if weight_sum > 0.0 { near_sum.map(|v| v / weight_sum) } else { nearest };
+                    [0, 1, 2].map(|c| far[c] + near[c])
+                })
+                .collect()
+        })
+        .collect()
+}

@@ -4,3 +4,8 @@ pub mod records;
 pub mod shadow;
 pub mod smoke;
 pub mod tonemap;
+pub mod gather;
+pub mod plan;
+pub mod renderer;
+pub mod shade;
+pub mod splat;

@@ -50,7 +50,8 @@ impl ShadowPass {
                 DEPTH_FORMAT,
                 vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
             )
-            .layers(layers.max(1)),
+            .layers(layers.max(1))
+            .array_view(),
         )?;
         let sampler = Sampler::shadow(gpu, DEPTH_FORMAT)?;
         Ok(ShadowPass {

@@ -228,6 +228,9 @@ pub fn prepare(
 ) -> Vec<PreparedLight> {
     let (center, radius) = (bounds.0, bounds.1.max(1e-6));
     let texel = 1.0 / shadow_map_size as f32;
+    // World size of two texels: the normal offset of lookups (glsl/common/lights.glsl). For
+    // local lights it is taken at the casters' centre.
+    let offset_ortho = 2.0 * (2.0 * radius) * texel;
     let mut out = Vec::new();
     let directional = |dir: Vec3, irradiance: Vec3| {
         let dir = dir.normalize();
@@ -238,9 +241,12 @@ pub fn prepare(
             position_kind: [0.0, 0.0, 0.0, LIGHT_DIRECTIONAL],
             direction_cos: [dir.x, dir.y, dir.z, 0.0],
             power_layer: [irradiance.x, irradiance.y, irradiance.z, -1.0],
-            spot_texel: [0.0, texel, 0.0, 0.0],
+            spot_texel: [0.0, texel, offset_ortho, 0.0],
             shadow_matrix: (proj * view).to_cols_array_2d(),
         }
+    };
+    let local_offset = |position: Vec3, half_angle: f32| {
+        2.0 * (2.0 * (center - position).length() * half_angle.tan()) * texel
     };
     let local = |position: Vec3, axis: Option<(Vec3, f32)>| {
         let to_center = center - position;
@@ -261,7 +267,7 @@ pub fn prepare(
         let far = dist + radius;
         let view = look_at_mat4(position, position + forward, any_up(forward));
         let proj = vulkan::perspective(2.0 * half_angle, 1.0, near, far);
-        proj * view
+        (proj * view, local_offset(position, half_angle))
     };
     for (source, light) in lights.iter().enumerate() {
         match light {
@@ -280,13 +286,14 @@ pub fn prepare(
                 shadows,
             } => {
                 let p = Vec3::from(*position);
+                let (matrix, offset) = local(p, None);
                 out.push(PreparedLight {
                     record: LightGpu {
                         position_kind: [p.x, p.y, p.z, LIGHT_POINT],
                         direction_cos: [0.0; 4],
                         power_layer: [intensity[0], intensity[1], intensity[2], -1.0],
-                        spot_texel: [0.0, texel, 0.0, 0.0],
-                        shadow_matrix: local(p, None).to_cols_array_2d(),
+                        spot_texel: [0.0, texel, offset, 0.0],
+                        shadow_matrix: matrix.to_cols_array_2d(),
                     },
                     casts_shadow: *shadows,
                     source,
@@ -304,17 +311,14 @@ pub fn prepare(
                 let axis = Vec3::from(*direction).normalize();
                 let outer = angle.to_radians();
                 let inner = outer * (1.0 - softness);
+                let (matrix, offset) = local(p, Some((axis, (outer * 1.05).min(85f32.to_radians()))));
                 out.push(PreparedLight {
                     record: LightGpu {
                         position_kind: [p.x, p.y, p.z, LIGHT_SPOT],
                         direction_cos: [axis.x, axis.y, axis.z, outer.cos()],
                         power_layer: [intensity[0], intensity[1], intensity[2], -1.0],
-                        spot_texel: [inner.cos(), texel, 0.0, 0.0],
-                        shadow_matrix: local(
-                            p,
-                            Some((axis, (outer * 1.05).min(85f32.to_radians()))),
-                        )
-                        .to_cols_array_2d(),
+                        spot_texel: [inner.cos(), texel, offset, 0.0],
+                        shadow_matrix: matrix.to_cols_array_2d(),
                     },
                     casts_shadow: *shadows,
                     source,

@@ -1,6 +1,7 @@
 //! Scenes: the TOML format (`format`), loading with errors that name the file, key path and
 //! line, value checks, and the built-in default scene.
 
+pub mod build;
 mod camera;
 pub mod format;
 pub mod lights;

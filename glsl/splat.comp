@@ -1,0 +1,50 @@
+#version 450
+// Irradiance splat: for every sample point, the irradiance transmitted into the medium from
+// every light: sum over lights of E_light cos(theta_i) F_t(cos theta_i, eta) V, with V from the
+// light's shadow map (3x3 PCF). Also the sample's near-field energy per channel
+// (dipole_near_energy), which depends only on its area and material, so that the gather pays
+// for it once per sample instead of once per pair.
+//
+// Bindings: 0 = samples (SampleRecord[], read), 1 = objects (ObjectRecord[], read),
+// 2 = lights (Light[], read), 3 = shadow maps (sampler2DArrayShadow),
+// 4 = splat output (vec4[2] per sample: rgb irradiance E_i and area; rgb near energy), write.
+// Push: sample count, light count.
+#include "dipole.glsl"
+#include "lights.glsl"
+#include "scene.glsl"
+
+layout(local_size_x = 64) in;
+layout(std430, set = 0, binding = 0) readonly buffer Samples { SampleRecord samples[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Objects { ObjectRecord objects[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Lights { Light lights[]; };
+layout(set = 0, binding = 3) uniform sampler2DArrayShadow shadow_maps;
+layout(std430, set = 0, binding = 4) writeonly buffer Splat { vec4 splat[]; };
+layout(push_constant) uniform Push { uint sample_count; uint light_count; } push;
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= push.sample_count) return;
+    SampleRecord s = samples[i];
+    ObjectRecord o = objects[uint(s.normal_object.w)];
+    vec3 p = s.position_area.xyz;
+    vec3 n = s.normal_object.xyz;
+    float eta = o.eta_norm_kind.x;
+    vec3 e = vec3(0.0);
+    for (uint l = 0u; l < push.light_count; ++l) {
+        vec3 wi, irradiance;
+        light_incidence(lights[l], p, wi, irradiance);
+        float cos_i = dot(n, wi);
+        if (cos_i <= 0.0) continue;
+        float v = light_visibility(lights[l], shadow_maps, p, n);
+        e += irradiance * (cos_i * dipole_fresnel_transmittance(cos_i, eta) * v);
+    }
+    float area = s.position_area.w;
+    float b = DIPOLE_B_PER_SQRT_AREA * sqrt(area);
+    vec3 near_energy;
+    for (int c = 0; c < 3; ++c) {
+        vec4 d = o.dipole[c];
+        near_energy[c] = dipole_near_energy(DipoleChannel(d.x, d.y, d.z, d.w), b);
+    }
+    splat[2u * i] = vec4(e, area);
+    splat[2u * i + 1u] = vec4(near_energy, 0.0);
+}

@@ -1,0 +1,359 @@
+//! `Renderer`: a prepared scene's GPU resources and the frame loop that records the passes a
+//! plan asks for, each timed with the `GpuTimer`. Outputs stay on the GPU between frames, so a
+//! frame that skips a pass reuses its last result.
+
+use super::gather::GatherPass;
+use super::plan::{self, Change, Pass, Plan, SceneNeeds};
+use super::records::{MATERIAL_OPAQUE, MATERIAL_TRANSLUCENT, ObjectRecord, SampleRecord, Vertex};
+use super::shade::{ShadePass, ShadePush};
+use super::shadow::{DrawRange, ShadowPass};
+use super::splat::{SPLAT_STRIDE, SplatPass};
+use super::tonemap::TonemapPass;
+use crate::gpu::{Buffer, BufferDesc, Gpu, GpuResult, GpuTimer, memory_barrier};
+use crate::optics::gpu::DipoleChannelGpu;
+use crate::optics::fresnel;
+use crate::scene::build::{PreparedScene, ResolvedMaterial};
+use crate::scene::lights::LightGpu;
+use ash::vk;
+use glam::Vec3;
+use std::sync::Arc;
+
+/// Per-pass GPU milliseconds of one frame, in recording order.
+#[derive(Clone, Debug, Default)]
+pub struct FrameTimings {
+    pub passes: Vec<(String, f64)>,
+}
+
+impl FrameTimings {
+    pub fn total(&self) -> f64 {
+        self.passes.iter().map(|(_, ms)| ms).sum()
+    }
+    pub fn get(&self, name: &str) -> Option<f64> {
+        self.passes.iter().find(|(n, _)| n == name).map(|(_, ms)| *ms)
+    }
+}
+
+pub struct Renderer {
+    gpu: Arc<Gpu>,
+    scene: PreparedScene,
+    needs: SceneNeeds,
+    vertices: Buffer,
+    indices: Buffer,
+    exitance: Buffer,
+    _objects: Buffer,
+    _samples: Buffer,
+    splat_buffer: Buffer,
+    _lights: Buffer,
+    shadow: ShadowPass,
+    splat: SplatPass,
+    gather: GatherPass,
+    shade: ShadePass,
+    tonemap: TonemapPass,
+    timer: GpuTimer,
+    draws: Vec<DrawRange>,
+    casters: Vec<DrawRange>,
+    light_matrices: Vec<[[f32; 4]; 4]>,
+    light_count: u32,
+    /// First vertex of each object in the shared buffers.
+    vertex_offsets: Vec<u32>,
+    background: [f32; 3],
+}
+
+fn storage(gpu: &Arc<Gpu>, name: &str, bytes: u64, extra: vk::BufferUsageFlags) -> GpuResult<Buffer> {
+    Buffer::new(gpu, &BufferDesc::gpu_only(name, bytes.max(16), vk::BufferUsageFlags::STORAGE_BUFFER | extra))
+}
+
+fn upload<T: bytemuck::Pod>(gpu: &Arc<Gpu>, name: &str, data: &[T], usage: vk::BufferUsageFlags) -> GpuResult<Buffer> {
+    let bytes = std::mem::size_of_val(data) as u64;
+    let mut buffer = storage(gpu, name, bytes, usage)?;
+    if bytes > 0 {
+        buffer.write(0, data)?;
+    }
+    Ok(buffer)
+}
+
+impl Renderer {
+    pub fn new(gpu: &Arc<Gpu>, scene: PreparedScene) -> GpuResult<Renderer> {
+        let mut vertices = Vec::new();
+        let mut indices: Vec<u32> = Vec::new();
+        let mut objects = Vec::new();
+        let mut samples = Vec::new();
+        let mut draws = Vec::new();
+        let mut casters = Vec::new();
+        let mut vertex_offsets = Vec::new();
+        let mut receivers = Vec::new();
+        for (i, o) in scene.objects.iter().enumerate() {
+            let first_vertex = vertices.len() as u32;
+            let first_sample = samples.len() as u32;
+            vertex_offsets.push(first_vertex);
+            for (p, n) in o.mesh.positions().iter().zip(o.mesh.vertex_normals()) {
+                vertices.push(Vertex { position: p.to_array(), normal: n.to_array() });
+            }
+            let draw = DrawRange {
+                first_index: indices.len() as u32,
+                index_count: 3 * o.mesh.triangles().len() as u32,
+                vertex_offset: first_vertex as i32,
+            };
+            indices.extend(o.mesh.triangles().iter().flatten());
+            draws.push(draw);
+            if o.casts_shadow {
+                casters.push(draw);
+            }
+            for s in &o.samples {
+                samples.push(SampleRecord {
+                    position_area: [s.position.x, s.position.y, s.position.z, s.area as f32],
+                    normal_object: [s.normal.x, s.normal.y, s.normal.z, i as f32],
+                });
+            }
+            let vertex_count = o.mesh.positions().len() as u32;
+            let ranges = [first_vertex, vertex_count, first_sample, o.samples.len() as u32];
+            objects.push(match &o.material {
+                ResolvedMaterial::Translucent { material, dipoles, roughness, .. } => {
+                    receivers.push((i as u32, vertex_count));
+                    let t_eta = fresnel::diffuse_transmittance(material.eta);
+                    let channel = |c: usize| {
+                        let d = DipoleChannelGpu::from(&dipoles[c]);
+                        [d.alpha_prime, d.sigma_tr, d.z_r, d.z_v]
+                    };
+                    ObjectRecord {
+                        albedo_roughness: [0.0, 0.0, 0.0, *roughness],
+                        eta_norm_kind: [
+                            material.eta as f32,
+                            (1.0 / (std::f64::consts::PI * t_eta)) as f32,
+                            MATERIAL_TRANSLUCENT,
+                            0.0,
+                        ],
+                        dipole: [channel(0), channel(1), channel(2)],
+                        ranges,
+                    }
+                }
+                ResolvedMaterial::Opaque { albedo, roughness } => ObjectRecord {
+                    albedo_roughness: [albedo[0], albedo[1], albedo[2], *roughness],
+                    eta_norm_kind: [1.5, 0.0, MATERIAL_OPAQUE, 0.0],
+                    dipole: [[0.0; 4]; 3],
+                    ranges,
+                },
+            });
+        }
+        let lights: Vec<LightGpu> = scene.lights.iter().map(|l| l.record).collect();
+        let mut light_matrices = vec![[[0.0; 4]; 4]; scene.shadow_layers as usize];
+        for l in &lights {
+            if l.power_layer[3] >= 0.0 {
+                light_matrices[l.power_layer[3] as usize] = l.shadow_matrix;
+            }
+        }
+        let vertex_buffer = upload(gpu, "vertices", &vertices, vk::BufferUsageFlags::VERTEX_BUFFER)?;
+        let index_buffer = upload(gpu, "indices", &indices, vk::BufferUsageFlags::INDEX_BUFFER)?;
+        // Opaque vertices keep zero exitance; translucent ones are written by the gather.
+        let exitance = upload(gpu, "exitance", &vec![[0f32; 4]; vertices.len()], vk::BufferUsageFlags::VERTEX_BUFFER)?;
+        let object_buffer = upload(gpu, "objects", &objects, vk::BufferUsageFlags::empty())?;
+        let sample_buffer = upload(gpu, "samples", &samples, vk::BufferUsageFlags::empty())?;
+        let splat_buffer = storage(gpu, "splat", SPLAT_STRIDE * samples.len() as u64, vk::BufferUsageFlags::empty())?;
+        let light_buffer = upload(gpu, "lights", &lights, vk::BufferUsageFlags::empty())?;
+
+        let settings = &scene.scene.file.render;
+        let shadow = ShadowPass::new(gpu, settings.shadow_map_size, scene.shadow_layers)?;
+        let light_count = lights.len() as u32;
+        let splat = SplatPass::new(
+            gpu,
+            &sample_buffer,
+            samples.len() as u32,
+            &object_buffer,
+            &light_buffer,
+            light_count,
+            shadow.maps(),
+            shadow.sampler(),
+            &splat_buffer,
+        )?;
+        let gather =
+            GatherPass::new(gpu, &vertex_buffer, &sample_buffer, &splat_buffer, &object_buffer, &exitance, receivers)?;
+        let [width, height] = scene.scene.file.camera.resolution;
+        let shade = ShadePass::new(gpu, width, height, &object_buffer, &light_buffer, shadow.maps(), shadow.sampler())?;
+        let tonemap = TonemapPass::new(gpu, shade.hdr())?;
+        let timer = GpuTimer::new(gpu, 8)?;
+        let background = settings.background.unwrap_or_else(|| match &scene.environment {
+            // The sky's radiance near the horizon, as a backdrop.
+            Some(env) => {
+                let scale = scene
+                    .scene
+                    .file
+                    .lights
+                    .iter()
+                    .find_map(|l| match l {
+                        crate::scene::Light::Environment { scale, .. } => Some(*scale),
+                        _ => None,
+                    })
+                    .unwrap_or(1.0);
+                let row = env.height / 2 - 1;
+                let sum: Vec3 = env.radiance[row * env.width..(row + 1) * env.width].iter().sum();
+                (sum / env.width as f32 * scale).to_array()
+            }
+            None => [0.0; 3],
+        });
+        let needs = SceneNeeds {
+            shadow_layers: scene.shadow_layers,
+            translucent_objects: scene.objects.iter().filter(|o| !o.samples.is_empty()).count(),
+        };
+        Ok(Renderer {
+            gpu: gpu.clone(),
+            scene,
+            needs,
+            vertices: vertex_buffer,
+            indices: index_buffer,
+            exitance,
+            _objects: object_buffer,
+            _samples: sample_buffer,
+            splat_buffer,
+            _lights: light_buffer,
+            shadow,
+            splat,
+            gather,
+            shade,
+            tonemap,
+            timer,
+            draws,
+            casters,
+            light_matrices,
+            light_count,
+            vertex_offsets,
+            background,
+        })
+    }
+
+    pub fn scene(&self) -> &PreparedScene {
+        &self.scene
+    }
+
+    /// The passes a frame with this change would run.
+    pub fn plan(&self, change: Change) -> Plan {
+        plan::plan(self.needs, change)
+    }
+
+    /// Render one frame: record the passes of `plan` in one submission, wait, and return their
+    /// GPU times.
+    pub fn frame(&mut self, plan: &Plan) -> GpuResult<FrameTimings> {
+        let gpu = self.gpu.clone();
+        let device = gpu.device();
+        let camera = &self.scene.scene.file.camera;
+        let push = ShadePush {
+            view_proj: (camera.projection(self.scene.bounds.0, self.scene.bounds.1) * camera.view()).to_cols_array_2d(),
+            eye_object: [camera.eye[0], camera.eye[1], camera.eye[2], 0.0],
+            counts: [self.light_count, 0, 0, 0],
+        };
+        let exposure = self.scene.scene.file.render.exposure;
+        let compute_to_compute = (
+            (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_STORAGE_WRITE),
+            (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_STORAGE_READ),
+        );
+        let timer = &mut self.timer;
+        gpu.one_shot("frame", |cmd| {
+            timer.reset(cmd);
+            if plan.runs(Pass::Shadow) {
+                timer.begin(cmd, "shadow");
+                self.shadow.record(&gpu, cmd, &self.vertices, &self.indices, &self.casters, &self.light_matrices);
+                timer.end(cmd);
+            }
+            if plan.runs(Pass::Splat) {
+                timer.begin(cmd, "splat");
+                self.splat.record(cmd);
+                timer.end(cmd);
+                memory_barrier(device, cmd, compute_to_compute.0, compute_to_compute.1);
+            }
+            if plan.runs(Pass::Gather) {
+                timer.begin(cmd, "gather");
+                self.gather.record(cmd);
+                timer.end(cmd);
+                memory_barrier(
+                    device,
+                    cmd,
+                    (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_STORAGE_WRITE),
+                    (
+                        vk::PipelineStageFlags2::VERTEX_ATTRIBUTE_INPUT | vk::PipelineStageFlags2::HOST,
+                        vk::AccessFlags2::VERTEX_ATTRIBUTE_READ | vk::AccessFlags2::HOST_READ,
+                    ),
+                );
+            }
+            if plan.runs(Pass::Shade) {
+                timer.begin(cmd, "shade");
+                self.shade.record(
+                    &gpu,
+                    cmd,
+                    &self.vertices,
+                    &self.exitance,
+                    &self.indices,
+                    &self.draws,
+                    push,
+                    self.background,
+                );
+                timer.end(cmd);
+            }
+            if plan.runs(Pass::Tonemap) {
+                timer.begin(cmd, "tonemap");
+                self.tonemap.record(&gpu, cmd, exposure);
+                timer.end(cmd);
+            }
+            memory_barrier(
+                device,
+                cmd,
+                (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_WRITE),
+                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+            );
+        })?;
+        Ok(FrameTimings { passes: self.timer.results()? })
+    }
+
+    /// The last tone-mapped image (RGBA8, rows top to bottom) and how many of its HDR pixels
+    /// were non-finite (they are drawn black).
+    pub fn image(&self) -> GpuResult<(Vec<u8>, u32)> {
+        self.tonemap.read()
+    }
+
+    /// The last linear HDR image, RGBA f32, rows top to bottom.
+    pub fn hdr_image(&self) -> GpuResult<Vec<f32>> {
+        let bytes = self.shade.hdr().read(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, 16)?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+
+    /// Radiant exitance (RGB, W/m^2 per unit irradiance of the lights) at every vertex of
+    /// object `object`, from the last gather.
+    pub fn exitance(&self, object: usize) -> GpuResult<Vec<[f32; 3]>> {
+        let all: Vec<[f32; 4]> = self.exitance.read()?;
+        let first = self.vertex_offsets[object] as usize;
+        let count = self.scene.objects[object].mesh.positions().len();
+        Ok(all[first..first + count].iter().map(|e| [e[0], e[1], e[2]]).collect())
+    }
+
+    /// Splat output of every sample, in scene order: (irradiance RGB, area).
+    pub fn splat_irradiance(&self) -> GpuResult<Vec<([f32; 3], f32)>> {
+        let all: Vec<[f32; 4]> = self.splat_buffer.read()?;
+        Ok(all.chunks(2).map(|c| ([c[0][0], c[0][1], c[0][2]], c[0][3])).collect())
+    }
+
+    /// Replace the splat output (irradiance RGB per sample, scene order) and recompute the near
+    /// energies on the CPU, so a test can feed the gather the same input as the reference.
+    pub fn set_splat_irradiance(&mut self, irradiance: &[[f32; 3]]) -> GpuResult<()> {
+        let mut data = Vec::with_capacity(2 * irradiance.len());
+        let mut k = 0;
+        for o in &self.scene.objects {
+            for s in &o.samples {
+                let e = irradiance[k];
+                data.push([e[0], e[1], e[2], s.area as f32]);
+                let near = match &o.material {
+                    ResolvedMaterial::Translucent { dipoles, .. } => {
+                        let b = crate::optics::kernel::B_PER_SQRT_AREA * s.area.sqrt();
+                        [0, 1, 2].map(|c| crate::optics::kernel::near_energy(&dipoles[c], b) as f32)
+                    }
+                    ResolvedMaterial::Opaque { .. } => [0.0; 3],
+                };
+                data.push([near[0], near[1], near[2], 0.0]);
+                k += 1;
+            }
+        }
+        self.splat_buffer.write(0, &data)
+    }
+
+    /// Bytes of device memory in use by the allocator.
+    pub fn device_memory(&self) -> u64 {
+        self.gpu.memory_usage().0
+    }
+}

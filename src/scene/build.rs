@@ -1,0 +1,265 @@
+//! From a parsed scene to what the renderer uploads: meshes loaded, transformed to world space
+//! and validated; materials resolved; sample points placed on each translucent mesh; lights
+//! prepared with shadow layers. Everything here is CPU work done once per scene.
+
+use super::lights::{self, Environment, PreparedLight};
+use super::{AssetSource, Light, MaterialSpec, Scene, Shape};
+use crate::mesh::{LoadOptions, Mesh};
+use crate::optics::{Dipole, Material};
+use crate::sampling::{self, Method, SampleOptions, SamplePoint};
+use anyhow::{Context, Result, bail};
+use glam::{EulerRot, Mat4, Quat, Vec3};
+use std::str::FromStr;
+
+/// An object's material, resolved.
+#[derive(Clone, Debug)]
+pub enum ResolvedMaterial {
+    Translucent { material: Material, dipoles: [Dipole; 3], mm_per_unit: f64, roughness: f32 },
+    Opaque { albedo: [f32; 3], roughness: f32 },
+}
+
+#[derive(Clone, Debug)]
+pub struct PreparedObject {
+    /// For messages: the mesh path or the built-in shape.
+    pub name: String,
+    /// World-space mesh.
+    pub mesh: Mesh,
+    pub material: ResolvedMaterial,
+    pub casts_shadow: bool,
+    /// World-space sample points with area weights (translucent objects only).
+    pub samples: Vec<SamplePoint>,
+}
+
+#[derive(Clone, Debug)]
+pub struct PreparedScene {
+    pub scene: Scene,
+    pub objects: Vec<PreparedObject>,
+    pub lights: Vec<PreparedLight>,
+    pub shadow_layers: u32,
+    pub environment: Option<Environment>,
+    /// Bounding sphere of everything (centre, radius).
+    pub bounds: (Vec3, f32),
+}
+
+/// Overrides from the command line, applied on top of the scene file.
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    pub samples: Option<usize>,
+    pub sampler: Option<String>,
+    pub gather: Option<String>,
+    pub resolution: Option<[u32; 2]>,
+}
+
+impl PreparedScene {
+    pub fn new(scene: &Scene, overrides: &Overrides) -> Result<PreparedScene> {
+        let mut scene = scene.clone();
+        if let Some(n) = overrides.samples {
+            if n == 0 {
+                bail!("--samples must be at least 1");
+            }
+            scene.file.sampling.count = n;
+        }
+        if let Some(m) = &overrides.sampler {
+            scene.file.sampling.method = m.clone();
+        }
+        if let Some(g) = &overrides.gather {
+            if !["vertex", "pixel"].contains(&g.as_str()) {
+                bail!("--gather {g:?} is not vertex or pixel");
+            }
+            scene.file.render.gather = g.clone();
+        }
+        if let Some(r) = overrides.resolution {
+            scene.file.camera.resolution = r;
+        }
+        let method = Method::from_str(&scene.file.sampling.method)
+            .map_err(|e| anyhow::anyhow!("{}: `sampling.method`: {e}", scene.name))?;
+
+        let mut objects = Vec::new();
+        for (i, o) in scene.file.objects.iter().enumerate() {
+            let (name, mesh) = load_shape(&scene, &o.shape).with_context(|| format!("{}: object[{i}]", scene.name))?;
+            let mesh = transform_mesh(mesh, &o.transform)
+                .with_context(|| format!("{}: object[{i}] ({name}): transform", scene.name))?;
+            let material = match &o.material {
+                MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, eta, mm_per_unit, roughness } => {
+                    let key = format!("{}: object[{i}].material", scene.name);
+                    let mut material = match preset {
+                        Some(p) => Material::preset(p).with_context(|| key.clone())?,
+                        None => Material::new(
+                            "custom",
+                            sigma_a.expect("checked when parsed"),
+                            sigma_s_prime.expect("checked when parsed"),
+                            eta.unwrap_or(1.3),
+                        )
+                        .with_context(|| key.clone())?,
+                    };
+                    if let (Some(e), Some(_)) = (eta, preset) {
+                        material = material.with_eta(*e).with_context(|| key.clone())?;
+                    }
+                    let dipoles = material.dipoles(*mm_per_unit).with_context(|| key.clone())?;
+                    ResolvedMaterial::Translucent { material, dipoles, mm_per_unit: *mm_per_unit, roughness: *roughness }
+                }
+                MaterialSpec::Opaque { albedo, roughness } => {
+                    ResolvedMaterial::Opaque { albedo: *albedo, roughness: *roughness }
+                }
+            };
+            let samples = match material {
+                ResolvedMaterial::Translucent { .. } => {
+                    let options = SampleOptions::new(method, scene.file.sampling.count)
+                        .with_seed(scene.file.sampling.seed.wrapping_add(i as u64));
+                    sampling::sample(&mesh, &options)
+                        .with_context(|| format!("{}: object[{i}] ({name}): sampling", scene.name))?
+                        .points
+                }
+                ResolvedMaterial::Opaque { .. } => Vec::new(),
+            };
+            objects.push(PreparedObject { name, mesh, material, casts_shadow: o.casts_shadow, samples });
+        }
+
+        let bounds = bounding_sphere(objects.iter().map(|o| &o.mesh));
+        let casters: Vec<&Mesh> = objects.iter().filter(|o| o.casts_shadow).map(|o| &o.mesh).collect();
+        let caster_bounds = if casters.is_empty() { bounds } else { bounding_sphere(casters.iter().copied()) };
+        let environment = scene
+            .file
+            .lights
+            .iter()
+            .find_map(|l| match l {
+                Light::Environment { map, .. } => Some(map.clone()),
+                _ => None,
+            })
+            .map(|map| match map {
+                None => Ok(Environment::procedural_sky(128, 64)),
+                Some(path) => match scene.resolve(&path)? {
+                    AssetSource::File(p) => Environment::load(&p).map_err(anyhow::Error::msg),
+                    AssetSource::Embedded(_) => bail!("embedded environment maps are not supported"),
+                },
+            })
+            .transpose()
+            .with_context(|| format!("{}: environment light", scene.name))?;
+        let mut prepared =
+            lights::prepare(&scene.file.lights, environment.as_ref(), caster_bounds, scene.file.render.shadow_map_size);
+        let shadow_layers = lights::assign_shadow_layers(&mut prepared, !casters.is_empty());
+        Ok(PreparedScene { scene, objects, lights: prepared, shadow_layers, environment, bounds })
+    }
+
+    pub fn sample_count(&self) -> usize {
+        self.objects.iter().map(|o| o.samples.len()).sum()
+    }
+    pub fn vertex_count(&self) -> usize {
+        self.objects.iter().map(|o| o.mesh.positions().len()).sum()
+    }
+    pub fn has_translucent(&self) -> bool {
+        self.objects.iter().any(|o| matches!(o.material, ResolvedMaterial::Translucent { .. }))
+    }
+}
+
+fn load_shape(scene: &Scene, shape: &Shape) -> Result<(String, Mesh)> {
+    match shape {
+        Shape::Mesh { path } => {
+            let mesh = match scene.resolve(path)? {
+                AssetSource::File(p) => Mesh::load(&p, &LoadOptions::default())?,
+                AssetSource::Embedded(bytes) => {
+                    let text = std::str::from_utf8(bytes).context("embedded mesh is not UTF-8")?;
+                    Mesh::from_obj_text(text, path, &LoadOptions::default())?
+                }
+            };
+            Ok((path.clone(), mesh))
+        }
+        Shape::Plane { size, divisions } => Ok(("plane".into(), plane(*size, *divisions)?)),
+        Shape::Sphere { radius, divisions } => Ok(("sphere".into(), sphere(*radius, *divisions)?)),
+    }
+}
+
+/// Apply fit, scale, rotation (degrees, x then y then z) and translation, in that order.
+fn transform_mesh(mesh: Mesh, t: &super::Transform) -> Result<Mesh> {
+    let mut m = Mat4::IDENTITY;
+    if let Some(fit) = t.fit {
+        let (lo, hi) = mesh.bounds();
+        let extent = (hi - lo).max_element();
+        if !(extent > 0.0) {
+            bail!("cannot fit a mesh with an empty bounding box");
+        }
+        let centre = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
+        m = Mat4::from_scale(Vec3::splat(fit / extent)) * Mat4::from_translation(-centre);
+    }
+    if let Some(s) = t.scale {
+        m = Mat4::from_scale(Vec3::splat(s)) * m;
+    }
+    if let Some([x, y, z]) = t.rotate {
+        let q = Quat::from_euler(EulerRot::ZYX, z.to_radians(), y.to_radians(), x.to_radians());
+        m = Mat4::from_quat(q) * m;
+    }
+    if let Some(tr) = t.translate {
+        m = Mat4::from_translation(Vec3::from(tr)) * m;
+    }
+    if m == Mat4::IDENTITY {
+        return Ok(mesh);
+    }
+    let positions = mesh.positions().iter().map(|p| m.transform_point3(*p)).collect();
+    Ok(Mesh::from_triangles(positions, mesh.triangles().to_vec())?)
+}
+
+/// A square in the xz plane at y = 0, facing +y.
+pub fn plane(size: f32, divisions: u32) -> Result<Mesh> {
+    let n = divisions as usize;
+    let mut positions = Vec::with_capacity((n + 1) * (n + 1));
+    for j in 0..=n {
+        for i in 0..=n {
+            let u = i as f32 / n as f32 - 0.5;
+            let v = j as f32 / n as f32 - 0.5;
+            positions.push(Vec3::new(u * size, 0.0, v * size));
+        }
+    }
+    let mut triangles = Vec::with_capacity(2 * n * n);
+    let at = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    for j in 0..n {
+        for i in 0..n {
+            // Counter-clockwise seen from +y.
+            triangles.push([at(i, j), at(i, j + 1), at(i + 1, j)]);
+            triangles.push([at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)]);
+        }
+    }
+    Ok(Mesh::from_triangles(positions, triangles)?)
+}
+
+/// A UV sphere centred at the origin (outward-facing).
+pub fn sphere(radius: f32, divisions: u32) -> Result<Mesh> {
+    let rings = divisions.max(3) as usize;
+    let segments = 2 * rings;
+    let mut positions = vec![Vec3::new(0.0, radius, 0.0)];
+    for r in 1..rings {
+        let theta = std::f32::consts::PI * r as f32 / rings as f32;
+        for s in 0..segments {
+            let phi = 2.0 * std::f32::consts::PI * s as f32 / segments as f32;
+            positions.push(radius * Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()));
+        }
+    }
+    positions.push(Vec3::new(0.0, -radius, 0.0));
+    let bottom = (positions.len() - 1) as u32;
+    let ring = |r: usize, s: usize| (1 + (r - 1) * segments + s % segments) as u32;
+    let mut triangles = Vec::new();
+    for s in 0..segments {
+        triangles.push([0, ring(1, s + 1), ring(1, s)]);
+        triangles.push([bottom, ring(rings - 1, s), ring(rings - 1, s + 1)]);
+    }
+    for r in 1..rings - 1 {
+        for s in 0..segments {
+            triangles.push([ring(r, s), ring(r, s + 1), ring(r + 1, s)]);
+            triangles.push([ring(r, s + 1), ring(r + 1, s + 1), ring(r + 1, s)]);
+        }
+    }
+    Ok(Mesh::from_triangles(positions, triangles)?)
+}
+
+fn bounding_sphere<'a>(meshes: impl Iterator<Item = &'a Mesh>) -> (Vec3, f32) {
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for m in meshes {
+        let (a, b) = m.bounds();
+        lo = lo.min(a);
+        hi = hi.max(b);
+    }
+    if !lo.is_finite() {
+        return (Vec3::ZERO, 1.0);
+    }
+    ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-6))
+}

@@ -1,0 +1,185 @@
+//! The renderer against physics and against the CPU reference, on lavapipe with validation on.
+
+mod common;
+
+use common::with_gpu;
+use glam::DVec3;
+use translucent::optics::{Material, fresnel};
+use translucent::reference;
+use translucent::render::plan::{Change, Pass};
+use translucent::render::renderer::Renderer;
+use translucent::scene::Scene;
+use translucent::scene::build::{Overrides, PreparedScene};
+
+fn prepare(toml: &str, overrides: &Overrides) -> PreparedScene {
+    let scene = Scene::parse(toml, "test scene", None).expect("test scene parses");
+    PreparedScene::new(&scene, overrides).expect("test scene prepares")
+}
+
+/// A large translucent plane (size in mm, with 1 unit = 1 mm) under light from straight above.
+fn plane_scene(preset: &str, size: f32, samples: usize, extra: &str) -> String {
+    format!(
+        r#"
+[camera]
+eye = [0.0, {h}, 0.001]
+target = [0.0, 0.0, 0.0]
+resolution = [64, 64]
+
+[[object]]
+shape = {{ type = "plane", size = {size}, divisions = 48 }}
+material = {{ type = "translucent", preset = "{preset}", mm_per_unit = 1.0 }}
+casts_shadow = false
+
+[[light]]
+type = "directional"
+direction = [0.0, 1.0, 0.0]
+irradiance = [1.0, 1.0, 1.0]
+
+[sampling]
+method = "poisson"
+count = {samples}
+{extra}
+"#,
+        h = size
+    )
+}
+
+fn run_all(gpu: &std::sync::Arc<translucent::gpu::Gpu>, prepared: PreparedScene) -> Renderer {
+    let mut renderer = Renderer::new(gpu, prepared).expect("renderer");
+    let plan = renderer.plan(Change::Everything);
+    renderer.frame(&plan).expect("frame");
+    renderer
+}
+
+#[test]
+fn uniformly_lit_plane_reflects_total_diffuse_reflectance() {
+    with_gpu(|gpu| {
+        for preset in ["marble", "skimmilk", "ketchup", "spectralon"] {
+            let prepared = prepare(&plane_scene(preset, 1000.0, 3000, ""), &Overrides::default());
+            let material = Material::preset(preset).unwrap();
+            let dipoles = material.dipoles(1.0).unwrap();
+            let f_t = fresnel::fresnel_transmittance(1.0, material.eta);
+            let mesh = prepared.objects[0].mesh.clone();
+            let renderer = run_all(gpu, prepared);
+            let exitance = renderer.exitance(0).unwrap();
+            // Vertices within 100 mm of the centre see the plane as infinite.
+            let middle: Vec<usize> =
+                (0..mesh.positions().len()).filter(|&v| mesh.positions()[v].length() < 100.0).collect();
+            assert!(middle.len() > 10);
+            for c in 0..3 {
+                let expected = dipoles[c].r_d_total() * f_t;
+                let mean = middle.iter().map(|&v| exitance[v][c] as f64).sum::<f64>() / middle.len() as f64;
+                let err = (mean - expected).abs() / expected;
+                eprintln!("{preset} channel {c}: exitance {mean:.6}, R_d,total F_t = {expected:.6}, error {err:.2e}");
+                assert!(err < 0.02, "{preset} channel {c}: {mean} vs {expected}");
+            }
+        }
+    });
+}
+
+#[test]
+fn gather_matches_the_f64_reference_on_the_default_scene() {
+    with_gpu(|gpu| {
+        let overrides = Overrides { resolution: Some([64, 64]), ..Default::default() };
+        let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+        let occluders = reference::occluders(&prepared);
+        let irradiance = reference::splat(&prepared, &occluders);
+        let expected = reference::gather(&prepared, &irradiance);
+        let mut renderer = Renderer::new(gpu, prepared).unwrap();
+        let as_f32: Vec<[f32; 3]> = irradiance.iter().map(|e| e.map(|v| v as f32)).collect();
+        renderer.set_splat_irradiance(&as_f32).unwrap();
+        let mut plan = renderer.plan(Change::Everything);
+        plan.passes.retain(|(p, _)| *p == Pass::Gather);
+        renderer.frame(&plan).unwrap();
+        let got = renderer.exitance(0).unwrap();
+        let peak = expected[0].iter().flat_map(|m| m.iter()).fold(0.0f64, |a, b| a.max(*b));
+        let mut worst = 0.0f64;
+        for (g, e) in got.iter().zip(&expected[0]) {
+            for c in 0..3 {
+                // Relative error, with a floor at 1e-3 of the peak for the darkest vertices.
+                let err = (g[c] as f64 - e[c]).abs() / e[c].max(1e-3 * peak);
+                worst = worst.max(err);
+            }
+        }
+        eprintln!("gather vs f64 reference: worst relative error {worst:.2e} over {} vertices", got.len());
+        assert!(worst < 0.01, "worst relative error {worst}");
+    });
+}
+
+#[test]
+fn splat_visibility_matches_ray_casting() {
+    with_gpu(|gpu| {
+        let overrides = Overrides { resolution: Some([64, 64]), ..Default::default() };
+        let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+        let occluders = reference::occluders(&prepared);
+        let expected = reference::splat(&prepared, &occluders);
+        let renderer = run_all(gpu, prepared);
+        let got = renderer.splat_irradiance().unwrap();
+        let peak = expected.iter().flat_map(|e| e.iter()).fold(0.0f64, |a, b| a.max(*b));
+        let differing = got
+            .iter()
+            .zip(&expected)
+            .filter(|((g, _), e)| (0..3).any(|c| (g[c] as f64 - e[c]).abs() > 0.02 * e[c].max(0.05 * peak)))
+            .count();
+        for k in 0..5 { eprintln!("sample {k}: gpu {:?} cpu {:?}", got[k].0, expected[k]); }
+        let fraction = differing as f64 / got.len() as f64;
+        eprintln!("splat: {differing} of {} samples differ from ray-cast visibility by over 2% ({:.2}%)", got.len(), 100.0 * fraction);
+        assert!(fraction <= 0.02, "{differing} of {} samples differ", got.len());
+    });
+}
+
+#[test]
+fn light_bleeds_across_a_shadow_edge_as_the_dipole_predicts() {
+    // An opaque board above x < 0 shadows half of a large marble plane. Under the
+    // diffusion model, exitance at distance x from the edge is
+    //   M(x) = E F_t [ R_total / 2 + sign(x) integral_0^|x| L(u) du ],
+    //   L(u) = integral R_d(sqrt(u^2 + y^2)) dy  (the line integral across the edge).
+    let extra = r#"
+[[object]]
+shape = { type = "plane", size = 600.0, divisions = 4 }
+transform = { translate = [-300.0, 50.0, 0.0] }
+material = { type = "opaque", albedo = [0.5, 0.5, 0.5] }
+
+[render]
+shadow_map_size = 2048
+"#;
+    let toml = plane_scene("marble", 400.0, 4000, "").replace("[sampling]", &format!("{extra}\n[sampling]"));
+    with_gpu(|gpu| {
+        let prepared = prepare(&toml, &Overrides::default());
+        let material = Material::preset("marble").unwrap();
+        let dipole = &material.dipoles(1.0).unwrap()[0];
+        let f_t = fresnel::fresnel_transmittance(1.0, material.eta);
+        let mesh = prepared.objects[0].mesh.clone();
+        let renderer = run_all(gpu, prepared);
+        let exitance = renderer.exitance(0).unwrap();
+        let line = |u: f64| {
+            let n = 2000;
+            let y_max = 200.0;
+            (0..n).map(|k| dipole.r_d((u * u + ((k as f64 + 0.5) * y_max / n as f64).powi(2)).sqrt())).sum::<f64>()
+                * 2.0
+                * y_max
+                / n as f64
+        };
+        let predicted = |x: f64| {
+            let n = 400;
+            let integral = (0..n).map(|k| line((k as f64 + 0.5) * x.abs() / n as f64)).sum::<f64>() * x.abs() / n as f64;
+            f_t * (0.5 * dipole.r_d_total() + x.signum() * integral)
+        };
+        let lit_far = f_t * dipole.r_d_total();
+        let mut checked = 0;
+        for (v, p) in mesh.positions().iter().enumerate() {
+            let (x, z) = (p.x as f64, p.z as f64);
+            // Away from the plane's rim, and from the edge by more than a few shadow texels.
+            if z.abs() > 60.0 || x.abs() > 60.0 || x.abs() < 3.0 {
+                continue;
+            }
+            let want = predicted(x);
+            let got = exitance[v][0] as f64;
+            assert!((got - want).abs() < 0.05 * lit_far, "x = {x:.1}: exitance {got:.5}, predicted {want:.5}");
+            checked += 1;
+        }
+        eprintln!("shadow edge: {checked} vertices within 5% of the lit level of the predicted profile");
+        assert!(checked > 20);
+        let _ = DVec3::ZERO;
+    });
+}
