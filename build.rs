@@ -33,18 +33,11 @@ fn main() {
             Some("frag") => shaderc::ShaderKind::Fragment,
             _ => continue, // headers (.glsl) are compiled through the shaders that include them
         };
-        let rel = path
-            .strip_prefix(&root)
-            .unwrap()
-            .to_string_lossy()
-            .replace('\\', "/");
+        let rel = path.strip_prefix(&root).unwrap().to_string_lossy().replace('\\', "/");
         let source = fs::read_to_string(path).unwrap_or_else(|e| panic!("{rel}: {e}"));
 
         let mut options = shaderc::CompileOptions::new().unwrap();
-        options.set_target_env(
-            shaderc::TargetEnv::Vulkan,
-            shaderc::EnvVersion::Vulkan1_2 as u32,
-        );
+        options.set_target_env(shaderc::TargetEnv::Vulkan, shaderc::EnvVersion::Vulkan1_2 as u32);
         options.set_target_spirv(shaderc::SpirvVersion::V1_5);
         options.set_warnings_as_errors();
         if release {
@@ -54,10 +47,7 @@ fn main() {
         }
         let common = root.join("common");
         options.set_include_callback(move |name, _ty, from, _depth| {
-            let from_dir = Path::new(from)
-                .parent()
-                .map(Path::to_path_buf)
-                .unwrap_or_default();
+            let from_dir = Path::new(from).parent().map(Path::to_path_buf).unwrap_or_default();
             for dir in [from_dir, common.clone()] {
                 let candidate = dir.join(name);
                 if let Ok(content) = fs::read_to_string(&candidate) {
@@ -68,9 +58,7 @@ fn main() {
                     });
                 }
             }
-            Err(format!(
-                "cannot find include \"{name}\" (looked beside {from} and in glsl/common/)"
-            ))
+            Err(format!("cannot find include \"{name}\" (looked beside {from} and in glsl/common/)"))
         });
 
         let display = path.to_string_lossy();
@@ -81,12 +69,7 @@ fn main() {
                 }
                 let spv = out.join(format!("{}.spv", rel.replace('/', "__")));
                 fs::write(&spv, artifact.as_binary_u8()).unwrap();
-                writeln!(
-                    table,
-                    "    ({rel:?}, include_bytes!({:?})),",
-                    spv.display().to_string()
-                )
-                .unwrap();
+                writeln!(table, "    ({rel:?}, include_bytes!({:?})),", spv.display().to_string()).unwrap();
             }
             Err(e) => errors.push(e.to_string()),
         }

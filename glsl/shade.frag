@@ -56,7 +56,7 @@ void main() {
         light_incidence(lights[l], v_position, wi, irradiance);
         float cos_i = dot(n, wi);
         if (cos_i <= 0.0) continue;
-        float v = light_visibility(lights[l], shadow_maps, v_position, n);
+        float v = light_visibility(lights[l], shadow_maps, v_position, n, 1);
         vec3 h = normalize(wi + wo);
         float fresnel = dipole_fresnel_reflectance(max(dot(wi, h), 0.0), eta);
         vec3 lit = irradiance * v;

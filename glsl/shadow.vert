@@ -1,10 +1,13 @@
 #version 450
-// Shadow maps: depth of every shadow-casting object seen from one light (one array layer per
-// light). Depth only, no fragment shader. Vertex input: binding 0 = position (vec3) + normal.
-// Push: the light's world -> clip matrix.
+#extension GL_ARB_shader_viewport_layer_array : require
+// Shadow maps: depth of every shadow-casting object seen from each shadow-casting light, all
+// lights in one layered render of a D32 array image; gl_Layer picks the light's layer.
+// Depth only, no fragment shader. Vertex input: binding 0 = position (vec3) + normal.
+// Push: the light's world -> clip matrix and its layer.
 layout(location = 0) in vec3 position;
-layout(push_constant) uniform Push { mat4 light_matrix; } push;
+layout(push_constant) uniform Push { mat4 light_matrix; uint layer; uint pad0; uint pad1; uint pad2; } push;
 
 void main() {
     gl_Position = push.light_matrix * vec4(position, 1.0);
+    gl_Layer = int(push.layer);
 }

@@ -1,7 +1,7 @@
 #version 450
 // Irradiance splat: for every sample point, the irradiance transmitted into the medium from
 // every light: sum over lights of E_light cos(theta_i) F_t(cos theta_i, eta) V, with V from the
-// light's shadow map (3x3 PCF). Also the sample's near-field energy per channel
+// light's shadow map (one bilinear compare tap: the sharpest, closest to ray casting). Also the sample's near-field energy per channel
 // (dipole_near_energy), which depends only on its area and material, so that the gather pays
 // for it once per sample instead of once per pair.
 //
@@ -35,7 +35,7 @@ void main() {
         light_incidence(lights[l], p, wi, irradiance);
         float cos_i = dot(n, wi);
         if (cos_i <= 0.0) continue;
-        float v = light_visibility(lights[l], shadow_maps, p, n);
+        float v = light_visibility(lights[l], shadow_maps, p, n, 0);
         e += irradiance * (cos_i * dipole_fresnel_transmittance(cos_i, eta) * v);
     }
     float area = s.position_area.w;

@@ -44,7 +44,10 @@ pub fn write_exitance_ply(path: &Path, points: &[([f32; 3], [f32; 3])]) -> Resul
     atomic_write(path, |tmp| {
         let file = std::fs::File::create(tmp).with_context(|| format!("cannot create {}", tmp.display()))?;
         let mut w = std::io::BufWriter::new(file);
-        writeln!(w, "ply\nformat ascii 1.0\ncomment translucent: radiant exitance per vertex, linear W/m^2, world space")?;
+        writeln!(
+            w,
+            "ply\nformat ascii 1.0\ncomment translucent: radiant exitance per vertex, linear W/m^2, world space"
+        )?;
         writeln!(w, "element vertex {}", points.len())?;
         for p in ["x", "y", "z", "exitance_r", "exitance_g", "exitance_b"] {
             writeln!(w, "property float {p}")?;

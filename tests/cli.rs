@@ -4,9 +4,7 @@ use std::process::{Command, Output};
 
 fn translucent(args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_translucent"));
-    cmd.args(args)
-        .env("TRANSLUCENT_VALIDATION", "1")
-        .env_remove("TRANSLUCENT_DEVICE");
+    cmd.args(args).env("TRANSLUCENT_VALIDATION", "1").env_remove("TRANSLUCENT_DEVICE");
     for (k, v) in env {
         cmd.env(k, v);
     }
@@ -19,16 +17,9 @@ fn text(bytes: &[u8]) -> String {
 
 fn assert_clean_failure(out: &Output) -> String {
     let stderr = text(&out.stderr);
-    assert!(
-        !out.status.success(),
-        "expected failure, got success; stdout: {}",
-        text(&out.stdout)
-    );
+    assert!(!out.status.success(), "expected failure, got success; stdout: {}", text(&out.stdout));
     assert_eq!(out.status.code(), Some(1), "stderr: {stderr}");
-    assert!(
-        !stderr.contains("panicked"),
-        "panic instead of an error: {stderr}"
-    );
+    assert!(!stderr.contains("panicked"), "panic instead of an error: {stderr}");
     stderr
 }
 
@@ -42,53 +33,72 @@ fn devices_lists_llvmpipe() {
         "no llvmpipe (lavapipe) device; run `bash scripts/setup` to install mesa-vulkan-drivers.\n{stdout}"
     );
     let json = translucent(&["devices", "--json"], &[]);
-    let parsed: serde_json::Value =
-        serde_json::from_slice(&json.stdout).expect("devices --json is JSON");
-    assert!(
-        parsed
-            .as_array()
-            .is_some_and(|a| a.iter().any(|d| d["driver"] == "llvmpipe")),
-        "{parsed}"
-    );
+    let parsed: serde_json::Value = serde_json::from_slice(&json.stdout).expect("devices --json is JSON");
+    assert!(parsed.as_array().is_some_and(|a| a.iter().any(|d| d["driver"] == "llvmpipe")), "{parsed}");
 }
 
 #[test]
-fn smoke_render_runs_clean_under_validation() {
-    let out = translucent(&["render", "--count", "4096"], &[]);
+fn default_render_runs_clean_under_validation() {
+    let dir = std::env::temp_dir().join(format!("translucent-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("default.png");
+    let out = translucent(&["render", "--resolution", "96x64", "-o", png.to_str().unwrap(), "--timings"], &[]);
     let stderr = text(&out.stderr);
     assert!(out.status.success(), "stderr: {stderr}");
     assert!(!stderr.contains("[vulkan"), "validation messages: {stderr}");
-    assert!(
-        text(&out.stdout).contains("4096 values correct"),
-        "{}",
-        text(&out.stdout)
-    );
+    let img = image::open(&png).expect("a PNG was written").to_rgba8();
+    assert_eq!(img.dimensions(), (96, 64));
+    let stdout = text(&out.stdout);
+    for pass in ["shadow", "splat", "gather", "shade", "tonemap"] {
+        assert!(stdout.contains(pass), "--timings lacks {pass}: {stdout}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn bad_scene_input_fails_cleanly_without_output() {
+    let dir = std::env::temp_dir().join(format!("translucent-cli-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("out.png");
+    let scene = dir.join("scene.toml");
+    std::fs::write(&scene, "[camera]\neye = [0.0, 1.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\nzoom = 2\n").unwrap();
+    let out = translucent(&["render", scene.to_str().unwrap(), "-o", png.to_str().unwrap()], &[]);
+    let stderr = assert_clean_failure(&out);
+    assert!(stderr.contains("zoom") && stderr.contains("line 4"), "{stderr}");
+    let missing = dir.join("missing.toml");
+    let out = translucent(&["render", missing.to_str().unwrap(), "-o", png.to_str().unwrap()], &[]);
+    let stderr = assert_clean_failure(&out);
+    assert!(stderr.contains("missing.toml"), "{stderr}");
+    // A mesh that is not there, named with the scene's key.
+    std::fs::write(
+        &scene,
+        "[camera]\neye = [0.0, 1.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\n[[object]]\nshape = { type = \"mesh\", path = \"nope.obj\" }\nmaterial = { type = \"opaque\", albedo = [0.5, 0.5, 0.5] }\n",
+    )
+    .unwrap();
+    let out = translucent(&["render", scene.to_str().unwrap(), "-o", png.to_str().unwrap()], &[]);
+    let stderr = assert_clean_failure(&out);
+    assert!(stderr.contains("object[0]") && stderr.contains("nope.obj"), "{stderr}");
+    assert!(!png.exists(), "no image may be written on failure");
+    let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+    assert_eq!(leftovers.len(), 1, "only the scene file remains: {leftovers:?}");
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
 fn unknown_device_lists_the_devices() {
     let out = translucent(&["--device", "no-such-gpu-xyz", "render"], &[]);
     let stderr = assert_clean_failure(&out);
-    assert!(
-        stderr.contains("no-such-gpu-xyz") && stderr.contains("llvmpipe"),
-        "{stderr}"
-    );
+    assert!(stderr.contains("no-such-gpu-xyz") && stderr.contains("llvmpipe"), "{stderr}");
     let out = translucent(&["render"], &[("TRANSLUCENT_DEVICE", "99")]);
     let stderr = assert_clean_failure(&out);
-    assert!(
-        stderr.contains("\"99\"") && stderr.contains("available devices"),
-        "{stderr}"
-    );
+    assert!(stderr.contains("\"99\"") && stderr.contains("available devices"), "{stderr}");
 }
 
 #[test]
 fn no_vulkan_driver_says_what_to_install() {
     // Point the loader at a driver manifest that does not exist: the state of a machine
     // without mesa-vulkan-drivers.
-    let env = [
-        ("VK_ICD_FILENAMES", "/nonexistent/icd.json"),
-        ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
-    ];
+    let env = [("VK_ICD_FILENAMES", "/nonexistent/icd.json"), ("VK_DRIVER_FILES", "/nonexistent/icd.json")];
     for args in [&["devices"][..], &["render"][..]] {
         let out = translucent(args, &env);
         let stderr = assert_clean_failure(&out);
@@ -98,13 +108,9 @@ fn no_vulkan_driver_says_what_to_install() {
 
 #[test]
 fn help_is_everywhere() {
-    for args in [
-        &["--help"][..],
-        &["devices", "--help"],
-        &["render", "--help"],
-        &["material", "--help"],
-        &["sample", "--help"],
-    ] {
+    for args in
+        [&["--help"][..], &["devices", "--help"], &["render", "--help"], &["material", "--help"], &["sample", "--help"]]
+    {
         let out = translucent(args, &[]);
         assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
         assert!(text(&out.stdout).contains("Usage"), "{args:?}");

@@ -5,8 +5,7 @@ mod common;
 use ash::vk;
 use common::with_gpu;
 use translucent::gpu::{
-    Binding, BindingKind, Buffer, GpuTimer, GraphicsDesc, GraphicsPipeline, Image, ImageDesc,
-    image_barrier, shaders,
+    Binding, BindingKind, Buffer, GpuTimer, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, image_barrier, shaders,
 };
 use translucent::render::smoke;
 
@@ -25,11 +24,7 @@ fn gpu_timer_is_positive_and_finite() {
     with_gpu(|gpu| {
         let input = vec![1.0f32; 1 << 18];
         let result = smoke::run(gpu, &input).expect("smoke dispatch");
-        assert!(
-            result.gpu_ms.is_finite() && result.gpu_ms > 0.0,
-            "GPU time {} ms",
-            result.gpu_ms
-        );
+        assert!(result.gpu_ms.is_finite() && result.gpu_ms > 0.0, "GPU time {} ms", result.gpu_ms);
         // A dispatch over 2^18 elements on any device takes far less than ten seconds.
         assert!(result.gpu_ms < 10_000.0, "GPU time {} ms", result.gpu_ms);
     });
@@ -60,10 +55,7 @@ fn every_embedded_shader_is_spirv() {
     assert!(names.contains(&"smoke.comp"), "embedded shaders: {names:?}");
     for name in names {
         let words = shaders::spirv(name).unwrap();
-        assert_eq!(
-            words[0], 0x0723_0203,
-            "{name} does not start with the SPIR-V magic number"
-        );
+        assert_eq!(words[0], 0x0723_0203, "{name} does not start with the SPIR-V magic number");
     }
     assert!(shaders::spirv("no-such.comp").is_err());
 }
@@ -80,55 +72,21 @@ fn graphics_pipeline_draws_a_triangle() {
         }
         // Counter-clockwise in framebuffer space (y down), covering the centre.
         let vertices = [
-            Vertex {
-                position: [-0.8, -0.8],
-                color: [1.0, 1.0, 0.0],
-            },
-            Vertex {
-                position: [-0.8, 0.8],
-                color: [1.0, 1.0, 0.0],
-            },
-            Vertex {
-                position: [0.8, 0.0],
-                color: [1.0, 1.0, 0.0],
-            },
+            Vertex { position: [-0.8, -0.8], color: [1.0, 1.0, 0.0] },
+            Vertex { position: [-0.8, 0.8], color: [1.0, 1.0, 0.0] },
+            Vertex { position: [0.8, 0.0], color: [1.0, 1.0, 0.0] },
         ];
-        let vbuf = Buffer::from_slice(
-            gpu,
-            "triangle",
-            &vertices,
-            vk::BufferUsageFlags::VERTEX_BUFFER,
-        )
-        .unwrap();
-        let tint = Buffer::from_slice(
-            gpu,
-            "tint",
-            &[1.0f32, 0.5, 0.5, 1.0],
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-        )
-        .unwrap();
+        let vbuf = Buffer::from_slice(gpu, "triangle", &vertices, vk::BufferUsageFlags::VERTEX_BUFFER).unwrap();
+        let tint =
+            Buffer::from_slice(gpu, "tint", &[1.0f32, 0.5, 0.5, 1.0], vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
         let format = vk::Format::R8G8B8A8_UNORM;
-        let color = Image::new(
-            gpu,
-            &ImageDesc::new(
-                "target",
-                SIZE,
-                SIZE,
-                format,
-                vk::ImageUsageFlags::COLOR_ATTACHMENT,
-            ),
-        )
-        .unwrap();
+        let color =
+            Image::new(gpu, &ImageDesc::new("target", SIZE, SIZE, format, vk::ImageUsageFlags::COLOR_ATTACHMENT))
+                .unwrap();
         let depth_format = vk::Format::D32_SFLOAT;
         let depth = Image::new(
             gpu,
-            &ImageDesc::new(
-                "depth",
-                SIZE,
-                SIZE,
-                depth_format,
-                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-            ),
+            &ImageDesc::new("depth", SIZE, SIZE, depth_format, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT),
         )
         .unwrap();
         let mut desc = GraphicsDesc::new("test/triangle.vert", Some("test/triangle.frag"));
@@ -164,31 +122,20 @@ fn graphics_pipeline_draws_a_triangle() {
                 cmd,
                 color.raw(),
                 vk::ImageAspectFlags::COLOR,
-                (
-                    vk::ImageLayout::UNDEFINED,
-                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                ),
+                (vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
                 (vk::PipelineStageFlags2::TOP_OF_PIPE, vk::AccessFlags2::NONE),
-                (
-                    vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
-                    vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
-                ),
+                (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
             );
             image_barrier(
                 device,
                 cmd,
                 depth.raw(),
                 vk::ImageAspectFlags::DEPTH,
-                (
-                    vk::ImageLayout::UNDEFINED,
-                    vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
-                ),
+                (vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL),
                 (vk::PipelineStageFlags2::TOP_OF_PIPE, vk::AccessFlags2::NONE),
                 (
-                    vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
-                        | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
-                    vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE
-                        | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ,
+                    vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                    vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ,
                 ),
             );
             let colors = [vk::RenderingAttachmentInfo::default()
@@ -196,27 +143,15 @@ fn graphics_pipeline_draws_a_triangle() {
                 .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
                 .load_op(vk::AttachmentLoadOp::CLEAR)
                 .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue {
-                    color: vk::ClearColorValue {
-                        float32: [0.0, 0.0, 1.0, 1.0],
-                    },
-                })];
+                .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0, 0.0, 1.0, 1.0] } })];
             let depth_attachment = vk::RenderingAttachmentInfo::default()
                 .image_view(depth.view())
                 .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
                 .load_op(vk::AttachmentLoadOp::CLEAR)
                 .store_op(vk::AttachmentStoreOp::DONT_CARE)
-                .clear_value(vk::ClearValue {
-                    depth_stencil: vk::ClearDepthStencilValue {
-                        depth: 1.0,
-                        stencil: 0,
-                    },
-                });
+                .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
             let rendering = vk::RenderingInfo::default()
-                .render_area(vk::Rect2D {
-                    offset: vk::Offset2D::default(),
-                    extent: color.extent(),
-                })
+                .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent: color.extent() })
                 .layer_count(1)
                 .color_attachments(&colors)
                 .depth_attachment(&depth_attachment);
@@ -229,24 +164,14 @@ fn graphics_pipeline_draws_a_triangle() {
             }
         })
         .unwrap();
-        let pixels = color
-            .read(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, 4)
-            .unwrap();
+        let pixels = color.read(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, 4).unwrap();
         let at = |x: u32, y: u32| {
             let i = 4 * (y * SIZE + x) as usize;
             [pixels[i], pixels[i + 1], pixels[i + 2], pixels[i + 3]]
         };
-        assert_eq!(
-            at(SIZE / 2, SIZE / 2),
-            [255, 128, 0, 255],
-            "centre is the tinted triangle"
-        );
+        assert_eq!(at(SIZE / 2, SIZE / 2), [255, 128, 0, 255], "centre is the tinted triangle");
         assert_eq!(at(1, 1), [0, 0, 255, 255], "corner keeps the clear colour");
-        assert_eq!(
-            at(SIZE - 2, 2),
-            [0, 0, 255, 255],
-            "right top corner keeps the clear colour"
-        );
+        assert_eq!(at(SIZE - 2, 2), [0, 0, 255, 255], "right top corner keeps the clear colour");
     });
 }
 
@@ -265,26 +190,14 @@ fn device_info_names_the_device() {
 fn validation_counts_a_leaked_object() {
     // The machinery every other test relies on: a VkBuffer left alive when the device is
     // destroyed must be reported and counted.
-    let gpu = translucent::gpu::Gpu::new(&translucent::gpu::GpuOptions {
-        validation: true,
-        ..Default::default()
-    })
-    .expect("a Vulkan device with validation layers (run `bash scripts/setup`)");
+    let gpu = translucent::gpu::Gpu::new(&translucent::gpu::GpuOptions { validation: true, ..Default::default() })
+        .expect("a Vulkan device with validation layers (run `bash scripts/setup`)");
     let counters = gpu.validation();
-    let info = vk::BufferCreateInfo::default()
-        .size(256)
-        .usage(vk::BufferUsageFlags::STORAGE_BUFFER);
+    let info = vk::BufferCreateInfo::default().size(256).usage(vk::BufferUsageFlags::STORAGE_BUFFER);
     // SAFETY: a valid buffer, deliberately never destroyed.
     let _leaked = unsafe { gpu.device().create_buffer(&info, None) }.unwrap();
     assert_eq!(counters.total(), 0);
     drop(gpu);
-    assert!(
-        counters.errors() > 0,
-        "the leaked VkBuffer was not reported"
-    );
-    assert!(
-        counters.messages().iter().any(|m| m.contains("VkBuffer")),
-        "{:?}",
-        counters.messages()
-    );
+    assert!(counters.errors() > 0, "the leaked VkBuffer was not reported");
+    assert!(counters.messages().iter().any(|m| m.contains("VkBuffer")), "{:?}", counters.messages());
 }

@@ -196,7 +196,8 @@ fn tilted_plane_curvature_is_zero_up_to_f32_rounding() {
     // Rotated about a skew axis and shifted: every f32 position is now rounded off the plane by
     // about 1e-7, which the curvature sees divided by the squared edge length (1/60)^2, so a few
     // 1e-4. Far below the curvature of anything the size of the plane (about 1).
-    let m = Mat4::from_translation(Vec3::new(0.3, -0.2, 0.1)) * Mat4::from_axis_angle(Vec3::new(1.0, 2.0, 0.5).normalize(), 0.7);
+    let m = Mat4::from_translation(Vec3::new(0.3, -0.2, 0.1))
+        * Mat4::from_axis_angle(Vec3::new(1.0, 2.0, 0.5).normalize(), 0.7);
     let (pos, tris) = plane(60, 0.4, m);
     let mesh = Mesh::from_triangles(pos, tris).unwrap();
     let h = max_abs(mesh.mean_curvature());
@@ -245,7 +246,8 @@ fn torus_curvature_follows_the_analytic_range() {
 fn angle_weighted_normals_ignore_how_faces_are_split() {
     // A unit cube whose faces are split along different diagonals: area-weighted normals would
     // lean towards the faces with more triangles at a corner, angle-weighted ones do not.
-    let pos: Vec<Vec3> = (0..8).map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32)).collect();
+    let pos: Vec<Vec3> =
+        (0..8).map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32)).collect();
     let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     let mut tris = Vec::new();
     for (k, q) in quads.iter().enumerate() {
@@ -389,7 +391,8 @@ fn inconsistent_winding_is_reported() {
 
 #[test]
 fn memory_meshes_are_validated() {
-    let err = Mesh::from_triangles(vec![Vec3::ZERO, Vec3::X, Vec3::new(f32::NAN, 0.0, 0.0)], vec![[0, 1, 2]]).unwrap_err();
+    let err =
+        Mesh::from_triangles(vec![Vec3::ZERO, Vec3::X, Vec3::new(f32::NAN, 0.0, 0.0)], vec![[0, 1, 2]]).unwrap_err();
     assert!(matches!(err, MeshError::NonFinite { vertex: 2, .. }), "{err}");
     let err = Mesh::from_triangles(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 3]]).unwrap_err();
     assert!(matches!(err, MeshError::IndexOutOfRange { index: 3, count: 3, .. }), "{err}");
@@ -456,7 +459,8 @@ fn obj_scale_and_mirroring_transform() {
     let scaled = Mesh::load(&path, &LoadOptions::default().with_scale(2.0)).unwrap();
     assert!((scaled.total_area() - 4.0 * base.total_area()).abs() < 1e-9);
     // A mirror keeps normals pointing out of the solid.
-    let mirror = Mesh::load(&path, &LoadOptions::default().with_transform(Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)))).unwrap();
+    let mirror =
+        Mesh::load(&path, &LoadOptions::default().with_transform(Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)))).unwrap();
     let centre = mirror.positions().iter().copied().sum::<Vec3>() / 4.0;
     for (t, tri) in mirror.triangles().iter().enumerate() {
         let c = tri.iter().map(|&i| mirror.positions()[i as usize]).sum::<Vec3>() / 3.0;
@@ -464,7 +468,8 @@ fn obj_scale_and_mirroring_transform() {
     }
     let err = Mesh::load(&path, &LoadOptions::default().with_scale(0.0)).unwrap_err();
     assert!(matches!(err, MeshError::InvalidOptions(_)), "{err}");
-    let err = Mesh::load(&path, &LoadOptions::default().with_transform(Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0)))).unwrap_err();
+    let err = Mesh::load(&path, &LoadOptions::default().with_transform(Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0))))
+        .unwrap_err();
     assert!(matches!(err, MeshError::InvalidOptions(_)), "{err}");
 }
 
@@ -546,12 +551,15 @@ fn relative_and_forward_indices_are_accepted() {
 #[test]
 fn files_without_faces_or_area_are_errors() {
     let dir = temp_dir("empty");
-    for (name, text) in [("empty.obj", ""), ("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"), ("lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n")] {
+    for (name, text) in
+        [("empty.obj", ""), ("points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"), ("lines.obj", "v 0 0 0\nv 1 0 0\nl 1 2\n")]
+    {
         let err = Mesh::load(write_obj(&dir, name, text), &LoadOptions::default()).unwrap_err();
         assert!(matches!(err, MeshError::NoFaces { .. }), "{name}: {err}");
         assert!(err.to_string().contains(name), "{err}");
     }
-    let err = Mesh::load(write_obj(&dir, "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"), &LoadOptions::default()).unwrap_err();
+    let err = Mesh::load(write_obj(&dir, "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"), &LoadOptions::default())
+        .unwrap_err();
     assert!(matches!(err, MeshError::NoArea { .. }), "{err}");
     assert!(err.to_string().contains("flat.obj"));
 }

@@ -7,9 +7,7 @@
 use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 use std::f64::consts::PI;
-use translucent::optics::fresnel::{
-    self, fresnel_moment1, fresnel_reflectance, fresnel_transmittance,
-};
+use translucent::optics::fresnel::{self, fresnel_moment1, fresnel_reflectance, fresnel_transmittance};
 use translucent::optics::gpu::{DipoleChannelGpu, DipoleEvalInput, DipoleEvalOutput};
 use translucent::optics::kernel::{self, footprint_kernel, near_energy, point_kernel};
 use translucent::optics::presets::{self, JENSEN_2001, NARASIMHAN_2006};
@@ -47,11 +45,7 @@ fn preset_dipoles() -> Vec<(String, Dipole)> {
 }
 
 fn rel(a: f64, b: f64) -> f64 {
-    if a == b {
-        0.0
-    } else {
-        (a - b).abs() / b.abs().max(a.abs())
-    }
+    if a == b { 0.0 } else { (a - b).abs() / b.abs().max(a.abs()) }
 }
 
 // ---------------------------------------------------------------- the dipole profile
@@ -68,17 +62,11 @@ fn total_reflectance_equals_numerical_integral_of_r_d() {
         let hi = d.z_v + 60.0 * d.diffusion_length();
         let numeric = radial_integral(|r| d.r_d(r), 1e-9 * d.z_r, hi, 40_000);
         let e = rel(numeric, d.r_d_total());
-        assert!(
-            e < 1e-6,
-            "{name}: numeric {numeric} vs closed form {}",
-            d.r_d_total()
-        );
+        assert!(e < 1e-6, "{name}: numeric {numeric} vs closed form {}", d.r_d_total());
         worst = worst.max(e);
         checked += 1;
     }
-    println!(
-        "closed-form R_d,total vs Simpson over r, {checked} channels: worst relative {worst:.1e}"
-    );
+    println!("closed-form R_d,total vs Simpson over r, {checked} channels: worst relative {worst:.1e}");
     assert!(checked > 100);
 }
 
@@ -94,27 +82,15 @@ fn disk_integral_matches_numerics_and_tends_to_total() {
                 let numeric = radial_integral(|r| d.r_d(r), 1e-10 * d.z_r, radius, 40_000);
                 let exact = d.r_d_disk(radius);
                 // Below 1e-10 z_r the disk holds ~1e-20 of R_d(0) pi z_r^2: negligible.
-                assert!(
-                    rel(exact, numeric) < 1e-8,
-                    "{name} R={radius}: {exact} vs {numeric}"
-                );
+                assert!(rel(exact, numeric) < 1e-8, "{name} R={radius}: {exact} vs {numeric}");
                 assert!(exact > previous && exact <= d.r_d_total() * (1.0 + 1e-12));
                 previous = exact;
                 // Ring = difference of disks, and what lies outside = total - disk.
-                assert!(
-                    rel(
-                        d.r_d_ring(0.5 * radius, radius),
-                        exact - d.r_d_disk(0.5 * radius)
-                    ) < 1e-9
-                );
+                assert!(rel(d.r_d_ring(0.5 * radius, radius), exact - d.r_d_disk(0.5 * radius)) < 1e-9);
                 assert!(rel(d.r_d_outside(radius), d.r_d_total() - exact) < 1e-6);
             }
             let far = d.r_d_disk(d.z_v + 80.0 * l);
-            assert!(
-                rel(far, d.r_d_total()) < 1e-12,
-                "{name}: P(inf) {far} vs {}",
-                d.r_d_total()
-            );
+            assert!(rel(far, d.r_d_total()) < 1e-12, "{name}: P(inf) {far} vs {}", d.r_d_total());
         }
     }
 }
@@ -130,10 +106,7 @@ fn thin_rings_and_tiny_disks_do_not_cancel() {
         assert!(rel(d.r_d_disk(radius), approx) < 3.0 * f, "R = {f} z_r");
         let (r, dr) = (2.0 * d.z_r, f * d.z_r);
         let approx_ring = d.r_d(r + 0.5 * dr) * 2.0 * PI * (r + 0.5 * dr) * dr;
-        assert!(
-            rel(d.r_d_ring(r, r + dr), approx_ring) < f,
-            "ring dr = {f} z_r"
-        );
+        assert!(rel(d.r_d_ring(r, r + dr), approx_ring) < f, "ring dr = {f} z_r");
     }
 }
 
@@ -142,17 +115,10 @@ fn r_d_decreases_monotonically_and_stays_finite() {
     for (name, d) in preset_dipoles() {
         let mut previous = f64::INFINITY;
         for i in 0..=400 {
-            let r = if i == 0 {
-                0.0
-            } else {
-                d.z_r * 10f64.powf(-4.0 + i as f64 * 0.02)
-            };
+            let r = if i == 0 { 0.0 } else { d.z_r * 10f64.powf(-4.0 + i as f64 * 0.02) };
             let v = d.r_d(r);
             assert!(v.is_finite() && v >= 0.0, "{name}: R_d({r}) = {v}");
-            assert!(
-                v <= previous,
-                "{name}: R_d rises at r = {r}: {v} > {previous}"
-            );
+            assert!(v <= previous, "{name}: R_d rises at r = {r}: {v} > {previous}");
             previous = v;
         }
     }
@@ -163,19 +129,10 @@ fn energy_bounds_hold_over_random_parameters() {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(0x7a55_1d0e);
     let mut max_total = 0.0f64;
     for _ in 0..20_000 {
-        let log_uniform = |rng: &mut rand_pcg::Pcg64, lo: f64, hi: f64| {
-            10f64.powf(rng.random_range(lo.log10()..hi.log10()))
-        };
-        let sigma_a = if rng.random_range(0..8) == 0 {
-            0.0
-        } else {
-            log_uniform(&mut rng, 1e-6, 1e4)
-        };
-        let sigma_s_prime = if rng.random_range(0..16) == 0 {
-            0.0
-        } else {
-            log_uniform(&mut rng, 1e-6, 1e4)
-        };
+        let log_uniform =
+            |rng: &mut rand_pcg::Pcg64, lo: f64, hi: f64| 10f64.powf(rng.random_range(lo.log10()..hi.log10()));
+        let sigma_a = if rng.random_range(0..8) == 0 { 0.0 } else { log_uniform(&mut rng, 1e-6, 1e4) };
+        let sigma_s_prime = if rng.random_range(0..16) == 0 { 0.0 } else { log_uniform(&mut rng, 1e-6, 1e4) };
         if sigma_a + sigma_s_prime == 0.0 {
             continue;
         }
@@ -184,18 +141,12 @@ fn energy_bounds_hold_over_random_parameters() {
         let total = d.r_d_total();
         let ctx = format!("sigma_a {sigma_a} sigma_s' {sigma_s_prime} eta {eta}");
         assert!((0.0..=1.0).contains(&total), "{ctx}: total {total}");
-        assert!(
-            total <= d.alpha_prime + 1e-15,
-            "{ctx}: reflects more than it scatters"
-        );
+        assert!(total <= d.alpha_prime + 1e-15, "{ctx}: reflects more than it scatters");
         // The kernel pieces stay within the same bounds.
         let area = log_uniform(&mut rng, 1e-6, 1e6) * d.z_r * d.z_r;
         let b = kernel::B_PER_SQRT_AREA * area.sqrt();
         let e_near = near_energy(&d, b);
-        assert!(
-            e_near >= 0.0 && e_near <= total * (1.0 + 1e-9),
-            "{ctx}: E_near {e_near} total {total}"
-        );
+        assert!(e_near >= 0.0 && e_near <= total * (1.0 + 1e-9), "{ctx}: E_near {e_near} total {total}");
         let r = log_uniform(&mut rng, 1e-6, 1e6) * d.z_r;
         let k = footprint_kernel(&d, r, area);
         assert!(k.is_finite() && k >= 0.0, "{ctx}: K({r}, {area}) = {k}");
@@ -216,11 +167,7 @@ fn no_absorption_reflects_exactly_everything_it_scatters() {
             assert!(d.r_d(0.0).is_finite() && d.r_d(1e12).is_finite());
         }
     }
-    for d in Material::preset("spectralon")
-        .unwrap()
-        .dipoles(1.0)
-        .unwrap()
-    {
+    for d in Material::preset("spectralon").unwrap().dipoles(1.0).unwrap() {
         assert_eq!(d.r_d_total(), 1.0);
     }
 }
@@ -229,15 +176,9 @@ fn no_absorption_reflects_exactly_everything_it_scatters() {
 fn derived_quantities_follow_their_definitions() {
     // Cross-check the stored fields against the definitions written the other way round.
     for (name, d) in preset_dipoles() {
-        assert!(
-            rel(d.sigma_tr, (d.sigma_a / d.D).sqrt()) < 1e-12,
-            "{name}: sigma_tr"
-        );
+        assert!(rel(d.sigma_tr, (d.sigma_a / d.D).sqrt()) < 1e-12, "{name}: sigma_tr");
         assert!(rel(d.z_v, d.z_r + 4.0 * d.A * d.D) < 1e-12, "{name}: z_v");
-        assert!(
-            rel(d.alpha_prime + d.one_minus_alpha_prime, 1.0) < 1e-15,
-            "{name}"
-        );
+        assert!(rel(d.alpha_prime + d.one_minus_alpha_prime, 1.0) < 1e-15, "{name}");
         assert!(rel(d.A, (1.0 + d.F_dr) / (1.0 - d.F_dr)) < 1e-15, "{name}");
         assert_eq!(d.mean_free_path(), d.z_r);
     }
@@ -298,10 +239,7 @@ fn fresnel_limits() {
             let sin_t_sq = (1.0 - cos_i * cos_i) / (eta * eta);
             if sin_t_sq < 1.0 {
                 let cos_t = (1.0 - sin_t_sq).sqrt();
-                let (a, b) = (
-                    fresnel_reflectance(cos_i, eta),
-                    fresnel_reflectance(cos_t, 1.0 / eta),
-                );
+                let (a, b) = (fresnel_reflectance(cos_i, eta), fresnel_reflectance(cos_t, 1.0 / eta));
                 assert!((a - b).abs() < 1e-12, "eta {eta} cos {cos_i}: {a} vs {b}");
             }
         }
@@ -312,20 +250,7 @@ fn fresnel_limits() {
 
 #[test]
 fn fresnel_moment_matches_brute_force_and_reciprocity() {
-    for eta in [
-        1.0 / 3.0,
-        0.5,
-        1.0 / 1.5,
-        1.0 / 1.3,
-        0.95,
-        1.001,
-        1.05,
-        1.3,
-        1.33,
-        1.5,
-        2.0,
-        3.0,
-    ] {
+    for eta in [1.0 / 3.0, 0.5, 1.0 / 1.5, 1.0 / 1.3, 0.95, 1.001, 1.05, 1.3, 1.33, 1.5, 2.0, 3.0] {
         // Midpoint rule with 2e6 cells: the kink at the critical angle limits it to ~1e-9.
         let n = 2_000_000;
         let brute: f64 = (0..n)
@@ -336,30 +261,17 @@ fn fresnel_moment_matches_brute_force_and_reciprocity() {
             .sum::<f64>()
             / n as f64;
         let fm1 = fresnel_moment1(eta);
-        assert!(
-            (fm1 - brute).abs() < 1e-8,
-            "eta {eta}: FM1 {fm1} vs brute force {brute}"
-        );
+        assert!((fm1 - brute).abs() < 1e-8, "eta {eta}: FM1 {fm1} vs brute force {brute}");
         // Hemispherical transmittance inside = outside / eta^2 (radiance compression).
-        let (t_out, t_in) = (
-            fresnel::diffuse_transmittance(eta),
-            fresnel::diffuse_transmittance(1.0 / eta),
-        );
-        assert!(
-            (t_in - t_out / (eta * eta)).abs() < 1e-10,
-            "eta {eta}: {t_in} vs {}",
-            t_out / (eta * eta)
-        );
+        let (t_out, t_in) = (fresnel::diffuse_transmittance(eta), fresnel::diffuse_transmittance(1.0 / eta));
+        assert!((t_in - t_out / (eta * eta)).abs() < 1e-10, "eta {eta}: {t_in} vs {}", t_out / (eta * eta));
     }
     // The F_dr fit approximates the exact internal diffuse reflectance 2 FM1(1/eta).
     println!(" eta   F_dr fit  2 FM1(1/eta)");
     for eta in [1.1, 1.3, 1.5, 2.0, 2.5] {
         let (fit, exact) = (fresnel::F_dr(eta), 2.0 * fresnel_moment1(1.0 / eta));
         println!("{eta:4.2}  {fit:.5}   {exact:.5}");
-        assert!(
-            (fit - exact).abs() < 0.01,
-            "eta {eta}: fit {fit} vs exact {exact}"
-        );
+        assert!((fit - exact).abs() < 0.01, "eta {eta}: fit {fit} vs exact {exact}");
     }
 }
 
@@ -379,10 +291,7 @@ fn bssrdf_normalization_conserves_energy() {
                 })
                 .sum();
             let per_exitance = lobe / (d.r_d(d.z_r) * fresnel_transmittance(1.0, d.eta));
-            assert!(
-                rel(per_exitance, 1.0) < 1e-6,
-                "{name}: lobe integrates to {per_exitance}"
-            );
+            assert!(rel(per_exitance, 1.0) < 1e-6, "{name}: lobe integrates to {per_exitance}");
             // A uniformly lit plane: reflected flux / incident flux = F_t(theta_i) R_d,total <= 1
             // for every angle of incidence, and under diffuse light T(eta) R_d,total <= 1.
             for cos_i in [1.0, 0.5, 0.1, 0.0] {
@@ -422,12 +331,7 @@ fn lattice_sums(d: &Dipole, h: f64, rc: f64) -> (f64, f64) {
                 };
                 let pk = point_kernel(d, r, area);
                 p += mult * pk;
-                k += mult
-                    * if r >= far {
-                        pk
-                    } else {
-                        footprint_kernel(d, r, area)
-                    };
+                k += mult * if r >= far { pk } else { footprint_kernel(d, r, area) };
             }
             (p, k)
         })
@@ -450,13 +354,8 @@ fn kernel_plane_reflects_total_for_every_spacing() {
         ("sprite", 0),
     ];
     let ratios: Vec<f64> = (-6..=6).map(|k| 10f64.powf(k as f64 / 2.0)).collect();
-    println!(
-        "Uniformly lit plane of samples on a grid of spacing h: sum of kernels / R_d,total - 1"
-    );
-    println!(
-        "{:>24} {:>10} {:>10} {:>12} {:>12}",
-        "channel", "L/h", "z_r/h", "point", "footprint"
-    );
+    println!("Uniformly lit plane of samples on a grid of spacing h: sum of kernels / R_d,total - 1");
+    println!("{:>24} {:>10} {:>10} {:>12} {:>12}", "channel", "L/h", "z_r/h", "point", "footprint");
     let mut worst_point = vec![0.0f64; ratios.len()];
     let mut worst_kernel = vec![0.0f64; ratios.len()];
     for (name, c) in cases {
@@ -468,32 +367,18 @@ fn kernel_plane_reflects_total_for_every_spacing() {
             let h = d.diffusion_length() / ratio;
             let (p, f) = lattice_sums(&d, h, rc.max(2.0 * h));
             let (ep, ef) = (p / total - 1.0, f / total - 1.0);
-            println!(
-                "{:>24} {ratio:>10.3e} {:>10.3e} {ep:>12.3e} {ef:>12.3e}",
-                format!("{name} [{c}]"),
-                d.z_r / h
-            );
+            println!("{:>24} {ratio:>10.3e} {:>10.3e} {ep:>12.3e} {ef:>12.3e}", format!("{name} [{c}]"), d.z_r / h);
             worst_point[k] = worst_point[k].max(ep.abs());
             worst_kernel[k] = worst_kernel[k].max(ef.abs());
         }
     }
-    eprintln!(
-        "\nWorst |sum / R_d,total - 1| over {} channels:",
-        cases.len()
-    );
+    eprintln!("\nWorst |sum / R_d,total - 1| over {} channels:", cases.len());
     eprintln!("{:>10} {:>14} {:>14}", "L/h", "point kernel", "footprint");
     for (k, ratio) in ratios.iter().enumerate() {
-        eprintln!(
-            "{ratio:>10.3e} {:>14.3e} {:>14.3e}",
-            worst_point[k], worst_kernel[k]
-        );
+        eprintln!("{ratio:>10.3e} {:>14.3e} {:>14.3e}", worst_point[k], worst_kernel[k]);
     }
     for (k, ratio) in ratios.iter().enumerate() {
-        assert!(
-            worst_kernel[k] < 0.01,
-            "footprint kernel off by {} at L/h = {ratio}",
-            worst_kernel[k]
-        );
+        assert!(worst_kernel[k] < 0.01, "footprint kernel off by {} at L/h = {ratio}", worst_kernel[k]);
     }
     // The test has teeth: plain point evaluation fails it badly when the spacing is coarse.
     assert!(worst_point[0] > 1.0 && worst_point[ratios.len() / 2] > 0.01);
@@ -504,14 +389,8 @@ fn kernel_plane_without_absorption() {
     // sigma_a = 0: no diffusion length, R_d falls as z/r^3, R_d,total = 1. Sum the lattice out to
     // 400 spacings and add the exact remainder beyond (there the kernel is the point kernel and
     // smooth on the scale of the grid).
-    let d = Material::preset("spectralon")
-        .unwrap()
-        .dipoles(1.0)
-        .unwrap()[1];
-    eprintln!(
-        "\nsigma_a = 0 (spectralon green), R_d,total = 1:\n{:>10} {:>12} {:>12}",
-        "z_r/h", "point", "footprint"
-    );
+    let d = Material::preset("spectralon").unwrap().dipoles(1.0).unwrap()[1];
+    eprintln!("\nsigma_a = 0 (spectralon green), R_d,total = 1:\n{:>10} {:>12} {:>12}", "z_r/h", "point", "footprint");
     for k in -6..=4 {
         let ratio = 10f64.powf(k as f64 / 2.0);
         let h = d.z_r / ratio;
@@ -520,22 +399,13 @@ fn kernel_plane_without_absorption() {
         let rest = d.r_d_outside(rc + 0.5 * h);
         let (ep, ef) = (p + rest - 1.0, f + rest - 1.0);
         eprintln!("{ratio:>10.3e} {ep:>12.3e} {ef:>12.3e}");
-        assert!(
-            ef.abs() < 0.01,
-            "z_r/h = {ratio}: footprint kernel off by {ef}"
-        );
+        assert!(ef.abs() < 0.01, "z_r/h = {ratio}: footprint kernel off by {ef}");
     }
 }
 
 #[test]
 fn kernel_integrates_to_total_and_has_no_seams() {
-    for (name, c) in [
-        ("marble", 0),
-        ("ketchup", 2),
-        ("spectralon", 0),
-        ("coke", 0),
-        ("cream", 2),
-    ] {
+    for (name, c) in [("marble", 0), ("ketchup", 2), ("spectralon", 0), ("coke", 0), ("cream", 2)] {
         let d = Material::preset(name).unwrap().dipoles(1.0).unwrap()[c];
         for area_per_z_sq in [1e-4, 1e-2, 1.0, 1e2, 1e4] {
             let area = area_per_z_sq * d.z_r * d.z_r;
@@ -543,14 +413,10 @@ fn kernel_integrates_to_total_and_has_no_seams() {
             let b = kernel::B_PER_SQRT_AREA * area.sqrt();
             let end = kernel::FAR_BLEND_END * b;
             // Continuous integral: dA R_d,total, up to the far blend's < 1e-3 of the tail.
-            let inner =
-                radial_integral(|r| footprint_kernel(&d, r, area), 1e-9 * rho, end, 400_000);
+            let inner = radial_integral(|r| footprint_kernel(&d, r, area), 1e-9 * rho, end, 400_000);
             let integral = inner + area * d.r_d_outside(end);
             let e = rel(integral, area * d.r_d_total());
-            assert!(
-                e < 2e-4,
-                "{name} dA = {area_per_z_sq} z_r^2: integral off by {e}"
-            );
+            assert!(e < 2e-4, "{name} dA = {area_per_z_sq} z_r^2: integral off by {e}");
             // No seam: across the footprint edge and both ends of the far blend, the jump over
             // [x (1 - eps), x (1 + eps)] shrinks with eps (a seam would not): by 100x at least
             // when eps shrinks 100x for a continuous kernel, 1e4x where the slope is also 0.
@@ -562,9 +428,7 @@ fn kernel_integrates_to_total_and_has_no_seams() {
                 end,
             ] {
                 let jump = |eps: f64| {
-                    (footprint_kernel(&d, x * (1.0 + eps), area)
-                        - footprint_kernel(&d, x * (1.0 - eps), area))
-                    .abs()
+                    (footprint_kernel(&d, x * (1.0 + eps), area) - footprint_kernel(&d, x * (1.0 - eps), area)).abs()
                 };
                 let (coarse, fine) = (jump(1e-6), jump(1e-8));
                 assert!(
@@ -574,10 +438,7 @@ fn kernel_integrates_to_total_and_has_no_seams() {
             }
             // Far from the footprint it is R_d(r) dA exactly.
             for f in [1.0, 1.5, 10.0] {
-                assert_eq!(
-                    footprint_kernel(&d, f * end, area),
-                    point_kernel(&d, f * end, area)
-                );
+                assert_eq!(footprint_kernel(&d, f * end, area), point_kernel(&d, f * end, area));
             }
         }
         // Limits at the centre: a footprint much wider than the diffusion length and z_r keeps
@@ -585,17 +446,9 @@ fn kernel_integrates_to_total_and_has_no_seams() {
         let wide = (1e4 * d.z_v.max(d.diffusion_length().min(1e6 * d.z_v))).powi(2);
         let k_wide = footprint_kernel(&d, 0.0, wide);
         let p_rho = d.r_d_disk((wide / PI).sqrt());
-        assert!(
-            rel(k_wide, p_rho) < 1e-3,
-            "{name}: K(0) {k_wide} vs P(rho) {p_rho}"
-        );
+        assert!(rel(k_wide, p_rho) < 1e-3, "{name}: K(0) {k_wide} vs P(rho) {p_rho}");
         let narrow = (1e-4 * d.z_r).powi(2);
-        assert!(
-            rel(
-                footprint_kernel(&d, 0.0, narrow),
-                point_kernel(&d, 0.0, narrow)
-            ) < 1e-6
-        );
+        assert!(rel(footprint_kernel(&d, 0.0, narrow), point_kernel(&d, 0.0, narrow)) < 1e-6);
         // No area, no light.
         assert_eq!(footprint_kernel(&d, 0.0, 0.0), 0.0);
     }
@@ -628,10 +481,7 @@ fn near_energy_is_accurate_in_both_branches() {
             let g2 = (-s * q).exp() * (s * s * q * q + 3.0 * s * q + 3.0) / (4.0 * q.powi(5));
             let taylor = beta * beta * z * g2;
             let bound = 2.0 * beta_rel * (0.5 * s_z + 2.5);
-            assert!(
-                rel(kernel::second_difference(z, s, beta), taylor) < bound,
-                "s z {s_z}, beta {beta_rel}"
-            );
+            assert!(rel(kernel::second_difference(z, s, beta), taylor) < bound, "s z {s_z}, beta {beta_rel}");
         }
     }
 }
@@ -701,10 +551,7 @@ fn std430_records_have_pinned_layouts() {
             .collect()
     };
     assert_eq!(fields("EvalInput").len() * 4, size_of::<DipoleEvalInput>());
-    assert_eq!(
-        fields("EvalOutput").len() * 4,
-        size_of::<DipoleEvalOutput>()
-    );
+    assert_eq!(fields("EvalOutput").len() * 4, size_of::<DipoleEvalOutput>());
     assert_eq!(fields("EvalOutput")[3], "F_dr");
     assert_eq!(fields("EvalOutput")[10], "kernel");
     assert_eq!(fields("EvalInput")[8], "t_eta");
@@ -716,11 +563,7 @@ fn presets_are_complete_valid_and_found_by_any_case() {
     assert_eq!(NARASIMHAN_2006.len(), 35);
     let mut keys = std::collections::HashSet::new();
     for m in presets::all() {
-        assert!(
-            keys.insert(presets::name_key(m.name)),
-            "{} collides",
-            m.name
-        );
+        assert!(keys.insert(presets::name_key(m.name)), "{} collides", m.name);
         let valid = Material::new(m.name, m.sigma_a, m.sigma_s_prime, m.eta).unwrap();
         assert_eq!(valid, m.material());
         for d in valid.dipoles(1.0).unwrap() {
@@ -728,28 +571,13 @@ fn presets_are_complete_valid_and_found_by_any_case() {
             assert!((0.0..=1.0).contains(&t));
         }
     }
-    for name in [
-        "marble",
-        "MARBLE",
-        "Marble",
-        "lowfat milk",
-        "Lowfat-Milk",
-        "LOWFAT_MILK",
-        "head & shoulders shampoo",
-    ] {
+    for name in ["marble", "MARBLE", "Marble", "lowfat milk", "Lowfat-Milk", "LOWFAT_MILK", "head & shoulders shampoo"]
+    {
         assert!(Material::preset(name).is_ok(), "{name}");
     }
     assert_eq!(Material::preset("marble").unwrap().eta, 1.5);
-    assert!(
-        JENSEN_2001
-            .iter()
-            .filter(|m| m.name != "Marble")
-            .all(|m| m.eta == 1.3)
-    );
-    assert_eq!(
-        Material::preset("granite"),
-        Err(OpticsError::UnknownPreset("granite".into()))
-    );
+    assert!(JENSEN_2001.iter().filter(|m| m.name != "Marble").all(|m| m.eta == 1.3));
+    assert_eq!(Material::preset("granite"), Err(OpticsError::UnknownPreset("granite".into())));
     assert!(Material::preset("").is_err());
 }
 
@@ -759,35 +587,20 @@ fn bad_input_is_refused_with_the_value_named() {
     let e = Material::new("x", [-0.1, 0.0, 0.0], [1.0; 3], 1.3).unwrap_err();
     assert!(msg(e.clone()).contains("-0.1") && msg(e).contains("sigma_a"));
     let e = Material::new("x", [0.1; 3], [1.0, f64::NAN, 1.0], 1.3).unwrap_err();
-    assert!(
-        msg(e.clone()).contains("NaN")
-            && msg(e.clone()).contains("sigma_s'")
-            && msg(e).contains("channel G")
-    );
-    assert!(
-        msg(Material::new("x", [f64::INFINITY; 3], [1.0; 3], 1.3).unwrap_err()).contains("inf")
-    );
+    assert!(msg(e.clone()).contains("NaN") && msg(e.clone()).contains("sigma_s'") && msg(e).contains("channel G"));
+    assert!(msg(Material::new("x", [f64::INFINITY; 3], [1.0; 3], 1.3).unwrap_err()).contains("inf"));
     for eta in [0.0, -1.3, f64::NAN, 0.2, 5.0] {
         let e = Material::new("x", [0.1; 3], [1.0; 3], eta).unwrap_err();
         assert!(matches!(e, OpticsError::BadEta(v) if v.to_bits() == eta.to_bits()));
         assert!(msg(e).contains(&format!("eta = {eta}")));
     }
-    assert!(matches!(
-        Material::new("x", [0.0; 3], [0.0; 3], 1.3),
-        Err(OpticsError::NoExtinction { channel: 0 })
-    ));
+    assert!(matches!(Material::new("x", [0.0; 3], [0.0; 3], 1.3), Err(OpticsError::NoExtinction { channel: 0 })));
     let m = Material::preset("marble").unwrap();
     for scale in [0.0, -1.0, f64::NAN, f64::INFINITY] {
         assert!(msg(m.dipoles(scale).unwrap_err()).contains(&format!("scale = {scale}")));
     }
-    assert!(matches!(
-        m.dipoles(1e-20),
-        Err(OpticsError::OutOfRange { .. })
-    ));
-    assert!(matches!(
-        Material::from_sigma_s("x", [0.1; 3], [1.0; 3], 1.0, 1.3),
-        Err(OpticsError::BadG(_))
-    ));
+    assert!(matches!(m.dipoles(1e-20), Err(OpticsError::OutOfRange { .. })));
+    assert!(matches!(Material::from_sigma_s("x", [0.1; 3], [1.0; 3], 1.0, 1.3), Err(OpticsError::BadG(_))));
     let with_g = Material::from_sigma_s("x", [0.1; 3], [2.0; 3], 0.75, 1.3).unwrap();
     assert_eq!(with_g.sigma_s_prime, [0.5; 3]);
     assert!(m.with_eta(0.0).is_err());
@@ -806,11 +619,7 @@ fn cli(args: &[&str]) -> std::process::Output {
 #[test]
 fn cli_prints_derived_quantities_as_json() {
     let out = cli(&["MARBLE", "--json", "--scale", "10"]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["name"], "Marble");
     assert_eq!(v["eta"], 1.5);
@@ -831,22 +640,12 @@ fn cli_prints_derived_quantities_as_json() {
         }
     }
     // Without absorption the diffusion length is infinite: JSON null, the table says inf.
-    let out = cli(&[
-        "--sigma-a",
-        "0",
-        "--sigma-s-prime",
-        "1,2,3",
-        "--eta",
-        "1.0",
-        "--json",
-    ]);
+    let out = cli(&["--sigma-a", "0", "--sigma-s-prime", "1,2,3", "--eta", "1.0", "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(v["channels"][0]["diffusion_length"].is_null());
     assert_eq!(v["channels"][2]["r_d_total"], 1.0);
     let table = String::from_utf8(cli(&["skin1", "--eta", "1.4"]).stdout).unwrap();
-    assert!(
-        table.contains("Skin1") && table.contains("eta 1.4") && table.contains("diffusion length")
-    );
+    assert!(table.contains("Skin1") && table.contains("eta 1.4") && table.contains("diffusion length"));
 }
 
 #[test]
@@ -855,17 +654,10 @@ fn cli_lists_every_preset() {
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
     for m in presets::all() {
-        assert!(
-            text.lines().any(|l| l.starts_with(m.name)),
-            "{} missing",
-            m.name
-        );
+        assert!(text.lines().any(|l| l.starts_with(m.name)), "{} missing", m.name);
     }
     let v: serde_json::Value = serde_json::from_slice(&cli(&["--list", "--json"]).stdout).unwrap();
-    assert_eq!(
-        v.as_array().unwrap().len(),
-        JENSEN_2001.len() + NARASIMHAN_2006.len()
-    );
+    assert_eq!(v.as_array().unwrap().len(), JENSEN_2001.len() + NARASIMHAN_2006.len());
 }
 
 #[test]
@@ -875,32 +667,9 @@ fn cli_refuses_bad_input_with_a_message_and_nonzero_exit() {
         (&["marble", "--eta", "0"], "eta = 0"),
         (&["marble", "--eta", "-1.5"], "eta = -1.5"),
         (&["marble", "--scale", "-2"], "scale = -2"),
-        (
-            &[
-                "--sigma-a",
-                "0.1,-0.5,0.1",
-                "--sigma-s-prime",
-                "1",
-                "--eta",
-                "1.3",
-            ],
-            "sigma_a = -0.5",
-        ),
-        (
-            &["--sigma-a", "0.1", "--sigma-s-prime", "NaN", "--eta", "1.3"],
-            "sigma_s' = NaN",
-        ),
-        (
-            &[
-                "--sigma-a",
-                "0.1",
-                "--sigma-s-prime",
-                "1,x,1",
-                "--eta",
-                "1.3",
-            ],
-            "\"x\"",
-        ),
+        (&["--sigma-a", "0.1,-0.5,0.1", "--sigma-s-prime", "1", "--eta", "1.3"], "sigma_a = -0.5"),
+        (&["--sigma-a", "0.1", "--sigma-s-prime", "NaN", "--eta", "1.3"], "sigma_s' = NaN"),
+        (&["--sigma-a", "0.1", "--sigma-s-prime", "1,x,1", "--eta", "1.3"], "\"x\""),
         (&["--sigma-a", "0.1", "--sigma-s-prime", "1"], "--eta"),
         (&[], "--list"),
     ] {

@@ -52,17 +52,12 @@ fn cases() -> Vec<Case> {
     // scales from micrometres to metres.
     for sigma_a in [0.0f32, 1e-4, 1e-2, 1.0, 1e2] {
         for sigma_s_prime in [1e-6f32, 1e-4, 1e-2, 1.0, 1e2, 1e4] {
-            for eta in [
-                fresnel::ETA_MIN as f32,
-                0.75,
-                1.0,
-                1.3,
-                1.5,
-                fresnel::ETA_MAX as f32,
-            ] {
+            for eta in [fresnel::ETA_MIN as f32, 0.75, 1.0, 1.3, 1.5, fresnel::ETA_MAX as f32] {
                 for mm_per_unit in [1e-3f32, 1.0, 1e3] {
                     out.push(Case {
-                        label: format!("sigma_a {sigma_a:e} sigma_s' {sigma_s_prime:e} eta {eta} scale {mm_per_unit:e}"),
+                        label: format!(
+                            "sigma_a {sigma_a:e} sigma_s' {sigma_s_prime:e} eta {eta} scale {mm_per_unit:e}"
+                        ),
                         sigma_a,
                         sigma_s_prime,
                         eta,
@@ -78,30 +73,19 @@ fn cases() -> Vec<Case> {
 /// The reference dipole for a case, from the very f32 inputs the GPU sees.
 fn dipole(case: &Case) -> Dipole {
     let scale = case.mm_per_unit as f64;
-    Dipole::new(
-        case.sigma_a as f64 * scale,
-        case.sigma_s_prime as f64 * scale,
-        case.eta as f64,
-        0,
-    )
-    .unwrap_or_else(|e| panic!("{}: {e}", case.label))
+    Dipole::new(case.sigma_a as f64 * scale, case.sigma_s_prime as f64 * scale, case.eta as f64, 0)
+        .unwrap_or_else(|e| panic!("{}: {e}", case.label))
 }
 
 /// The records for one case: sample areas from far below to far above z_r^2 and the diffusion
 /// length squared; distances 0, fractions of z_r, and up to 1e3 diffusion lengths (1e3 z_v when
 /// there is no absorption); a few angle pairs. Returns (records, sweep id per record).
 fn records(case: &Case, d: &Dipole, t_eta: f32) -> Vec<(DipoleEvalInput, usize)> {
-    let length = if d.sigma_tr > 0.0 {
-        d.diffusion_length()
-    } else {
-        d.z_v
-    };
+    let length = if d.sigma_tr > 0.0 { d.diffusion_length() } else { d.z_v };
     let mut distances = vec![0.0];
     distances.extend([1e-4, 1e-2, 0.1, 0.5, 1.0, 3.0, 10.0].map(|f| f * d.z_r));
     distances.extend([1e-2, 0.3, 1.0, 2.0, 5.0, 10.0, 30.0, 100.0, 300.0, 1e3].map(|f| f * length));
-    let mut areas: Vec<f64> = [1e-6, 1e-2, 1.0, 1e2, 1e6]
-        .map(|f| f * d.z_r * d.z_r)
-        .to_vec();
+    let mut areas: Vec<f64> = [1e-6, 1e-2, 1.0, 1e2, 1e6].map(|f| f * d.z_r * d.z_r).to_vec();
     areas.extend([1e-2, 1.0, 1e2].map(|f| f * length * length));
     let angles = [(1.0f32, 1.0f32), (0.7, 0.2), (0.05, 0.0)];
     let mut out = Vec::new();
@@ -195,47 +179,22 @@ const NAMES: [&str; 16] = [
 fn run_on_gpu(inputs: &[DipoleEvalInput]) -> Vec<DipoleEvalOutput> {
     with_gpu(|gpu| {
         let count = inputs.len() as u32;
-        let pipeline = ComputePipeline::new(
-            gpu,
-            "dipole_eval.comp",
-            &[BindingKind::StorageBuffer, BindingKind::StorageBuffer],
-            4,
-        )
-        .expect("dipole_eval pipeline");
-        let src = Buffer::from_slice(
-            gpu,
-            "dipole_eval inputs",
-            inputs,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-        )
-        .expect("input buffer");
+        let pipeline =
+            ComputePipeline::new(gpu, "dipole_eval.comp", &[BindingKind::StorageBuffer, BindingKind::StorageBuffer], 4)
+                .expect("dipole_eval pipeline");
+        let src = Buffer::from_slice(gpu, "dipole_eval inputs", inputs, vk::BufferUsageFlags::STORAGE_BUFFER)
+            .expect("input buffer");
         let bytes = (inputs.len() * std::mem::size_of::<DipoleEvalOutput>()) as u64;
-        let dst = Buffer::new(
-            gpu,
-            &BufferDesc::readback(
-                "dipole_eval outputs",
-                bytes,
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-            ),
-        )
-        .expect("output buffer");
-        let set = pipeline
-            .descriptor_set(&[Binding::Buffer(&src), Binding::Buffer(&dst)])
-            .expect("descriptor set");
+        let dst =
+            Buffer::new(gpu, &BufferDesc::readback("dipole_eval outputs", bytes, vk::BufferUsageFlags::STORAGE_BUFFER))
+                .expect("output buffer");
+        let set = pipeline.descriptor_set(&[Binding::Buffer(&src), Binding::Buffer(&dst)]).expect("descriptor set");
         gpu.one_shot("dipole_eval", |cmd| {
-            pipeline.dispatch(
-                cmd,
-                &set,
-                bytemuck::bytes_of(&count),
-                [count.div_ceil(LOCAL_SIZE), 1, 1],
-            );
+            pipeline.dispatch(cmd, &set, bytemuck::bytes_of(&count), [count.div_ceil(LOCAL_SIZE), 1, 1]);
             memory_barrier(
                 gpu.device(),
                 cmd,
-                (
-                    vk::PipelineStageFlags2::COMPUTE_SHADER,
-                    vk::AccessFlags2::SHADER_WRITE,
-                ),
+                (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_WRITE),
                 (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
             );
         })
@@ -253,9 +212,7 @@ fn glsl_twin_matches_f64_reference() {
     let cases = cases();
     for (ci, case) in cases.iter().enumerate() {
         let d = dipole(case);
-        let t_eta = Material::new("t", [0.0; 3], [1.0; 3], case.eta as f64)
-            .unwrap()
-            .diffuse_transmittance() as f32;
+        let t_eta = Material::new("t", [0.0; 3], [1.0; 3], case.eta as f64).unwrap().diffuse_transmittance() as f32;
         for (input, a) in records(case, &d, t_eta) {
             refs.push(reference(&d, &input));
             inputs.push(input);
@@ -295,17 +252,13 @@ fn glsl_twin_matches_f64_reference() {
                     worst[f] = (e, at.clone());
                 }
                 if e > REL_TOLERANCE {
-                    failures.push(format!(
-                        "{at}: GPU {g:e} vs f64 {want:e} (relative {e:.2e})"
-                    ));
+                    failures.push(format!("{at}: GPU {g:e} vs f64 {want:e} (relative {e:.2e})"));
                 }
             } else {
                 floor_only += 1;
                 let allowed = REL_TOLERANCE * F32_FLOOR.max(PEAK_FRACTION * peak);
                 if (g - want).abs() > allowed {
-                    failures.push(format!(
-                        "{at}: GPU {g:e} vs f64 {want:e} below the comparison floor"
-                    ));
+                    failures.push(format!("{at}: GPU {g:e} vs f64 {want:e} below the comparison floor"));
                 }
             }
         }
@@ -320,16 +273,10 @@ fn glsl_twin_matches_f64_reference() {
         println!("  {:<10} {e:9.2e}  {at}", NAMES[f]);
     }
     // Not vacuous: the bulk of the grid is compared relatively.
-    assert!(
-        compared > 8 * floor_only,
-        "only {compared} of {} values were compared",
-        compared + floor_only
-    );
+    assert!(compared > 8 * floor_only, "only {compared} of {} values were compared", compared + floor_only);
     let mut by_field: HashMap<&str, usize> = HashMap::new();
     for f in &failures {
-        *by_field
-            .entry(NAMES.iter().find(|n| f.starts_with(*n)).unwrap())
-            .or_default() += 1;
+        *by_field.entry(NAMES.iter().find(|n| f.starts_with(*n)).unwrap()).or_default() += 1;
     }
     assert!(
         failures.is_empty(),

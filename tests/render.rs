@@ -3,7 +3,6 @@
 mod common;
 
 use common::with_gpu;
-use glam::DVec3;
 use translucent::optics::{Material, fresnel};
 use translucent::reference;
 use translucent::render::plan::{Change, Pass};
@@ -121,9 +120,28 @@ fn splat_visibility_matches_ray_casting() {
             .zip(&expected)
             .filter(|((g, _), e)| (0..3).any(|c| (g[c] as f64 - e[c]).abs() > 0.02 * e[c].max(0.05 * peak)))
             .count();
-        for k in 0..5 { eprintln!("sample {k}: gpu {:?} cpu {:?}", got[k].0, expected[k]); }
+        for k in 0..5 {
+            eprintln!("sample {k}: gpu {:?} cpu {:?}", got[k].0, expected[k]);
+        }
+        let mut rel: Vec<f64> = got
+            .iter()
+            .zip(&expected)
+            .map(|((g, _), e)| (0..3).map(|c| (g[c] as f64 - e[c]).abs() / e[c].max(0.05 * peak)).fold(0.0, f64::max))
+            .collect();
+        rel.sort_by(f64::total_cmp);
+        eprintln!(
+            "splat relative differences: median {:.2e}, 95% {:.2e}, 98% {:.2e}, max {:.2e}",
+            rel[rel.len() / 2],
+            rel[rel.len() * 95 / 100],
+            rel[rel.len() * 98 / 100],
+            rel[rel.len() - 1]
+        );
         let fraction = differing as f64 / got.len() as f64;
-        eprintln!("splat: {differing} of {} samples differ from ray-cast visibility by over 2% ({:.2}%)", got.len(), 100.0 * fraction);
+        eprintln!(
+            "splat: {differing} of {} samples differ from ray-cast visibility by over 2% ({:.2}%)",
+            got.len(),
+            100.0 * fraction
+        );
         assert!(fraction <= 0.02, "{differing} of {} samples differ", got.len());
     });
 }
@@ -162,11 +180,13 @@ shadow_map_size = 2048
         };
         let predicted = |x: f64| {
             let n = 400;
-            let integral = (0..n).map(|k| line((k as f64 + 0.5) * x.abs() / n as f64)).sum::<f64>() * x.abs() / n as f64;
+            let integral =
+                (0..n).map(|k| line((k as f64 + 0.5) * x.abs() / n as f64)).sum::<f64>() * x.abs() / n as f64;
             f_t * (0.5 * dipole.r_d_total() + x.signum() * integral)
         };
         let lit_far = f_t * dipole.r_d_total();
         let mut checked = 0;
+        let mut worst = 0.0f64;
         for (v, p) in mesh.positions().iter().enumerate() {
             let (x, z) = (p.x as f64, p.z as f64);
             // Away from the plane's rim, and from the edge by more than a few shadow texels.
@@ -175,11 +195,11 @@ shadow_map_size = 2048
             }
             let want = predicted(x);
             let got = exitance[v][0] as f64;
+            worst = worst.max((got - want).abs() / lit_far);
             assert!((got - want).abs() < 0.05 * lit_far, "x = {x:.1}: exitance {got:.5}, predicted {want:.5}");
             checked += 1;
         }
-        eprintln!("shadow edge: {checked} vertices within 5% of the lit level of the predicted profile");
+        eprintln!("shadow edge: {checked} vertices, worst deviation {:.2}% of the lit level", 100.0 * worst);
         assert!(checked > 20);
-        let _ = DVec3::ZERO;
     });
 }

@@ -13,7 +13,8 @@ use translucent::sampling::feature::{feature_point_count, feature_points};
 use translucent::sampling::walk::walk;
 use translucent::sampling::weights::{WeightParams, area_weights};
 use translucent::sampling::{
-    GpuSample, MAX_COUNT, Method, SampleOptions, SampleSet, SamplingError, SpatialHash, SurfacePoint, nearest_neighbour_distances, sample,
+    GpuSample, MAX_COUNT, Method, SampleOptions, SampleSet, SamplingError, SpatialHash, SurfacePoint,
+    nearest_neighbour_distances, sample,
 };
 
 fn asset(name: &str) -> PathBuf {
@@ -126,7 +127,9 @@ fn turk_and_poisson_raise_the_minimum_spacing_over_random() {
         let random = min_nn(&run(bunny(), Method::Random, 400, seed));
         let turk = min_nn(&run(bunny(), Method::Turk, 400, seed));
         let poisson = min_nn(&run(bunny(), Method::Poisson, 400, seed));
-        eprintln!("seed {seed}: min nearest-neighbour distance random {random:.4}, turk {turk:.4}, poisson {poisson:.4}");
+        eprintln!(
+            "seed {seed}: min nearest-neighbour distance random {random:.4}, turk {turk:.4}, poisson {poisson:.4}"
+        );
         assert!(turk > 2.0 * random, "seed {seed}: turk {turk} vs random {random}");
         assert!(poisson > 2.0 * random, "seed {seed}: poisson {poisson} vs random {random}");
     }
@@ -136,7 +139,8 @@ fn turk_and_poisson_raise_the_minimum_spacing_over_random() {
 /// mesh's own per-vertex mean curvature, averaged per triangle), over the same in the rest.
 fn high_curvature_density_ratio(mesh: &Mesh, set: &SampleSet) -> f64 {
     let h = mesh.mean_curvature();
-    let tri_h: Vec<f64> = mesh.triangles().iter().map(|t| t.iter().map(|&v| h[v as usize].abs()).sum::<f64>()).collect();
+    let tri_h: Vec<f64> =
+        mesh.triangles().iter().map(|t| t.iter().map(|&v| h[v as usize].abs()).sum::<f64>()).collect();
     let mut order: Vec<usize> = (0..tri_h.len()).collect();
     order.sort_by(|&a, &b| tri_h[b].total_cmp(&tri_h[a]));
     let mut high = vec![false; tri_h.len()];
@@ -222,7 +226,11 @@ fn unit_square() -> Mesh {
 /// The surface point of the unit square at (x, y).
 fn on_square(x: f64, y: f64) -> SurfacePoint {
     // Triangle 0 is (0,0) (1,0) (1,1), below the diagonal; triangle 1 is (0,0) (1,1) (0,1).
-    if y <= x { SurfacePoint { triangle: 0, bary: [1.0 - x, x - y, y] } } else { SurfacePoint { triangle: 1, bary: [1.0 - y, x, y - x] } }
+    if y <= x {
+        SurfacePoint { triangle: 0, bary: [1.0 - x, x - y, y] }
+    } else {
+        SurfacePoint { triangle: 1, bary: [1.0 - y, x, y - x] }
+    }
 }
 
 #[test]
@@ -260,7 +268,8 @@ fn spatial_hash_agrees_with_brute_force() {
             hash.for_each_within(q, radius, |i, _| {
                 assert!(got.insert(i), "point {i} visited twice");
             });
-            let want: BTreeSet<u32> = (0..pts.len() as u32).filter(|&i| pts[i as usize].distance(q) <= radius).collect();
+            let want: BTreeSet<u32> =
+                (0..pts.len() as u32).filter(|&i| pts[i as usize].distance(q) <= radius).collect();
             assert_eq!(got, want);
         }
         let (near, d) = hash.nearest(q, None).unwrap();
@@ -299,7 +308,8 @@ fn walking_follows_the_surface_across_edges() {
     assert!(end.position(&grid).distance(p0 + DVec3::new(0.61, 0.37, 0.0)) < 1e-9);
 
     // Folded: from the middle of a cube's top face over an edge and down the side.
-    let cube_pos: Vec<Vec3> = (0..8).map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32)).collect();
+    let cube_pos: Vec<Vec3> =
+        (0..8).map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32)).collect();
     let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];
     let cube_tris: Vec<[u32; 3]> = quads.iter().flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect();
     let cube = Mesh::from_triangles(cube_pos, cube_tris).unwrap();
@@ -334,7 +344,8 @@ fn algorithm_1_places_2n_points_in_distinct_top_triangles() {
     let curv = |t: u32| mesh.triangles()[t as usize].iter().map(|&v| h[v as usize]).sum::<f64>() / 3.0;
     let chosen_curv: BTreeSet<u32> = pts[..100].iter().map(|p| p.triangle).collect();
     let weakest_chosen = chosen_curv.iter().map(|&t| curv(t)).fold(f64::INFINITY, f64::min);
-    let strongest_other = (0..mesh.triangles().len() as u32).filter(|t| !chosen_curv.contains(t)).map(curv).fold(0.0, f64::max);
+    let strongest_other =
+        (0..mesh.triangles().len() as u32).filter(|t| !chosen_curv.contains(t)).map(curv).fold(0.0, f64::max);
     assert!(weakest_chosen >= strongest_other, "first n are the n most curved triangles");
     let area = |t: u32| mesh.triangle_areas()[t as usize];
     let smallest_chosen = pts[100..].iter().map(|p| area(p.triangle)).fold(f64::INFINITY, f64::min);
@@ -383,7 +394,9 @@ fn algorithm_1_falls_back_to_the_centroid_on_flat_ground() {
 
 #[test]
 fn one_triangle_many_points_and_one_point() {
-    let tri = Mesh::from_triangles(vec![Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.5)], vec![[0, 1, 2]]).unwrap();
+    let tri =
+        Mesh::from_triangles(vec![Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.5)], vec![[0, 1, 2]])
+            .unwrap();
     for method in Method::ALL {
         for n in [1, 3, 200] {
             let set = run(&tri, method, n, 5);
@@ -465,7 +478,11 @@ fn cli(args: &[&str]) -> std::process::Output {
 }
 
 fn leftovers(dir: &Path) -> Vec<String> {
-    std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).filter(|n| n.contains(".tmp")).collect()
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp"))
+        .collect()
 }
 
 #[test]
@@ -473,7 +490,17 @@ fn cli_writes_a_ply_and_prints_statistics() {
     let dir = temp_dir("cli-ok");
     let out = dir.join("points.ply");
     let mesh = asset("bunny-1.8k.obj");
-    let result = cli(&[mesh.to_str().unwrap(), "--method", "poisson", "--count", "50", "--seed", "4", "-o", out.to_str().unwrap()]);
+    let result = cli(&[
+        mesh.to_str().unwrap(),
+        "--method",
+        "poisson",
+        "--count",
+        "50",
+        "--seed",
+        "4",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     assert!(result.status.success(), "{}", String::from_utf8_lossy(&result.stderr));
     let stdout = String::from_utf8_lossy(&result.stdout);
     for word in ["count", "total area", "nn distance", "cv", "time"] {
@@ -486,7 +513,8 @@ fn cli_writes_a_ply_and_prints_statistics() {
     for prop in ["x", "y", "z", "nx", "ny", "nz", "area"] {
         assert!(header.contains(&format!("property float {prop}\n")));
     }
-    let rows: Vec<Vec<f64>> = body.lines().map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect()).collect();
+    let rows: Vec<Vec<f64>> =
+        body.lines().map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect()).collect();
     assert_eq!(rows.len(), 50);
     assert!(rows.iter().all(|r| r.len() == 7));
     let total: f64 = rows.iter().map(|r| r[6]).sum();

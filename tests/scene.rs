@@ -29,15 +29,9 @@ fn builtin_scene_is_the_marble_bunny() {
     let scene = Scene::builtin();
     let s = &scene.file;
     assert!(matches!(&s.objects[0].shape, Shape::Mesh { path } if path == "bunny-37k.obj"));
-    assert!(
-        matches!(&s.objects[0].material, MaterialSpec::Translucent { preset: Some(p), .. } if p == "marble")
-    );
+    assert!(matches!(&s.objects[0].material, MaterialSpec::Translucent { preset: Some(p), .. } if p == "marble"));
     assert!(matches!(s.objects[1].material, MaterialSpec::Opaque { .. }));
-    assert!(
-        s.lights
-            .iter()
-            .any(|l| matches!(l, Light::Environment { .. }))
-    );
+    assert!(s.lights.iter().any(|l| matches!(l, Light::Environment { .. })));
     assert_eq!(s.sampling.count, 400);
     assert!(scene.resolve("bunny-37k.obj").is_ok());
     assert!(scene.resolve("missing.obj").is_err());
@@ -53,19 +47,10 @@ fn defaults_fill_what_is_left_out() {
 
 #[test]
 fn unknown_key_names_key_and_line() {
-    let text = MINIMAL.replace(
-        "target = [0.0, 0.0, 0.0]",
-        "target = [0.0, 0.0, 0.0]\nfov = 40.0",
-    );
+    let text = MINIMAL.replace("target = [0.0, 0.0, 0.0]", "target = [0.0, 0.0, 0.0]\nfov = 40.0");
     let e = error_of(&text);
-    assert!(
-        e.contains("test.toml") && e.contains("fov") && e.contains("line 5"),
-        "{e}"
-    );
-    let text = MINIMAL.replace(
-        "intensity = [1.0, 1.0, 1.0]",
-        "intensity = [1.0, 1.0, 1.0]\ncolour = 2",
-    );
+    assert!(e.contains("test.toml") && e.contains("fov") && e.contains("line 5"), "{e}");
+    let text = MINIMAL.replace("intensity = [1.0, 1.0, 1.0]", "intensity = [1.0, 1.0, 1.0]\ncolour = 2");
     let e = error_of(&text);
     assert!(e.contains("colour") && e.contains("line 14"), "{e}");
 }
@@ -73,27 +58,11 @@ fn unknown_key_names_key_and_line() {
 #[test]
 fn bad_values_name_the_key() {
     for (from, to, key) in [
-        (
-            "eye = [0.0, 1.0, 3.0]",
-            "eye = [0.0, 0.0, 0.0]",
-            "camera.target",
-        ),
-        (
-            "target = [0.0, 0.0, 0.0]",
-            "target = [0.0, 0.0, 0.0]\nfov_y = 190.0",
-            "camera.fov_y",
-        ),
+        ("eye = [0.0, 1.0, 3.0]", "eye = [0.0, 0.0, 0.0]", "camera.target"),
+        ("target = [0.0, 0.0, 0.0]", "target = [0.0, 0.0, 0.0]\nfov_y = 190.0", "camera.fov_y"),
         ("radius = 1.0", "radius = -1.0", "object[0].shape"),
-        (
-            "mm_per_unit = 10.0",
-            "mm_per_unit = nan",
-            "object[0].material.mm_per_unit",
-        ),
-        (
-            "intensity = [1.0, 1.0, 1.0]",
-            "intensity = [1.0, -1.0, 1.0]",
-            "light[0].intensity",
-        ),
+        ("mm_per_unit = 10.0", "mm_per_unit = nan", "object[0].material.mm_per_unit"),
+        ("intensity = [1.0, 1.0, 1.0]", "intensity = [1.0, -1.0, 1.0]", "light[0].intensity"),
         ("type = \"point\"", "type = \"laser\"", "light[0]"),
         ("preset = \"skimmilk\", ", "", "object[0].material"),
     ] {
@@ -103,10 +72,7 @@ fn bad_values_name_the_key() {
         assert!(e.contains(key), "expected {key} in: {e}");
     }
     let e = error_of(&format!("{MINIMAL}\n[sampling]\nmethod = \"grid\"\n"));
-    assert!(
-        e.contains("sampling.method") && e.contains("line 16"),
-        "{e}"
-    );
+    assert!(e.contains("sampling.method") && e.contains("line 16"), "{e}");
 }
 
 #[test]

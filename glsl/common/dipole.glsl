@@ -232,9 +232,9 @@ float dipole_far_kernel(DipoleChannel ch, float r, float area) {
     return dipole_kernel_with_near_energy(ch, r, area, 0.0);
 }
 
-const float DIPOLE_NEAR_BLEND_RADIUS = 2.0;
+const float DIPOLE_NEAR_BLEND_RADIUS = 1.5;
 
-// Shepard weight (1 - (r/R)^2)^3 inside R = 2 sqrt(area) (kernel::near_blend_weight).
+// Shepard weight (1 - (r/R)^2)^3 inside R = 1.5 sqrt(area) (kernel::near_blend_weight).
 float dipole_near_blend_weight(float r, float area) {
     float radius = DIPOLE_NEAR_BLEND_RADIUS * sqrt(max(area, 0.0));
     if (!(r < radius)) return 0.0;

@@ -37,12 +37,13 @@ void light_incidence(Light l, vec3 p, out vec3 wi, out vec3 irradiance) {
     }
 }
 
-// Fraction of `l` that reaches world point `p` with unit normal `n` (1 = lit), by a 3x3
-// percentage-closer filter over the light's shadow map; each tap of the compare sampler is itself
-// bilinear when the format allows. Points outside the map are lit (border colour white). The
-// lookup moves off the surface along the normal by about two texels, so a curved surface does
-// not shadow itself through the filter's neighbouring texels.
-float light_visibility(Light l, sampler2DArrayShadow maps, vec3 p, vec3 n) {
+// Fraction of `l` that reaches world point `p` with unit normal `n` (1 = lit), from the light's
+// shadow map through the compare sampler (each tap is itself a bilinear 2x2 percentage-closer
+// filter when the format allows). `radius` 0 takes one tap (sharpest, for the splat's sparse
+// sample points, closest to ray-cast visibility); 1 averages a 3x3 block of taps (softer edges
+// for shading pixels). Points outside the map are lit (border colour white). The lookup moves
+// off the surface along the normal by half a texel (`spot_texel.z`), against self-shadowing.
+float light_visibility(Light l, sampler2DArrayShadow maps, vec3 p, vec3 n, int radius) {
     float layer = l.power_layer.w;
     if (layer < 0.0) return 1.0;
     vec4 clip = l.shadow_matrix * vec4(p + n * l.spot_texel.z, 1.0);
@@ -52,12 +53,13 @@ float light_visibility(Light l, sampler2DArrayShadow maps, vec3 p, vec3 n) {
     vec2 uv = ndc.xy * 0.5 + 0.5;
     float texel = l.spot_texel.y;
     float lit = 0.0;
-    for (int y = -1; y <= 1; ++y) {
-        for (int x = -1; x <= 1; ++x) {
+    for (int y = -radius; y <= radius; ++y) {
+        for (int x = -radius; x <= radius; ++x) {
             lit += texture(maps, vec4(uv + vec2(x, y) * texel, layer, ndc.z));
         }
     }
-    return lit / 9.0;
+    float taps = float((2 * radius + 1) * (2 * radius + 1));
+    return lit / taps;
 }
 
 #endif

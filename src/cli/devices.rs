@@ -17,10 +17,7 @@ pub fn run(_gpu: &super::GpuArgs, args: &Args) -> anyhow::Result<()> {
     if args.json {
         println!("{}", serde_json::to_string_pretty(&devices)?);
     } else {
-        println!(
-            "{:<5} {:<36} {:<15} {:<10} {:<8} driver info",
-            "index", "name", "type", "driver", "vulkan"
-        );
+        println!("{:<5} {:<36} {:<15} {:<10} {:<8} driver info", "index", "name", "type", "driver", "vulkan");
         for d in &devices {
             println!(
                 "{:<5} {:<36} {:<15} {:<10} {:<8} {}",

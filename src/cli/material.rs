@@ -11,11 +11,9 @@ use translucent::optics::presets::{self, MeasuredMaterial};
 use translucent::optics::{Dipole, Material};
 
 #[derive(clap::Args, Debug)]
-#[command(
-    after_help = "Coefficients are in 1/mm; derived lengths are in scene units \
+#[command(after_help = "Coefficients are in 1/mm; derived lengths are in scene units \
     (1 scene unit = --scale mm). Preset names match case-insensitively, ignoring spaces and \
-    punctuation: marble, skin1, \"lowfat milk\", lowfat-milk."
-)]
+    punctuation: marble, skin1, \"lowfat milk\", lowfat-milk.")]
 pub struct Args {
     /// A measured material (see --list), e.g. marble, skin1, ketchup, "regular milk"
     #[arg(conflicts_with_all = ["list", "sigma_a", "sigma_s_prime"])]
@@ -24,31 +22,16 @@ pub struct Args {
     #[arg(long)]
     pub list: bool,
     /// Custom absorption coefficient sigma_a in 1/mm: R,G,B or one value for all channels
-    #[arg(
-        long,
-        value_name = "R,G,B",
-        allow_hyphen_values = true,
-        requires = "sigma_s_prime"
-    )]
+    #[arg(long, value_name = "R,G,B", allow_hyphen_values = true, requires = "sigma_s_prime")]
     pub sigma_a: Option<String>,
     /// Custom reduced scattering coefficient sigma_s' in 1/mm: R,G,B or one value
-    #[arg(
-        long = "sigma-s-prime",
-        value_name = "R,G,B",
-        allow_hyphen_values = true,
-        requires = "sigma_a"
-    )]
+    #[arg(long = "sigma-s-prime", value_name = "R,G,B", allow_hyphen_values = true, requires = "sigma_a")]
     pub sigma_s_prime: Option<String>,
     /// Relative index of refraction (a preset's own by default; required with custom coefficients)
     #[arg(long, allow_hyphen_values = true)]
     pub eta: Option<f64>,
     /// Scene scale: millimetres per scene unit
-    #[arg(
-        long,
-        value_name = "MM_PER_UNIT",
-        default_value_t = 1.0,
-        allow_hyphen_values = true
-    )]
+    #[arg(long, value_name = "MM_PER_UNIT", default_value_t = 1.0, allow_hyphen_values = true)]
     pub scale: f64,
     /// Print JSON instead of a table
     #[arg(long)]
@@ -105,17 +88,13 @@ fn parse_rgb(flag: &str, text: &str) -> anyhow::Result<[f64; 3]> {
         .split(',')
         .map(|part| {
             let part = part.trim();
-            part.parse::<f64>()
-                .with_context(|| format!("{flag}: {part:?} is not a number"))
+            part.parse::<f64>().with_context(|| format!("{flag}: {part:?} is not a number"))
         })
         .collect::<anyhow::Result<Vec<f64>>>()?;
     match values[..] {
         [v] => Ok([v; 3]),
         [r, g, b] => Ok([r, g, b]),
-        _ => bail!(
-            "{flag}: expected R,G,B or one value, got {text:?} ({} values)",
-            values.len()
-        ),
+        _ => bail!("{flag}: expected R,G,B or one value, got {text:?} ({} values)", values.len()),
     }
 }
 
@@ -153,12 +132,7 @@ struct Report<'a> {
     channels: Vec<ChannelReport>,
 }
 
-fn report<'a>(
-    m: &'a Material,
-    source: Option<&'a str>,
-    scale: f64,
-    dipoles: &[Dipole; 3],
-) -> Report<'a> {
+fn report<'a>(m: &'a Material, source: Option<&'a str>, scale: f64, dipoles: &[Dipole; 3]) -> Report<'a> {
     let channels = dipoles
         .iter()
         .zip(["R", "G", "B"])
@@ -194,17 +168,10 @@ fn report<'a>(
 fn table(m: &Material, source: Option<&str>, scale: f64, dipoles: &[Dipole; 3]) -> String {
     let mut out = String::new();
     let from = source.map(|s| format!(" ({s})")).unwrap_or_default();
-    let _ = writeln!(
-        out,
-        "{}{from}: eta {}, 1 scene unit = {} mm",
-        m.name, m.eta, scale
-    );
+    let _ = writeln!(out, "{}{from}: eta {}, 1 scene unit = {} mm", m.name, m.eta, scale);
     let _ = writeln!(out, "{:<26}{:>13}{:>13}{:>13}", "", "R", "G", "B");
     let mut row = |label: &str, f: &dyn Fn(&Dipole) -> f64| {
-        let cells: String = dipoles
-            .iter()
-            .map(|d| format!("{:>13}", fmt(f(d))))
-            .collect();
+        let cells: String = dipoles.iter().map(|d| format!("{:>13}", fmt(f(d)))).collect();
         let _ = writeln!(out, "{label:<26}{cells}");
     };
     row("sigma_a          [1/mm]", &|d| d.sigma_a / scale);
@@ -220,11 +187,7 @@ fn table(m: &Material, source: Option<&str>, scale: f64, dipoles: &[Dipole; 3]) 
     row("R_d,total", &|d| d.r_d_total());
     row("mean free path   [unit]", &|d| d.mean_free_path());
     row("diffusion length [unit]", &|d| d.diffusion_length());
-    let _ = writeln!(
-        out,
-        "BSSRDF normalization T(eta) = 1 - 2 FM1(eta) = {}",
-        fmt(m.diffuse_transmittance())
-    );
+    let _ = writeln!(out, "BSSRDF normalization T(eta) = 1 - 2 FM1(eta) = {}", fmt(m.diffuse_transmittance()));
     out
 }
 
@@ -233,11 +196,7 @@ fn fmt(v: f64) -> String {
     if v.is_infinite() {
         "inf".into()
     } else if v == 0.0 || (1e-3..1e5).contains(&v.abs()) {
-        let digits = if v == 0.0 {
-            0
-        } else {
-            (3 - v.abs().log10().floor() as i32).max(0) as usize
-        };
+        let digits = if v == 0.0 { 0 } else { (3 - v.abs().log10().floor() as i32).max(0) as usize };
         format!("{v:.digits$}")
     } else {
         format!("{v:.3e}")

@@ -20,9 +20,8 @@ pub struct GpuArgs {
 
 impl GpuArgs {
     pub fn options(&self) -> GpuOptions {
-        let env_validation = std::env::var("TRANSLUCENT_VALIDATION")
-            .map(|v| !v.is_empty() && v != "0")
-            .unwrap_or(false);
+        let env_validation =
+            std::env::var("TRANSLUCENT_VALIDATION").map(|v| !v.is_empty() && v != "0").unwrap_or(false);
         GpuOptions {
             device: self.device.clone(),
             validation: self.validation || env_validation,

@@ -172,7 +172,11 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     }
     if args.timings {
         let frames = totals.len();
-        println!("GPU time per pass on {} (median of {frames} frame(s){}):", gpu.info().name, if args.frames > 1 { " after the first" } else { "" });
+        println!(
+            "GPU time per pass on {} (median of {frames} frame(s){}):",
+            gpu.info().name,
+            if args.frames > 1 { " after the first" } else { "" }
+        );
         for (name, mut v) in per_pass {
             println!("  {name:<8} {:>9.3} ms", median(&mut v));
         }

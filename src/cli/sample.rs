@@ -131,7 +131,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         eprintln!("warning: {}: {warning}", report.source);
     }
     let fmt_opt = |v: Option<f64>| v.map_or("-".to_string(), num);
-    println!("mesh         {} ({} vertices, {} triangles)", report.source, mesh.positions().len(), mesh.triangles().len());
+    println!(
+        "mesh         {} ({} vertices, {} triangles)",
+        report.source,
+        mesh.positions().len(),
+        mesh.triangles().len()
+    );
     println!("method       {} (seed {})", options.method, args.seed);
     println!("count        {}", stats.count);
     println!(
@@ -140,7 +145,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         num(stats.total_weight),
         (stats.total_weight - stats.mesh_area).abs() / stats.mesh_area
     );
-    println!("nn distance  min {}  mean {}  max {}", fmt_opt(stats.nn_min), fmt_opt(stats.nn_mean), fmt_opt(stats.nn_max));
+    println!(
+        "nn distance  min {}  mean {}  max {}",
+        fmt_opt(stats.nn_min),
+        fmt_opt(stats.nn_mean),
+        fmt_opt(stats.nn_max)
+    );
     println!("weights      cv {:.4}  min {:.3e}  max {:.3e}", stats.weight_cv, stats.weight_min, stats.weight_max);
     println!("time         load {load_seconds:.3} s, sampling {sample_seconds:.3} s");
     if let Some(path) = &args.output {
@@ -172,7 +182,10 @@ fn mesh_warnings(r: &translucent::mesh::MeshReport) -> Vec<String> {
         w.push(format!("{} non-manifold edges (shared by three or more triangles)", r.non_manifold_edges));
     }
     if r.inconsistently_oriented_edges > 0 {
-        w.push(format!("{} edges with inconsistent winding (some normals may point inwards)", r.inconsistently_oriented_edges));
+        w.push(format!(
+            "{} edges with inconsistent winding (some normals may point inwards)",
+            r.inconsistently_oriented_edges
+        ));
     }
     w
 }

@@ -15,12 +15,7 @@ pub fn memory_barrier(
         .dst_stage_mask(dst.0)
         .dst_access_mask(dst.1)];
     // SAFETY: `cmd` is in the recording state (callers record inside Gpu::one_shot or their own).
-    unsafe {
-        device.cmd_pipeline_barrier2(
-            cmd,
-            &vk::DependencyInfo::default().memory_barriers(&barrier),
-        )
-    };
+    unsafe { device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier)) };
 }
 
 /// Move a whole image (all mips and layers of `aspect`) from one layout to another.
@@ -51,10 +46,5 @@ pub fn image_barrier(
                 .layer_count(vk::REMAINING_ARRAY_LAYERS),
         )];
     // SAFETY: as above.
-    unsafe {
-        device.cmd_pipeline_barrier2(
-            cmd,
-            &vk::DependencyInfo::default().image_memory_barriers(&barrier),
-        )
-    };
+    unsafe { device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&barrier)) };
 }

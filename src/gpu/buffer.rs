@@ -20,30 +20,15 @@ pub struct BufferDesc {
 impl BufferDesc {
     /// A device-local buffer; TRANSFER_SRC/DST are added so it can always be read back or filled.
     pub fn gpu_only(name: &str, size: u64, usage: vk::BufferUsageFlags) -> Self {
-        Self {
-            name: name.into(),
-            size,
-            usage,
-            location: MemoryLocation::GpuOnly,
-        }
+        Self { name: name.into(), size, usage, location: MemoryLocation::GpuOnly }
     }
     /// A host-visible buffer the CPU writes and the GPU reads.
     pub fn upload(name: &str, size: u64, usage: vk::BufferUsageFlags) -> Self {
-        Self {
-            name: name.into(),
-            size,
-            usage,
-            location: MemoryLocation::CpuToGpu,
-        }
+        Self { name: name.into(), size, usage, location: MemoryLocation::CpuToGpu }
     }
     /// A host-visible buffer the GPU writes and the CPU reads.
     pub fn readback(name: &str, size: u64, usage: vk::BufferUsageFlags) -> Self {
-        Self {
-            name: name.into(),
-            size,
-            usage,
-            location: MemoryLocation::GpuToCpu,
-        }
+        Self { name: name.into(), size, usage, location: MemoryLocation::GpuToCpu }
     }
 }
 
@@ -58,19 +43,12 @@ pub struct Buffer {
 impl Buffer {
     pub fn new(gpu: &Arc<Gpu>, desc: &BufferDesc) -> GpuResult<Buffer> {
         if desc.size == 0 {
-            return Err(GpuError::Invalid(format!(
-                "buffer {:?} has size 0",
-                desc.name
-            )));
+            return Err(GpuError::Invalid(format!("buffer {:?} has size 0", desc.name)));
         }
         let device = gpu.device();
         let info = vk::BufferCreateInfo::default()
             .size(desc.size)
-            .usage(
-                desc.usage
-                    | vk::BufferUsageFlags::TRANSFER_SRC
-                    | vk::BufferUsageFlags::TRANSFER_DST,
-            )
+            .usage(desc.usage | vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST)
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: valid create info; the buffer is destroyed in Drop or below on failure.
         let raw = unsafe { device.create_buffer(&info, None) }.vk("vkCreateBuffer")?;
@@ -86,30 +64,16 @@ impl Buffer {
             Ok(a) => a,
             Err(source) => {
                 unsafe { device.destroy_buffer(raw, None) };
-                return Err(GpuError::Alloc {
-                    what: desc.name.clone(),
-                    source,
-                });
+                return Err(GpuError::Alloc { what: desc.name.clone(), source });
             }
         };
         // SAFETY: the allocation satisfies `requirements` and is not bound elsewhere.
-        if let Err(result) =
-            unsafe { device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) }
-        {
+        if let Err(result) = unsafe { device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) } {
             unsafe { device.destroy_buffer(raw, None) };
             let _ = gpu.allocator().free(allocation);
-            return Err(GpuError::Vk {
-                what: "vkBindBufferMemory",
-                result,
-            });
+            return Err(GpuError::Vk { what: "vkBindBufferMemory", result });
         }
-        Ok(Buffer {
-            gpu: gpu.clone(),
-            raw,
-            allocation: Some(allocation),
-            size: desc.size,
-            name: desc.name.clone(),
-        })
+        Ok(Buffer { gpu: gpu.clone(), raw, allocation: Some(allocation), size: desc.size, name: desc.name.clone() })
     }
 
     /// A host-visible buffer filled with `data`.
@@ -151,19 +115,10 @@ impl Buffer {
             mapped[offset as usize..end as usize].copy_from_slice(bytes);
             return Ok(());
         }
-        let staging = Buffer::from_slice(
-            &self.gpu,
-            "staging upload",
-            bytes,
-            vk::BufferUsageFlags::TRANSFER_SRC,
-        )?;
+        let staging = Buffer::from_slice(&self.gpu, "staging upload", bytes, vk::BufferUsageFlags::TRANSFER_SRC)?;
         let device = self.gpu.device();
         self.gpu.one_shot("buffer upload", |cmd| {
-            let region = [vk::BufferCopy {
-                src_offset: 0,
-                dst_offset: offset,
-                size: bytes.len() as u64,
-            }];
+            let region = [vk::BufferCopy { src_offset: 0, dst_offset: offset, size: bytes.len() as u64 }];
             // SAFETY: both buffers are alive and large enough (checked above).
             unsafe { device.cmd_copy_buffer(cmd, staging.raw, self.raw, &region) };
         })
@@ -187,28 +142,17 @@ impl Buffer {
         }
         let staging = Buffer::new(
             &self.gpu,
-            &BufferDesc::readback(
-                "staging readback",
-                self.size,
-                vk::BufferUsageFlags::TRANSFER_DST,
-            ),
+            &BufferDesc::readback("staging readback", self.size, vk::BufferUsageFlags::TRANSFER_DST),
         )?;
         let device = self.gpu.device();
         self.gpu.one_shot("buffer readback", |cmd| {
-            let region = [vk::BufferCopy {
-                src_offset: 0,
-                dst_offset: 0,
-                size: self.size,
-            }];
+            let region = [vk::BufferCopy { src_offset: 0, dst_offset: 0, size: self.size }];
             // SAFETY: both buffers are alive and of the same size.
             unsafe { device.cmd_copy_buffer(cmd, self.raw, staging.raw, &region) };
             memory_barrier(
                 device,
                 cmd,
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                ),
+                (vk::PipelineStageFlags2::COPY, vk::AccessFlags2::TRANSFER_WRITE),
                 (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
             );
         })?;

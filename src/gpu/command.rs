@@ -28,45 +28,32 @@ impl Drop for Transient<'_> {
 impl Gpu {
     /// Record commands with `record`, submit them, and block until they finish (at most
     /// `self.timeout()`). `what` names the work in errors.
-    pub fn one_shot<R>(
-        &self,
-        what: &str,
-        record: impl FnOnce(vk::CommandBuffer) -> R,
-    ) -> GpuResult<R> {
+    pub fn one_shot<R>(&self, what: &str, record: impl FnOnce(vk::CommandBuffer) -> R) -> GpuResult<R> {
         let device = self.device();
         let pool_info = vk::CommandPoolCreateInfo::default()
             .queue_family_index(self.queue_family())
             .flags(vk::CommandPoolCreateFlags::TRANSIENT);
         // SAFETY: valid device; the pool is destroyed by `Transient`.
-        let pool =
-            unsafe { device.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")?;
-        let mut transient = Transient {
-            gpu: self,
-            pool,
-            fence: vk::Fence::null(),
-        };
+        let pool = unsafe { device.create_command_pool(&pool_info, None) }.vk("vkCreateCommandPool")?;
+        let mut transient = Transient { gpu: self, pool, fence: vk::Fence::null() };
         let alloc = vk::CommandBufferAllocateInfo::default()
             .command_pool(pool)
             .level(vk::CommandBufferLevel::PRIMARY)
             .command_buffer_count(1);
         // SAFETY: allocation from a pool owned by this thread.
-        let cmd =
-            unsafe { device.allocate_command_buffers(&alloc) }.vk("vkAllocateCommandBuffers")?[0];
-        let begin = vk::CommandBufferBeginInfo::default()
-            .flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        let cmd = unsafe { device.allocate_command_buffers(&alloc) }.vk("vkAllocateCommandBuffers")?[0];
+        let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
         unsafe { device.begin_command_buffer(cmd, &begin) }.vk("vkBeginCommandBuffer")?;
         let result = record(cmd);
         unsafe { device.end_command_buffer(cmd) }.vk("vkEndCommandBuffer")?;
 
-        transient.fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }
-            .vk("vkCreateFence")?;
+        transient.fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }.vk("vkCreateFence")?;
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
         let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
         {
             let queue = self.queue();
             // SAFETY: the queue is externally synchronised by the guard; `cmd` is fully recorded.
-            unsafe { device.queue_submit2(*queue, &submit, transient.fence) }
-                .vk("vkQueueSubmit2")?;
+            unsafe { device.queue_submit2(*queue, &submit, transient.fence) }.vk("vkQueueSubmit2")?;
         }
         let timeout_ns = u64::try_from(self.timeout().as_nanos()).unwrap_or(u64::MAX);
         // SAFETY: waiting on a fence we own.
@@ -75,17 +62,11 @@ impl Gpu {
             Err(vk::Result::TIMEOUT) => {
                 // The pool must not be destroyed while the work is pending.
                 let _ = unsafe { device.device_wait_idle() };
-                Err(GpuError::Timeout {
-                    what: what.to_string(),
-                    seconds: self.timeout().as_secs_f64(),
-                })
+                Err(GpuError::Timeout { what: what.to_string(), seconds: self.timeout().as_secs_f64() })
             }
             Err(result) => {
                 let _ = unsafe { device.device_wait_idle() };
-                Err(GpuError::Vk {
-                    what: "vkWaitForFences",
-                    result,
-                })
+                Err(GpuError::Vk { what: "vkWaitForFences", result })
             }
         }
     }

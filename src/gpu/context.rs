@@ -37,7 +37,8 @@ pub struct HostVulkan {
     pub entry: ash::Entry,
     pub instance: ash::Instance,
     pub physical_device: vk::PhysicalDevice,
-    /// Must have been created with Vulkan 1.3 `dynamicRendering` and `synchronization2` enabled.
+    /// Must have been created with Vulkan 1.3 `dynamicRendering` and `synchronization2` and
+    /// Vulkan 1.2 `shaderOutputLayer` enabled.
     pub device: ash::Device,
     /// A queue that supports graphics and compute. Submissions from `Gpu` lock an internal mutex;
     /// the host must not submit to the same queue concurrently.
@@ -57,6 +58,7 @@ impl Gpu {
             let devices = device::enumerate(&owned.instance)?;
             let info = device::select(&devices, options.device.as_deref())?;
             let (family, _) = device::queue_family(&owned.instance, &info)?;
+            device::check_features(&owned.instance, &info)?;
             let device = device::create_logical(&owned.instance, &info, family)?;
             Ok::<_, GpuError>((info, family, device))
         })();
@@ -71,18 +73,7 @@ impl Gpu {
         // SAFETY: queue 0 of `family` was requested in create_logical.
         let queue = unsafe { device.get_device_queue(family, 0) };
         let instance = owned.instance.clone();
-        Self::assemble(
-            entry,
-            instance,
-            Some(owned),
-            info.handle,
-            device,
-            true,
-            queue,
-            family,
-            counters,
-            options,
-        )
+        Self::assemble(entry, instance, Some(owned), info.handle, device, true, queue, family, counters, options)
     }
 
     /// Wrap Vulkan objects a host engine owns. Nothing of theirs is destroyed on Drop; only what
@@ -96,9 +87,7 @@ impl Gpu {
         let info = devices
             .into_iter()
             .find(|d| d.handle == host.physical_device)
-            .ok_or_else(|| {
-                GpuError::Invalid("the host's physical device is not one of its instance's".into())
-            })?;
+            .ok_or_else(|| GpuError::Invalid("the host's physical device is not one of its instance's".into()))?;
         let counters = Arc::new(ValidationCounters::default());
         Self::assemble(
             host.entry,
@@ -127,17 +116,11 @@ impl Gpu {
         counters: Arc<ValidationCounters>,
         options: &GpuOptions,
     ) -> GpuResult<Arc<Gpu>> {
-        let info = device::enumerate(&instance)?
-            .into_iter()
-            .find(|d| d.handle == physical)
-            .unwrap();
+        let info = device::enumerate(&instance)?.into_iter().find(|d| d.handle == physical).unwrap();
         // SAFETY: plain queries.
         let properties = unsafe { instance.get_physical_device_properties(physical) };
         let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
-        let timestamp_valid_bits = families
-            .get(queue_family as usize)
-            .map(|f| f.timestamp_valid_bits)
-            .unwrap_or(0);
+        let timestamp_valid_bits = families.get(queue_family as usize).map(|f| f.timestamp_valid_bits).unwrap_or(0);
         let allocator = Allocator::new(&AllocatorCreateDesc {
             instance: instance.clone(),
             device: device.clone(),
@@ -159,10 +142,7 @@ impl Gpu {
                         o.destroy();
                     }
                 }
-                return Err(GpuError::Alloc {
-                    what: "allocator".into(),
-                    source,
-                });
+                return Err(GpuError::Alloc { what: "allocator".into(), source });
             }
         };
         Ok(Arc::new(Gpu {
@@ -218,9 +198,7 @@ impl Gpu {
         self.counters.clone()
     }
     pub fn validation_enabled(&self) -> bool {
-        self.owned_instance
-            .as_ref()
-            .is_some_and(|o| o.debug.is_some())
+        self.owned_instance.as_ref().is_some_and(|o| o.debug.is_some())
     }
     /// Nanoseconds per timestamp tick, and how many low bits of a timestamp are valid.
     pub fn timestamp_info(&self) -> (f64, u32) {

@@ -32,11 +32,7 @@ impl ValidationCounters {
         self.first.lock().map(|m| m.clone()).unwrap_or_default()
     }
     fn record(&self, is_error: bool, text: String) {
-        let counter = if is_error {
-            &self.errors
-        } else {
-            &self.warnings
-        };
+        let counter = if is_error { &self.errors } else { &self.warnings };
         counter.fetch_add(1, Ordering::SeqCst);
         if let Ok(mut first) = self.first.lock()
             && first.len() < 16
@@ -56,13 +52,10 @@ pub(crate) struct DebugMessenger {
 }
 
 impl DebugMessenger {
-    pub(crate) fn create_info(
-        counters: &Arc<ValidationCounters>,
-    ) -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
+    pub(crate) fn create_info(counters: &Arc<ValidationCounters>) -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
         vk::DebugUtilsMessengerCreateInfoEXT::default()
             .message_severity(
-                vk::DebugUtilsMessageSeverityFlagsEXT::WARNING
-                    | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
+                vk::DebugUtilsMessageSeverityFlagsEXT::WARNING | vk::DebugUtilsMessageSeverityFlagsEXT::ERROR,
             )
             .message_type(
                 vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
@@ -83,20 +76,13 @@ impl DebugMessenger {
         // SAFETY: the user-data pointer stays valid while `counters` lives in this struct, and the
         // messenger is destroyed (Drop of Gpu) before this struct is dropped.
         let messenger = unsafe { loader.create_debug_utils_messenger(&info, None)? };
-        Ok(Self {
-            loader,
-            messenger,
-            counters,
-        })
+        Ok(Self { loader, messenger, counters })
     }
 
     /// # Safety
     /// Call once, before the instance is destroyed.
     pub(crate) unsafe fn destroy(&self) {
-        unsafe {
-            self.loader
-                .destroy_debug_utils_messenger(self.messenger, None)
-        };
+        unsafe { self.loader.destroy_debug_utils_messenger(self.messenger, None) };
     }
 }
 
@@ -112,9 +98,7 @@ unsafe extern "system" fn callback(
         let message = if data.is_null() || (*data).p_message.is_null() {
             "(no message)".to_string()
         } else {
-            CStr::from_ptr((*data).p_message)
-                .to_string_lossy()
-                .into_owned()
+            CStr::from_ptr((*data).p_message).to_string_lossy().into_owned()
         };
         (message, (user as *const ValidationCounters).as_ref())
     };

@@ -28,11 +28,7 @@ impl BindingKind {
 /// What to bind at one binding.
 pub enum Binding<'a> {
     Buffer(&'a Buffer),
-    Image {
-        view: vk::ImageView,
-        layout: vk::ImageLayout,
-        sampler: vk::Sampler,
-    },
+    Image { view: vk::ImageView, layout: vk::ImageLayout, sampler: vk::Sampler },
 }
 
 pub(crate) fn create_set_layout(
@@ -53,8 +49,7 @@ pub(crate) fn create_set_layout(
         .collect();
     let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings);
     // SAFETY: valid create info; the owner destroys the layout.
-    unsafe { gpu.device().create_descriptor_set_layout(&info, None) }
-        .vk("vkCreateDescriptorSetLayout")
+    unsafe { gpu.device().create_descriptor_set_layout(&info, None) }.vk("vkCreateDescriptorSetLayout")
 }
 
 pub struct DescriptorSet {
@@ -78,68 +73,29 @@ impl DescriptorSet {
             )));
         }
         let device = gpu.device();
-        let sizes: Vec<_> = kinds
-            .iter()
-            .map(|k| vk::DescriptorPoolSize {
-                ty: k.vk(),
-                descriptor_count: 1,
-            })
-            .collect();
-        let info = vk::DescriptorPoolCreateInfo::default()
-            .max_sets(1)
-            .pool_sizes(&sizes);
+        let sizes: Vec<_> = kinds.iter().map(|k| vk::DescriptorPoolSize { ty: k.vk(), descriptor_count: 1 }).collect();
+        let info = vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes);
         // SAFETY: valid create info; destroyed in Drop.
-        let pool =
-            unsafe { device.create_descriptor_pool(&info, None) }.vk("vkCreateDescriptorPool")?;
-        let mut out = DescriptorSet {
-            gpu: gpu.clone(),
-            pool,
-            set: vk::DescriptorSet::null(),
-        };
+        let pool = unsafe { device.create_descriptor_pool(&info, None) }.vk("vkCreateDescriptorPool")?;
+        let mut out = DescriptorSet { gpu: gpu.clone(), pool, set: vk::DescriptorSet::null() };
         let layouts = [layout];
-        let alloc = vk::DescriptorSetAllocateInfo::default()
-            .descriptor_pool(pool)
-            .set_layouts(&layouts);
-        out.set =
-            unsafe { device.allocate_descriptor_sets(&alloc) }.vk("vkAllocateDescriptorSets")?[0];
+        let alloc = vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts);
+        out.set = unsafe { device.allocate_descriptor_sets(&alloc) }.vk("vkAllocateDescriptorSets")?[0];
         out.update(kinds, bindings)?;
         Ok(out)
     }
 
     /// Point the bindings at other resources (same kinds). Not while the set is in use by the GPU.
-    pub(crate) fn update(
-        &mut self,
-        kinds: &[BindingKind],
-        bindings: &[Binding<'_>],
-    ) -> GpuResult<()> {
+    pub(crate) fn update(&mut self, kinds: &[BindingKind], bindings: &[Binding<'_>]) -> GpuResult<()> {
         let mut buffer_infos = Vec::new();
         let mut image_infos = Vec::new();
         for (i, (kind, binding)) in kinds.iter().zip(bindings).enumerate() {
             match (kind, binding) {
-                (BindingKind::StorageBuffer | BindingKind::UniformBuffer, Binding::Buffer(b)) => {
-                    buffer_infos.push((
-                        i,
-                        [vk::DescriptorBufferInfo {
-                            buffer: b.raw(),
-                            offset: 0,
-                            range: vk::WHOLE_SIZE,
-                        }],
-                    ))
-                }
-                (
-                    BindingKind::CombinedImageSampler,
-                    Binding::Image {
-                        view,
-                        layout,
-                        sampler,
-                    },
-                ) => image_infos.push((
+                (BindingKind::StorageBuffer | BindingKind::UniformBuffer, Binding::Buffer(b)) => buffer_infos
+                    .push((i, [vk::DescriptorBufferInfo { buffer: b.raw(), offset: 0, range: vk::WHOLE_SIZE }])),
+                (BindingKind::CombinedImageSampler, Binding::Image { view, layout, sampler }) => image_infos.push((
                     i,
-                    [vk::DescriptorImageInfo {
-                        sampler: *sampler,
-                        image_view: *view,
-                        image_layout: *layout,
-                    }],
+                    [vk::DescriptorImageInfo { sampler: *sampler, image_view: *view, image_layout: *layout }],
                 )),
                 _ => return Err(GpuError::Invalid(format!("binding {i}: expected {kind:?}"))),
             }

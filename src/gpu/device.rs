@@ -32,18 +32,12 @@ impl fmt::Display for DeviceInfo {
 }
 
 fn version_string(v: u32) -> String {
-    format!(
-        "{}.{}.{}",
-        vk::api_version_major(v),
-        vk::api_version_minor(v),
-        vk::api_version_patch(v)
-    )
+    format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v))
 }
 
 pub(crate) fn enumerate(instance: &ash::Instance) -> GpuResult<Vec<DeviceInfo>> {
     // SAFETY: plain queries on a live instance.
-    let handles =
-        unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
+    let handles = unsafe { instance.enumerate_physical_devices() }.vk("vkEnumeratePhysicalDevices")?;
     Ok(handles
         .into_iter()
         .enumerate()
@@ -53,10 +47,7 @@ pub(crate) fn enumerate(instance: &ash::Instance) -> GpuResult<Vec<DeviceInfo>> 
             // SAFETY: `props2` chains only `driver`, a 1.2-core struct every 1.1+ loader accepts.
             unsafe { instance.get_physical_device_properties2(handle, &mut props2) };
             let props = props2.properties;
-            let name = props
-                .device_name_as_c_str()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default();
+            let name = props.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
             let kind = match props.device_type {
                 vk::PhysicalDeviceType::DISCRETE_GPU => "discrete GPU",
                 vk::PhysicalDeviceType::INTEGRATED_GPU => "integrated GPU",
@@ -68,10 +59,7 @@ pub(crate) fn enumerate(instance: &ash::Instance) -> GpuResult<Vec<DeviceInfo>> 
                 index,
                 name,
                 kind: kind.to_string(),
-                driver: driver
-                    .driver_name_as_c_str()
-                    .map(|s| s.to_string_lossy().into_owned())
-                    .unwrap_or_default(),
+                driver: driver.driver_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
                 driver_info: driver
                     .driver_info_as_c_str()
                     .map(|s| s.to_string_lossy().into_owned())
@@ -95,20 +83,12 @@ pub(crate) fn select(devices: &[DeviceInfo], wanted: Option<&str>) -> GpuResult<
         Some(w) => {
             let by_index = w.parse::<usize>().ok().and_then(|i| devices.get(i));
             let lower = w.to_lowercase();
-            by_index
-                .or_else(|| {
-                    devices
-                        .iter()
-                        .find(|d| d.name.to_lowercase().contains(&lower))
-                })
-                .ok_or_else(|| GpuError::DeviceNotFound {
+            by_index.or_else(|| devices.iter().find(|d| d.name.to_lowercase().contains(&lower))).ok_or_else(|| {
+                GpuError::DeviceNotFound {
                     wanted: w.to_string(),
-                    available: devices
-                        .iter()
-                        .map(|d| format!("  {d}"))
-                        .collect::<Vec<_>>()
-                        .join("\n"),
-                })?
+                    available: devices.iter().map(|d| format!("  {d}")).collect::<Vec<_>>().join("\n"),
+                }
+            })?
         }
         None => {
             let rank = |d: &DeviceInfo| match d.device_type {
@@ -139,10 +119,7 @@ pub(crate) fn queue_family(instance: &ash::Instance, device: &DeviceInfo) -> Gpu
     families
         .iter()
         .enumerate()
-        .find(|(_, f)| {
-            f.queue_flags
-                .contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)
-        })
+        .find(|(_, f)| f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE))
         .map(|(i, f)| (i as u32, f.timestamp_valid_bits))
         .ok_or_else(|| GpuError::DeviceUnsuitable {
             name: device.name.clone(),
@@ -151,21 +128,31 @@ pub(crate) fn queue_family(instance: &ash::Instance, device: &DeviceInfo) -> Gpu
         })
 }
 
-pub(crate) fn create_logical(
-    instance: &ash::Instance,
-    device: &DeviceInfo,
-    family: u32,
-) -> GpuResult<ash::Device> {
+/// Optional Vulkan 1.2 features translucent relies on.
+pub(crate) fn check_features(instance: &ash::Instance, device: &DeviceInfo) -> GpuResult<()> {
+    let mut v12 = vk::PhysicalDeviceVulkan12Features::default();
+    let mut features = vk::PhysicalDeviceFeatures2::default().push_next(&mut v12);
+    // SAFETY: plain query with a 1.2-core chained struct.
+    unsafe { instance.get_physical_device_features2(device.handle, &mut features) };
+    if v12.shader_output_layer == vk::FALSE {
+        return Err(GpuError::DeviceUnsuitable {
+            name: device.name.clone(),
+            version: device.api_version.clone(),
+            detail: " and the shaderOutputLayer feature (layered shadow maps); it lacks it".into(),
+        });
+    }
+    Ok(())
+}
+
+pub(crate) fn create_logical(instance: &ash::Instance, device: &DeviceInfo, family: u32) -> GpuResult<ash::Device> {
     let priorities = [1.0f32];
-    let queues = [vk::DeviceQueueCreateInfo::default()
-        .queue_family_index(family)
-        .queue_priorities(&priorities)];
-    let mut v13 = vk::PhysicalDeviceVulkan13Features::default()
-        .dynamic_rendering(true)
-        .synchronization2(true);
-    let info = vk::DeviceCreateInfo::default()
-        .queue_create_infos(&queues)
-        .push_next(&mut v13);
-    // SAFETY: features requested are core in Vulkan 1.3, which `select` checked.
+    let queues = [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
+    let mut v13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
+    // shaderOutputLayer: the shadow pass picks each light's array layer with gl_Layer in one
+    // layered render (see render::shadow for why not one single-layer view per light).
+    let mut v12 = vk::PhysicalDeviceVulkan12Features::default().shader_output_layer(true);
+    let info = vk::DeviceCreateInfo::default().queue_create_infos(&queues).push_next(&mut v13).push_next(&mut v12);
+    // SAFETY: features requested are core in Vulkan 1.3 (`select` checked the version, and
+    // `check_features` that shaderOutputLayer is supported).
     unsafe { instance.create_device(device.handle, &info, None) }.vk("vkCreateDevice")
 }

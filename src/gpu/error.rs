@@ -17,29 +17,17 @@ pub enum GpuError {
     #[error("no Vulkan device matches --device {wanted:?}; available devices:\n{available}")]
     DeviceNotFound { wanted: String, available: String },
     #[error("device {name:?} supports Vulkan {version}, translucent needs Vulkan 1.3{detail}")]
-    DeviceUnsuitable {
-        name: String,
-        version: String,
-        detail: String,
-    },
+    DeviceUnsuitable { name: String, version: String, detail: String },
     #[error(
         "validation was requested but VK_LAYER_KHRONOS_validation is not installed\n  install it: \
          `apt-get install vulkan-validationlayers` (or run scripts/setup)"
     )]
     ValidationLayerMissing,
     #[error("{what} failed: {result}")]
-    Vk {
-        what: &'static str,
-        result: vk::Result,
-    },
+    Vk { what: &'static str, result: vk::Result },
     #[error("GPU memory allocation for {what:?} failed: {source}")]
-    Alloc {
-        what: String,
-        source: gpu_allocator::AllocationError,
-    },
-    #[error(
-        "GPU work {what:?} did not finish within {seconds} s (device hung or far too much work)"
-    )]
+    Alloc { what: String, source: gpu_allocator::AllocationError },
+    #[error("GPU work {what:?} did not finish within {seconds} s (device hung or far too much work)")]
     Timeout { what: String, seconds: f64 },
     #[error("no shader named {0:?} is embedded (shaders are compiled from glsl/ by build.rs)")]
     UnknownShader(String),

@@ -23,22 +23,8 @@ pub struct ImageDesc {
 }
 
 impl ImageDesc {
-    pub fn new(
-        name: &str,
-        width: u32,
-        height: u32,
-        format: vk::Format,
-        usage: vk::ImageUsageFlags,
-    ) -> Self {
-        Self {
-            name: name.into(),
-            width,
-            height,
-            format,
-            usage,
-            layers: 1,
-            array_view: false,
-        }
+    pub fn new(name: &str, width: u32, height: u32, format: vk::Format, usage: vk::ImageUsageFlags) -> Self {
+        Self { name: name.into(), width, height, format, usage, layers: 1, array_view: false }
     }
     pub fn layers(mut self, layers: u32) -> Self {
         self.layers = layers;
@@ -55,8 +41,6 @@ pub struct Image {
     gpu: Arc<Gpu>,
     raw: vk::Image,
     view: vk::ImageView,
-    /// One 2D view per layer, for rendering into a single layer (only when `layers > 1`).
-    layer_views: Vec<vk::ImageView>,
     allocation: Option<Allocation>,
     desc: ImageDesc,
 }
@@ -64,12 +48,10 @@ pub struct Image {
 /// Depth formats get the depth aspect, everything else colour.
 pub fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
     match format {
-        vk::Format::D16_UNORM | vk::Format::D32_SFLOAT | vk::Format::X8_D24_UNORM_PACK32 => {
+        vk::Format::D16_UNORM | vk::Format::D32_SFLOAT | vk::Format::X8_D24_UNORM_PACK32 => vk::ImageAspectFlags::DEPTH,
+        vk::Format::D24_UNORM_S8_UINT | vk::Format::D32_SFLOAT_S8_UINT | vk::Format::D16_UNORM_S8_UINT => {
             vk::ImageAspectFlags::DEPTH
         }
-        vk::Format::D24_UNORM_S8_UINT
-        | vk::Format::D32_SFLOAT_S8_UINT
-        | vk::Format::D16_UNORM_S8_UINT => vk::ImageAspectFlags::DEPTH,
         _ => vk::ImageAspectFlags::COLOR,
     }
 }
@@ -86,11 +68,7 @@ impl Image {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(desc.format)
-            .extent(vk::Extent3D {
-                width: desc.width,
-                height: desc.height,
-                depth: 1,
-            })
+            .extent(vk::Extent3D { width: desc.width, height: desc.height, depth: 1 })
             .mip_levels(1)
             .array_layers(desc.layers)
             .samples(vk::SampleCountFlags::TYPE_1)
@@ -111,17 +89,13 @@ impl Image {
             Ok(a) => a,
             Err(source) => {
                 unsafe { device.destroy_image(raw, None) };
-                return Err(GpuError::Alloc {
-                    what: desc.name.clone(),
-                    source,
-                });
+                return Err(GpuError::Alloc { what: desc.name.clone(), source });
             }
         };
         let mut image = Image {
             gpu: gpu.clone(),
             raw,
             view: vk::ImageView::null(),
-            layer_views: Vec::new(),
             allocation: Some(allocation),
             desc: desc.clone(),
         };
@@ -133,18 +107,14 @@ impl Image {
         } else {
             vk::ImageViewType::TYPE_2D
         };
-        let view_info = vk::ImageViewCreateInfo::default()
-            .image(raw)
-            .view_type(view_type)
-            .format(desc.format)
-            .subresource_range(
+        let view_info =
+            vk::ImageViewCreateInfo::default().image(raw).view_type(view_type).format(desc.format).subresource_range(
                 vk::ImageSubresourceRange::default()
                     .aspect_mask(aspect_of(desc.format))
                     .level_count(1)
                     .layer_count(desc.layers),
             );
-        image.view =
-            unsafe { device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
+        image.view = unsafe { device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
         Ok(image)
     }
 
@@ -154,32 +124,19 @@ impl Image {
     pub fn view(&self) -> vk::ImageView {
         self.view
     }
-    /// A 2D view of one layer (the whole-image view when there is only one layer).
-    pub fn layer_view(&self, layer: u32) -> vk::ImageView {
-        if self.layer_views.is_empty() {
-            self.view
-        } else {
-            self.layer_views[layer as usize]
-        }
-    }
     pub fn desc(&self) -> &ImageDesc {
         &self.desc
     }
     pub fn extent(&self) -> vk::Extent2D {
-        vk::Extent2D {
-            width: self.desc.width,
-            height: self.desc.height,
-        }
+        vk::Extent2D { width: self.desc.width, height: self.desc.height }
     }
 
     /// Copy layer 0 into host memory: tightly packed rows, `bytes_per_texel` each texel.
     /// `layout` is the image's current layout; it is left in TRANSFER_SRC_OPTIMAL.
     pub fn read(&self, layout: vk::ImageLayout, bytes_per_texel: u64) -> GpuResult<Vec<u8>> {
         let size = self.desc.width as u64 * self.desc.height as u64 * bytes_per_texel;
-        let staging = Buffer::new(
-            &self.gpu,
-            &BufferDesc::readback("image readback", size, vk::BufferUsageFlags::TRANSFER_DST),
-        )?;
+        let staging =
+            Buffer::new(&self.gpu, &BufferDesc::readback("image readback", size, vk::BufferUsageFlags::TRANSFER_DST))?;
         let device = self.gpu.device();
         let aspect = aspect_of(self.desc.format);
         self.gpu.one_shot("image readback", |cmd| {
@@ -189,26 +146,12 @@ impl Image {
                 self.raw,
                 aspect,
                 (layout, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
-                (
-                    vk::PipelineStageFlags2::ALL_COMMANDS,
-                    vk::AccessFlags2::MEMORY_WRITE,
-                ),
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::TRANSFER_READ,
-                ),
+                (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_WRITE),
+                (vk::PipelineStageFlags2::COPY, vk::AccessFlags2::TRANSFER_READ),
             );
             let region = [vk::BufferImageCopy::default()
-                .image_subresource(
-                    vk::ImageSubresourceLayers::default()
-                        .aspect_mask(aspect)
-                        .layer_count(1),
-                )
-                .image_extent(vk::Extent3D {
-                    width: self.desc.width,
-                    height: self.desc.height,
-                    depth: 1,
-                })];
+                .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(aspect).layer_count(1))
+                .image_extent(vk::Extent3D { width: self.desc.width, height: self.desc.height, depth: 1 })];
             // SAFETY: the staging buffer holds exactly one tightly packed layer.
             unsafe {
                 device.cmd_copy_image_to_buffer(
@@ -222,10 +165,7 @@ impl Image {
             memory_barrier(
                 device,
                 cmd,
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                ),
+                (vk::PipelineStageFlags2::COPY, vk::AccessFlags2::TRANSFER_WRITE),
                 (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
             );
         })?;
@@ -237,9 +177,6 @@ impl Drop for Image {
     fn drop(&mut self) {
         // SAFETY: all submissions wait on their fence, so the image is idle.
         unsafe {
-            for view in self.layer_views.drain(..) {
-                self.gpu.device().destroy_image_view(view, None);
-            }
             if self.view != vk::ImageView::null() {
                 self.gpu.device().destroy_image_view(self.view, None);
             }

@@ -29,13 +29,9 @@ pub(crate) fn create_instance(
     let mut extensions = Vec::new();
     if validation {
         // SAFETY: plain enumeration query.
-        let available = unsafe { entry.enumerate_instance_layer_properties() }
-            .vk("vkEnumerateInstanceLayerProperties")?;
-        let found = available.iter().any(|l| {
-            l.layer_name_as_c_str()
-                .map(|n| n == VALIDATION_LAYER)
-                .unwrap_or(false)
-        });
+        let available =
+            unsafe { entry.enumerate_instance_layer_properties() }.vk("vkEnumerateInstanceLayerProperties")?;
+        let found = available.iter().any(|l| l.layer_name_as_c_str().map(|n| n == VALIDATION_LAYER).unwrap_or(false));
         if !found {
             return Err(GpuError::ValidationLayerMissing);
         }
@@ -59,15 +55,10 @@ pub(crate) fn create_instance(
     let instance = match unsafe { entry.create_instance(&info, None) } {
         Ok(i) => i,
         Err(vk::Result::ERROR_INCOMPATIBLE_DRIVER) => {
-            return Err(GpuError::NoDevice(
-                " (the Vulkan loader found no driver)".into(),
-            ));
+            return Err(GpuError::NoDevice(" (the Vulkan loader found no driver)".into()));
         }
         Err(result) => {
-            return Err(GpuError::Vk {
-                what: "vkCreateInstance",
-                result,
-            });
+            return Err(GpuError::Vk { what: "vkCreateInstance", result });
         }
     };
     let debug = if validation {
@@ -76,10 +67,7 @@ pub(crate) fn create_instance(
             Err(result) => {
                 // SAFETY: nothing was created from this instance yet.
                 unsafe { instance.destroy_instance(None) };
-                return Err(GpuError::Vk {
-                    what: "vkCreateDebugUtilsMessengerEXT",
-                    result,
-                });
+                return Err(GpuError::Vk { what: "vkCreateDebugUtilsMessengerEXT", result });
             }
         }
     } else {

@@ -48,11 +48,7 @@ pub struct GpuOptions {
 
 impl Default for GpuOptions {
     fn default() -> Self {
-        Self {
-            device: None,
-            validation: false,
-            timeout: Duration::from_secs(120),
-        }
+        Self { device: None, validation: false, timeout: Duration::from_secs(120) }
     }
 }
 

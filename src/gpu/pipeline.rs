@@ -19,18 +19,9 @@ struct Layout {
 }
 
 impl Layout {
-    fn new(
-        gpu: &Arc<Gpu>,
-        kinds: &[BindingKind],
-        stages: vk::ShaderStageFlags,
-        push_bytes: u32,
-    ) -> GpuResult<Layout> {
-        if !push_bytes.is_multiple_of(4)
-            || push_bytes > gpu.properties().limits.max_push_constants_size
-        {
-            return Err(GpuError::Invalid(format!(
-                "push-constant block of {push_bytes} bytes is not allowed"
-            )));
+    fn new(gpu: &Arc<Gpu>, kinds: &[BindingKind], stages: vk::ShaderStageFlags, push_bytes: u32) -> GpuResult<Layout> {
+        if !push_bytes.is_multiple_of(4) || push_bytes > gpu.properties().limits.max_push_constants_size {
+            return Err(GpuError::Invalid(format!("push-constant block of {push_bytes} bytes is not allowed")));
         }
         let set_layout = create_set_layout(gpu, kinds, stages)?;
         let mut layout = Layout {
@@ -41,41 +32,24 @@ impl Layout {
             stages,
             push_bytes,
         };
-        let ranges = [vk::PushConstantRange {
-            stage_flags: stages,
-            offset: 0,
-            size: push_bytes,
-        }];
+        let ranges = [vk::PushConstantRange { stage_flags: stages, offset: 0, size: push_bytes }];
         let set_layouts = [set_layout];
         let mut info = vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts);
         if push_bytes > 0 {
             info = info.push_constant_ranges(&ranges);
         }
         // SAFETY: valid create info; Drop destroys it.
-        layout.pipeline_layout = unsafe { gpu.device().create_pipeline_layout(&info, None) }
-            .vk("vkCreatePipelineLayout")?;
+        layout.pipeline_layout =
+            unsafe { gpu.device().create_pipeline_layout(&info, None) }.vk("vkCreatePipelineLayout")?;
         Ok(layout)
     }
 
-    fn bind(
-        &self,
-        cmd: vk::CommandBuffer,
-        point: vk::PipelineBindPoint,
-        set: Option<&DescriptorSet>,
-        push: &[u8],
-    ) {
+    fn bind(&self, cmd: vk::CommandBuffer, point: vk::PipelineBindPoint, set: Option<&DescriptorSet>, push: &[u8]) {
         let device = self.gpu.device();
         // SAFETY: `cmd` is recording; set and push block match this layout (push length checked).
         unsafe {
             if let Some(set) = set {
-                device.cmd_bind_descriptor_sets(
-                    cmd,
-                    point,
-                    self.pipeline_layout,
-                    0,
-                    &[set.raw()],
-                    &[],
-                );
+                device.cmd_bind_descriptor_sets(cmd, point, self.pipeline_layout, 0, &[set.raw()], &[]);
             }
             if !push.is_empty() {
                 device.cmd_push_constants(cmd, self.pipeline_layout, self.stages, 0, push);
@@ -84,11 +58,7 @@ impl Layout {
     }
 
     fn check_push(&self, push: &[u8]) {
-        assert_eq!(
-            push.len() as u32,
-            self.push_bytes,
-            "push-constant block size differs from the pipeline's"
-        );
+        assert_eq!(push.len() as u32, self.push_bytes, "push-constant block size differs from the pipeline's");
     }
 }
 
@@ -96,12 +66,8 @@ impl Drop for Layout {
     fn drop(&mut self) {
         // SAFETY: pipelines using this layout are destroyed first (field order in their structs).
         unsafe {
-            self.gpu
-                .device()
-                .destroy_pipeline_layout(self.pipeline_layout, None);
-            self.gpu
-                .device()
-                .destroy_descriptor_set_layout(self.set_layout, None);
+            self.gpu.device().destroy_pipeline_layout(self.pipeline_layout, None);
+            self.gpu.device().destroy_descriptor_set_layout(self.set_layout, None);
         }
     }
 }
@@ -117,8 +83,7 @@ impl<'a> Module<'a> {
         let words = shaders::spirv(name)?;
         let info = vk::ShaderModuleCreateInfo::default().code(&words);
         // SAFETY: `words` is SPIR-V compiled by glslang for Vulkan 1.2.
-        let raw =
-            unsafe { gpu.device().create_shader_module(&info, None) }.vk("vkCreateShaderModule")?;
+        let raw = unsafe { gpu.device().create_shader_module(&info, None) }.vk("vkCreateShaderModule")?;
         Ok(Module { gpu, raw })
     }
 }
@@ -138,61 +103,32 @@ pub struct ComputePipeline {
 
 impl ComputePipeline {
     /// `shader` is a path under `glsl/` ("smoke.comp"); `bindings` are set 0's bindings in order.
-    pub fn new(
-        gpu: &Arc<Gpu>,
-        shader: &str,
-        bindings: &[BindingKind],
-        push_bytes: u32,
-    ) -> GpuResult<ComputePipeline> {
+    pub fn new(gpu: &Arc<Gpu>, shader: &str, bindings: &[BindingKind], push_bytes: u32) -> GpuResult<ComputePipeline> {
         let layout = Layout::new(gpu, bindings, vk::ShaderStageFlags::COMPUTE, push_bytes)?;
         let module = Module::new(gpu, shader)?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module.raw)
             .name(c"main");
-        let info = [vk::ComputePipelineCreateInfo::default()
-            .stage(stage)
-            .layout(layout.pipeline_layout)];
+        let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout.pipeline_layout)];
         // SAFETY: valid create info referencing live module and layout.
-        let pipeline = unsafe {
-            gpu.device()
-                .create_compute_pipelines(vk::PipelineCache::null(), &info, None)
-        }
-        .map_err(|(_, result)| GpuError::Vk {
-            what: "vkCreateComputePipelines",
-            result,
-        })?[0];
-        Ok(ComputePipeline {
-            pipeline,
-            layout,
-            name: shader.to_string(),
-        })
+        let pipeline = unsafe { gpu.device().create_compute_pipelines(vk::PipelineCache::null(), &info, None) }
+            .map_err(|(_, result)| GpuError::Vk { what: "vkCreateComputePipelines", result })?[0];
+        Ok(ComputePipeline { pipeline, layout, name: shader.to_string() })
     }
 
     /// A descriptor set for this pipeline's set 0.
     pub fn descriptor_set(&self, bindings: &[Binding<'_>]) -> GpuResult<DescriptorSet> {
-        DescriptorSet::new(
-            &self.layout.gpu,
-            self.layout.set_layout,
-            &self.layout.kinds,
-            bindings,
-        )
+        DescriptorSet::new(&self.layout.gpu, self.layout.set_layout, &self.layout.kinds, bindings)
     }
 
     /// Record a dispatch of `groups` workgroups.
-    pub fn dispatch(
-        &self,
-        cmd: vk::CommandBuffer,
-        set: &DescriptorSet,
-        push: &[u8],
-        groups: [u32; 3],
-    ) {
+    pub fn dispatch(&self, cmd: vk::CommandBuffer, set: &DescriptorSet, push: &[u8], groups: [u32; 3]) {
         self.layout.check_push(push);
         let device = self.layout.gpu.device();
         // SAFETY: `cmd` is recording, outside a render pass.
         unsafe { device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline) };
-        self.layout
-            .bind(cmd, vk::PipelineBindPoint::COMPUTE, Some(set), push);
+        self.layout.bind(cmd, vk::PipelineBindPoint::COMPUTE, Some(set), push);
         unsafe { device.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
     }
 
@@ -204,12 +140,7 @@ impl ComputePipeline {
 impl Drop for ComputePipeline {
     fn drop(&mut self) {
         // SAFETY: no pending submission uses it (every submission is waited on).
-        unsafe {
-            self.layout
-                .gpu
-                .device()
-                .destroy_pipeline(self.pipeline, None)
-        };
+        unsafe { self.layout.gpu.device().destroy_pipeline(self.pipeline, None) };
     }
 }
 
@@ -257,11 +188,7 @@ impl GraphicsPipeline {
         let stages_flags = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         let layout = Layout::new(gpu, &desc.bindings, stages_flags, desc.push_bytes)?;
         let vertex = Module::new(gpu, &desc.vertex)?;
-        let fragment = desc
-            .fragment
-            .as_deref()
-            .map(|f| Module::new(gpu, f))
-            .transpose()?;
+        let fragment = desc.fragment.as_deref().map(|f| Module::new(gpu, f)).transpose()?;
         let mut stages = vec![
             vk::PipelineShaderStageCreateInfo::default()
                 .stage(vk::ShaderStageFlags::VERTEX)
@@ -279,24 +206,19 @@ impl GraphicsPipeline {
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
             .vertex_binding_descriptions(&desc.vertex_bindings)
             .vertex_attribute_descriptions(&desc.vertex_attributes);
-        let assembly = vk::PipelineInputAssemblyStateCreateInfo::default()
-            .topology(vk::PrimitiveTopology::TRIANGLE_LIST);
-        let viewport = vk::PipelineViewportStateCreateInfo::default()
-            .viewport_count(1)
-            .scissor_count(1);
+        let assembly =
+            vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+        let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
         let mut raster = vk::PipelineRasterizationStateCreateInfo::default()
             .polygon_mode(vk::PolygonMode::FILL)
             .cull_mode(desc.cull)
             .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
             .line_width(1.0);
         if let Some((constant, slope)) = desc.depth_bias {
-            raster = raster
-                .depth_bias_enable(true)
-                .depth_bias_constant_factor(constant)
-                .depth_bias_slope_factor(slope);
+            raster = raster.depth_bias_enable(true).depth_bias_constant_factor(constant).depth_bias_slope_factor(slope);
         }
-        let multisample = vk::PipelineMultisampleStateCreateInfo::default()
-            .rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let multisample =
+            vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth_format.is_some())
             .depth_write_enable(desc.depth_format.is_some())
@@ -304,10 +226,7 @@ impl GraphicsPipeline {
         let attachments: Vec<_> = desc
             .color_formats
             .iter()
-            .map(|_| {
-                vk::PipelineColorBlendAttachmentState::default()
-                    .color_write_mask(vk::ColorComponentFlags::RGBA)
-            })
+            .map(|_| vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA))
             .collect();
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
         let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
@@ -328,35 +247,18 @@ impl GraphicsPipeline {
             .layout(layout.pipeline_layout)
             .push_next(&mut rendering)];
         // SAFETY: every pointer refers to locals alive for the call; dynamic rendering is enabled.
-        let pipeline = unsafe {
-            gpu.device()
-                .create_graphics_pipelines(vk::PipelineCache::null(), &info, None)
-        }
-        .map_err(|(_, result)| GpuError::Vk {
-            what: "vkCreateGraphicsPipelines",
-            result,
-        })?[0];
+        let pipeline = unsafe { gpu.device().create_graphics_pipelines(vk::PipelineCache::null(), &info, None) }
+            .map_err(|(_, result)| GpuError::Vk { what: "vkCreateGraphicsPipelines", result })?[0];
         Ok(GraphicsPipeline { pipeline, layout })
     }
 
     pub fn descriptor_set(&self, bindings: &[Binding<'_>]) -> GpuResult<DescriptorSet> {
-        DescriptorSet::new(
-            &self.layout.gpu,
-            self.layout.set_layout,
-            &self.layout.kinds,
-            bindings,
-        )
+        DescriptorSet::new(&self.layout.gpu, self.layout.set_layout, &self.layout.kinds, bindings)
     }
 
     /// Bind the pipeline, its set and push block, and set a full-extent viewport and scissor.
     /// Call inside `cmd_begin_rendering`.
-    pub fn bind(
-        &self,
-        cmd: vk::CommandBuffer,
-        set: Option<&DescriptorSet>,
-        push: &[u8],
-        extent: vk::Extent2D,
-    ) {
+    pub fn bind(&self, cmd: vk::CommandBuffer, set: Option<&DescriptorSet>, push: &[u8], extent: vk::Extent2D) {
         self.layout.check_push(push);
         let device = self.layout.gpu.device();
         let viewport = vk::Viewport {
@@ -371,28 +273,15 @@ impl GraphicsPipeline {
         unsafe {
             device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
             device.cmd_set_viewport(cmd, 0, &[viewport]);
-            device.cmd_set_scissor(
-                cmd,
-                0,
-                &[vk::Rect2D {
-                    offset: vk::Offset2D::default(),
-                    extent,
-                }],
-            );
+            device.cmd_set_scissor(cmd, 0, &[vk::Rect2D { offset: vk::Offset2D::default(), extent }]);
         }
-        self.layout
-            .bind(cmd, vk::PipelineBindPoint::GRAPHICS, set, push);
+        self.layout.bind(cmd, vk::PipelineBindPoint::GRAPHICS, set, push);
     }
 }
 
 impl Drop for GraphicsPipeline {
     fn drop(&mut self) {
         // SAFETY: as for ComputePipeline.
-        unsafe {
-            self.layout
-                .gpu
-                .device()
-                .destroy_pipeline(self.pipeline, None)
-        };
+        unsafe { self.layout.gpu.device().destroy_pipeline(self.pipeline, None) };
     }
 }

@@ -27,18 +27,10 @@ impl Sampler {
     /// each tap is already a 2x2 percentage-closer filter.
     pub fn shadow(gpu: &Arc<Gpu>, depth_format: vk::Format) -> GpuResult<Sampler> {
         // SAFETY: plain query.
-        let props = unsafe {
-            gpu.instance()
-                .get_physical_device_format_properties(gpu.physical_device(), depth_format)
-        };
-        let linear = props
-            .optimal_tiling_features
-            .contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR);
-        let filter = if linear {
-            vk::Filter::LINEAR
-        } else {
-            vk::Filter::NEAREST
-        };
+        let props =
+            unsafe { gpu.instance().get_physical_device_format_properties(gpu.physical_device(), depth_format) };
+        let linear = props.optimal_tiling_features.contains(vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR);
+        let filter = if linear { vk::Filter::LINEAR } else { vk::Filter::NEAREST };
         let info = vk::SamplerCreateInfo::default()
             .mag_filter(filter)
             .min_filter(filter)
@@ -54,10 +46,7 @@ impl Sampler {
     fn create(gpu: &Arc<Gpu>, info: vk::SamplerCreateInfo<'_>) -> GpuResult<Sampler> {
         // SAFETY: valid create info; Drop destroys it.
         let raw = unsafe { gpu.device().create_sampler(&info, None) }.vk("vkCreateSampler")?;
-        Ok(Sampler {
-            gpu: gpu.clone(),
-            raw,
-        })
+        Ok(Sampler { gpu: gpu.clone(), raw })
     }
 
     pub fn raw(&self) -> vk::Sampler {

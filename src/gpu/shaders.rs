@@ -13,10 +13,8 @@ pub fn names() -> impl Iterator<Item = &'static str> {
 
 /// The SPIR-V words of the shader at `name` (its path under `glsl/`, e.g. "smoke.comp").
 pub fn spirv(name: &str) -> GpuResult<Vec<u32>> {
-    let (_, bytes) = generated::SHADERS
-        .iter()
-        .find(|(n, _)| *n == name)
-        .ok_or_else(|| GpuError::UnknownShader(name.into()))?;
+    let (_, bytes) =
+        generated::SHADERS.iter().find(|(n, _)| *n == name).ok_or_else(|| GpuError::UnknownShader(name.into()))?;
     // read_spv copies into u32 words, so the bytes' alignment does not matter.
     ash::util::read_spv(&mut std::io::Cursor::new(bytes))
         .map_err(|e| GpuError::Invalid(format!("embedded shader {name} is not SPIR-V: {e}")))

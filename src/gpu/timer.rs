@@ -22,49 +22,26 @@ impl GpuTimer {
     pub fn new(gpu: &Arc<Gpu>, max_passes: u32) -> GpuResult<GpuTimer> {
         let (_, valid_bits) = gpu.timestamp_info();
         if valid_bits == 0 {
-            return Err(GpuError::Invalid(format!(
-                "device {} cannot write timestamps on its queue",
-                gpu.info().name
-            )));
+            return Err(GpuError::Invalid(format!("device {} cannot write timestamps on its queue", gpu.info().name)));
         }
-        let info = vk::QueryPoolCreateInfo::default()
-            .query_type(vk::QueryType::TIMESTAMP)
-            .query_count(2 * max_passes);
+        let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(2 * max_passes);
         // SAFETY: valid create info; Drop destroys it.
-        let pool =
-            unsafe { gpu.device().create_query_pool(&info, None) }.vk("vkCreateQueryPool")?;
-        Ok(GpuTimer {
-            gpu: gpu.clone(),
-            pool,
-            capacity: max_passes,
-            names: Vec::new(),
-            open: None,
-        })
+        let pool = unsafe { gpu.device().create_query_pool(&info, None) }.vk("vkCreateQueryPool")?;
+        Ok(GpuTimer { gpu: gpu.clone(), pool, capacity: max_passes, names: Vec::new(), open: None })
     }
 
     /// Record the reset of every query; forgets the names of the previous submission.
     pub fn reset(&mut self, cmd: vk::CommandBuffer) {
         // SAFETY: `cmd` is recording, outside a render pass.
-        unsafe {
-            self.gpu
-                .device()
-                .cmd_reset_query_pool(cmd, self.pool, 0, 2 * self.capacity)
-        };
+        unsafe { self.gpu.device().cmd_reset_query_pool(cmd, self.pool, 0, 2 * self.capacity) };
         self.names.clear();
         self.open = None;
     }
 
     /// Record the start timestamp of pass `name` (after all earlier work has finished).
     pub fn begin(&mut self, cmd: vk::CommandBuffer, name: &str) {
-        assert!(
-            self.open.is_none(),
-            "GpuTimer: pass {name:?} begun inside another pass"
-        );
-        assert!(
-            (self.names.len() as u32) < self.capacity,
-            "GpuTimer: more than {} passes",
-            self.capacity
-        );
+        assert!(self.open.is_none(), "GpuTimer: pass {name:?} begun inside another pass");
+        assert!((self.names.len() as u32) < self.capacity, "GpuTimer: more than {} passes", self.capacity);
         let index = self.names.len();
         self.names.push(name.to_string());
         self.open = Some(index);
@@ -110,11 +87,7 @@ impl GpuTimer {
         }
         .vk("vkGetQueryPoolResults")?;
         let (period_ns, valid_bits) = self.gpu.timestamp_info();
-        let mask = if valid_bits >= 64 {
-            u64::MAX
-        } else {
-            (1u64 << valid_bits) - 1
-        };
+        let mask = if valid_bits >= 64 { u64::MAX } else { (1u64 << valid_bits) - 1 };
         Ok(self
             .names
             .iter()
@@ -144,9 +117,5 @@ pub fn median(values: &mut [f64]) -> f64 {
     }
     values.sort_by(f64::total_cmp);
     let n = values.len();
-    if n % 2 == 1 {
-        values[n / 2]
-    } else {
-        0.5 * (values[n / 2 - 1] + values[n / 2])
-    }
+    if n % 2 == 1 { values[n / 2] } else { 0.5 * (values[n / 2 - 1] + values[n / 2]) }
 }

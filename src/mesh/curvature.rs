@@ -112,7 +112,14 @@ pub(super) fn compute(positions: &[Vec3], triangles: &[[u32; 3]], topo: &Topolog
     }
     fill_boundary(&mut mean, &mut gauss, &mixed, topo);
 
-    Geometry { triangle_areas, face_normals, vertex_normals, mean_curvature: mean, gaussian_curvature: gauss, mixed_areas: mixed }
+    Geometry {
+        triangle_areas,
+        face_normals,
+        vertex_normals,
+        mean_curvature: mean,
+        gaussian_curvature: gauss,
+        mixed_areas: mixed,
+    }
 }
 
 /// At boundary (and non-manifold) vertices half the one-ring is missing, so the cotangent sum

@@ -126,7 +126,12 @@ impl Mesh {
         Mesh::build("<memory>".to_string(), positions, triangles, false)
     }
 
-    fn build(source: String, positions: Vec<Vec3>, triangles: Vec<[u32; 3]>, flip_winding: bool) -> Result<Mesh, MeshError> {
+    fn build(
+        source: String,
+        positions: Vec<Vec3>,
+        triangles: Vec<[u32; 3]>,
+        flip_winding: bool,
+    ) -> Result<Mesh, MeshError> {
         let mut report = MeshReport {
             source: source.clone(),
             input_vertices: positions.len(),
@@ -141,7 +146,12 @@ impl Mesh {
         }
         for (triangle, tri) in triangles.iter().enumerate() {
             if let Some(&index) = tri.iter().find(|&&i| i as usize >= positions.len()) {
-                return Err(MeshError::IndexOutOfRange { source_name: source, triangle, index, count: positions.len() });
+                return Err(MeshError::IndexOutOfRange {
+                    source_name: source,
+                    triangle,
+                    index,
+                    count: positions.len(),
+                });
             }
         }
 
@@ -280,7 +290,11 @@ impl Mesh {
     #[inline]
     pub fn corners(&self, t: usize) -> [DVec3; 3] {
         let [a, b, c] = self.triangles[t];
-        [self.positions[a as usize].as_dvec3(), self.positions[b as usize].as_dvec3(), self.positions[c as usize].as_dvec3()]
+        [
+            self.positions[a as usize].as_dvec3(),
+            self.positions[b as usize].as_dvec3(),
+            self.positions[c as usize].as_dvec3(),
+        ]
     }
 
     /// The point of triangle `t` at barycentric coordinates `bary` (weights of its corners).

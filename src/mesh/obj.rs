@@ -37,7 +37,10 @@ impl LoadOptions {
             return Err(MeshError::InvalidOptions(format!("scale must be finite and non-zero, got {}", self.scale)));
         }
         if !self.transform.is_finite() || self.transform.determinant() == 0.0 {
-            return Err(MeshError::InvalidOptions(format!("transform must be finite and invertible, got {:?}", self.transform)));
+            return Err(MeshError::InvalidOptions(format!(
+                "transform must be finite and invertible, got {:?}",
+                self.transform
+            )));
         }
         Ok(())
     }
@@ -67,7 +70,8 @@ pub(super) fn parse(text: &str, source_name: &str, options: &LoadOptions) -> Res
     let source_name = source_name.to_string();
     prescan(text, &source_name)?;
 
-    let tobj_options = tobj::LoadOptions { single_index: true, triangulate: true, ignore_points: true, ignore_lines: true };
+    let tobj_options =
+        tobj::LoadOptions { single_index: true, triangulate: true, ignore_points: true, ignore_lines: true };
     // Materials are not used: refuse to open .mtl files instead of reading them.
     let (models, _materials) =
         tobj::load_obj_buf(&mut Cursor::new(text.as_bytes()), &tobj_options, |_| Err(tobj::LoadError::GenericFailure))
@@ -138,15 +142,25 @@ fn prescan(text: &str, source_name: &str) -> Result<(), MeshError> {
                         }
                         if part.is_empty() {
                             if kind == 0 {
-                                return Err(parse_error(source_name, line_no, format!("face vertex `{word}` has no position index"), line));
+                                return Err(parse_error(
+                                    source_name,
+                                    line_no,
+                                    format!("face vertex `{word}` has no position index"),
+                                    line,
+                                ));
                             }
                             continue;
                         }
-                        let index: i64 = part
-                            .parse()
-                            .map_err(|_| parse_error(source_name, line_no, format!("face index `{part}` is not an integer"), line))?;
+                        let index: i64 = part.parse().map_err(|_| {
+                            parse_error(source_name, line_no, format!("face index `{part}` is not an integer"), line)
+                        })?;
                         if index == 0 {
-                            return Err(parse_error(source_name, line_no, "face index 0 is invalid (OBJ indices start at 1)".into(), line));
+                            return Err(parse_error(
+                                source_name,
+                                line_no,
+                                "face index 0 is invalid (OBJ indices start at 1)".into(),
+                                line,
+                            ));
                         }
                         if index < 0 && -index > counts[kind] {
                             return Err(parse_error(
@@ -178,14 +192,26 @@ fn prescan(text: &str, source_name: &str) -> Result<(), MeshError> {
         };
         let mut values = 0;
         for word in words.by_ref().take(needed) {
-            let value: f32 = word.parse().map_err(|_| parse_error(source_name, line_no, format!("`{word}` is not a number"), line))?;
+            let value: f32 = word
+                .parse()
+                .map_err(|_| parse_error(source_name, line_no, format!("`{word}` is not a number"), line))?;
             if !value.is_finite() {
-                return Err(parse_error(source_name, line_no, format!("coordinate `{word}` is not a finite f32 number"), line));
+                return Err(parse_error(
+                    source_name,
+                    line_no,
+                    format!("coordinate `{word}` is not a finite f32 number"),
+                    line,
+                ));
             }
             values += 1;
         }
         if values < needed {
-            return Err(parse_error(source_name, line_no, format!("`{keyword}` needs {needed} numbers, found {values}"), line));
+            return Err(parse_error(
+                source_name,
+                line_no,
+                format!("`{keyword}` needs {needed} numbers, found {values}"),
+                line,
+            ));
         }
         if keyword == "v" {
             // An optional fourth value is the homogeneous w (positions are divided by it); three
@@ -194,9 +220,9 @@ fn prescan(text: &str, source_name: &str) -> Result<(), MeshError> {
             match rest.len() {
                 0 | 3 => {}
                 1 => {
-                    let w: f32 = rest[0]
-                        .parse()
-                        .map_err(|_| parse_error(source_name, line_no, format!("weight `{}` is not a number", rest[0]), line))?;
+                    let w: f32 = rest[0].parse().map_err(|_| {
+                        parse_error(source_name, line_no, format!("weight `{}` is not a number", rest[0]), line)
+                    })?;
                     if !w.is_finite() || w == 0.0 {
                         return Err(parse_error(
                             source_name,
@@ -207,7 +233,12 @@ fn prescan(text: &str, source_name: &str) -> Result<(), MeshError> {
                     }
                 }
                 k => {
-                    return Err(parse_error(source_name, line_no, format!("`v` takes 3, 4 or 6 numbers, found {}", 3 + k), line));
+                    return Err(parse_error(
+                        source_name,
+                        line_no,
+                        format!("`v` takes 3, 4 or 6 numbers, found {}", 3 + k),
+                        line,
+                    ));
                 }
             }
         }

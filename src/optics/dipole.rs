@@ -46,12 +46,7 @@ pub struct Dipole {
 impl Dipole {
     /// Derives the dipole of one channel from coefficients per scene unit (seed section 2).
     /// Errors name the bad value; `channel` only labels it.
-    pub fn new(
-        sigma_a: f64,
-        sigma_s_prime: f64,
-        eta: f64,
-        channel: usize,
-    ) -> Result<Self, OpticsError> {
+    pub fn new(sigma_a: f64, sigma_s_prime: f64, eta: f64, channel: usize) -> Result<Self, OpticsError> {
         check_coefficient("sigma_a", channel, sigma_a)?;
         check_coefficient("sigma_s'", channel, sigma_s_prime)?;
         check_eta(eta)?;
@@ -132,8 +127,7 @@ impl Dipole {
     /// inner radius and the difference of the squared radii, which callers often know exactly.
     pub fn r_d_ring_sq(&self, r1_sq: f64, delta_sq: f64) -> f64 {
         let s = self.sigma_tr;
-        0.5 * self.alpha_prime
-            * (ring_term(self.z_r, s, r1_sq, delta_sq) + ring_term(self.z_v, s, r1_sq, delta_sq))
+        0.5 * self.alpha_prime * (ring_term(self.z_r, s, r1_sq, delta_sq) + ring_term(self.z_v, s, r1_sq, delta_sq))
     }
 
     /// What lies outside a disk: `R_d,total - P(R) = (alpha'/2) sum_z z e^(-sigma_tr d(R)) / d(R)`,
@@ -212,26 +206,10 @@ pub fn ring_term(z: f64, s: f64, r1_sq: f64, delta_sq: f64) -> f64 {
     (z / d1) * (-s * d1).exp() * (gap / d2 + (d1 / d2) * -(-s * gap).exp_m1())
 }
 
-pub(crate) fn check_coefficient(
-    name: &'static str,
-    channel: usize,
-    value: f64,
-) -> Result<(), OpticsError> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(())
-    } else {
-        Err(OpticsError::BadCoefficient {
-            name,
-            channel,
-            value,
-        })
-    }
+pub(crate) fn check_coefficient(name: &'static str, channel: usize, value: f64) -> Result<(), OpticsError> {
+    if value.is_finite() && value >= 0.0 { Ok(()) } else { Err(OpticsError::BadCoefficient { name, channel, value }) }
 }
 
 pub(crate) fn check_eta(eta: f64) -> Result<(), OpticsError> {
-    if (fresnel::ETA_MIN..=fresnel::ETA_MAX).contains(&eta) {
-        Ok(())
-    } else {
-        Err(OpticsError::BadEta(eta))
-    }
+    if (fresnel::ETA_MIN..=fresnel::ETA_MAX).contains(&eta) { Ok(()) } else { Err(OpticsError::BadEta(eta)) }
 }

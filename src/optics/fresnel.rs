@@ -96,11 +96,7 @@ pub fn fresnel_moment1(eta: f64) -> f64 {
         return 0.0;
     }
     // Below mu_c (only when eta < 1) F_r = 1.
-    let mu_c = if eta < 1.0 {
-        ((1.0 - eta) * (1.0 + eta)).sqrt()
-    } else {
-        0.0
-    };
+    let mu_c = if eta < 1.0 { ((1.0 - eta) * (1.0 + eta)).sqrt() } else { 0.0 };
     let tir = 0.5 * mu_c * mu_c;
     let f = |mu: f64| fresnel_reflectance(mu, eta) * mu;
     tir + graded_integral(f, mu_c, 1.0)
@@ -124,12 +120,7 @@ fn graded_integral(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> f64 {
         let a = 0.5 * b;
         let (x0, x1) = (lo + width * a, lo + width * b);
         let (mid, half) = (0.5 * (x0 + x1), 0.5 * (x1 - x0));
-        sum += half
-            * nodes
-                .iter()
-                .zip(&weights)
-                .map(|(x, w)| w * f(mid + half * x))
-                .sum::<f64>();
+        sum += half * nodes.iter().zip(&weights).map(|(x, w)| w * f(mid + half * x)).sum::<f64>();
         b = a;
     }
     // The last sliver [lo, lo + width 2^-40] holds a negligible share of a bounded integrand.

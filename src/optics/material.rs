@@ -42,12 +42,7 @@ impl Material {
             }
         }
         check_eta(eta)?;
-        Ok(Material {
-            name: name.into(),
-            sigma_a,
-            sigma_s_prime,
-            eta,
-        })
+        Ok(Material { name: name.into(), sigma_a, sigma_s_prime, eta })
     }
 
     /// A material from the (unreduced) scattering coefficient `sigma_s` and the mean cosine `g`
@@ -92,10 +87,7 @@ impl Material {
             let sigma_s_prime = self.sigma_s_prime[c] * mm_per_unit;
             let sigma_t_prime = sigma_a + sigma_s_prime;
             if !(SIGMA_T_PRIME_MIN..=SIGMA_T_PRIME_MAX).contains(&sigma_t_prime) {
-                return Err(OpticsError::OutOfRange {
-                    channel: c,
-                    value: sigma_t_prime,
-                });
+                return Err(OpticsError::OutOfRange { channel: c, value: sigma_t_prime });
             }
             *slot = Some(Dipole::new(sigma_a, sigma_s_prime, self.eta, c)?);
         }

@@ -32,11 +32,7 @@ pub use presets::{MeasuredMaterial, Source};
 pub enum OpticsError {
     /// A coefficient that is NaN, infinite or negative.
     #[error("{name} = {value} in channel {} is not a finite number >= 0 (1/mm)", channel_name(*channel))]
-    BadCoefficient {
-        name: &'static str,
-        channel: usize,
-        value: f64,
-    },
+    BadCoefficient { name: &'static str, channel: usize, value: f64 },
     /// Neither absorption nor scattering: there is no medium to diffuse in.
     #[error(
         "sigma_a = 0 and sigma_s' = 0 in channel {}: the medium neither absorbs nor \

@@ -58,33 +58,12 @@ impl MeasuredMaterial {
     }
 }
 
-const fn jensen(
-    name: &'static str,
-    sigma_s_prime: [f64; 3],
-    sigma_a: [f64; 3],
-    eta: f64,
-) -> MeasuredMaterial {
-    MeasuredMaterial {
-        name,
-        sigma_s_prime,
-        sigma_a,
-        eta,
-        source: Source::Jensen2001,
-    }
+const fn jensen(name: &'static str, sigma_s_prime: [f64; 3], sigma_a: [f64; 3], eta: f64) -> MeasuredMaterial {
+    MeasuredMaterial { name, sigma_s_prime, sigma_a, eta, source: Source::Jensen2001 }
 }
 
-const fn dilution(
-    name: &'static str,
-    sigma_s_prime: [f64; 3],
-    sigma_a: [f64; 3],
-) -> MeasuredMaterial {
-    MeasuredMaterial {
-        name,
-        sigma_s_prime,
-        sigma_a,
-        eta: 1.33,
-        source: Source::Narasimhan2006,
-    }
+const fn dilution(name: &'static str, sigma_s_prime: [f64; 3], sigma_a: [f64; 3]) -> MeasuredMaterial {
+    MeasuredMaterial { name, sigma_s_prime, sigma_a, eta: 1.33, source: Source::Narasimhan2006 }
 }
 
 /// The 12 materials measured by Jensen et al. 2001: (name, sigma_s', sigma_a, eta).
@@ -152,10 +131,7 @@ pub fn all() -> impl Iterator<Item = &'static MeasuredMaterial> {
 /// The key names are compared by: lower case, letters and digits only, so that `marble`,
 /// `MARBLE`, `lowfat milk`, `Lowfat-Milk` and `lowfat_milk` all match.
 pub fn name_key(name: &str) -> String {
-    name.chars()
-        .filter(|c| c.is_alphanumeric())
-        .flat_map(char::to_lowercase)
-        .collect()
+    name.chars().filter(|c| c.is_alphanumeric()).flat_map(char::to_lowercase).collect()
 }
 
 /// The preset with this name, compared case-insensitively (and ignoring spaces and punctuation).

@@ -12,10 +12,7 @@ struct Aabb {
 
 impl Aabb {
     fn empty() -> Self {
-        Aabb {
-            min: DVec3::splat(f64::INFINITY),
-            max: DVec3::splat(f64::NEG_INFINITY),
-        }
+        Aabb { min: DVec3::splat(f64::INFINITY), max: DVec3::splat(f64::NEG_INFINITY) }
     }
     fn grow(&mut self, p: DVec3) {
         self.min = self.min.min(p);
@@ -51,16 +48,9 @@ const LEAF_SIZE: usize = 4;
 impl Bvh {
     pub fn new(triangles: Vec<[DVec3; 3]>) -> Bvh {
         let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
-        let centroids: Vec<DVec3> = triangles
-            .iter()
-            .map(|t| (t[0] + t[1] + t[2]) / 3.0)
-            .collect();
+        let centroids: Vec<DVec3> = triangles.iter().map(|t| (t[0] + t[1] + t[2]) / 3.0).collect();
         let mut nodes = Vec::with_capacity(2 * triangles.len() / LEAF_SIZE + 1);
-        nodes.push(Node {
-            bounds: Aabb::empty(),
-            first: 0,
-            count: 0,
-        });
+        nodes.push(Node { bounds: Aabb::empty(), first: 0, count: 0 });
         if !triangles.is_empty() {
             // Explicit stack: (node index, start, end) over `order`.
             let mut stack = vec![(0usize, 0usize, triangles.len())];
@@ -92,27 +82,15 @@ impl Bvh {
                     centroids[*a as usize][axis].total_cmp(&centroids[*b as usize][axis])
                 });
                 let left = nodes.len();
-                nodes.push(Node {
-                    bounds: Aabb::empty(),
-                    first: 0,
-                    count: 0,
-                });
-                nodes.push(Node {
-                    bounds: Aabb::empty(),
-                    first: 0,
-                    count: 0,
-                });
+                nodes.push(Node { bounds: Aabb::empty(), first: 0, count: 0 });
+                nodes.push(Node { bounds: Aabb::empty(), first: 0, count: 0 });
                 nodes[node].first = left as u32;
                 nodes[node].count = 0;
                 stack.push((left, start, mid));
                 stack.push((left + 1, mid, end));
             }
         }
-        Bvh {
-            triangles,
-            nodes,
-            order,
-        }
+        Bvh { triangles, nodes, order }
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -186,28 +164,20 @@ mod tests {
         for i in 0..20 {
             for j in 0..20 {
                 let o = DVec3::new(i as f64, (i * j % 7) as f64 * 0.3, j as f64);
-                tris.push([
-                    o,
-                    o + DVec3::new(0.9, 0.1, 0.0),
-                    o + DVec3::new(0.0, 0.2, 0.9),
-                ]);
+                tris.push([o, o + DVec3::new(0.9, 0.1, 0.0), o + DVec3::new(0.0, 0.2, 0.9)]);
             }
         }
         let bvh = Bvh::new(tris.clone());
         let mut state = 12345u64;
         let mut rnd = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         let mut hits = 0;
         for _ in 0..2000 {
             let origin = DVec3::new(rnd() * 22.0 - 1.0, rnd() * 4.0 - 1.0, rnd() * 22.0 - 1.0);
             let dir = DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);
-            let brute = tris
-                .iter()
-                .any(|t| intersect(t, origin, dir).is_some_and(|t| t > 1e-9 && t < 5.0));
+            let brute = tris.iter().any(|t| intersect(t, origin, dir).is_some_and(|t| t > 1e-9 && t < 5.0));
             assert_eq!(bvh.occluded(origin, dir, 1e-9, 5.0), brute);
             hits += brute as u32;
         }

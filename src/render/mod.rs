@@ -1,11 +1,11 @@
 //! GPU passes: each is one module here and one GLSL file of the same name in `glsl/`.
 
-pub mod records;
-pub mod shadow;
-pub mod smoke;
-pub mod tonemap;
 pub mod gather;
 pub mod plan;
+pub mod records;
 pub mod renderer;
 pub mod shade;
+pub mod shadow;
+pub mod smoke;
 pub mod splat;
+pub mod tonemap;

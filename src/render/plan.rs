@@ -84,7 +84,11 @@ pub fn plan(needs: SceneNeeds, change: Change) -> Plan {
         Pass::Shadow,
         has_shadows && lights_stale,
         "lights changed: shadow maps are stale",
-        if has_shadows { "lights and geometry unchanged: shadow maps reused" } else { "no light casts a shadow onto a caster" },
+        if has_shadows {
+            "lights and geometry unchanged: shadow maps reused"
+        } else {
+            "no light casts a shadow onto a caster"
+        },
     );
     let translucent = needs.translucent_objects > 0;
     add(

@@ -45,12 +45,7 @@ impl Vertex {
         }
     }
     pub fn position_attribute() -> vk::VertexInputAttributeDescription {
-        vk::VertexInputAttributeDescription {
-            location: 0,
-            binding: 0,
-            format: vk::Format::R32G32B32_SFLOAT,
-            offset: 0,
-        }
+        vk::VertexInputAttributeDescription { location: 0, binding: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 0 }
     }
     pub fn normal_attribute() -> vk::VertexInputAttributeDescription {
         vk::VertexInputAttributeDescription {

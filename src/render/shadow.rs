@@ -2,17 +2,23 @@
 //! light into one layer of a D32 array image, which the splat and shade passes sample with a
 //! compare sampler (percentage-closer filtering, `glsl/common/lights.glsl`).
 //!
-//! Vertex input: binding 0 = `records::Vertex`. Push: the light's world -> clip matrix.
+//! Vertex input: binding 0 = `records::Vertex`. Push: the light's world -> clip matrix, its layer.
 
 use super::records::Vertex;
-use crate::gpu::{
-    Buffer, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler,
-    image_barrier,
-};
+use crate::gpu::{Buffer, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler, image_barrier};
 use ash::vk;
 use std::sync::Arc;
 
-pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+pub const DEPTH_FORMAT: vk::Format = vk::Format::D16_UNORM;
+
+/// The push block of shadow.vert.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ShadowPush {
+    light_matrix: [[f32; 4]; 4],
+    layer: u32,
+    _pad: [u32; 3],
+}
 
 /// A draw of one caster: index range and vertex offset in the shared buffers.
 #[derive(Clone, Copy, Debug)]
@@ -34,7 +40,7 @@ impl ShadowPass {
     /// bound even when nothing casts a shadow).
     pub fn new(gpu: &Arc<Gpu>, size: u32, layers: u32) -> GpuResult<ShadowPass> {
         let mut desc = GraphicsDesc::new("shadow.vert", None);
-        desc.push_bytes = 64;
+        desc.push_bytes = std::mem::size_of::<ShadowPush>() as u32;
         desc.vertex_bindings = vec![Vertex::binding()];
         desc.vertex_attributes = vec![Vertex::position_attribute()];
         desc.depth_format = Some(DEPTH_FORMAT);
@@ -48,18 +54,56 @@ impl ShadowPass {
                 size,
                 size,
                 DEPTH_FORMAT,
-                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                    | vk::ImageUsageFlags::SAMPLED
+                    | vk::ImageUsageFlags::TRANSFER_DST,
             )
             .layers(layers.max(1))
             .array_view(),
         )?;
         let sampler = Sampler::shadow(gpu, DEPTH_FORMAT)?;
-        Ok(ShadowPass {
-            pipeline,
-            maps,
-            sampler,
-            layers,
-        })
+        // Start cleared to the far plane (everything lit) and readable, so the passes that sample
+        // the maps are valid even when the plan never renders them (no shadow caster).
+        let device = gpu.device();
+        gpu.one_shot("shadow map init", |cmd| {
+            image_barrier(
+                device,
+                cmd,
+                maps.raw(),
+                vk::ImageAspectFlags::DEPTH,
+                (vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL),
+                (vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE),
+                (vk::PipelineStageFlags2::CLEAR, vk::AccessFlags2::TRANSFER_WRITE),
+            );
+            let range = [vk::ImageSubresourceRange::default()
+                .aspect_mask(vk::ImageAspectFlags::DEPTH)
+                .level_count(1)
+                .layer_count(vk::REMAINING_ARRAY_LAYERS)];
+            let far = vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 };
+            // SAFETY: the image is in TRANSFER_DST_OPTIMAL and has TRANSFER_DST usage.
+            unsafe {
+                device.cmd_clear_depth_stencil_image(
+                    cmd,
+                    maps.raw(),
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &far,
+                    &range,
+                )
+            };
+            image_barrier(
+                device,
+                cmd,
+                maps.raw(),
+                vk::ImageAspectFlags::DEPTH,
+                (vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
+                (vk::PipelineStageFlags2::CLEAR, vk::AccessFlags2::TRANSFER_WRITE),
+                (
+                    vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COMPUTE_SHADER,
+                    vk::AccessFlags2::SHADER_SAMPLED_READ,
+                ),
+            );
+        })?;
+        Ok(ShadowPass { pipeline, maps, sampler, layers })
     }
 
     pub fn maps(&self) -> &Image {
@@ -87,76 +131,50 @@ impl ShadowPass {
             cmd,
             self.maps.raw(),
             vk::ImageAspectFlags::DEPTH,
-            (
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
-            ),
+            (vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL),
             (
                 vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COMPUTE_SHADER,
                 vk::AccessFlags2::SHADER_SAMPLED_READ,
             ),
             (
-                vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
-                    | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
-                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
-                    | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
+                vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
             ),
         );
         let extent = self.maps.extent();
-        for layer in 0..self.layers.max(1) {
-            let attachment = vk::RenderingAttachmentInfo::default()
-                .image_view(self.maps.layer_view(layer))
-                .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue {
-                    depth_stencil: vk::ClearDepthStencilValue {
-                        depth: 1.0,
-                        stencil: 0,
-                    },
-                });
-            let info = vk::RenderingInfo::default()
-                .render_area(vk::Rect2D {
-                    offset: vk::Offset2D::default(),
-                    extent,
-                })
-                .layer_count(1)
-                .depth_attachment(&attachment);
-            // SAFETY: `cmd` is recording; the layer view is a depth attachment in the right layout.
-            unsafe { device.cmd_begin_rendering(cmd, &info) };
-            if let Some(matrix) = matrices.get(layer as usize).filter(|_| layer < self.layers) {
-                self.pipeline
-                    .bind(cmd, None, bytemuck::bytes_of(matrix), extent);
-                unsafe {
-                    device.cmd_bind_vertex_buffers(cmd, 0, &[vertices.raw()], &[0]);
-                    device.cmd_bind_index_buffer(cmd, indices.raw(), 0, vk::IndexType::UINT32);
-                    for d in casters {
-                        device.cmd_draw_indexed(
-                            cmd,
-                            d.index_count,
-                            1,
-                            d.first_index,
-                            d.vertex_offset,
-                            0,
-                        );
-                    }
+        // One layered render: the clear covers every layer, and each light's draws pick its
+        // layer with gl_Layer (shadow.vert).
+        let attachment = vk::RenderingAttachmentInfo::default()
+            .image_view(self.maps.view())
+            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
+        let info = vk::RenderingInfo::default()
+            .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent })
+            .layer_count(self.layers.max(1))
+            .depth_attachment(&attachment);
+        // SAFETY: `cmd` is recording; the array view is a depth attachment in the right layout.
+        unsafe { device.cmd_begin_rendering(cmd, &info) };
+        for (layer, matrix) in matrices.iter().enumerate().take(self.layers as usize) {
+            let push = ShadowPush { light_matrix: *matrix, layer: layer as u32, _pad: [0; 3] };
+            self.pipeline.bind(cmd, None, bytemuck::bytes_of(&push), extent);
+            unsafe {
+                device.cmd_bind_vertex_buffers(cmd, 0, &[vertices.raw()], &[0]);
+                device.cmd_bind_index_buffer(cmd, indices.raw(), 0, vk::IndexType::UINT32);
+                for d in casters {
+                    device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0);
                 }
             }
-            unsafe { device.cmd_end_rendering(cmd) };
         }
+        unsafe { device.cmd_end_rendering(cmd) };
         image_barrier(
             device,
             cmd,
             self.maps.raw(),
             vk::ImageAspectFlags::DEPTH,
-            (
-                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
-                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-            ),
-            (
-                vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
-                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
-            ),
+            (vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
+            (vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS, vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE),
             (
                 vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COMPUTE_SHADER,
                 vk::AccessFlags2::SHADER_SAMPLED_READ,

@@ -3,10 +3,7 @@
 //!
 //! Bindings: 0 = input f32 (storage, read), 1 = output f32 (storage, write). Push: u32 count.
 
-use crate::gpu::{
-    Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Gpu, GpuResult, GpuTimer,
-    memory_barrier,
-};
+use crate::gpu::{Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Gpu, GpuResult, GpuTimer, memory_barrier};
 use ash::vk;
 use std::sync::Arc;
 
@@ -20,60 +17,32 @@ pub struct SmokeResult {
 
 /// The values the shader must produce, computed on the CPU.
 pub fn expected(input: &[f32]) -> Vec<f32> {
-    input
-        .iter()
-        .enumerate()
-        .map(|(i, v)| 2.0 * v + i as f32)
-        .collect()
+    input.iter().enumerate().map(|(i, v)| 2.0 * v + i as f32).collect()
 }
 
 pub fn run(gpu: &Arc<Gpu>, input: &[f32]) -> GpuResult<SmokeResult> {
     let count = input.len() as u32;
-    let pipeline = ComputePipeline::new(
-        gpu,
-        "smoke.comp",
-        &[BindingKind::StorageBuffer, BindingKind::StorageBuffer],
-        4,
-    )?;
-    let src = Buffer::from_slice(
-        gpu,
-        "smoke input",
-        input,
-        vk::BufferUsageFlags::STORAGE_BUFFER,
-    )?;
+    let pipeline =
+        ComputePipeline::new(gpu, "smoke.comp", &[BindingKind::StorageBuffer, BindingKind::StorageBuffer], 4)?;
+    let src = Buffer::from_slice(gpu, "smoke input", input, vk::BufferUsageFlags::STORAGE_BUFFER)?;
     let dst = Buffer::new(
         gpu,
-        &BufferDesc::readback(
-            "smoke output",
-            4 * count as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-        ),
+        &BufferDesc::readback("smoke output", 4 * count as u64, vk::BufferUsageFlags::STORAGE_BUFFER),
     )?;
     let set = pipeline.descriptor_set(&[Binding::Buffer(&src), Binding::Buffer(&dst)])?;
     let mut timer = GpuTimer::new(gpu, 1)?;
     gpu.one_shot("smoke dispatch", |cmd| {
         timer.reset(cmd);
         timer.begin(cmd, "smoke");
-        pipeline.dispatch(
-            cmd,
-            &set,
-            bytemuck::bytes_of(&count),
-            [count.div_ceil(LOCAL_SIZE), 1, 1],
-        );
+        pipeline.dispatch(cmd, &set, bytemuck::bytes_of(&count), [count.div_ceil(LOCAL_SIZE), 1, 1]);
         timer.end(cmd);
         memory_barrier(
             gpu.device(),
             cmd,
-            (
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_WRITE,
-            ),
+            (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_WRITE),
             (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
         );
     })?;
     let gpu_ms = timer.results()?.first().map(|(_, ms)| *ms).unwrap_or(0.0);
-    Ok(SmokeResult {
-        output: dst.read()?,
-        gpu_ms,
-    })
+    Ok(SmokeResult { output: dst.read()?, gpu_ms })
 }

@@ -34,8 +34,7 @@ impl SplatPass {
         output: &Buffer,
     ) -> GpuResult<SplatPass> {
         let s = BindingKind::StorageBuffer;
-        let pipeline =
-            ComputePipeline::new(gpu, "splat.comp", &[s, s, s, BindingKind::CombinedImageSampler, s], 8)?;
+        let pipeline = ComputePipeline::new(gpu, "splat.comp", &[s, s, s, BindingKind::CombinedImageSampler, s], 8)?;
         let set = pipeline.descriptor_set(&[
             Binding::Buffer(samples),
             Binding::Buffer(objects),

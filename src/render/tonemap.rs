@@ -5,8 +5,7 @@
 //! Push: width, height, exposure.
 
 use crate::gpu::{
-    Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuResult,
-    Image, Sampler,
+    Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuResult, Image, Sampler,
 };
 use ash::vk;
 use std::sync::Arc;
@@ -35,11 +34,7 @@ impl TonemapPass {
         let pipeline = ComputePipeline::new(
             gpu,
             "tonemap.comp",
-            &[
-                BindingKind::CombinedImageSampler,
-                BindingKind::StorageBuffer,
-                BindingKind::StorageBuffer,
-            ],
+            &[BindingKind::CombinedImageSampler, BindingKind::StorageBuffer, BindingKind::StorageBuffer],
             12,
         )?;
         let extent = hdr.extent();
@@ -52,10 +47,8 @@ impl TonemapPass {
                 vk::BufferUsageFlags::STORAGE_BUFFER,
             ),
         )?;
-        let counters = Buffer::new(
-            gpu,
-            &BufferDesc::readback("tonemap counters", 16, vk::BufferUsageFlags::STORAGE_BUFFER),
-        )?;
+        let counters =
+            Buffer::new(gpu, &BufferDesc::readback("tonemap counters", 16, vk::BufferUsageFlags::STORAGE_BUFFER))?;
         let set = pipeline.descriptor_set(&[
             Binding::Image {
                 view: hdr.view(),
@@ -79,27 +72,17 @@ impl TonemapPass {
     /// Record the pass; zeroes the non-finite counter first.
     pub fn record(&self, gpu: &Gpu, cmd: vk::CommandBuffer, exposure: f32) {
         // SAFETY: `cmd` is recording outside a render pass; the counter buffer is ours.
-        unsafe {
-            gpu.device()
-                .cmd_fill_buffer(cmd, self.counters.raw(), 0, vk::WHOLE_SIZE, 0)
-        };
+        unsafe { gpu.device().cmd_fill_buffer(cmd, self.counters.raw(), 0, vk::WHOLE_SIZE, 0) };
         crate::gpu::memory_barrier(
             gpu.device(),
             cmd,
-            (
-                vk::PipelineStageFlags2::CLEAR,
-                vk::AccessFlags2::TRANSFER_WRITE,
-            ),
+            (vk::PipelineStageFlags2::CLEAR, vk::AccessFlags2::TRANSFER_WRITE),
             (
                 vk::PipelineStageFlags2::COMPUTE_SHADER,
                 vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
             ),
         );
-        let push = Push {
-            width: self.width,
-            height: self.height,
-            exposure,
-        };
+        let push = Push { width: self.width, height: self.height, exposure };
         self.pipeline.dispatch(
             cmd,
             &self.set,

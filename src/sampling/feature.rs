@@ -57,7 +57,12 @@ impl Default for FeatureParams {
     fn default() -> Self {
         // Twice Turk's default iterations: Algorithm 1 starts half the points in a few tight
         // clusters, further from equilibrium than a random start.
-        FeatureParams { feature_fraction: 0.5, contrast: 1.0, cap: 3.0, turk: TurkParams { iterations: 80, ..TurkParams::default() } }
+        FeatureParams {
+            feature_fraction: 0.5,
+            contrast: 1.0,
+            cap: 3.0,
+            turk: TurkParams { iterations: 80, ..TurkParams::default() },
+        }
     }
 }
 
@@ -131,7 +136,11 @@ pub fn feature_points(mesh: &Mesh, two_n: usize) -> Vec<SurfacePoint> {
         .map(|&t| {
             let w = tris[t as usize].map(|v| abs_h[v as usize]);
             let sum = w[0] + w[1] + w[2];
-            let eq12 = if sum.is_finite() && sum > NEGLIGIBLE * mean_h && sum > 0.0 { w.map(|x| x / sum) } else { [1.0 / 3.0; 3] };
+            let eq12 = if sum.is_finite() && sum > NEGLIGIBLE * mean_h && sum > 0.0 {
+                w.map(|x| x / sum)
+            } else {
+                [1.0 / 3.0; 3]
+            };
             let bary = eq12.map(|x| (1.0 - CENTROID_BLEND) * x + CENTROID_BLEND / 3.0);
             SurfacePoint { triangle: t, bary }
         })

@@ -172,7 +172,13 @@ impl SpatialHash {
     /// `visit(index, squared distance)` for their points. After each ring, `done(reach)` is asked
     /// whether to stop, where `reach` is a distance that every point not yet visited exceeds.
     #[inline]
-    fn ring_search<S>(&self, p: DVec3, state: &mut S, visit: impl Fn(&mut S, u32, f64), done: impl Fn(&S, f64) -> bool) {
+    fn ring_search<S>(
+        &self,
+        p: DVec3,
+        state: &mut S,
+        visit: impl Fn(&mut S, u32, f64),
+        done: impl Fn(&S, f64) -> bool,
+    ) {
         if self.positions.is_empty() {
             return;
         }

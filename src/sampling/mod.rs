@@ -149,7 +149,12 @@ pub struct GpuSample {
 
 impl SamplePoint {
     pub fn gpu(&self) -> GpuSample {
-        GpuSample { position: self.position.to_array(), area: self.area as f32, normal: self.normal.to_array(), pad: 0.0 }
+        GpuSample {
+            position: self.position.to_array(),
+            area: self.area as f32,
+            normal: self.normal.to_array(),
+            pad: 0.0,
+        }
     }
 }
 

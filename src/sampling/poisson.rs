@@ -108,7 +108,8 @@ pub fn eliminate(mesh: &Mesh, candidates: &[SurfacePoint], n: usize) -> Vec<Surf
         neighbours.extend(list);
     }
 
-    let mut weights: Vec<f64> = (0..m).map(|i| neighbours[offsets[i]..offsets[i + 1]].iter().map(|e| e.1).sum()).collect();
+    let mut weights: Vec<f64> =
+        (0..m).map(|i| neighbours[offsets[i]..offsets[i + 1]].iter().map(|e| e.1).sum()).collect();
     let mut heap: BinaryHeap<Entry> = (0..m).map(|i| Entry { weight: weights[i], index: i as u32 }).collect();
     let mut removed = vec![false; m];
     let mut alive = m;

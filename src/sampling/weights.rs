@@ -64,7 +64,9 @@ pub fn area_weights(mesh: &Mesh, points: &[SurfacePoint], params: &WeightParams)
                     let centroid = a + (b - a) * u + (c - a) * v;
                     // Prefer samples on the same side of a thin sheet as this piece.
                     let best = hash
-                        .nearest_preferring(centroid, spacing, |j| normals[points[j as usize].triangle as usize].dot(nt) > 0.0)
+                        .nearest_preferring(centroid, spacing, |j| {
+                            normals[points[j as usize].triangle as usize].dot(nt) > 0.0
+                        })
                         .expect("there is at least one sample");
                     match out.last_mut() {
                         Some((s, w)) if *s == best => *w += each,

@@ -13,6 +13,7 @@ use std::str::FromStr;
 
 /// An object's material, resolved.
 #[derive(Clone, Debug)]
+#[allow(clippy::large_enum_variant)] // one per object, never in a hot loop
 pub enum ResolvedMaterial {
     Translucent { material: Material, dipoles: [Dipole; 3], mm_per_unit: f64, roughness: f32 },
     Opaque { albedo: [f32; 3], roughness: f32 },
@@ -96,7 +97,12 @@ impl PreparedScene {
                         material = material.with_eta(*e).with_context(|| key.clone())?;
                     }
                     let dipoles = material.dipoles(*mm_per_unit).with_context(|| key.clone())?;
-                    ResolvedMaterial::Translucent { material, dipoles, mm_per_unit: *mm_per_unit, roughness: *roughness }
+                    ResolvedMaterial::Translucent {
+                        material,
+                        dipoles,
+                        mm_per_unit: *mm_per_unit,
+                        roughness: *roughness,
+                    }
                 }
                 MaterialSpec::Opaque { albedo, roughness } => {
                     ResolvedMaterial::Opaque { albedo: *albedo, roughness: *roughness }
@@ -175,7 +181,7 @@ fn transform_mesh(mesh: Mesh, t: &super::Transform) -> Result<Mesh> {
     if let Some(fit) = t.fit {
         let (lo, hi) = mesh.bounds();
         let extent = (hi - lo).max_element();
-        if !(extent > 0.0) {
+        if extent.is_nan() || extent <= 0.0 {
             bail!("cannot fit a mesh with an empty bounding box");
         }
         let centre = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));

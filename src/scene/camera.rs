@@ -6,11 +6,7 @@ use glam::{Mat4, Vec3};
 
 impl Camera {
     pub fn view(&self) -> Mat4 {
-        look_at_mat4(
-            Vec3::from(self.eye),
-            Vec3::from(self.target),
-            Vec3::from(self.up).normalize(),
-        )
+        look_at_mat4(Vec3::from(self.eye), Vec3::from(self.target), Vec3::from(self.up).normalize())
     }
 
     /// Perspective projection with near and far planes fitted around a scene bounding sphere.

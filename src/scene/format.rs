@@ -176,7 +176,7 @@ fn one() -> f32 {
     1.0
 }
 fn env_directions() -> u32 {
-    24
+    16
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -192,11 +192,7 @@ pub struct Sampling {
 
 impl Default for Sampling {
     fn default() -> Self {
-        Self {
-            method: method(),
-            count: count(),
-            seed: seed(),
-        }
+        Self { method: method(), count: count(), seed: seed() }
     }
 }
 
@@ -228,12 +224,7 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self {
-            gather: gather(),
-            exposure: 1.0,
-            shadow_map_size: shadow_size(),
-            background: None,
-        }
+        Self { gather: gather(), exposure: 1.0, shadow_map_size: shadow_size(), background: None }
     }
 }
 
@@ -241,5 +232,5 @@ fn gather() -> String {
     "vertex".into()
 }
 fn shadow_size() -> u32 {
-    1024
+    2048
 }

@@ -13,18 +13,12 @@ use std::path::{Path, PathBuf};
 pub const DEFAULT_SCENE: &str = include_str!("../../assets/scenes/default.toml");
 
 /// Assets embedded in the binary, so the default scene renders from any working directory.
-pub const EMBEDDED_ASSETS: &[(&str, &[u8])] = &[(
-    "bunny-37k.obj",
-    include_bytes!("../../assets/bunny-37k.obj"),
-)];
+pub const EMBEDDED_ASSETS: &[(&str, &[u8])] = &[("bunny-37k.obj", include_bytes!("../../assets/bunny-37k.obj"))];
 
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     #[error("cannot read scene {path}: {source}")]
-    Read {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Read { path: PathBuf, source: std::io::Error },
     #[error("{file}: {message}")]
     Invalid { file: String, message: String },
 }
@@ -51,20 +45,15 @@ impl Scene {
     }
 
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text =
+            std::fs::read_to_string(path).map_err(|source| SceneError::Read { path: path.to_path_buf(), source })?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Scene::parse(&text, &path.display().to_string(), Some(base))
     }
 
     /// Parse and check `text`; `name` appears in errors.
     pub fn parse(text: &str, name: &str, base: Option<PathBuf>) -> Result<Scene, SceneError> {
-        let invalid = |message: String| SceneError::Invalid {
-            file: name.to_string(),
-            message,
-        };
+        let invalid = |message: String| SceneError::Invalid { file: name.to_string(), message };
         let deserializer = toml::Deserializer::parse(text).map_err(|e| invalid(e.to_string()))?;
         let file: SceneFile = serde_path_to_error::deserialize(deserializer).map_err(|e| {
             let path = e.path().to_string();
@@ -85,16 +74,10 @@ impl Scene {
             }
         })?;
         check(&file).map_err(|(key, message)| {
-            let line = line_of(text, &key)
-                .map(|l| format!("line {l}: "))
-                .unwrap_or_default();
+            let line = line_of(text, &key).map(|l| format!("line {l}: ")).unwrap_or_default();
             invalid(format!("{line}`{key}`: {message}"))
         })?;
-        Ok(Scene {
-            file,
-            base,
-            name: name.to_string(),
-        })
+        Ok(Scene { file, base, name: name.to_string() })
     }
 
     /// Resolve a path named in the scene: relative to the scene file, or among embedded assets.
@@ -119,8 +102,7 @@ fn line_of(text: &str, key: &str) -> Option<usize> {
     text.lines()
         .position(|l| {
             let l = l.trim_start();
-            l.strip_prefix(last)
-                .is_some_and(|rest| rest.trim_start().starts_with('='))
+            l.strip_prefix(last).is_some_and(|rest| rest.trim_start().starts_with('='))
         })
         .map(|i| i + 1)
 }
@@ -136,11 +118,7 @@ fn finite(key: &str, values: &[f32]) -> Check {
 
 fn nonzero(key: &str, v: [f32; 3]) -> Check {
     finite(key, &v)?;
-    if v.iter().all(|c| *c == 0.0) {
-        Err((key.into(), "must not be the zero vector".into()))
-    } else {
-        Ok(())
-    }
+    if v.iter().all(|c| *c == 0.0) { Err((key.into(), "must not be the zero vector".into())) } else { Ok(()) }
 }
 
 fn non_negative(key: &str, values: &[f32]) -> Check {
@@ -160,16 +138,10 @@ fn check(scene: &SceneFile) -> Check {
         return Err(("camera.target".into(), "equals camera.eye".into()));
     }
     if !(c.fov_y > 0.0 && c.fov_y < 180.0) {
-        return Err((
-            "camera.fov_y".into(),
-            format!("{} must be between 0 and 180 degrees", c.fov_y),
-        ));
+        return Err(("camera.fov_y".into(), format!("{} must be between 0 and 180 degrees", c.fov_y)));
     }
     if c.resolution.iter().any(|r| *r == 0 || *r > 16384) {
-        return Err((
-            "camera.resolution".into(),
-            format!("{:?} must be 1 to 16384 pixels each", c.resolution),
-        ));
+        return Err(("camera.resolution".into(), format!("{:?} must be 1 to 16384 pixels each", c.resolution)));
     }
     if scene.objects.is_empty() {
         return Err(("object".into(), "the scene has no [[object]]".into()));
@@ -180,19 +152,12 @@ fn check(scene: &SceneFile) -> Check {
             Shape::Mesh { path } if path.trim().is_empty() => {
                 return Err((key("shape.path"), "is empty".into()));
             }
-            Shape::Plane { size, divisions }
-            | Shape::Sphere {
-                radius: size,
-                divisions,
-            } => {
+            Shape::Plane { size, divisions } | Shape::Sphere { radius: size, divisions } => {
                 if !(size.is_finite() && *size > 0.0) {
                     return Err((key("shape"), format!("size/radius {size} must be positive")));
                 }
                 if *divisions == 0 || *divisions > 2048 {
-                    return Err((
-                        key("shape.divisions"),
-                        format!("{divisions} must be 1 to 2048"),
-                    ));
+                    return Err((key("shape.divisions"), format!("{divisions} must be 1 to 2048")));
                 }
             }
             _ => {}
@@ -206,46 +171,24 @@ fn check(scene: &SceneFile) -> Check {
             }
         }
         finite(&key("transform.rotate"), &t.rotate.unwrap_or_default())?;
-        finite(
-            &key("transform.translate"),
-            &t.translate.unwrap_or_default(),
-        )?;
+        finite(&key("transform.translate"), &t.translate.unwrap_or_default())?;
         match &o.material {
-            MaterialSpec::Translucent {
-                preset,
-                sigma_a,
-                sigma_s_prime,
-                mm_per_unit,
-                roughness,
-                ..
-            } => {
+            MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, mm_per_unit, roughness, .. } => {
                 if preset.is_none() && (sigma_a.is_none() || sigma_s_prime.is_none()) {
-                    return Err((
-                        key("material"),
-                        "needs `preset` or both `sigma_a` and `sigma_s_prime`".into(),
-                    ));
+                    return Err((key("material"), "needs `preset` or both `sigma_a` and `sigma_s_prime`".into()));
                 }
                 if preset.is_some() && (sigma_a.is_some() || sigma_s_prime.is_some()) {
-                    return Err((
-                        key("material"),
-                        "give `preset` or coefficients, not both".into(),
-                    ));
+                    return Err((key("material"), "give `preset` or coefficients, not both".into()));
                 }
                 if !(mm_per_unit.is_finite() && *mm_per_unit > 0.0) {
-                    return Err((
-                        key("material.mm_per_unit"),
-                        format!("{mm_per_unit} must be positive"),
-                    ));
+                    return Err((key("material.mm_per_unit"), format!("{mm_per_unit} must be positive")));
                 }
                 non_negative(&key("material.roughness"), &[*roughness])?;
             }
             MaterialSpec::Opaque { albedo, roughness } => {
                 non_negative(&key("material.albedo"), albedo)?;
                 if albedo.iter().any(|a| *a > 1.0) {
-                    return Err((
-                        key("material.albedo"),
-                        format!("{albedo:?} must be at most 1 (energy)"),
-                    ));
+                    return Err((key("material.albedo"), format!("{albedo:?} must be at most 1 (energy)")));
                 }
                 non_negative(&key("material.roughness"), &[*roughness])?;
             }
@@ -255,49 +198,26 @@ fn check(scene: &SceneFile) -> Check {
     for (i, l) in scene.lights.iter().enumerate() {
         let key = |k: &str| format!("light[{i}].{k}");
         match l {
-            Light::Directional {
-                direction,
-                irradiance,
-                ..
-            } => {
+            Light::Directional { direction, irradiance, .. } => {
                 nonzero(&key("direction"), *direction)?;
                 non_negative(&key("irradiance"), irradiance)?;
             }
-            Light::Point {
-                position,
-                intensity,
-                ..
-            } => {
+            Light::Point { position, intensity, .. } => {
                 finite(&key("position"), position)?;
                 non_negative(&key("intensity"), intensity)?;
             }
-            Light::Spot {
-                position,
-                direction,
-                intensity,
-                angle,
-                softness,
-                ..
-            } => {
+            Light::Spot { position, direction, intensity, angle, softness, .. } => {
                 finite(&key("position"), position)?;
                 nonzero(&key("direction"), *direction)?;
                 non_negative(&key("intensity"), intensity)?;
                 if !(*angle > 0.0 && *angle < 90.0) {
-                    return Err((
-                        key("angle"),
-                        format!("{angle} must be between 0 and 90 degrees"),
-                    ));
+                    return Err((key("angle"), format!("{angle} must be between 0 and 90 degrees")));
                 }
                 if !(0.0..=1.0).contains(softness) {
-                    return Err((
-                        key("softness"),
-                        format!("{softness} must be between 0 and 1"),
-                    ));
+                    return Err((key("softness"), format!("{softness} must be between 0 and 1")));
                 }
             }
-            Light::Environment {
-                scale, directions, ..
-            } => {
+            Light::Environment { scale, directions, .. } => {
                 environments += 1;
                 non_negative(&key("scale"), &[*scale])?;
                 if *directions == 0 || *directions > 256 {
@@ -311,38 +231,20 @@ fn check(scene: &SceneFile) -> Check {
     }
     let s = &scene.sampling;
     if !["random", "turk", "feature", "poisson"].contains(&s.method.as_str()) {
-        return Err((
-            "sampling.method".into(),
-            format!(
-                "{:?} is not one of random, turk, feature, poisson",
-                s.method
-            ),
-        ));
+        return Err(("sampling.method".into(), format!("{:?} is not one of random, turk, feature, poisson", s.method)));
     }
     if s.count == 0 || s.count > 1_000_000 {
-        return Err((
-            "sampling.count".into(),
-            format!("{} must be 1 to 1000000", s.count),
-        ));
+        return Err(("sampling.count".into(), format!("{} must be 1 to 1000000", s.count)));
     }
     let r = &scene.render;
     if !["vertex", "pixel"].contains(&r.gather.as_str()) {
-        return Err((
-            "render.gather".into(),
-            format!("{:?} is not vertex or pixel", r.gather),
-        ));
+        return Err(("render.gather".into(), format!("{:?} is not vertex or pixel", r.gather)));
     }
     if !(r.exposure.is_finite() && r.exposure > 0.0) {
-        return Err((
-            "render.exposure".into(),
-            format!("{} must be positive", r.exposure),
-        ));
+        return Err(("render.exposure".into(), format!("{} must be positive", r.exposure)));
     }
     if !(16..=8192).contains(&r.shadow_map_size) {
-        return Err((
-            "render.shadow_map_size".into(),
-            format!("{} must be 16 to 8192", r.shadow_map_size),
-        ));
+        return Err(("render.shadow_map_size".into(), format!("{} must be 16 to 8192", r.shadow_map_size)));
     }
     non_negative("render.background", &r.background.unwrap_or_default())?;
     Ok(())
