@@ -203,3 +203,58 @@ shadow_map_size = 2048
         assert!(checked > 20);
     });
 }
+
+#[test]
+fn light_crosses_a_skimmilk_sphere_but_not_a_ketchup_one() {
+    // A 2 cm sphere lit from +x only: the dipole sum carries light through the sphere to the
+    // unlit side in proportion to the diffusion length (skimmilk: about 1 to 2 cm in red and
+    // green; ketchup: 5 mm in red, under 0.2 mm in green and blue).
+    let scene = |preset: &str| {
+        format!(
+            r#"
+[camera]
+eye = [0.0, 0.0, 60.0]
+target = [0.0, 0.0, 0.0]
+resolution = [32, 32]
+
+[[object]]
+shape = {{ type = "sphere", radius = 10.0, divisions = 48 }}
+material = {{ type = "translucent", preset = "{preset}", mm_per_unit = 1.0 }}
+
+[[light]]
+type = "directional"
+direction = [1.0, 0.0, 0.0]
+irradiance = [1.0, 1.0, 1.0]
+
+[sampling]
+method = "poisson"
+count = 1500
+"#
+        )
+    };
+    with_gpu(|gpu| {
+        let mut ratios = Vec::new();
+        for preset in ["skimmilk", "ketchup"] {
+            let prepared = prepare(&scene(preset), &Overrides::default());
+            let mesh = prepared.objects[0].mesh.clone();
+            let renderer = run_all(gpu, prepared);
+            let exitance = renderer.exitance(0).unwrap();
+            // Per channel: mean exitance on the unlit side (x < -0.7 R) over the lit side (x > 0.7 R).
+            let mean = |side: f32, c: usize| {
+                let vs: Vec<usize> =
+                    (0..mesh.positions().len()).filter(|&v| mesh.positions()[v].x * side > 7.0).collect();
+                vs.iter().map(|&v| exitance[v][c] as f64).sum::<f64>() / vs.len() as f64
+            };
+            let ratio = [0, 1, 2].map(|c| mean(-1.0, c) / mean(1.0, c));
+            eprintln!("{preset}: unlit / lit exitance per channel {ratio:?}");
+            assert!(ratio.iter().all(|r| r.is_finite() && *r >= 0.0));
+            ratios.push(ratio);
+        }
+        let (milk, ketchup) = (ratios[0], ratios[1]);
+        // Green: skimmilk's diffusion length is about 1.6 cm, ketchup's under 0.2 mm.
+        assert!(milk[1] > 0.01, "skimmilk carries green light to the unlit side: {milk:?}");
+        assert!(ketchup[1] < 1e-6, "ketchup does not: {ketchup:?}");
+        // Red, where ketchup's diffusion length is 5 mm, still far less than skimmilk's.
+        assert!(milk[0] > 2.0 * ketchup[0], "{milk:?} vs {ketchup:?}");
+    });
+}
