@@ -258,3 +258,29 @@ count = 1500
         assert!(milk[0] > 2.0 * ketchup[0], "{milk:?} vs {ketchup:?}");
     });
 }
+
+#[test]
+fn moving_one_light_redraws_only_its_shadows_and_matches_a_full_render() {
+    with_gpu(|gpu| {
+        let overrides = Overrides { resolution: Some([64, 64]), ..Default::default() };
+        let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+        // A: full first frame, then the key light orbits and only its layer is redrawn.
+        let mut a = Renderer::new(gpu, prepared.clone()).unwrap();
+        a.frame(&a.plan(Change::Everything)).unwrap();
+        a.orbit_light(0, 40.0).unwrap();
+        let plan = a.plan(Change::Light(0));
+        assert_eq!(plan.shadow_light, Some(0));
+        a.frame(&plan).unwrap();
+        // B: the light is moved before anything is drawn, then everything is drawn.
+        let mut b = Renderer::new(gpu, prepared).unwrap();
+        b.orbit_light(0, 40.0).unwrap();
+        b.frame(&b.plan(Change::Everything)).unwrap();
+        let (sa, sb) = (a.splat_irradiance().unwrap(), b.splat_irradiance().unwrap());
+        assert_eq!(sa, sb, "partial shadow redraw differs from a full one");
+        assert_eq!(a.image().unwrap(), b.image().unwrap());
+        // And the light really moved: the splat differs from the unmoved scene's.
+        let mut c = Renderer::new(gpu, PreparedScene::new(&Scene::builtin(), &overrides).unwrap()).unwrap();
+        c.frame(&c.plan(Change::Everything)).unwrap();
+        assert_ne!(c.splat_irradiance().unwrap(), sa);
+    });
+}

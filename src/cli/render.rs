@@ -8,8 +8,8 @@ use translucent::gpu::{Gpu, median};
 use translucent::output;
 use translucent::render::plan::Change;
 use translucent::render::renderer::Renderer;
-use translucent::scene::Scene;
 use translucent::scene::build::{Overrides, PreparedScene};
+use translucent::scene::{Light, Scene};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -36,9 +36,15 @@ pub struct Args {
     /// Frames to render; after the first, each frame recomputes what `--moving` invalidates
     #[arg(long, default_value_t = 1)]
     pub frames: u32,
-    /// What changes between frames: lights (splat, gather, shade) or camera (shade only)
-    #[arg(long, default_value = "lights")]
+    /// What changes between frames: `light` (the first non-environment light orbits 3 degrees
+    /// a frame: its shadow maps, splat, gather, shade), `lights` (every light: all shadow maps
+    /// too) or `camera` (shade only)
+    #[arg(long, default_value = "light")]
     pub moving: String,
+    /// Submit each pass separately and time it from submission to fence (wall clock), for
+    /// devices whose timestamps do not wait for asynchronous compute (lavapipe)
+    #[arg(long)]
+    pub isolate: bool,
     /// Print per-pass GPU milliseconds (median over the frames after the first)
     #[arg(long)]
     pub timings: bool,
@@ -61,7 +67,8 @@ impl Default for Args {
             gather: None,
             resolution: None,
             frames: 1,
-            moving: "lights".into(),
+            moving: "light".into(),
+            isolate: false,
             timings: false,
             plan: false,
             export_exitance: None,
@@ -79,11 +86,9 @@ fn parse_resolution(s: &str) -> Result<[u32; 2], String> {
 }
 
 pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
-    let moving = match args.moving.as_str() {
-        "lights" => Change::Lights,
-        "camera" => Change::Camera,
-        other => bail!("--moving {other:?} is not lights or camera"),
-    };
+    if !["light", "lights", "camera"].contains(&args.moving.as_str()) {
+        bail!("--moving {:?} is not light, lights or camera", args.moving);
+    }
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
@@ -117,6 +122,18 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     );
     let [width, height] = prepared.scene.file.camera.resolution;
     let mut renderer = Renderer::new(&gpu, prepared).context("creating GPU resources")?;
+    let moving = match args.moving.as_str() {
+        "light" => {
+            let key = renderer.scene().scene.file.lights.iter().position(|l| !matches!(l, Light::Environment { .. }));
+            match key {
+                Some(i) => Change::Light(i),
+                None if args.frames > 1 => bail!("--moving light: the scene has no directional, point or spot light"),
+                None => Change::Lights,
+            }
+        }
+        "lights" => Change::Lights,
+        _ => Change::Camera,
+    };
 
     let progress = if args.frames > 1 {
         ProgressBar::new(args.frames as u64)
@@ -128,11 +145,14 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let mut totals = Vec::new();
     for frame in 0..args.frames {
         let change = if frame == 0 { Change::Everything } else { moving };
+        if let Change::Light(i) = change {
+            renderer.orbit_light(i, 3.0)?;
+        }
         let plan = renderer.plan(change);
         if args.plan && frame < 2 {
             eprintln!("frame {frame} ({change:?}):\n{plan}");
         }
-        let timings = renderer.frame(&plan)?;
+        let timings = if args.isolate { renderer.frame_isolated(&plan)? } else { renderer.frame(&plan)? };
         // The first frame builds everything and warms caches: it is not counted.
         if frame > 0 || args.frames == 1 {
             totals.push(timings.total());
@@ -172,11 +192,9 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     }
     if args.timings {
         let frames = totals.len();
-        println!(
-            "GPU time per pass on {} (median of {frames} frame(s){}):",
-            gpu.info().name,
-            if args.frames > 1 { " after the first" } else { "" }
-        );
+        let how = if args.isolate { "submission-to-fence wall time" } else { "GPU time (timestamp queries)" };
+        let after = if args.frames > 1 { " after the first" } else { "" };
+        println!("{how} per pass on {} (median of {frames} frame(s){after}):", gpu.info().name);
         for (name, mut v) in per_pass {
             println!("  {name:<8} {:>9.3} ms", median(&mut v));
         }

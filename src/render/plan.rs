@@ -32,23 +32,30 @@ impl Pass {
 pub enum Change {
     /// Nothing computed yet.
     Everything,
-    /// A light moved or changed: visibility and irradiance are stale.
+    /// Every light moved or changed: all visibility and irradiance are stale.
     Lights,
+    /// One light (index in the scene's lights) moved: only its shadow maps are stale, but the
+    /// irradiance it adds to every sample is.
+    Light(usize),
     /// Only the camera moved.
     Camera,
 }
 
 /// What a scene contains that decides its passes.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct SceneNeeds {
     pub shadow_layers: u32,
     pub translucent_objects: usize,
+    /// Scene lights that own at least one shadow-map layer.
+    pub shadowed_lights: Vec<usize>,
 }
 
 #[derive(Clone, Debug, Default)]
 pub struct Plan {
     pub passes: Vec<(Pass, String)>,
     pub skipped: Vec<(Pass, String)>,
+    /// When only one light's shadow maps are redrawn: that scene light; `None` redraws all.
+    pub shadow_light: Option<usize>,
 }
 
 impl Plan {
@@ -69,9 +76,9 @@ impl fmt::Display for Plan {
     }
 }
 
-pub fn plan(needs: SceneNeeds, change: Change) -> Plan {
+pub fn plan(needs: &SceneNeeds, change: Change) -> Plan {
     let mut plan = Plan::default();
-    let lights_stale = matches!(change, Change::Everything | Change::Lights);
+    let lights_stale = matches!(change, Change::Everything | Change::Lights | Change::Light(_));
     let mut add = |pass: Pass, run: bool, yes: &str, no: &str| {
         if run {
             plan.passes.push((pass, yes.to_string()));
@@ -80,16 +87,30 @@ pub fn plan(needs: SceneNeeds, change: Change) -> Plan {
         }
     };
     let has_shadows = needs.shadow_layers > 0;
-    add(
-        Pass::Shadow,
-        has_shadows && lights_stale,
-        "lights changed: shadow maps are stale",
-        if has_shadows {
-            "lights and geometry unchanged: shadow maps reused"
-        } else {
-            "no light casts a shadow onto a caster"
-        },
-    );
+    match change {
+        Change::Light(i) if !needs.shadowed_lights.contains(&i) => add(
+            Pass::Shadow,
+            false,
+            "",
+            if has_shadows { "the moved light casts no shadow: shadow maps reused" } else { "no shadow-casting light" },
+        ),
+        Change::Light(_) => {
+            add(Pass::Shadow, true, "one light moved: only its shadow maps are redrawn, the others are reused", "")
+        }
+        _ => add(
+            Pass::Shadow,
+            has_shadows && lights_stale,
+            "lights changed: shadow maps are stale",
+            if has_shadows {
+                "lights and geometry unchanged: shadow maps reused"
+            } else {
+                "no light casts a shadow onto a caster"
+            },
+        ),
+    }
+    if let Change::Light(i) = change {
+        plan.shadow_light = Some(i);
+    }
     let translucent = needs.translucent_objects > 0;
     add(
         Pass::Splat,
@@ -106,4 +127,42 @@ pub fn plan(needs: SceneNeeds, change: Change) -> Plan {
     add(Pass::Shade, true, "every frame draws the view", "");
     add(Pass::Tonemap, true, "every frame's HDR image is tone-mapped", "");
     plan
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn needs(shadow_layers: u32, translucent_objects: usize) -> SceneNeeds {
+        SceneNeeds {
+            shadow_layers,
+            translucent_objects,
+            shadowed_lights: if shadow_layers > 0 { vec![0] } else { vec![] },
+        }
+    }
+
+    #[test]
+    fn a_camera_move_only_shades() {
+        let p = plan(&needs(3, 1), Change::Camera);
+        assert!(p.runs(Pass::Shade) && p.runs(Pass::Tonemap));
+        assert!(!p.runs(Pass::Shadow) && !p.runs(Pass::Splat) && !p.runs(Pass::Gather));
+    }
+
+    #[test]
+    fn scenes_without_translucency_or_shadows_skip_those_passes() {
+        let p = plan(&needs(0, 0), Change::Everything);
+        assert_eq!(p.passes.iter().map(|(p, _)| *p).collect::<Vec<_>>(), [Pass::Shade, Pass::Tonemap]);
+        assert_eq!(p.skipped.len(), 3);
+        let p = plan(&needs(2, 1), Change::Everything);
+        assert_eq!(p.passes.len(), 5);
+    }
+
+    #[test]
+    fn one_moved_light_redraws_only_its_shadows() {
+        let p = plan(&needs(3, 1), Change::Light(0));
+        assert!(p.runs(Pass::Shadow) && p.runs(Pass::Splat) && p.runs(Pass::Gather));
+        assert_eq!(p.shadow_light, Some(0));
+        let p = plan(&needs(3, 1), Change::Light(5));
+        assert!(!p.runs(Pass::Shadow) && p.runs(Pass::Splat));
+    }
 }

@@ -43,13 +43,13 @@ pub struct Renderer {
     _objects: Buffer,
     _samples: Buffer,
     splat_buffer: Buffer,
-    _lights: Buffer,
+    lights: Buffer,
     shadow: ShadowPass,
     splat: SplatPass,
     gather: GatherPass,
     shade: ShadePass,
     tonemap: TonemapPass,
-    timer: GpuTimer,
+    timer: Option<GpuTimer>,
     draws: Vec<DrawRange>,
     casters: Vec<DrawRange>,
     light_matrices: Vec<[[f32; 4]; 4]>,
@@ -190,9 +190,13 @@ impl Renderer {
             }
             None => [0.0; 3],
         });
+        let mut shadowed_lights: Vec<usize> =
+            scene.lights.iter().filter(|l| l.record.power_layer[3] >= 0.0).map(|l| l.source).collect();
+        shadowed_lights.dedup();
         let needs = SceneNeeds {
             shadow_layers: scene.shadow_layers,
             translucent_objects: scene.objects.iter().filter(|o| !o.samples.is_empty()).count(),
+            shadowed_lights,
         };
         Ok(Renderer {
             gpu: gpu.clone(),
@@ -204,13 +208,13 @@ impl Renderer {
             _objects: object_buffer,
             _samples: sample_buffer,
             splat_buffer,
-            _lights: light_buffer,
+            lights: light_buffer,
             shadow,
             splat,
             gather,
             shade,
             tonemap,
-            timer,
+            timer: Some(timer),
             draws,
             casters,
             light_matrices,
@@ -226,57 +230,96 @@ impl Renderer {
 
     /// The passes a frame with this change would run.
     pub fn plan(&self, change: Change) -> Plan {
-        plan::plan(self.needs, change)
+        plan::plan(&self.needs, change)
     }
 
     /// Render one frame: record the passes of `plan` in one submission, wait, and return their
-    /// GPU times.
+    /// GPU times from timestamp queries.
     pub fn frame(&mut self, plan: &Plan) -> GpuResult<FrameTimings> {
         let gpu = self.gpu.clone();
-        let device = gpu.device();
-        let camera = &self.scene.scene.file.camera;
-        let push = ShadePush {
-            view_proj: (camera.projection(self.scene.bounds.0, self.scene.bounds.1) * camera.view()).to_cols_array_2d(),
-            eye_object: [camera.eye[0], camera.eye[1], camera.eye[2], 0.0],
-            counts: [self.light_count, 0, 0, 0],
-        };
-        let exposure = self.scene.scene.file.render.exposure;
-        let compute_to_compute = (
-            (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_STORAGE_WRITE),
-            (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_STORAGE_READ),
-        );
-        let timer = &mut self.timer;
-        gpu.one_shot("frame", |cmd| {
+        // Taken out for the recording, which borrows `self` immutably.
+        let mut timer = self.timer.take().expect("the timer is always put back");
+        let result = gpu.one_shot("frame", |cmd| {
             timer.reset(cmd);
-            if plan.runs(Pass::Shadow) {
-                timer.begin(cmd, "shadow");
-                self.shadow.record(&gpu, cmd, &self.vertices, &self.indices, &self.casters, &self.light_matrices);
+            for (pass, _) in &plan.passes {
+                timer.begin(cmd, pass.name());
+                self.record_pass(cmd, plan, *pass);
                 timer.end(cmd);
             }
-            if plan.runs(Pass::Splat) {
-                timer.begin(cmd, "splat");
+        });
+        let passes = result.and_then(|()| timer.results());
+        self.timer = Some(timer);
+        Ok(FrameTimings { passes: passes? })
+    }
+
+    /// Render one frame with every pass in a submission of its own, and return each pass's
+    /// time from submission to fence (wall clock, milliseconds). Slower than `frame`, but on
+    /// devices whose timestamps do not wait for compute work (lavapipe runs dispatches
+    /// asynchronously), this is the figure that bounds each pass.
+    pub fn frame_isolated(&mut self, plan: &Plan) -> GpuResult<FrameTimings> {
+        let gpu = self.gpu.clone();
+        let mut passes = Vec::new();
+        for (pass, _) in &plan.passes {
+            let start = std::time::Instant::now();
+            gpu.one_shot(pass.name(), |cmd| self.record_pass(cmd, plan, *pass))?;
+            passes.push((pass.name().to_string(), start.elapsed().as_secs_f64() * 1e3));
+        }
+        Ok(FrameTimings { passes })
+    }
+
+    /// Record one pass, followed by the barrier that makes its writes visible to the passes
+    /// (and host reads) after it.
+    fn record_pass(&self, cmd: vk::CommandBuffer, plan: &Plan, pass: Pass) {
+        let gpu = &self.gpu;
+        let device = gpu.device();
+        let compute_writes = (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_STORAGE_WRITE);
+        match pass {
+            Pass::Shadow => {
+                let only: Option<Vec<u32>> = plan.shadow_light.map(|source| {
+                    let lights = self.scene.lights.iter().filter(|l| l.source == source);
+                    lights.filter(|l| l.record.power_layer[3] >= 0.0).map(|l| l.record.power_layer[3] as u32).collect()
+                });
+                self.shadow.record(
+                    gpu,
+                    cmd,
+                    &self.vertices,
+                    &self.indices,
+                    &self.casters,
+                    &self.light_matrices,
+                    only.as_deref(),
+                )
+            }
+            Pass::Splat => {
                 self.splat.record(cmd);
-                timer.end(cmd);
-                memory_barrier(device, cmd, compute_to_compute.0, compute_to_compute.1);
-            }
-            if plan.runs(Pass::Gather) {
-                timer.begin(cmd, "gather");
-                self.gather.record(cmd);
-                timer.end(cmd);
                 memory_barrier(
                     device,
                     cmd,
-                    (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_STORAGE_WRITE),
+                    compute_writes,
+                    (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_STORAGE_READ),
+                );
+            }
+            Pass::Gather => {
+                self.gather.record(cmd);
+                memory_barrier(
+                    device,
+                    cmd,
+                    compute_writes,
                     (
                         vk::PipelineStageFlags2::VERTEX_ATTRIBUTE_INPUT | vk::PipelineStageFlags2::HOST,
                         vk::AccessFlags2::VERTEX_ATTRIBUTE_READ | vk::AccessFlags2::HOST_READ,
                     ),
                 );
             }
-            if plan.runs(Pass::Shade) {
-                timer.begin(cmd, "shade");
+            Pass::Shade => {
+                let camera = &self.scene.scene.file.camera;
+                let view_proj = camera.projection(self.scene.bounds.0, self.scene.bounds.1) * camera.view();
+                let push = ShadePush {
+                    view_proj: view_proj.to_cols_array_2d(),
+                    eye_object: [camera.eye[0], camera.eye[1], camera.eye[2], 0.0],
+                    counts: [self.light_count, 0, 0, 0],
+                };
                 self.shade.record(
-                    &gpu,
+                    gpu,
                     cmd,
                     &self.vertices,
                     &self.exitance,
@@ -285,21 +328,17 @@ impl Renderer {
                     push,
                     self.background,
                 );
-                timer.end(cmd);
             }
-            if plan.runs(Pass::Tonemap) {
-                timer.begin(cmd, "tonemap");
-                self.tonemap.record(&gpu, cmd, exposure);
-                timer.end(cmd);
+            Pass::Tonemap => {
+                self.tonemap.record(gpu, cmd, self.scene.scene.file.render.exposure);
+                memory_barrier(
+                    device,
+                    cmd,
+                    compute_writes,
+                    (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+                );
             }
-            memory_barrier(
-                device,
-                cmd,
-                (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_WRITE),
-                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-            );
-        })?;
-        Ok(FrameTimings { passes: self.timer.results()? })
+        }
     }
 
     /// The last tone-mapped image (RGBA8, rows top to bottom) and how many of its HDR pixels
@@ -350,6 +389,35 @@ impl Renderer {
             }
         }
         self.splat_buffer.write(0, &data)
+    }
+
+    /// Turn scene light `index` (directional, point or spot) by `degrees` about the vertical
+    /// axis through the scene's centre, and upload its new record and shadow matrix. Render the
+    /// next frame with `Change::Light(index)`.
+    pub fn orbit_light(&mut self, index: usize, degrees: f32) -> GpuResult<()> {
+        let centre = self.scene.bounds.0;
+        let rotation = glam::Quat::from_rotation_y(degrees.to_radians());
+        let turn = |v: [f32; 3]| (rotation * Vec3::from(v)).to_array();
+        let turn_point = |p: [f32; 3]| (centre + rotation * (Vec3::from(p) - centre)).to_array();
+        let lights = &mut self.scene.scene.file.lights;
+        match lights.get_mut(index) {
+            Some(crate::scene::Light::Directional { direction, .. }) => *direction = turn(*direction),
+            Some(crate::scene::Light::Point { position, .. }) => *position = turn_point(*position),
+            Some(crate::scene::Light::Spot { position, direction, .. }) => {
+                *position = turn_point(*position);
+                *direction = turn(*direction);
+            }
+            _ => return Err(crate::gpu::GpuError::Invalid(format!("light {index} cannot be moved"))),
+        }
+        self.scene.reprepare_lights();
+        for l in &self.scene.lights {
+            let layer = l.record.power_layer[3];
+            if layer >= 0.0 {
+                self.light_matrices[layer as usize] = l.record.shadow_matrix;
+            }
+        }
+        let records: Vec<LightGpu> = self.scene.lights.iter().map(|l| l.record).collect();
+        self.lights.write(0, &records)
     }
 
     /// Bytes of device memory in use by the allocator.

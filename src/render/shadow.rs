@@ -113,9 +113,9 @@ impl ShadowPass {
         &self.sampler
     }
 
-    /// Record: render every layer (`matrices[i]` into layer i), then leave the maps in
-    /// SHADER_READ_ONLY_OPTIMAL for compute and fragment shaders. With no layers, the single
-    /// placeholder layer is cleared to 1 (everything lit).
+    /// Record: render every layer (`matrices[i]` into layer i), or with `only` just those
+    /// layers (the others keep their contents), then leave the maps in SHADER_READ_ONLY_OPTIMAL
+    /// for compute and fragment shaders.
     pub fn record(
         &self,
         gpu: &Gpu,
@@ -124,6 +124,7 @@ impl ShadowPass {
         indices: &Buffer,
         casters: &[DrawRange],
         matrices: &[[[f32; 4]; 4]],
+        only: Option<&[u32]>,
     ) {
         let device = gpu.device();
         image_barrier(
@@ -131,7 +132,11 @@ impl ShadowPass {
             cmd,
             self.maps.raw(),
             vk::ImageAspectFlags::DEPTH,
-            (vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL),
+            // Redrawing some layers keeps the others: their contents must survive the transition.
+            (
+                if only.is_some() { vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL } else { vk::ImageLayout::UNDEFINED },
+                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
+            ),
             (
                 vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COMPUTE_SHADER,
                 vk::AccessFlags2::SHADER_SAMPLED_READ,
@@ -142,12 +147,12 @@ impl ShadowPass {
             ),
         );
         let extent = self.maps.extent();
-        // One layered render: the clear covers every layer, and each light's draws pick its
-        // layer with gl_Layer (shadow.vert).
+        // One layered render: each light's draws pick its layer with gl_Layer (shadow.vert). A
+        // full redraw clears every layer on load; a partial one loads and clears only its layers.
         let attachment = vk::RenderingAttachmentInfo::default()
             .image_view(self.maps.view())
             .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .load_op(if only.is_some() { vk::AttachmentLoadOp::LOAD } else { vk::AttachmentLoadOp::CLEAR })
             .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
         let info = vk::RenderingInfo::default()
@@ -156,7 +161,28 @@ impl ShadowPass {
             .depth_attachment(&attachment);
         // SAFETY: `cmd` is recording; the array view is a depth attachment in the right layout.
         unsafe { device.cmd_begin_rendering(cmd, &info) };
+        if let Some(layers) = only {
+            let clear = [vk::ClearAttachment {
+                aspect_mask: vk::ImageAspectFlags::DEPTH,
+                color_attachment: 0,
+                clear_value: vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } },
+            }];
+            let rects: Vec<_> = layers
+                .iter()
+                .map(|&l| vk::ClearRect {
+                    rect: vk::Rect2D { offset: vk::Offset2D::default(), extent },
+                    base_array_layer: l,
+                    layer_count: 1,
+                })
+                .collect();
+            // SAFETY: inside the render; every rect lies in the attachment's extent and layers.
+            unsafe { device.cmd_clear_attachments(cmd, &clear, &rects) };
+        }
+        let redraw = |layer: u32| only.is_none_or(|l| l.contains(&layer));
         for (layer, matrix) in matrices.iter().enumerate().take(self.layers as usize) {
+            if !redraw(layer as u32) {
+                continue;
+            }
             let push = ShadowPush { light_matrix: *matrix, layer: layer as u32, _pad: [0; 3] };
             self.pipeline.bind(cmd, None, bytemuck::bytes_of(&push), extent);
             unsafe {

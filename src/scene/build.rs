@@ -40,6 +40,9 @@ pub struct PreparedScene {
     pub environment: Option<Environment>,
     /// Bounding sphere of everything (centre, radius).
     pub bounds: (Vec3, f32),
+    /// Bounding sphere of the shadow casters, which every shadow frustum covers.
+    pub caster_bounds: (Vec3, f32),
+    pub any_caster: bool,
 }
 
 /// Overrides from the command line, applied on top of the scene file.
@@ -124,6 +127,7 @@ impl PreparedScene {
         let bounds = bounding_sphere(objects.iter().map(|o| &o.mesh));
         let casters: Vec<&Mesh> = objects.iter().filter(|o| o.casts_shadow).map(|o| &o.mesh).collect();
         let caster_bounds = if casters.is_empty() { bounds } else { bounding_sphere(casters.iter().copied()) };
+        let any_caster = !casters.is_empty();
         let environment = scene
             .file
             .lights
@@ -141,10 +145,28 @@ impl PreparedScene {
             })
             .transpose()
             .with_context(|| format!("{}: environment light", scene.name))?;
-        let mut prepared =
-            lights::prepare(&scene.file.lights, environment.as_ref(), caster_bounds, scene.file.render.shadow_map_size);
-        let shadow_layers = lights::assign_shadow_layers(&mut prepared, !casters.is_empty());
-        Ok(PreparedScene { scene, objects, lights: prepared, shadow_layers, environment, bounds })
+        let mut prepared = PreparedScene {
+            scene,
+            objects,
+            lights: Vec::new(),
+            shadow_layers: 0,
+            environment,
+            bounds,
+            caster_bounds,
+            any_caster,
+        };
+        prepared.reprepare_lights();
+        Ok(prepared)
+    }
+
+    /// Recompute the GPU light records from `scene.file.lights` (after a light moved). The
+    /// environment's directions and every light's shadow layer stay as they were.
+    pub fn reprepare_lights(&mut self) {
+        let file = &self.scene.file;
+        let mut lights =
+            lights::prepare(&file.lights, self.environment.as_ref(), self.caster_bounds, file.render.shadow_map_size);
+        self.shadow_layers = lights::assign_shadow_layers(&mut lights, self.any_caster);
+        self.lights = lights;
     }
 
     pub fn sample_count(&self) -> usize {

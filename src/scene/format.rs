@@ -232,5 +232,5 @@ fn gather() -> String {
     "vertex".into()
 }
 fn shadow_size() -> u32 {
-    2048
+    1024
 }
