@@ -116,6 +116,7 @@ impl ShadowPass {
     /// Record: render every layer (`matrices[i]` into layer i), or with `only` just those
     /// layers (the others keep their contents), then leave the maps in SHADER_READ_ONLY_OPTIMAL
     /// for compute and fragment shaders.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         gpu: &Gpu,

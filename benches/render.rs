@@ -1,0 +1,128 @@
+//! Renderer benchmark: per-pass GPU times and frames per second on the default scene, and the
+//! seed paper's FPS-against-sample-count comparison (its Figure 7), on whatever device the
+//! loader offers (TRANSLUCENT_DEVICE to choose). Prints figures; asserts nothing.
+//!
+//!     cargo bench --bench render
+//!
+//! Two timings per pass: GPU timestamp queries inside one submission, and the wall time of the
+//! pass submitted alone (submission to fence). On lavapipe, compute dispatches run
+//! asynchronously and their timestamps do not wait for them, so there the isolated wall time
+//! is the figure that bounds a compute pass; frames per second come from whole-frame wall time.
+
+use std::time::Instant;
+use translucent::gpu::{Gpu, GpuOptions, median};
+use translucent::render::plan::Change;
+use translucent::render::renderer::Renderer;
+use translucent::scene::Scene;
+use translucent::scene::build::{Overrides, PreparedScene};
+
+const WARM_UP: usize = 1;
+const FRAMES: usize = 5;
+
+struct Measured {
+    /// (pass, median timestamp ms, median isolated wall ms)
+    passes: Vec<(String, f64, f64)>,
+    frame_wall_ms: f64,
+}
+
+fn measure(renderer: &mut Renderer, change: Change) -> Measured {
+    let mut stamp: Vec<(String, Vec<f64>)> = Vec::new();
+    let mut isolated: Vec<(String, Vec<f64>)> = Vec::new();
+    let mut walls = Vec::new();
+    let step = |renderer: &mut Renderer| {
+        if let Change::Light(i) = change {
+            renderer.orbit_light(i, 3.0).expect("orbit");
+        }
+        renderer.plan(change)
+    };
+    for frame in 0..WARM_UP + FRAMES {
+        let plan = step(renderer);
+        let start = Instant::now();
+        let timings = renderer.frame(&plan).expect("frame");
+        let wall = start.elapsed().as_secs_f64() * 1e3;
+        let plan = step(renderer);
+        let alone = renderer.frame_isolated(&plan).expect("isolated frame");
+        if frame < WARM_UP {
+            continue;
+        }
+        walls.push(wall);
+        for (into, from) in [(&mut stamp, timings.passes), (&mut isolated, alone.passes)] {
+            for (name, ms) in from {
+                match into.iter_mut().find(|(n, _)| *n == name) {
+                    Some((_, v)) => v.push(ms),
+                    None => into.push((name, vec![ms])),
+                }
+            }
+        }
+    }
+    let passes = stamp
+        .into_iter()
+        .map(|(name, mut v)| {
+            let mut alone = isolated.iter().find(|(n, _)| *n == name).map(|(_, v)| v.clone()).unwrap_or_default();
+            let m = median(&mut alone);
+            (name, median(&mut v), m)
+        })
+        .collect();
+    Measured { passes, frame_wall_ms: median(&mut walls) }
+}
+
+fn print(title: &str, m: &Measured) {
+    println!("\n{title}");
+    println!("  {:<8} {:>14} {:>16}", "pass", "timestamps ms", "alone (wall) ms");
+    for (name, stamp, alone) in &m.passes {
+        println!("  {name:<8} {stamp:>14.2} {alone:>16.2}");
+    }
+    println!("  frame wall time {:.1} ms = {:.2} frames/s", m.frame_wall_ms, 1000.0 / m.frame_wall_ms);
+}
+
+fn main() {
+    let options = GpuOptions { device: std::env::var("TRANSLUCENT_DEVICE").ok(), ..Default::default() };
+    let gpu = Gpu::new(&options).expect("a Vulkan device (run `bash scripts/setup`)");
+    println!("device: {} ({}, {} {})", gpu.info().name, gpu.info().kind, gpu.info().driver, gpu.info().driver_info);
+    println!("cores: {}", std::thread::available_parallelism().map(|n| n.get()).unwrap_or(0));
+
+    let scene = Scene::builtin();
+    let overrides = Overrides { resolution: Some([512, 512]), ..Default::default() };
+    let prepared = PreparedScene::new(&scene, &overrides).expect("default scene");
+    println!(
+        "default scene at 512x512: {} vertices, {} samples ({}), {} lights, {} shadow maps of {}^2",
+        prepared.vertex_count(),
+        prepared.sample_count(),
+        prepared.scene.file.sampling.method,
+        prepared.lights.len(),
+        prepared.shadow_layers,
+        prepared.scene.file.render.shadow_map_size
+    );
+    let mut renderer = Renderer::new(&gpu, prepared).expect("renderer");
+    renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
+    print(
+        "key light moves every frame (its shadow map, splat, gather, shade, tone map):",
+        &measure(&mut renderer, Change::Light(0)),
+    );
+    print("only the camera moves (shade, tone map):", &measure(&mut renderer, Change::Camera));
+    println!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
+    drop(renderer);
+
+    println!("\nFPS against sample count (key light moving every frame, 512x512), seed Figure 7:");
+    println!("  {:<8} {:>8} {:>12} {:>12} {:>10}", "sampler", "samples", "gather ms", "frame ms", "frames/s");
+    for method in ["turk", "feature"] {
+        for count in [100, 200, 400, 800, 1600] {
+            let overrides = Overrides {
+                samples: Some(count),
+                sampler: Some(method.into()),
+                resolution: Some([512, 512]),
+                ..Default::default()
+            };
+            let prepared = PreparedScene::new(&scene, &overrides).expect("scene");
+            let mut renderer = Renderer::new(&gpu, prepared).expect("renderer");
+            renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
+            let m = measure(&mut renderer, Change::Light(0));
+            let gather = m.passes.iter().find(|(n, _, _)| n == "gather").map(|p| p.2).unwrap_or(0.0);
+            println!(
+                "  {method:<8} {count:>8} {gather:>12.1} {:>12.1} {:>10.2}",
+                m.frame_wall_ms,
+                1000.0 / m.frame_wall_ms
+            );
+        }
+    }
+}
