@@ -2,8 +2,10 @@
 // Forward shading, fragment stage: linear HDR radiance.
 // Translucent: the BSSRDF's outgoing lobe turns exitance into radiance,
 //     L_o = M F_t(cos theta_o, eta) / (pi T(eta))         (seed Eq. 9 normalized, Dipole::s_d),
-// plus a dielectric GGX specular lobe per light. Opaque: Lambert plus GGX. Every light term is
-// shadowed with the light's shadow map (3x3 PCF).
+// plus a dielectric GGX specular lobe per light. Opaque: Lambert plus GGX. Key lights are
+// evaluated per pixel, shadowed with their shadow maps (3x3 PCF); the environment's directions
+// reach diffuse surfaces through the per-vertex irradiance cached by vertex_light.comp (and
+// translucent ones through the splat and gather), and add no specular lobe.
 // Bindings: 0 = objects (ObjectRecord[]), 1 = lights (Light[]), 2 = shadow maps.
 #include "dipole.glsl"
 #include "lights.glsl"
@@ -12,6 +14,7 @@
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec3 v_exitance;
+layout(location = 3) in vec3 v_environment;
 layout(location = 0) out vec4 out_radiance;
 layout(std430, set = 0, binding = 0) readonly buffer Objects { ObjectRecord objects[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Lights { Light lights[]; };
@@ -51,7 +54,9 @@ void main() {
     if (translucent) {
         radiance += v_exitance * dipole_fresnel_transmittance(cos_o, eta) * o.eta_norm_kind.y;
     }
-    for (uint l = 0u; l < push.counts.x; ++l) {
+    if (!translucent) radiance += v_environment * (o.albedo_roughness.rgb / DIPOLE_PI);
+    // The key lights come first in the buffer (scene::lights::prepare); counts.y of them.
+    for (uint l = 0u; l < push.counts.y; ++l) {
         vec3 wi, irradiance;
         light_incidence(lights[l], v_position, wi, irradiance);
         float cos_i = dot(n, wi);

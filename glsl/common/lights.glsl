@@ -14,9 +14,16 @@ struct Light {
     vec4 power_layer;      // rgb: irradiance W/m^2 (directional) or intensity W/sr (point, spot);
                            //      w: shadow-map layer, negative when the light casts no shadow
     vec4 spot_texel;       // x: cos of the spot's inner angle; y: shadow-map texel size in uv;
-                           // z: normal offset (world units) against self-shadowing
+                           // z: normal offset (world units) against self-shadowing;
+                           // w: 1 for a direction of the environment light, else 0
     mat4 shadow_matrix;    // world -> shadow clip space (depth 0..1)
 };
+
+// Environment directions light diffuse surfaces through the per-vertex cache of
+// vertex_light.comp; the shading pass evaluates only the other lights per pixel.
+bool light_is_environment(Light l) {
+    return l.spot_texel.w > 0.5;
+}
 
 // Unit direction towards the light from `p`, and the irradiance it delivers to a surface facing
 // it (inverse-square falloff and spot cone for local lights), before visibility and cosine.

@@ -9,3 +9,4 @@ pub mod shadow;
 pub mod smoke;
 pub mod splat;
 pub mod tonemap;
+pub mod vertex_light;

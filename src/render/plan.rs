@@ -9,6 +9,7 @@ use std::fmt;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Pass {
     Shadow,
+    VertexLight,
     Splat,
     Gather,
     Shade,
@@ -19,6 +20,7 @@ impl Pass {
     pub fn name(self) -> &'static str {
         match self {
             Pass::Shadow => "shadow",
+            Pass::VertexLight => "vertex_light",
             Pass::Splat => "splat",
             Pass::Gather => "gather",
             Pass::Shade => "shade",
@@ -48,6 +50,8 @@ pub struct SceneNeeds {
     pub translucent_objects: usize,
     /// Scene lights that own at least one shadow-map layer.
     pub shadowed_lights: Vec<usize>,
+    /// Whether the scene has an environment light (cached per vertex by the vertex-light pass).
+    pub environment: bool,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -111,6 +115,18 @@ pub fn plan(needs: &SceneNeeds, change: Change) -> Plan {
     if let Change::Light(i) = change {
         plan.shadow_light = Some(i);
     }
+    // Environment directions are static under a single moved light (orbit_light refuses them).
+    let environment_stale = matches!(change, Change::Everything | Change::Lights);
+    add(
+        Pass::VertexLight,
+        needs.environment && environment_stale,
+        "the environment changed: per-vertex sky irradiance is stale",
+        if needs.environment {
+            "the environment is unchanged: per-vertex sky irradiance reused"
+        } else {
+            "no environment light"
+        },
+    );
     let translucent = needs.translucent_objects > 0;
     add(
         Pass::Splat,
@@ -138,6 +154,7 @@ mod tests {
             shadow_layers,
             translucent_objects,
             shadowed_lights: if shadow_layers > 0 { vec![0] } else { vec![] },
+            environment: shadow_layers > 1,
         }
     }
 
@@ -146,21 +163,23 @@ mod tests {
         let p = plan(&needs(3, 1), Change::Camera);
         assert!(p.runs(Pass::Shade) && p.runs(Pass::Tonemap));
         assert!(!p.runs(Pass::Shadow) && !p.runs(Pass::Splat) && !p.runs(Pass::Gather));
+        assert!(!p.runs(Pass::VertexLight));
     }
 
     #[test]
     fn scenes_without_translucency_or_shadows_skip_those_passes() {
         let p = plan(&needs(0, 0), Change::Everything);
         assert_eq!(p.passes.iter().map(|(p, _)| *p).collect::<Vec<_>>(), [Pass::Shade, Pass::Tonemap]);
-        assert_eq!(p.skipped.len(), 3);
+        assert_eq!(p.skipped.len(), 4);
         let p = plan(&needs(2, 1), Change::Everything);
-        assert_eq!(p.passes.len(), 5);
+        assert_eq!(p.passes.len(), 6);
     }
 
     #[test]
     fn one_moved_light_redraws_only_its_shadows() {
         let p = plan(&needs(3, 1), Change::Light(0));
         assert!(p.runs(Pass::Shadow) && p.runs(Pass::Splat) && p.runs(Pass::Gather));
+        assert!(!p.runs(Pass::VertexLight), "the environment did not move");
         assert_eq!(p.shadow_light, Some(0));
         let p = plan(&needs(3, 1), Change::Light(5));
         assert!(!p.runs(Pass::Shadow) && p.runs(Pass::Splat));

@@ -9,6 +9,7 @@ use super::shade::{ShadePass, ShadePush};
 use super::shadow::{DrawRange, ShadowPass};
 use super::splat::{SPLAT_STRIDE, SplatPass};
 use super::tonemap::TonemapPass;
+use super::vertex_light::VertexLightPass;
 use crate::gpu::{Buffer, BufferDesc, Gpu, GpuResult, GpuTimer, memory_barrier};
 use crate::optics::fresnel;
 use crate::optics::gpu::DipoleChannelGpu;
@@ -40,11 +41,13 @@ pub struct Renderer {
     vertices: Buffer,
     indices: Buffer,
     exitance: Buffer,
+    environment_irradiance: Buffer,
     _objects: Buffer,
     _samples: Buffer,
     splat_buffer: Buffer,
     lights: Buffer,
     shadow: ShadowPass,
+    vertex_light: VertexLightPass,
     splat: SplatPass,
     gather: GatherPass,
     shade: ShadePass,
@@ -146,6 +149,12 @@ impl Renderer {
         let index_buffer = upload(gpu, "indices", &indices, vk::BufferUsageFlags::INDEX_BUFFER)?;
         // Opaque vertices keep zero exitance; translucent ones are written by the gather.
         let exitance = upload(gpu, "exitance", &vec![[0f32; 4]; vertices.len()], vk::BufferUsageFlags::VERTEX_BUFFER)?;
+        let environment_irradiance = upload(
+            gpu,
+            "environment irradiance",
+            &vec![[0f32; 4]; vertices.len()],
+            vk::BufferUsageFlags::VERTEX_BUFFER,
+        )?;
         let object_buffer = upload(gpu, "objects", &objects, vk::BufferUsageFlags::empty())?;
         let sample_buffer = upload(gpu, "samples", &samples, vk::BufferUsageFlags::empty())?;
         let splat_buffer = storage(gpu, "splat", SPLAT_STRIDE * samples.len() as u64, vk::BufferUsageFlags::empty())?;
@@ -154,6 +163,16 @@ impl Renderer {
         let settings = &scene.scene.file.render;
         let shadow = ShadowPass::new(gpu, settings.shadow_map_size, scene.shadow_layers)?;
         let light_count = lights.len() as u32;
+        let vertex_light = VertexLightPass::new(
+            gpu,
+            &vertex_buffer,
+            vertices.len() as u32,
+            &light_buffer,
+            light_count,
+            shadow.maps(),
+            shadow.sampler(),
+            &environment_irradiance,
+        )?;
         let splat = SplatPass::new(
             gpu,
             &sample_buffer,
@@ -197,6 +216,7 @@ impl Renderer {
             shadow_layers: scene.shadow_layers,
             translucent_objects: scene.objects.iter().filter(|o| !o.samples.is_empty()).count(),
             shadowed_lights,
+            environment: lights.iter().any(|l| l.spot_texel[3] > 0.5),
         };
         Ok(Renderer {
             gpu: gpu.clone(),
@@ -205,11 +225,13 @@ impl Renderer {
             vertices: vertex_buffer,
             indices: index_buffer,
             exitance,
+            environment_irradiance,
             _objects: object_buffer,
             _samples: sample_buffer,
             splat_buffer,
             lights: light_buffer,
             shadow,
+            vertex_light,
             splat,
             gather,
             shade,
@@ -289,6 +311,15 @@ impl Renderer {
                     only.as_deref(),
                 )
             }
+            Pass::VertexLight => {
+                self.vertex_light.record(cmd);
+                memory_barrier(
+                    device,
+                    cmd,
+                    compute_writes,
+                    (vk::PipelineStageFlags2::VERTEX_ATTRIBUTE_INPUT, vk::AccessFlags2::VERTEX_ATTRIBUTE_READ),
+                );
+            }
             Pass::Splat => {
                 self.splat.record(cmd);
                 memory_barrier(
@@ -316,13 +347,14 @@ impl Renderer {
                 let push = ShadePush {
                     view_proj: view_proj.to_cols_array_2d(),
                     eye_object: [camera.eye[0], camera.eye[1], camera.eye[2], 0.0],
-                    counts: [self.light_count, 0, 0, 0],
+                    counts: [self.light_count, crate::scene::lights::key_light_count(&self.scene.lights) as u32, 0, 0],
                 };
                 self.shade.record(
                     gpu,
                     cmd,
                     &self.vertices,
                     &self.exitance,
+                    &self.environment_irradiance,
                     &self.indices,
                     &self.draws,
                     push,

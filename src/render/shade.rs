@@ -3,7 +3,8 @@
 //! through the BSSRDF's outgoing Fresnel lobe, every surface gets a GGX specular lobe per light,
 //! opaque surfaces Lambert, all shadowed by the shadow maps.
 //!
-//! Vertex input: binding 0 = `records::Vertex`, binding 1 = exitance (vec4 per vertex).
+//! Vertex input: binding 0 = `records::Vertex`, binding 1 = exitance, binding 2 = cached
+//! environment irradiance (vec4 per vertex each).
 //! Bindings: 0 = objects, 1 = lights, 2 = shadow maps. Push: `ShadePush`.
 
 use super::records::Vertex;
@@ -15,7 +16,7 @@ use crate::gpu::{
 use ash::vk;
 use std::sync::Arc;
 
-pub const HDR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
 /// The push block of shade.vert/shade.frag.
@@ -25,7 +26,7 @@ pub struct ShadePush {
     pub view_proj: [[f32; 4]; 4],
     /// xyz: camera position; w: object index.
     pub eye_object: [f32; 4],
-    /// x: light count.
+    /// x: light count; y: key (non-environment) lights, which come first in the buffer.
     pub counts: [u32; 4],
 }
 
@@ -52,6 +53,7 @@ impl ShadePass {
         desc.vertex_bindings = vec![
             Vertex::binding(),
             vk::VertexInputBindingDescription { binding: 1, stride: 16, input_rate: vk::VertexInputRate::VERTEX },
+            vk::VertexInputBindingDescription { binding: 2, stride: 16, input_rate: vk::VertexInputRate::VERTEX },
         ];
         desc.vertex_attributes = vec![
             Vertex::position_attribute(),
@@ -59,6 +61,12 @@ impl ShadePass {
             vk::VertexInputAttributeDescription {
                 location: 2,
                 binding: 1,
+                format: vk::Format::R32G32B32A32_SFLOAT,
+                offset: 0,
+            },
+            vk::VertexInputAttributeDescription {
+                location: 3,
+                binding: 2,
                 format: vk::Format::R32G32B32A32_SFLOAT,
                 offset: 0,
             },
@@ -105,6 +113,7 @@ impl ShadePass {
         cmd: vk::CommandBuffer,
         vertices: &Buffer,
         exitance: &Buffer,
+        environment_irradiance: &Buffer,
         indices: &Buffer,
         draws: &[DrawRange],
         push: ShadePush,
@@ -155,7 +164,12 @@ impl ShadePass {
         // SAFETY: `cmd` is recording; attachments are in the layouts the barriers above set.
         unsafe {
             device.cmd_begin_rendering(cmd, &info);
-            device.cmd_bind_vertex_buffers(cmd, 0, &[vertices.raw(), exitance.raw()], &[0, 0]);
+            device.cmd_bind_vertex_buffers(
+                cmd,
+                0,
+                &[vertices.raw(), exitance.raw(), environment_irradiance.raw()],
+                &[0, 0, 0],
+            );
             device.cmd_bind_index_buffer(cmd, indices.raw(), 0, vk::IndexType::UINT32);
         }
         for (i, d) in draws.iter().enumerate() {

@@ -194,7 +194,7 @@ pub fn prepare(
     // 1%, 2 texels 2.25%; 1024^2 maps with 0.5 texel: 1.5%.
     let offset_ortho = 0.5 * (2.0 * radius) * texel;
     let mut out = Vec::new();
-    let directional = |dir: Vec3, irradiance: Vec3| {
+    let directional = |dir: Vec3, irradiance: Vec3, environment: bool| {
         let dir = dir.normalize();
         let eye = center + dir * (2.0 * radius);
         let view = look_at_mat4(eye, center, any_up(dir));
@@ -203,7 +203,7 @@ pub fn prepare(
             position_kind: [0.0, 0.0, 0.0, LIGHT_DIRECTIONAL],
             direction_cos: [dir.x, dir.y, dir.z, 0.0],
             power_layer: [irradiance.x, irradiance.y, irradiance.z, -1.0],
-            spot_texel: [0.0, texel, offset_ortho, 0.0],
+            spot_texel: [0.0, texel, offset_ortho, if environment { 1.0 } else { 0.0 }],
             shadow_matrix: (proj * view).to_cols_array_2d(),
         }
     };
@@ -229,7 +229,7 @@ pub fn prepare(
     for (source, light) in lights.iter().enumerate() {
         match light {
             Light::Directional { direction, irradiance, shadows } => out.push(PreparedLight {
-                record: directional(Vec3::from(*direction), Vec3::from(*irradiance)),
+                record: directional(Vec3::from(*direction), Vec3::from(*irradiance), false),
                 casts_shadow: *shadows,
                 source,
             }),
@@ -270,7 +270,7 @@ pub fn prepare(
                 if let Some(env) = environment {
                     for (dir, irradiance) in env.median_cut(*directions as usize) {
                         out.push(PreparedLight {
-                            record: directional(dir, irradiance * *scale),
+                            record: directional(dir, irradiance * *scale, true),
                             casts_shadow: *shadows,
                             source,
                         });
@@ -279,7 +279,15 @@ pub fn prepare(
             }
         }
     }
+    // Key lights first, the environment's directions after: shading loops over the key lights
+    // only (`key_light_count`), the environment reaching it through the per-vertex cache.
+    out.sort_by_key(|l| l.record.spot_texel[3] > 0.5);
     out
+}
+
+/// How many of `lights` (as `prepare` orders them) are not environment directions.
+pub fn key_light_count(lights: &[PreparedLight]) -> usize {
+    lights.iter().take_while(|l| l.record.spot_texel[3] <= 0.5).count()
 }
 
 /// Assign shadow-map layers to the lights that cast shadows; returns the layer count.

@@ -1,0 +1,35 @@
+#version 450
+// Vertex light: irradiance from the environment's directional lights at every mesh vertex,
+// sum_l E_l max(cos, 0) V_l with V from the shadow maps (3x3 PCF), cached per vertex. It is
+// view-independent and changes only when the environment does, so a moving camera or a moving
+// key light reuses it; the shading pass interpolates it for diffuse surfaces instead of looking
+// up every environment shadow map at every pixel.
+//
+// Bindings: 0 = vertices (float[6] per vertex: position, normal), 1 = lights (Light[]),
+// 2 = shadow maps (sampler2DArrayShadow), 3 = output (vec4 per vertex: rgb irradiance).
+// Push: vertex count, light count.
+#include "lights.glsl"
+
+layout(local_size_x = 64) in;
+layout(std430, set = 0, binding = 0) readonly buffer Vertices { float vertices[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Lights { Light lights[]; };
+layout(set = 0, binding = 2) uniform sampler2DArrayShadow shadow_maps;
+layout(std430, set = 0, binding = 3) writeonly buffer Irradiance { vec4 irradiance_out[]; };
+layout(push_constant) uniform Push { uint vertex_count; uint light_count; } push;
+
+void main() {
+    uint v = gl_GlobalInvocationID.x;
+    if (v >= push.vertex_count) return;
+    vec3 p = vec3(vertices[6u * v], vertices[6u * v + 1u], vertices[6u * v + 2u]);
+    vec3 n = normalize(vec3(vertices[6u * v + 3u], vertices[6u * v + 4u], vertices[6u * v + 5u]));
+    vec3 e = vec3(0.0);
+    for (uint l = 0u; l < push.light_count; ++l) {
+        if (!light_is_environment(lights[l])) continue;
+        vec3 wi, irradiance;
+        light_incidence(lights[l], p, wi, irradiance);
+        float cos_i = dot(n, wi);
+        if (cos_i <= 0.0) continue;
+        e += irradiance * (cos_i * light_visibility(lights[l], shadow_maps, p, n, 1));
+    }
+    irradiance_out[v] = vec4(e, 0.0);
+}
