@@ -12,6 +12,7 @@
 // Push: object index.
 #include "dipole.glsl"
 #include "scene.glsl"
+#include "gather.glsl"
 
 #define TILE 64u
 layout(local_size_x = 64) in;
@@ -35,20 +36,8 @@ void main() {
     bool is_receiver = v < vertex_count;
     uint vi = first_vertex + min(v, max(vertex_count, 1u) - 1u);
     vec3 x = vec3(vertices[6u * vi], vertices[6u * vi + 1u], vertices[6u * vi + 2u]);
-    DipoleChannel ch[3];
-    for (int c = 0; c < 3; ++c) {
-        vec4 d = o.dipole[c];
-        ch[c] = DipoleChannel(d.x, d.y, d.z, d.w);
-    }
-    // Far part: sum_i E_i far_kernel(r_i, A_i), Kahan-compensated. `precise`: the
-    // compensation only works if the compiler keeps the adds in this order.
-    precise vec3 sum = vec3(0.0);
-    precise vec3 compensation = vec3(0.0);
-    // Near part: Shepard blend of the samples' near exitance E_i E_near,i (kernel::far_kernel).
-    vec3 near_sum = vec3(0.0);
-    float weight_sum = 0.0;
-    float nearest_r = 3.4e38;
-    vec3 nearest_near = vec3(0.0);
+    DipoleChannel ch[3] = gather_channels(o);
+    GatherSum g = gather_begin();
     for (uint base = 0u; base < sample_count; base += TILE) {
         uint j = base + local;
         if (j < sample_count) {
@@ -61,30 +50,10 @@ void main() {
         uint n = min(TILE, sample_count - base);
         if (is_receiver) {
             for (uint k = 0u; k < n; ++k) {
-                vec4 pa = tile_position_area[k];
-                float r = distance(x, pa.xyz);
-                vec3 e = tile_irradiance[k].rgb;
-                vec3 term;
-                for (int c = 0; c < 3; ++c) {
-                    term[c] = e[c] * dipole_far_kernel(ch[c], r, pa.w);
-                }
-                precise vec3 y = term - compensation;
-                precise vec3 t = sum + y;
-                compensation = (t - sum) - y;
-                sum = t;
-                vec3 near_exitance = e * tile_near_energy[k].rgb;
-                float w = dipole_near_blend_weight(r, pa.w);
-                near_sum += w * near_exitance;
-                weight_sum += w;
-                if (r < nearest_r) {
-                    nearest_r = r;
-                    nearest_near = near_exitance;
-                }
+                gather_add(g, ch, x, tile_position_area[k], tile_irradiance[k].rgb, tile_near_energy[k].rgb);
             }
         }
         barrier();
     }
-    vec3 near = weight_sum > 0.0 ? near_sum / weight_sum : nearest_near;
-    sum += near;
-    if (is_receiver) exitance[first_vertex + v] = vec4(max(sum, vec3(0.0)), 1.0);
+    if (is_receiver) exitance[first_vertex + v] = vec4(gather_end(g), 1.0);
 }

@@ -284,3 +284,28 @@ fn moving_one_light_redraws_only_its_shadows_and_matches_a_full_render() {
         assert_ne!(c.splat_irradiance().unwrap(), sa);
     });
 }
+
+#[test]
+fn pixel_gather_agrees_with_the_vertex_gather() {
+    // Per-pixel exitance is exact where vertex exitance is interpolated; on the 37.7k-vertex
+    // bunny the two pictures must agree closely, and the pixel mode must follow the camera.
+    with_gpu(|gpu| {
+        let image = |gather: &str| {
+            let overrides =
+                Overrides { resolution: Some([128, 128]), gather: Some(gather.into()), ..Default::default() };
+            let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+            let mut renderer = Renderer::new(gpu, prepared).unwrap();
+            renderer.frame(&renderer.plan(Change::Everything)).unwrap();
+            let plan = renderer.plan(Change::Camera);
+            assert_eq!(plan.runs(Pass::Gather), gather == "pixel", "{gather}: {plan}");
+            let (rgba, non_finite) = renderer.image().unwrap();
+            assert_eq!(non_finite, 0);
+            rgba
+        };
+        let (vertex, pixel) = (image("vertex"), image("pixel"));
+        let mean = vertex.iter().zip(&pixel).map(|(a, b)| a.abs_diff(*b) as f64).sum::<f64>() / vertex.len() as f64;
+        let worst = vertex.iter().zip(&pixel).map(|(a, b)| a.abs_diff(*b)).max().unwrap();
+        eprintln!("pixel vs vertex gather: mean difference {mean:.3}/255, worst {worst}/255");
+        assert!(mean < 1.0, "mean difference {mean}");
+    });
+}

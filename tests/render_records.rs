@@ -84,6 +84,6 @@ fn vertex_and_push_layouts() {
     assert_eq!(size_of::<ShadePush>(), 96);
     assert_eq!(offset_of!(ShadePush, eye_object), 64);
     assert_eq!(offset_of!(ShadePush, counts), 80);
-    let frag = include_str!("../glsl/shade.frag");
+    let frag = include_str!("../glsl/common/shade.glsl");
     assert!(frag.contains("mat4 view_proj;") && frag.contains("vec4 eye_object;") && frag.contains("uvec4 counts;"));
 }

@@ -107,9 +107,6 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let prepared = PreparedScene::new(&scene, &overrides);
     spinner.finish_and_clear();
     let prepared = prepared?;
-    if prepared.scene.file.render.gather == "pixel" {
-        bail!("{}: `render.gather = \"pixel\"` is not implemented yet; use \"vertex\"", prepared.scene.name);
-    }
     let gpu: Arc<Gpu> = Gpu::new(&gpu_args.options())?;
     eprintln!(
         "device: {} | {} vertices, {} samples ({}), {} lights ({} shadow maps)",

@@ -13,6 +13,7 @@ pub enum BindingKind {
     StorageBuffer,
     UniformBuffer,
     CombinedImageSampler,
+    StorageImage,
 }
 
 impl BindingKind {
@@ -21,6 +22,7 @@ impl BindingKind {
             BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
             BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
             BindingKind::CombinedImageSampler => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+            BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
         }
     }
 }
@@ -93,7 +95,10 @@ impl DescriptorSet {
             match (kind, binding) {
                 (BindingKind::StorageBuffer | BindingKind::UniformBuffer, Binding::Buffer(b)) => buffer_infos
                     .push((i, [vk::DescriptorBufferInfo { buffer: b.raw(), offset: 0, range: vk::WHOLE_SIZE }])),
-                (BindingKind::CombinedImageSampler, Binding::Image { view, layout, sampler }) => image_infos.push((
+                (
+                    BindingKind::CombinedImageSampler | BindingKind::StorageImage,
+                    Binding::Image { view, layout, sampler },
+                ) => image_infos.push((
                     i,
                     [vk::DescriptorImageInfo { sampler: *sampler, image_view: *view, image_layout: *layout }],
                 )),

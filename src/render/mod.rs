@@ -1,6 +1,7 @@
 //! GPU passes: each is one module here and one GLSL file of the same name in `glsl/`.
 
 pub mod gather;
+pub mod gather_pixel;
 pub mod plan;
 pub mod records;
 pub mod renderer;

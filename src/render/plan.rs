@@ -52,6 +52,8 @@ pub struct SceneNeeds {
     pub shadowed_lights: Vec<usize>,
     /// Whether the scene has an environment light (cached per vertex by the vertex-light pass).
     pub environment: bool,
+    /// Exitance gathered per pixel (after shading, every frame) instead of per vertex.
+    pub pixel_gather: bool,
 }
 
 #[derive(Clone, Debug, Default)]
@@ -134,13 +136,23 @@ pub fn plan(needs: &SceneNeeds, change: Change) -> Plan {
         "lights changed: irradiance at the samples is stale",
         if translucent { "lights unchanged: sample irradiance reused" } else { "no translucent object" },
     );
-    add(
-        Pass::Gather,
-        translucent && lights_stale,
-        "sample irradiance changed: exitance is stale",
-        if translucent { "exitance is view-independent and unchanged: reused" } else { "no translucent object" },
-    );
-    add(Pass::Shade, true, "every frame draws the view", "");
+    if needs.pixel_gather {
+        add(Pass::Shade, true, "every frame draws the view (and, for the pixel gather, each pixel's surface)", "");
+        add(
+            Pass::Gather,
+            translucent,
+            "pixel gather: the receivers are the pixels in view, redone every frame",
+            "no translucent object",
+        );
+    } else {
+        add(
+            Pass::Gather,
+            translucent && lights_stale,
+            "sample irradiance changed: exitance is stale",
+            if translucent { "exitance is view-independent and unchanged: reused" } else { "no translucent object" },
+        );
+        add(Pass::Shade, true, "every frame draws the view", "");
+    }
     add(Pass::Tonemap, true, "every frame's HDR image is tone-mapped", "");
     plan
 }
@@ -155,6 +167,7 @@ mod tests {
             translucent_objects,
             shadowed_lights: if shadow_layers > 0 { vec![0] } else { vec![] },
             environment: shadow_layers > 1,
+            pixel_gather: false,
         }
     }
 
@@ -173,6 +186,15 @@ mod tests {
         assert_eq!(p.skipped.len(), 4);
         let p = plan(&needs(2, 1), Change::Everything);
         assert_eq!(p.passes.len(), 6);
+    }
+
+    #[test]
+    fn the_pixel_gather_follows_the_camera() {
+        let mut n = needs(3, 1);
+        n.pixel_gather = true;
+        let p = plan(&n, Change::Camera);
+        let order: Vec<Pass> = p.passes.iter().map(|(p, _)| *p).collect();
+        assert_eq!(order, [Pass::Shade, Pass::Gather, Pass::Tonemap]);
     }
 
     #[test]

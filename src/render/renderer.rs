@@ -3,6 +3,7 @@
 //! frame that skips a pass reuses its last result.
 
 use super::gather::GatherPass;
+use super::gather_pixel::GatherPixelPass;
 use super::plan::{self, Change, Pass, Plan, SceneNeeds};
 use super::records::{MATERIAL_OPAQUE, MATERIAL_TRANSLUCENT, ObjectRecord, SampleRecord, Vertex};
 use super::shade::{ShadePass, ShadePush};
@@ -18,6 +19,14 @@ use crate::scene::lights::LightGpu;
 use ash::vk;
 use glam::Vec3;
 use std::sync::Arc;
+
+/// Where exitance is gathered (`render.gather`).
+enum Gather {
+    /// At every vertex of the translucent objects, interpolated by the shading pass.
+    Vertex(GatherPass),
+    /// At every pixel showing a translucent object, after the shading pass.
+    Pixel(GatherPixelPass),
+}
 
 /// Per-pass GPU milliseconds of one frame, in recording order.
 #[derive(Clone, Debug, Default)]
@@ -49,7 +58,7 @@ pub struct Renderer {
     shadow: ShadowPass,
     vertex_light: VertexLightPass,
     splat: SplatPass,
-    gather: GatherPass,
+    gather: Gather,
     shade: ShadePass,
     tonemap: TonemapPass,
     timer: Option<GpuTimer>,
@@ -184,10 +193,37 @@ impl Renderer {
             shadow.sampler(),
             &splat_buffer,
         )?;
-        let gather =
-            GatherPass::new(gpu, &vertex_buffer, &sample_buffer, &splat_buffer, &object_buffer, &exitance, receivers)?;
         let [width, height] = scene.scene.file.camera.resolution;
-        let shade = ShadePass::new(gpu, width, height, &object_buffer, &light_buffer, shadow.maps(), shadow.sampler())?;
+        let pixel_gather = settings.gather == "pixel";
+        let shade = ShadePass::new(
+            gpu,
+            width,
+            height,
+            &object_buffer,
+            &light_buffer,
+            shadow.maps(),
+            shadow.sampler(),
+            pixel_gather,
+        )?;
+        let gather = match shade.surface() {
+            Some(surface) => Gather::Pixel(GatherPixelPass::new(
+                gpu,
+                surface,
+                &sample_buffer,
+                &splat_buffer,
+                &object_buffer,
+                shade.hdr(),
+            )?),
+            None => Gather::Vertex(GatherPass::new(
+                gpu,
+                &vertex_buffer,
+                &sample_buffer,
+                &splat_buffer,
+                &object_buffer,
+                &exitance,
+                receivers,
+            )?),
+        };
         let tonemap = TonemapPass::new(gpu, shade.hdr())?;
         let timer = GpuTimer::new(gpu, 8)?;
         let background = settings.background.unwrap_or_else(|| match &scene.environment {
@@ -217,6 +253,7 @@ impl Renderer {
             translucent_objects: scene.objects.iter().filter(|o| !o.samples.is_empty()).count(),
             shadowed_lights,
             environment: lights.iter().any(|l| l.spot_texel[3] > 0.5),
+            pixel_gather: settings.gather == "pixel",
         };
         Ok(Renderer {
             gpu: gpu.clone(),
@@ -330,7 +367,10 @@ impl Renderer {
                 );
             }
             Pass::Gather => {
-                self.gather.record(cmd);
+                match &self.gather {
+                    Gather::Vertex(pass) => pass.record(cmd),
+                    Gather::Pixel(pass) => pass.record(gpu, cmd),
+                }
                 memory_barrier(
                     device,
                     cmd,

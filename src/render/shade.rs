@@ -16,7 +16,9 @@ use crate::gpu::{
 use ash::vk;
 use std::sync::Arc;
 
-pub const HDR_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+pub const HDR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+/// Pixel gather only: world position and translucent object of each pixel.
+pub const SURFACE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
 /// The push block of shade.vert/shade.frag.
@@ -35,9 +37,12 @@ pub struct ShadePass {
     set: DescriptorSet,
     hdr: Image,
     depth: Image,
+    /// Pixel gather only (shade_pixel.frag's second attachment).
+    surface: Option<Image>,
 }
 
 impl ShadePass {
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &Arc<Gpu>,
         width: u32,
@@ -46,8 +51,10 @@ impl ShadePass {
         lights: &Buffer,
         shadow_maps: &Image,
         shadow_sampler: &Sampler,
+        pixel_gather: bool,
     ) -> GpuResult<ShadePass> {
-        let mut desc = GraphicsDesc::new("shade.vert", Some("shade.frag"));
+        let fragment = if pixel_gather { "shade_pixel.frag" } else { "shade.frag" };
+        let mut desc = GraphicsDesc::new("shade.vert", Some(fragment));
         desc.bindings = vec![BindingKind::StorageBuffer, BindingKind::StorageBuffer, BindingKind::CombinedImageSampler];
         desc.push_bytes = std::mem::size_of::<ShadePush>() as u32;
         desc.vertex_bindings = vec![
@@ -71,7 +78,7 @@ impl ShadePass {
                 offset: 0,
             },
         ];
-        desc.color_formats = vec![HDR_FORMAT];
+        desc.color_formats = if pixel_gather { vec![HDR_FORMAT, SURFACE_FORMAT] } else { vec![HDR_FORMAT] };
         desc.depth_format = Some(DEPTH_FORMAT);
         let pipeline = GraphicsPipeline::new(gpu, &desc)?;
         let set = pipeline.descriptor_set(&[
@@ -90,18 +97,37 @@ impl ShadePass {
                 width,
                 height,
                 HDR_FORMAT,
-                vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+                // STORAGE: the pixel gather adds its exitance in place.
+                vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::STORAGE,
             ),
         )?;
+        let surface = pixel_gather
+            .then(|| {
+                Image::new(
+                    gpu,
+                    &ImageDesc::new(
+                        "surface",
+                        width,
+                        height,
+                        SURFACE_FORMAT,
+                        vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+                    ),
+                )
+            })
+            .transpose()?;
         let depth = Image::new(
             gpu,
             &ImageDesc::new("camera depth", width, height, DEPTH_FORMAT, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT),
         )?;
-        Ok(ShadePass { pipeline, set, hdr, depth })
+        Ok(ShadePass { pipeline, set, hdr, depth, surface })
     }
 
     pub fn hdr(&self) -> &Image {
         &self.hdr
+    }
+    /// The surface image (pixel gather only), SHADER_READ_ONLY_OPTIMAL after the pass.
+    pub fn surface(&self) -> Option<&Image> {
+        self.surface.as_ref()
     }
 
     /// Record: clear to `background`, draw every object (`draws[i]` is object i), leave the HDR
@@ -141,14 +167,37 @@ impl ShadePass {
                 vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
             ),
         );
-        let colors = [vk::RenderingAttachmentInfo::default()
-            .image_view(self.hdr.view())
-            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue {
-                color: vk::ClearColorValue { float32: [background[0], background[1], background[2], 1.0] },
-            })];
+        if let Some(surface) = &self.surface {
+            image_barrier(
+                device,
+                cmd,
+                surface.raw(),
+                vk::ImageAspectFlags::COLOR,
+                (vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
+                (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_SAMPLED_READ),
+                (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
+            );
+        }
+        let mut colors = vec![
+            vk::RenderingAttachmentInfo::default()
+                .image_view(self.hdr.view())
+                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue {
+                    color: vk::ClearColorValue { float32: [background[0], background[1], background[2], 1.0] },
+                }),
+        ];
+        if let Some(surface) = &self.surface {
+            colors.push(
+                vk::RenderingAttachmentInfo::default()
+                    .image_view(surface.view())
+                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                    .load_op(vk::AttachmentLoadOp::CLEAR)
+                    .store_op(vk::AttachmentStoreOp::STORE)
+                    .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } }),
+            );
+        }
         let depth = vk::RenderingAttachmentInfo::default()
             .image_view(self.depth.view())
             .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
@@ -188,5 +237,16 @@ impl ShadePass {
             (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
             (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_SAMPLED_READ),
         );
+        if let Some(surface) = &self.surface {
+            image_barrier(
+                device,
+                cmd,
+                surface.raw(),
+                vk::ImageAspectFlags::COLOR,
+                (vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
+                (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
+                (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_SAMPLED_READ),
+            );
+        }
     }
 }

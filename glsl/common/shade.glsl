@@ -1,0 +1,88 @@
+// Forward shading, fragment stage: linear HDR radiance.
+// Translucent: the BSSRDF's outgoing lobe turns exitance into radiance,
+//     L_o = M F_t(cos theta_o, eta) / (pi T(eta))         (seed Eq. 9 normalized, Dipole::s_d),
+// plus a dielectric GGX specular lobe per light. Opaque: Lambert plus GGX. Key lights are
+// evaluated per pixel, shadowed with their shadow maps (3x3 PCF); the environment's directions
+// reach diffuse surfaces through the per-vertex irradiance cached by vertex_light.comp (and
+// translucent ones through the splat and gather), and add no specular lobe.
+// Bindings: 0 = objects (ObjectRecord[]), 1 = lights (Light[]), 2 = shadow maps.
+// Compiled twice: shade.frag (vertex gather: exitance arrives interpolated from the vertices)
+// and shade_pixel.frag (PIXEL_GATHER: a second attachment receives each pixel's world position
+// and translucent object, and the HDR alpha the factor F_t / (pi T) that gather_pixel.comp
+// multiplies the pixel's gathered exitance by).
+#ifndef SHADE_GLSL
+#define SHADE_GLSL
+#include "dipole.glsl"
+#include "lights.glsl"
+#include "scene.glsl"
+
+layout(location = 0) in vec3 v_position;
+layout(location = 1) in vec3 v_normal;
+layout(location = 2) in vec3 v_exitance;
+layout(location = 3) in vec3 v_environment;
+layout(location = 0) out vec4 out_radiance;
+#ifdef PIXEL_GATHER
+layout(location = 1) out vec4 out_surface;  // xyz: world position; w: object index + 1, 0 if opaque
+#endif
+layout(std430, set = 0, binding = 0) readonly buffer Objects { ObjectRecord objects[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Lights { Light lights[]; };
+layout(set = 0, binding = 2) uniform sampler2DArrayShadow shadow_maps;
+layout(push_constant) uniform Push {
+    mat4 view_proj;
+    vec4 eye_object;
+    uvec4 counts;
+} push;
+
+// GGX / Trowbridge-Reitz microfacet specular (Walter et al. 2007) with the height-correlated
+// Smith visibility term (Heitz 2014); returns f_s cos(theta_i) without the Fresnel factor.
+float ggx_specular(vec3 n, vec3 wi, vec3 wo, float alpha) {
+    vec3 h = normalize(wi + wo);
+    float nh = max(dot(n, h), 0.0), ni = max(dot(n, wi), 0.0), no = max(dot(n, wo), 1e-4);
+    float a2 = max(alpha * alpha, 1e-6);
+    float d = nh * nh * (a2 - 1.0) + 1.0;
+    float D = a2 / (DIPOLE_PI * d * d);
+    float vi = no * sqrt(ni * ni * (1.0 - a2) + a2);
+    float vo = ni * sqrt(no * no * (1.0 - a2) + a2);
+    float V = 0.5 / max(vi + vo, 1e-7);
+    return D * V * ni;
+}
+
+void main() {
+    ObjectRecord o = objects[uint(push.eye_object.w)];
+    vec3 n = normalize(v_normal);
+    vec3 wo = normalize(push.eye_object.xyz - v_position);
+    // Seen from behind (open meshes, the far side of a thin plane): shade the visible side.
+    if (dot(n, wo) < 0.0) n = -n;
+    float cos_o = max(dot(n, wo), 0.0);
+    bool translucent = uint(o.eta_norm_kind.z) == MATERIAL_TRANSLUCENT;
+    float eta = translucent ? o.eta_norm_kind.x : 1.5;
+    float roughness = o.albedo_roughness.w;
+    float alpha = max(roughness * roughness, 1e-3);
+    vec3 radiance = vec3(0.0);
+    float exitance_to_radiance = translucent ? dipole_fresnel_transmittance(cos_o, eta) * o.eta_norm_kind.y : 0.0;
+    // Zero under the pixel gather (no vertex gather runs), which adds its exitance afterwards.
+    radiance += v_exitance * exitance_to_radiance;
+    if (!translucent) radiance += v_environment * (o.albedo_roughness.rgb / DIPOLE_PI);
+    // The key lights come first in the buffer (scene::lights::prepare); counts.y of them.
+    for (uint l = 0u; l < push.counts.y; ++l) {
+        vec3 wi, irradiance;
+        light_incidence(lights[l], v_position, wi, irradiance);
+        float cos_i = dot(n, wi);
+        if (cos_i <= 0.0) continue;
+        float v = light_visibility(lights[l], shadow_maps, v_position, n, 1);
+        vec3 h = normalize(wi + wo);
+        float fresnel = dipole_fresnel_reflectance(max(dot(wi, h), 0.0), eta);
+        vec3 lit = irradiance * v;
+        radiance += lit * (fresnel * ggx_specular(n, wi, wo, alpha));
+        if (!translucent) radiance += lit * (o.albedo_roughness.rgb / DIPOLE_PI * cos_i);
+    }
+    // Nothing non-finite leaves this pass (the tone map counts any that would).
+#ifdef PIXEL_GATHER
+    out_radiance = vec4(radiance, exitance_to_radiance);
+    out_surface = vec4(v_position, translucent ? push.eye_object.w + 1.0 : 0.0);
+#else
+    out_radiance = vec4(radiance, 1.0);
+#endif
+}
+
+#endif
