@@ -164,7 +164,7 @@ fn graphics_pipeline_draws_a_triangle() {
             }
         })
         .unwrap();
-        let pixels = color.read(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, 4).unwrap();
+        let pixels = color.read(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL).unwrap();
         let at = |x: u32, y: u32| {
             let i = 4 * (y * SIZE + x) as usize;
             [pixels[i], pixels[i + 1], pixels[i + 2], pixels[i + 3]]

@@ -20,7 +20,7 @@ fn plane_scene(preset: &str, size: f32, samples: usize, extra: &str) -> String {
     format!(
         r#"
 [camera]
-eye = [0.0, {h}, 0.001]
+eye = [0.0, {h}, {z}]
 target = [0.0, 0.0, 0.0]
 resolution = [64, 64]
 
@@ -39,7 +39,8 @@ method = "poisson"
 count = {samples}
 {extra}
 "#,
-        h = size
+        h = size,
+        z = 0.5 * size
     )
 }
 

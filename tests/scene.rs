@@ -65,6 +65,8 @@ fn bad_values_name_the_key() {
         ("intensity = [1.0, 1.0, 1.0]", "intensity = [1.0, -1.0, 1.0]", "light[0].intensity"),
         ("type = \"point\"", "type = \"laser\"", "light[0]"),
         ("preset = \"skimmilk\", ", "", "object[0].material"),
+        ("eye = [0.0, 1.0, 3.0]", "eye = [0.0, 3.0, 0.0]", "camera.up"),
+        ("mm_per_unit = 10.0", "mm_per_unit = 10.0, roughness = 2.0", "object[0].material.roughness"),
     ] {
         let text = MINIMAL.replace(from, to);
         assert_ne!(text, MINIMAL, "replacement {from:?} did not apply");

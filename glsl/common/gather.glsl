@@ -38,7 +38,8 @@ void gather_add(inout GatherSum g, DipoleChannel ch[3], vec3 x, vec4 position_ar
     // Kahan summation; `precise` keeps the compiler from reassociating it away.
     precise vec3 y = term - g.compensation;
     precise vec3 t = g.far + y;
-    g.compensation = (t - g.far) - y;
+    precise vec3 c = (t - g.far) - y;
+    g.compensation = c;
     g.far = t;
     vec3 near_exitance = e * near_energy;
     float w = dipole_near_blend_weight(r, position_area.w);

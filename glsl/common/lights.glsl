@@ -56,7 +56,10 @@ float light_visibility(Light l, sampler2DArrayShadow maps, vec3 p, vec3 n, int r
     vec4 clip = l.shadow_matrix * vec4(p + n * l.spot_texel.z, 1.0);
     if (clip.w <= 0.0) return 1.0;
     vec3 ndc = clip.xyz / clip.w;
-    if (ndc.z >= 1.0) return 1.0;
+    // Beyond the far plane (receivers that cast no shadow can lie past the casters' sphere):
+    // compare at the far plane, so a texel that holds a caster still shadows and a cleared
+    // texel (depth 1) stays lit.
+    ndc.z = min(ndc.z, 1.0);
     vec2 uv = ndc.xy * 0.5 + 0.5;
     float texel = l.spot_texel.y;
     float lit = 0.0;

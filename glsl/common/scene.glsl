@@ -9,7 +9,7 @@ const uint MATERIAL_TRANSLUCENT = 1u;
 struct ObjectRecord {
     vec4 albedo_roughness;  // opaque: rgb albedo; w: GGX roughness (both kinds)
     vec4 eta_norm_kind;     // x: relative index of refraction eta; y: BSSRDF normalization
-                            // 1 / (c pi) with c = 1 - 2 FM1(1/eta) (see optics::Dipole::s_d);
+                            // 1 / (pi T(eta)), T(eta) = 1 - 2 FM1(eta) (optics::Dipole::s_d);
                             // z: kind (MATERIAL_*); w: unused
     vec4 dipole[3];         // per channel: alpha', sigma_tr, z_r, z_v in scene units
     uvec4 ranges;           // x: first vertex, y: vertex count, z: first sample, w: sample count

@@ -36,9 +36,10 @@ pub struct Args {
     /// Frames to render; after the first, each frame recomputes what `--moving` invalidates
     #[arg(long, default_value_t = 1)]
     pub frames: u32,
-    /// What changes between frames: `light` (the first non-environment light orbits 3 degrees
-    /// a frame: its shadow maps, splat, gather, shade), `lights` (every light: all shadow maps
-    /// too) or `camera` (shade only)
+    /// What each frame after the first recomputes: `light` (the first non-environment light
+    /// orbits 3 degrees a frame: its shadow maps, splat, gather, shade), `lights` (as if every
+    /// light changed: all shadow maps too) or `camera` (as if the camera moved: shading only,
+    /// plus the gather in pixel mode; the view itself stays put)
     #[arg(long, default_value = "light")]
     pub moving: String,
     /// Submit each pass separately and time it from submission to fence (wall clock), for

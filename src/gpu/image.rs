@@ -45,6 +45,18 @@ pub struct Image {
     desc: ImageDesc,
 }
 
+/// Bytes per texel of the formats this crate reads back.
+pub fn bytes_per_texel(format: vk::Format) -> Option<u64> {
+    match format {
+        vk::Format::R8G8B8A8_UNORM | vk::Format::R8G8B8A8_SRGB | vk::Format::B8G8R8A8_UNORM => Some(4),
+        vk::Format::R32_SFLOAT | vk::Format::D32_SFLOAT => Some(4),
+        vk::Format::D16_UNORM => Some(2),
+        vk::Format::R16G16B16A16_SFLOAT => Some(8),
+        vk::Format::R32G32B32A32_SFLOAT => Some(16),
+        _ => None,
+    }
+}
+
 /// Depth formats get the depth aspect, everything else colour.
 pub fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
     match format {
@@ -131,9 +143,11 @@ impl Image {
         vk::Extent2D { width: self.desc.width, height: self.desc.height }
     }
 
-    /// Copy layer 0 into host memory: tightly packed rows, `bytes_per_texel` each texel.
+    /// Copy layer 0 into host memory: tightly packed rows of texels as the format stores them.
     /// `layout` is the image's current layout; it is left in TRANSFER_SRC_OPTIMAL.
-    pub fn read(&self, layout: vk::ImageLayout, bytes_per_texel: u64) -> GpuResult<Vec<u8>> {
+    pub fn read(&self, layout: vk::ImageLayout) -> GpuResult<Vec<u8>> {
+        let bytes_per_texel = bytes_per_texel(self.desc.format)
+            .ok_or_else(|| GpuError::Invalid(format!("reading back {:?} images is not supported", self.desc.format)))?;
         let size = self.desc.width as u64 * self.desc.height as u64 * bytes_per_texel;
         let staging =
             Buffer::new(&self.gpu, &BufferDesc::readback("image readback", size, vk::BufferUsageFlags::TRANSFER_DST))?;

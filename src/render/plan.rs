@@ -50,8 +50,8 @@ pub struct SceneNeeds {
     pub translucent_objects: usize,
     /// Scene lights that own at least one shadow-map layer.
     pub shadowed_lights: Vec<usize>,
-    /// Whether the scene has an environment light (cached per vertex by the vertex-light pass).
-    pub environment: bool,
+    /// The scene's environment light, if any (cached per vertex by the vertex-light pass).
+    pub environment: Option<usize>,
     /// Exitance gathered per pixel (after shading, every frame) instead of per vertex.
     pub pixel_gather: bool,
 }
@@ -117,13 +117,16 @@ pub fn plan(needs: &SceneNeeds, change: Change) -> Plan {
     if let Change::Light(i) = change {
         plan.shadow_light = Some(i);
     }
-    // Environment directions are static under a single moved light (orbit_light refuses them).
-    let environment_stale = matches!(change, Change::Everything | Change::Lights);
+    let environment_stale = match change {
+        Change::Everything | Change::Lights => true,
+        Change::Light(i) => needs.environment == Some(i),
+        Change::Camera => false,
+    };
     add(
         Pass::VertexLight,
-        needs.environment && environment_stale,
+        needs.environment.is_some() && environment_stale,
         "the environment changed: per-vertex sky irradiance is stale",
-        if needs.environment {
+        if needs.environment.is_some() {
             "the environment is unchanged: per-vertex sky irradiance reused"
         } else {
             "no environment light"
@@ -166,7 +169,7 @@ mod tests {
             shadow_layers,
             translucent_objects,
             shadowed_lights: if shadow_layers > 0 { vec![0] } else { vec![] },
-            environment: shadow_layers > 1,
+            environment: (shadow_layers > 1).then_some(1),
             pixel_gather: false,
         }
     }

@@ -154,6 +154,16 @@ impl Renderer {
                 light_matrices[l.power_layer[3] as usize] = l.shadow_matrix;
             }
         }
+        // The vertex-wide and sample-wide passes dispatch one workgroup of 64 per 64 items in x.
+        let max_groups = gpu.properties().limits.max_compute_work_group_count[0] as usize;
+        for (what, count) in [("vertices", vertices.len()), ("sample points", samples.len())] {
+            if count.div_ceil(64) > max_groups {
+                return Err(crate::gpu::GpuError::Invalid(format!(
+                    "the scene has {count} {what}; this device dispatches at most {} (64 x {max_groups})",
+                    64 * max_groups
+                )));
+            }
+        }
         let vertex_buffer = upload(gpu, "vertices", &vertices, vk::BufferUsageFlags::VERTEX_BUFFER)?;
         let index_buffer = upload(gpu, "indices", &indices, vk::BufferUsageFlags::INDEX_BUFFER)?;
         // Opaque vertices keep zero exitance; translucent ones are written by the gather.
@@ -252,7 +262,7 @@ impl Renderer {
             shadow_layers: scene.shadow_layers,
             translucent_objects: scene.objects.iter().filter(|o| !o.samples.is_empty()).count(),
             shadowed_lights,
-            environment: lights.iter().any(|l| l.spot_texel[3] > 0.5),
+            environment: scene.lights.iter().find(|l| l.record.spot_texel[3] > 0.5).map(|l| l.source),
             pixel_gather: settings.gather == "pixel",
         };
         Ok(Renderer {
@@ -421,12 +431,12 @@ impl Renderer {
 
     /// The last linear HDR image, RGBA f32, rows top to bottom.
     pub fn hdr_image(&self) -> GpuResult<Vec<f32>> {
-        let bytes = self.shade.hdr().read(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, 16)?;
+        let bytes = self.shade.hdr().read(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
-    /// Radiant exitance (RGB, W/m^2 per unit irradiance of the lights) at every vertex of
-    /// object `object`, from the last gather.
+    /// Radiant exitance (RGB, W/m^2 for the scene's light units) at every vertex of object
+    /// `object`, from the last vertex gather (zero in pixel-gather mode).
     pub fn exitance(&self, object: usize) -> GpuResult<Vec<[f32; 3]>> {
         let all: Vec<[f32; 4]> = self.exitance.read()?;
         let first = self.vertex_offsets[object] as usize;

@@ -1,5 +1,5 @@
 //! Shadow-map pass (`glsl/shadow.vert`): depth of the shadow casters from each shadow-casting
-//! light into one layer of a D32 array image, which the splat and shade passes sample with a
+//! light into one layer of a D16 array image, which the splat and shade passes sample with a
 //! compare sampler (percentage-closer filtering, `glsl/common/lights.glsl`).
 //!
 //! Vertex input: binding 0 = `records::Vertex`. Push: the light's world -> clip matrix, its layer.

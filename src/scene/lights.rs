@@ -34,11 +34,13 @@ pub struct Environment {
 }
 
 impl Environment {
-    /// The built-in sky: a blue zenith fading to a bright horizon, and a dim ground below.
+    /// The built-in sky: a blue zenith fading to a bright horizon; nothing from below the
+    /// horizon (light bounced off the ground is not simulated, and would reach objects through
+    /// floors that cast no shadow).
     pub fn procedural_sky(width: usize, height: usize) -> Environment {
         let zenith = Vec3::new(0.30, 0.45, 0.85);
         let horizon = Vec3::new(0.85, 0.88, 0.95);
-        let ground = Vec3::new(0.12, 0.11, 0.10);
+        let ground = Vec3::ZERO;
         let mut radiance = Vec::with_capacity(width * height);
         for y in 0..height {
             for x in 0..width {
@@ -220,8 +222,10 @@ pub fn prepare(
                 (to_center / dist, half.min(80f32.to_radians()))
             }
         };
-        let near = (dist - radius).max(dist * 1e-3).max(1e-5);
-        let far = dist + radius;
+        // Along the view axis: a spot looks along its own axis, not at the casters' centre.
+        let axial = to_center.dot(forward);
+        let near = (axial - radius).max(dist * 1e-3).max(1e-5);
+        let far = (axial + radius).max(near * 2.0);
         let view = look_at_mat4(position, position + forward, any_up(forward));
         let proj = vulkan::perspective(2.0 * half_angle, 1.0, near, far);
         (proj * view, local_offset(position, half_angle))

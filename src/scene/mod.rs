@@ -129,6 +129,10 @@ fn non_negative(key: &str, values: &[f32]) -> Check {
     }
 }
 
+fn unit_interval(key: &str, v: f32) -> Check {
+    if (0.0..=1.0).contains(&v) { Ok(()) } else { Err((key.into(), format!("{v} must be between 0 and 1"))) }
+}
+
 fn check(scene: &SceneFile) -> Check {
     let c = &scene.camera;
     finite("camera.eye", &c.eye)?;
@@ -136,6 +140,10 @@ fn check(scene: &SceneFile) -> Check {
     nonzero("camera.up", c.up)?;
     if c.eye == c.target {
         return Err(("camera.target".into(), "equals camera.eye".into()));
+    }
+    let forward = (glam::Vec3::from(c.target) - glam::Vec3::from(c.eye)).normalize();
+    if forward.cross(glam::Vec3::from(c.up).normalize()).length() < 1e-4 {
+        return Err(("camera.up".into(), format!("{:?} is parallel to the view direction", c.up)));
     }
     if !(c.fov_y > 0.0 && c.fov_y < 180.0) {
         return Err(("camera.fov_y".into(), format!("{} must be between 0 and 180 degrees", c.fov_y)));
@@ -183,14 +191,14 @@ fn check(scene: &SceneFile) -> Check {
                 if !(mm_per_unit.is_finite() && *mm_per_unit > 0.0) {
                     return Err((key("material.mm_per_unit"), format!("{mm_per_unit} must be positive")));
                 }
-                non_negative(&key("material.roughness"), &[*roughness])?;
+                unit_interval(&key("material.roughness"), *roughness)?;
             }
             MaterialSpec::Opaque { albedo, roughness } => {
                 non_negative(&key("material.albedo"), albedo)?;
                 if albedo.iter().any(|a| *a > 1.0) {
                     return Err((key("material.albedo"), format!("{albedo:?} must be at most 1 (energy)")));
                 }
-                non_negative(&key("material.roughness"), &[*roughness])?;
+                unit_interval(&key("material.roughness"), *roughness)?;
             }
         }
     }
@@ -213,8 +221,8 @@ fn check(scene: &SceneFile) -> Check {
                 if !(*angle > 0.0 && *angle < 90.0) {
                     return Err((key("angle"), format!("{angle} must be between 0 and 90 degrees")));
                 }
-                if !(0.0..=1.0).contains(softness) {
-                    return Err((key("softness"), format!("{softness} must be between 0 and 1")));
+                if !(*softness > 0.0 && *softness <= 1.0) {
+                    return Err((key("softness"), format!("{softness} must be above 0 and at most 1")));
                 }
             }
             Light::Environment { scale, directions, .. } => {
