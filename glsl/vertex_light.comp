@@ -1,6 +1,6 @@
 #version 450
 // Vertex light: irradiance from the environment's directional lights at every mesh vertex,
-// sum_l E_l max(cos, 0) V_l with V from the shadow maps (3x3 PCF), cached per vertex. It is
+// sum_l E_l max(cos, 0) V_l with V from the shadow maps (4-tap PCF), cached per vertex. It is
 // view-independent and changes only when the environment does, so a moving camera or a moving
 // key light reuses it; the shading pass interpolates it for diffuse surfaces instead of looking
 // up every environment shadow map at every pixel.

@@ -229,7 +229,13 @@ float dipole_kernel(DipoleChannel ch, float r, float area) {
 // The far part alone (kernel::far_kernel): the gather adds the near energy through a blend
 // over neighbouring samples instead of each sample's own disk (see far_kernel's doc).
 float dipole_far_kernel(DipoleChannel ch, float r, float area) {
-    return dipole_kernel_with_near_energy(ch, r, area, 0.0);
+    if (!(area > 0.0)) return 0.0;
+    float b = DIPOLE_B_PER_SQRT_AREA * sqrt(area);
+    float start = DIPOLE_FAR_BLEND_START * b, end = DIPOLE_FAR_BLEND_END * b;
+    if (r >= end) return dipole_point_kernel(ch, r, area);
+    float far = area * dipole_r_d_far(ch, r, b);
+    if (r <= start) return far;
+    return far + smoothstep(start, end, r) * (dipole_point_kernel(ch, r, area) - far);
 }
 
 const float DIPOLE_NEAR_BLEND_RADIUS = 1.5;

@@ -47,8 +47,8 @@ void light_incidence(Light l, vec3 p, out vec3 wi, out vec3 irradiance) {
 // Fraction of `l` that reaches world point `p` with unit normal `n` (1 = lit), from the light's
 // shadow map through the compare sampler (each tap is itself a bilinear 2x2 percentage-closer
 // filter when the format allows). `radius` 0 takes one tap (sharpest, for the splat's sparse
-// sample points, closest to ray-cast visibility); 1 averages a 3x3 block of taps (softer edges
-// for shading pixels). Points outside the map are lit (border colour white). The lookup moves
+// sample points, closest to ray-cast visibility); 1 averages four taps around it (softer edges
+// for shading pixels and vertices). Points outside the map are lit (border colour white). The lookup moves
 // off the surface along the normal by half a texel (`spot_texel.z`), against self-shadowing.
 float light_visibility(Light l, sampler2DArrayShadow maps, vec3 p, vec3 n, int radius) {
     float layer = l.power_layer.w;
@@ -61,15 +61,13 @@ float light_visibility(Light l, sampler2DArrayShadow maps, vec3 p, vec3 n, int r
     // texel (depth 1) stays lit.
     ndc.z = min(ndc.z, 1.0);
     vec2 uv = ndc.xy * 0.5 + 0.5;
-    float texel = l.spot_texel.y;
-    float lit = 0.0;
-    for (int y = -radius; y <= radius; ++y) {
-        for (int x = -radius; x <= radius; ++x) {
-            lit += texture(maps, vec4(uv + vec2(x, y) * texel, layer, ndc.z));
-        }
-    }
-    float taps = float((2 * radius + 1) * (2 * radius + 1));
-    return lit / taps;
+    if (radius == 0) return texture(maps, vec4(uv, layer, ndc.z));
+    // Four bilinear compare taps half a texel off centre: a 3x3-texel tent filter from 16 texel
+    // reads (a 3x3 grid of taps would read 36).
+    float h = 0.5 * l.spot_texel.y;
+    float lit = texture(maps, vec4(uv + vec2(-h, -h), layer, ndc.z)) + texture(maps, vec4(uv + vec2(h, -h), layer, ndc.z))
+              + texture(maps, vec4(uv + vec2(-h, h), layer, ndc.z)) + texture(maps, vec4(uv + vec2(h, h), layer, ndc.z));
+    return 0.25 * lit;
 }
 
 #endif

@@ -2,7 +2,7 @@
 // Translucent: the BSSRDF's outgoing lobe turns exitance into radiance,
 //     L_o = M F_t(cos theta_o, eta) / (pi T(eta))         (seed Eq. 9 normalized, Dipole::s_d),
 // plus a dielectric GGX specular lobe per light. Opaque: Lambert plus GGX. Key lights are
-// evaluated per pixel, shadowed with their shadow maps (3x3 PCF); the environment's directions
+// evaluated per pixel, shadowed with their shadow maps (4-tap PCF); the environment's directions
 // reach diffuse surfaces through the per-vertex irradiance cached by vertex_light.comp (and
 // translucent ones through the splat and gather), and add no specular lobe.
 // Bindings: 0 = objects (ObjectRecord[]), 1 = lights (Light[]), 2 = shadow maps.
