@@ -205,27 +205,6 @@ float dipole_point_kernel(DipoleChannel ch, float r, float area) {
     return dipole_r_d(ch, r) * area;
 }
 
-// The kernel with the sample's near energy e_near = dipole_near_energy(ch, 1.5 sqrt(area))
-// computed beforehand.
-float dipole_kernel_with_near_energy(DipoleChannel ch, float r, float area, float e_near) {
-    if (!(area > 0.0)) return 0.0;
-    float b = DIPOLE_B_PER_SQRT_AREA * sqrt(area);
-    float start = DIPOLE_FAR_BLEND_START * b, end = DIPOLE_FAR_BLEND_END * b;
-    if (r >= end) return dipole_point_kernel(ch, r, area);
-    float rho = sqrt(area / DIPOLE_PI);
-    float near = area * dipole_r_d_far(ch, r, b) + e_near * dipole_footprint_weight(r / rho);
-    if (r <= start) return near;
-    float w = smoothstep(start, end, r);
-    return near + w * (dipole_point_kernel(ch, r, area) - near);
-}
-
-// What a sample of area `area` contributes to the exitance of a receiver at distance r, per unit
-// flux density at the sample (dimensionless).
-float dipole_kernel(DipoleChannel ch, float r, float area) {
-    if (!(area > 0.0)) return 0.0;
-    return dipole_kernel_with_near_energy(ch, r, area, dipole_near_energy(ch, DIPOLE_B_PER_SQRT_AREA * sqrt(area)));
-}
-
 // The far part alone (kernel::far_kernel): the gather adds the near energy through a blend
 // over neighbouring samples instead of each sample's own disk (see far_kernel's doc).
 float dipole_far_kernel(DipoleChannel ch, float r, float area) {
@@ -237,6 +216,23 @@ float dipole_far_kernel(DipoleChannel ch, float r, float area) {
     if (r <= start) return far;
     return far + smoothstep(start, end, r) * (dipole_point_kernel(ch, r, area) - far);
 }
+
+// The kernel with the sample's near energy e_near = dipole_near_energy(ch, 1.5 sqrt(area))
+// computed beforehand.
+float dipole_kernel_with_near_energy(DipoleChannel ch, float r, float area, float e_near) {
+    if (!(area > 0.0)) return 0.0;
+    // The footprint ends at 1.244 rho, inside the start of the far blend (8 b = 13.5 rho).
+    float rho = sqrt(area / DIPOLE_PI);
+    return dipole_far_kernel(ch, r, area) + e_near * dipole_footprint_weight(r / rho);
+}
+
+// What a sample of area `area` contributes to the exitance of a receiver at distance r, per unit
+// flux density at the sample (dimensionless).
+float dipole_kernel(DipoleChannel ch, float r, float area) {
+    if (!(area > 0.0)) return 0.0;
+    return dipole_kernel_with_near_energy(ch, r, area, dipole_near_energy(ch, DIPOLE_B_PER_SQRT_AREA * sqrt(area)));
+}
+
 
 const float DIPOLE_NEAR_BLEND_RADIUS = 1.5;
 

@@ -163,18 +163,11 @@ pub fn footprint_kernel(dipole: &Dipole, r: f64, area: f64) -> f64 {
     if area <= 0.0 {
         return 0.0;
     }
+    // The footprint ends at 1.244 rho, far inside the start of the far blend (8 b = 13.5 rho),
+    // so the near energy adds to the far kernel without touching its blend.
     let b = B_PER_SQRT_AREA * area.sqrt();
-    let (start, end) = (FAR_BLEND_START * b, FAR_BLEND_END * b);
-    if r >= end {
-        return point_kernel(dipole, r, area);
-    }
     let rho = (area / PI).sqrt();
-    let near = area * r_d_far(dipole, r, b) + near_energy(dipole, b) * footprint_weight(r / rho);
-    if r <= start {
-        return near;
-    }
-    let w = smoothstep((r - start) / (end - start));
-    near + w * (point_kernel(dipole, r, area) - near)
+    far_kernel(dipole, r, area) + near_energy(dipole, b) * footprint_weight(r / rho)
 }
 
 /// The far part of [`footprint_kernel`] alone: `dA R_far(r)` blended into the point kernel

@@ -188,8 +188,7 @@ impl Renderer {
             vertices.len() as u32,
             &light_buffer,
             light_count,
-            shadow.maps(),
-            shadow.sampler(),
+            &shadow,
             &environment_irradiance,
         )?;
         let splat = SplatPass::new(
@@ -199,22 +198,12 @@ impl Renderer {
             &object_buffer,
             &light_buffer,
             light_count,
-            shadow.maps(),
-            shadow.sampler(),
+            &shadow,
             &splat_buffer,
         )?;
         let [width, height] = scene.scene.file.camera.resolution;
         let pixel_gather = settings.gather == "pixel";
-        let shade = ShadePass::new(
-            gpu,
-            width,
-            height,
-            &object_buffer,
-            &light_buffer,
-            shadow.maps(),
-            shadow.sampler(),
-            pixel_gather,
-        )?;
+        let shade = ShadePass::new(gpu, width, height, &object_buffer, &light_buffer, &shadow, pixel_gather)?;
         let gather = match shade.surface() {
             Some(surface) => Gather::Pixel(GatherPixelPass::new(
                 gpu,

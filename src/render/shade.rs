@@ -9,9 +9,10 @@
 
 use super::records::Vertex;
 use super::shadow::DrawRange;
+use super::shadow::ShadowPass;
 use crate::gpu::{
     Binding, BindingKind, Buffer, DescriptorSet, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline, Image, ImageDesc,
-    Sampler, image_barrier,
+    image_barrier,
 };
 use ash::vk;
 use std::sync::Arc;
@@ -42,15 +43,13 @@ pub struct ShadePass {
 }
 
 impl ShadePass {
-    #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &Arc<Gpu>,
         width: u32,
         height: u32,
         objects: &Buffer,
         lights: &Buffer,
-        shadow_maps: &Image,
-        shadow_sampler: &Sampler,
+        shadow: &ShadowPass,
         pixel_gather: bool,
     ) -> GpuResult<ShadePass> {
         let fragment = if pixel_gather { "shade_pixel.frag" } else { "shade.frag" };
@@ -81,15 +80,7 @@ impl ShadePass {
         desc.color_formats = if pixel_gather { vec![HDR_FORMAT, SURFACE_FORMAT] } else { vec![HDR_FORMAT] };
         desc.depth_format = Some(DEPTH_FORMAT);
         let pipeline = GraphicsPipeline::new(gpu, &desc)?;
-        let set = pipeline.descriptor_set(&[
-            Binding::Buffer(objects),
-            Binding::Buffer(lights),
-            Binding::Image {
-                view: shadow_maps.view(),
-                layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                sampler: shadow_sampler.raw(),
-            },
-        ])?;
+        let set = pipeline.descriptor_set(&[Binding::Buffer(objects), Binding::Buffer(lights), shadow.binding()])?;
         let hdr = Image::new(
             gpu,
             &ImageDesc::new(

@@ -5,7 +5,9 @@
 //! Vertex input: binding 0 = `records::Vertex`. Push: the light's world -> clip matrix, its layer.
 
 use super::records::Vertex;
-use crate::gpu::{Buffer, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler, image_barrier};
+use crate::gpu::{
+    Binding, Buffer, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler, image_barrier,
+};
 use ash::vk;
 use std::sync::Arc;
 
@@ -106,11 +108,13 @@ impl ShadowPass {
         Ok(ShadowPass { pipeline, maps, sampler, layers })
     }
 
-    pub fn maps(&self) -> &Image {
-        &self.maps
-    }
-    pub fn sampler(&self) -> &Sampler {
-        &self.sampler
+    /// The maps with their compare sampler, as the passes that read them bind them.
+    pub fn binding(&self) -> Binding<'_> {
+        Binding::Image {
+            view: self.maps.view(),
+            layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            sampler: self.sampler.raw(),
+        }
     }
 
     /// Record: render every layer (`matrices[i]` into layer i), or with `only` just those

@@ -6,7 +6,8 @@
 //! Bindings: 0 = samples, 1 = objects, 2 = lights, 3 = shadow maps, 4 = splat output
 //! (2 x vec4 per sample). Push: sample count, light count.
 
-use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, DescriptorSet, Gpu, GpuResult, Image, Sampler};
+use super::shadow::ShadowPass;
+use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use ash::vk;
 use std::sync::Arc;
 
@@ -29,8 +30,7 @@ impl SplatPass {
         objects: &Buffer,
         lights: &Buffer,
         light_count: u32,
-        shadow_maps: &Image,
-        shadow_sampler: &Sampler,
+        shadow: &ShadowPass,
         output: &Buffer,
     ) -> GpuResult<SplatPass> {
         let s = BindingKind::StorageBuffer;
@@ -39,11 +39,7 @@ impl SplatPass {
             Binding::Buffer(samples),
             Binding::Buffer(objects),
             Binding::Buffer(lights),
-            Binding::Image {
-                view: shadow_maps.view(),
-                layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                sampler: shadow_sampler.raw(),
-            },
+            shadow.binding(),
             Binding::Buffer(output),
         ])?;
         Ok(SplatPass { pipeline, set, sample_count, light_count })

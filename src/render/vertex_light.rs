@@ -6,7 +6,8 @@
 //! Bindings: 0 = vertices, 1 = lights, 2 = shadow maps, 3 = output (vec4 per vertex).
 //! Push: vertex count, light count.
 
-use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, DescriptorSet, Gpu, GpuResult, Image, Sampler};
+use super::shadow::ShadowPass;
+use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use ash::vk;
 use std::sync::Arc;
 
@@ -18,15 +19,13 @@ pub struct VertexLightPass {
 }
 
 impl VertexLightPass {
-    #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &Arc<Gpu>,
         vertices: &Buffer,
         vertex_count: u32,
         lights: &Buffer,
         light_count: u32,
-        shadow_maps: &Image,
-        shadow_sampler: &Sampler,
+        shadow: &ShadowPass,
         output: &Buffer,
     ) -> GpuResult<VertexLightPass> {
         let s = BindingKind::StorageBuffer;
@@ -35,11 +34,7 @@ impl VertexLightPass {
         let set = pipeline.descriptor_set(&[
             Binding::Buffer(vertices),
             Binding::Buffer(lights),
-            Binding::Image {
-                view: shadow_maps.view(),
-                layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                sampler: shadow_sampler.raw(),
-            },
+            shadow.binding(),
             Binding::Buffer(output),
         ])?;
         Ok(VertexLightPass { pipeline, set, vertex_count, light_count })
