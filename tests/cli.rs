@@ -116,3 +116,41 @@ fn help_is_everywhere() {
         assert!(text(&out.stdout).contains("Usage"), "{args:?}");
     }
 }
+
+#[test]
+fn exr_and_exitance_exports_are_complete_files() {
+    let dir = std::env::temp_dir().join(format!("translucent-cli-exports-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (png, exr, ply) = (dir.join("a.png"), dir.join("a.exr"), dir.join("a.ply"));
+    let out = translucent(
+        &[
+            "render",
+            "--resolution",
+            "48x40",
+            "--samples",
+            "150",
+            "-o",
+            png.to_str().unwrap(),
+            "--exr",
+            exr.to_str().unwrap(),
+            "--export-exitance",
+            ply.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(out.status.success(), "stderr: {}", text(&out.stderr));
+    let hdr = image::open(&exr).expect("the EXR reads back").to_rgba32f();
+    assert_eq!(hdr.dimensions(), (48, 40));
+    assert!(hdr.pixels().all(|p| p.0.iter().all(|v| v.is_finite())), "non-finite HDR pixel");
+    assert!(hdr.pixels().any(|p| p[0] > 0.0), "an all-black HDR image");
+    let ply_text = std::fs::read_to_string(&ply).unwrap();
+    let count: usize =
+        ply_text.lines().find_map(|l| l.strip_prefix("element vertex ")).expect("a vertex count").parse().unwrap();
+    assert_eq!(count, 37_706, "one row per vertex of the translucent bunny");
+    let rows: Vec<&str> = ply_text.lines().skip_while(|l| *l != "end_header").skip(1).collect();
+    assert_eq!(rows.len(), count);
+    let exitance: Vec<f64> = rows.iter().map(|r| r.split_whitespace().nth(3).unwrap().parse().unwrap()).collect();
+    assert!(exitance.iter().all(|e| e.is_finite() && *e >= 0.0));
+    assert!(exitance.iter().any(|e| *e > 0.0));
+    std::fs::remove_dir_all(&dir).ok();
+}

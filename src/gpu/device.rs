@@ -112,7 +112,8 @@ pub(crate) fn select(devices: &[DeviceInfo], wanted: Option<&str>) -> GpuResult<
     Ok(chosen.clone())
 }
 
-/// The first queue family that does graphics and compute and can write timestamps.
+/// The first queue family that does graphics and compute, and its timestamp valid bits (0 when
+/// it cannot write timestamps: then there are no GPU timings).
 pub(crate) fn queue_family(instance: &ash::Instance, device: &DeviceInfo) -> GpuResult<(u32, u32)> {
     // SAFETY: plain query.
     let families = unsafe { instance.get_physical_device_queue_family_properties(device.handle) };

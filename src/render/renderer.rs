@@ -224,7 +224,14 @@ impl Renderer {
             )?),
         };
         let tonemap = TonemapPass::new(gpu, shade.hdr())?;
-        let timer = GpuTimer::new(gpu, 8)?;
+        // Timing is optional: a queue without timestamps still renders.
+        let timer = match GpuTimer::new(gpu, 8) {
+            Ok(t) => Some(t),
+            Err(e) => {
+                log::warn!("no GPU timings: {e}");
+                None
+            }
+        };
         let background = settings.background.unwrap_or_else(|| match &scene.environment {
             // The sky's radiance near the horizon, as a backdrop.
             Some(env) => {
@@ -272,7 +279,7 @@ impl Renderer {
             gather,
             shade,
             tonemap,
-            timer: Some(timer),
+            timer,
             draws,
             casters,
             light_matrices,
@@ -292,21 +299,27 @@ impl Renderer {
     }
 
     /// Render one frame: record the passes of `plan` in one submission, wait, and return their
-    /// GPU times from timestamp queries.
+    /// GPU times from timestamp queries (none on a queue that cannot write timestamps).
     pub fn frame(&mut self, plan: &Plan) -> GpuResult<FrameTimings> {
         let gpu = self.gpu.clone();
         // Taken out for the recording, which borrows `self` immutably.
-        let mut timer = self.timer.take().expect("the timer is always put back");
+        let mut timer = self.timer.take();
         let result = gpu.one_shot("frame", |cmd| {
-            timer.reset(cmd);
+            if let Some(t) = timer.as_mut() {
+                t.reset(cmd);
+            }
             for (pass, _) in &plan.passes {
-                timer.begin(cmd, pass.name());
+                if let Some(t) = timer.as_mut() {
+                    t.begin(cmd, pass.name());
+                }
                 self.record_pass(cmd, plan, *pass);
-                timer.end(cmd);
+                if let Some(t) = timer.as_mut() {
+                    t.end(cmd);
+                }
             }
         });
-        let passes = result.and_then(|()| timer.results());
-        self.timer = Some(timer);
+        let passes = result.and_then(|()| timer.as_ref().map_or(Ok(Vec::new()), GpuTimer::results));
+        self.timer = timer;
         Ok(FrameTimings { passes: passes? })
     }
 
