@@ -103,6 +103,36 @@ fn main() {
     println!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
     drop(renderer);
 
+    println!("\nWhere the gather runs: time against difference from the vertex gather (key light moving, 512x512):");
+    println!(
+        "  {:<8} {:>12} {:>12} {:>10} {:>22}",
+        "gather", "gather ms", "frame ms", "frames/s", "image diff (of 255)"
+    );
+    let mut reference_image: Option<Vec<u8>> = None;
+    for gather in ["vertex", "sparse", "pixel"] {
+        let overrides = Overrides { gather: Some(gather.into()), resolution: Some([512, 512]), ..Default::default() };
+        let prepared = PreparedScene::new(&scene, &overrides).expect("scene");
+        let mut renderer = Renderer::new(&gpu, prepared).expect("renderer");
+        renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
+        let image = renderer.image().expect("image").0;
+        let m = measure(&mut renderer, Change::Light(0));
+        let gather_ms = m.passes.iter().find(|(n, _, _)| n == "gather").map(|p| p.2).unwrap_or(0.0);
+        let diff = match &reference_image {
+            None => {
+                reference_image = Some(image);
+                0.0
+            }
+            Some(reference) => {
+                reference.iter().zip(&image).map(|(a, b)| a.abs_diff(*b) as f64).sum::<f64>() / image.len() as f64
+            }
+        };
+        println!(
+            "  {gather:<8} {gather_ms:>12.1} {:>12.1} {:>10.2} {diff:>22.3}",
+            m.frame_wall_ms,
+            1000.0 / m.frame_wall_ms
+        );
+    }
+
     println!("\nFPS against sample count (key light moving every frame, 512x512), seed Figure 7:");
     println!("  {:<8} {:>8} {:>12} {:>12} {:>10}", "sampler", "samples", "gather ms", "frame ms", "frames/s");
     for method in ["turk", "feature"] {

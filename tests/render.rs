@@ -54,8 +54,13 @@ fn run_all(gpu: &std::sync::Arc<translucent::gpu::Gpu>, prepared: PreparedScene)
 #[test]
 fn uniformly_lit_plane_reflects_total_diffuse_reflectance() {
     with_gpu(|gpu| {
-        for preset in ["marble", "skimmilk", "ketchup", "spectralon"] {
-            let prepared = prepare(&plane_scene(preset, 1000.0, 3000, ""), &Overrides::default());
+        let cases = ["marble", "skimmilk", "ketchup", "spectralon"]
+            .map(|p| (p, "vertex"))
+            .into_iter()
+            .chain([("marble", "sparse"), ("skimmilk", "sparse")]);
+        for (preset, gather) in cases {
+            let overrides = Overrides { gather: Some(gather.into()), ..Default::default() };
+            let prepared = prepare(&plane_scene(preset, 1000.0, 3000, ""), &overrides);
             let material = Material::preset(preset).unwrap();
             let dipoles = material.dipoles(1.0).unwrap();
             let f_t = fresnel::fresnel_transmittance(1.0, material.eta);
@@ -70,7 +75,9 @@ fn uniformly_lit_plane_reflects_total_diffuse_reflectance() {
                 let expected = dipoles[c].r_d_total() * f_t;
                 let mean = middle.iter().map(|&v| exitance[v][c] as f64).sum::<f64>() / middle.len() as f64;
                 let err = (mean - expected).abs() / expected;
-                eprintln!("{preset} channel {c}: exitance {mean:.6}, R_d,total F_t = {expected:.6}, error {err:.2e}");
+                eprintln!(
+                    "{preset} ({gather} gather) channel {c}: exitance {mean:.6}, R_d,total F_t = {expected:.6}, error {err:.2e}"
+                );
                 assert!(err < 0.02, "{preset} channel {c}: {mean} vs {expected}");
             }
         }
@@ -308,5 +315,45 @@ fn pixel_gather_agrees_with_the_vertex_gather() {
         let worst = vertex.iter().zip(&pixel).map(|(a, b)| a.abs_diff(*b)).max().unwrap();
         eprintln!("pixel vs vertex gather: mean difference {mean:.3}/255, worst {worst}/255");
         assert!(mean < 1.0, "mean difference {mean}");
+    });
+}
+
+#[test]
+fn sparse_gather_matches_its_reference_and_stays_close_to_the_vertex_gather() {
+    with_gpu(|gpu| {
+        let overrides = Overrides { resolution: Some([64, 64]), gather: Some("sparse".into()), ..Default::default() };
+        let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+        let occluders = reference::occluders(&prepared);
+        let irradiance = reference::splat(&prepared, &occluders);
+        let sparse = reference::gather_sparse(&prepared, &irradiance);
+        let full = reference::gather(&prepared, &irradiance);
+        let mut renderer = Renderer::new(gpu, prepared).unwrap();
+        let as_f32: Vec<[f32; 3]> = irradiance.iter().map(|e| e.map(|v| v as f32)).collect();
+        renderer.set_splat_irradiance(&as_f32).unwrap();
+        let mut plan = renderer.plan(Change::Everything);
+        plan.passes.retain(|(p, _)| *p == Pass::Gather);
+        renderer.frame(&plan).unwrap();
+        let got = renderer.exitance(0).unwrap();
+        let peak = full[0].iter().flat_map(|m| m.iter()).fold(0.0f64, |a, b| a.max(*b));
+        let rel = |a: f64, b: f64| (a - b).abs() / b.max(1e-3 * peak);
+        let mut worst_gpu = 0.0f64;
+        let (mut sum_dev, mut worst_dev, mut n) = (0.0, 0.0f64, 0);
+        for v in 0..got.len() {
+            for c in 0..3 {
+                worst_gpu = worst_gpu.max(rel(got[v][c] as f64, sparse[0][v][c]));
+                let dev = rel(sparse[0][v][c], full[0][v][c]);
+                sum_dev += dev;
+                worst_dev = worst_dev.max(dev);
+                n += 1;
+            }
+        }
+        let mean_dev = sum_dev / n as f64;
+        eprintln!(
+            "sparse gather: GPU vs f64 worst {worst_gpu:.2e}; against the vertex gather mean {:.2}%, worst {:.1}%",
+            100.0 * mean_dev,
+            100.0 * worst_dev
+        );
+        assert!(worst_gpu < 0.01, "GPU sparse gather vs its f64 reference: {worst_gpu}");
+        assert!(mean_dev < 0.03, "sparse gather strays {:.2}% on average from the vertex gather", 100.0 * mean_dev);
     });
 }

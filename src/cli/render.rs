@@ -27,7 +27,8 @@ pub struct Args {
     /// Sampler: random, turk, feature or poisson (overrides the scene)
     #[arg(long)]
     pub sampler: Option<String>,
-    /// Where exitance is gathered: vertex or pixel (overrides the scene)
+    /// Where exitance is gathered: vertex, pixel, or sparse (at the samples, blended to the
+    /// vertices) (overrides the scene)
     #[arg(long)]
     pub gather: Option<String>,
     /// Image size WIDTHxHEIGHT (overrides the scene)

@@ -132,3 +132,62 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3
         })
         .collect()
 }
+
+/// The sparse gather (`render.gather = "sparse"`, glsl/gather_sparse.comp) in f64: exitance at
+/// each sample (far sum plus its own near exitance), blended to every vertex with the
+/// near-field Shepard weights.
+pub fn gather_sparse(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3]>> {
+    let mut offset = 0;
+    scene
+        .objects
+        .iter()
+        .map(|o| {
+            let first = offset;
+            offset += o.samples.len();
+            let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else {
+                return vec![[0.0; 3]; o.mesh.positions().len()];
+            };
+            let at_samples: Vec<(DVec3, f64, [f64; 3])> = o
+                .samples
+                .par_iter()
+                .enumerate()
+                .map(|(j, sj)| {
+                    let x = sj.position.as_dvec3();
+                    let mut t = [0.0; 3];
+                    for (i, si) in o.samples.iter().enumerate() {
+                        let r = x.distance(si.position.as_dvec3());
+                        for c in 0..3 {
+                            t[c] += irradiance[first + i][c] * kernel::far_kernel(&dipoles[c], r, si.area);
+                        }
+                    }
+                    let b = kernel::B_PER_SQRT_AREA * sj.area.sqrt();
+                    for c in 0..3 {
+                        t[c] = t[c].max(0.0) + irradiance[first + j][c] * kernel::near_energy(&dipoles[c], b);
+                    }
+                    (x, sj.area, t)
+                })
+                .collect();
+            o.mesh
+                .positions()
+                .par_iter()
+                .map(|x| {
+                    let x = x.as_dvec3();
+                    let (mut sum, mut weight_sum) = ([0.0; 3], 0.0);
+                    let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; 3]);
+                    for (p, area, t) in &at_samples {
+                        let r = x.distance(*p);
+                        let w = kernel::near_blend_weight(r, *area);
+                        for c in 0..3 {
+                            sum[c] += w * t[c];
+                        }
+                        weight_sum += w;
+                        if r < nearest_r {
+                            (nearest_r, nearest) = (r, *t);
+                        }
+                    }
+                    if weight_sum > 0.0 { sum.map(|v| v / weight_sum) } else { nearest }
+                })
+                .collect()
+        })
+        .collect()
+}

@@ -2,6 +2,7 @@
 
 pub mod gather;
 pub mod gather_pixel;
+pub mod gather_sparse;
 pub mod plan;
 pub mod records;
 pub mod renderer;

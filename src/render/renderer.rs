@@ -4,6 +4,7 @@
 
 use super::gather::GatherPass;
 use super::gather_pixel::GatherPixelPass;
+use super::gather_sparse::GatherSparsePass;
 use super::plan::{self, Change, Pass, Plan, SceneNeeds};
 use super::records::{MATERIAL_OPAQUE, MATERIAL_TRANSLUCENT, ObjectRecord, SampleRecord, Vertex};
 use super::shade::{ShadePass, ShadePush};
@@ -26,6 +27,8 @@ enum Gather {
     Vertex(GatherPass),
     /// At every pixel showing a translucent object, after the shading pass.
     Pixel(GatherPixelPass),
+    /// At the sample points, blended to the vertices.
+    Sparse(GatherSparsePass),
 }
 
 /// Per-pass GPU milliseconds of one frame, in recording order.
@@ -204,7 +207,21 @@ impl Renderer {
         let [width, height] = scene.scene.file.camera.resolution;
         let pixel_gather = settings.gather == "pixel";
         let shade = ShadePass::new(gpu, width, height, &object_buffer, &light_buffer, &shadow, pixel_gather)?;
+        let sparse_receivers: Vec<(u32, u32, u32)> = receivers
+            .iter()
+            .map(|&(object, vertex_count)| (object, vertex_count, scene.objects[object as usize].samples.len() as u32))
+            .collect();
         let gather = match shade.surface() {
+            None if settings.gather == "sparse" => Gather::Sparse(GatherSparsePass::new(
+                gpu,
+                &vertex_buffer,
+                &sample_buffer,
+                samples.len() as u32,
+                &splat_buffer,
+                &object_buffer,
+                &exitance,
+                sparse_receivers,
+            )?),
             Some(surface) => Gather::Pixel(GatherPixelPass::new(
                 gpu,
                 surface,
@@ -382,6 +399,7 @@ impl Renderer {
                 match &self.gather {
                     Gather::Vertex(pass) => pass.record(cmd),
                     Gather::Pixel(pass) => pass.record(gpu, cmd),
+                    Gather::Sparse(pass) => pass.record(gpu, cmd),
                 }
                 memory_barrier(
                     device,

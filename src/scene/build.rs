@@ -67,8 +67,8 @@ impl PreparedScene {
             scene.file.sampling.method = m.clone();
         }
         if let Some(g) = &overrides.gather {
-            if !["vertex", "pixel"].contains(&g.as_str()) {
-                bail!("--gather {g:?} is not vertex or pixel");
+            if !["vertex", "pixel", "sparse"].contains(&g.as_str()) {
+                bail!("--gather {g:?} is not vertex, pixel or sparse");
             }
             scene.file.render.gather = g.clone();
         }

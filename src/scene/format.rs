@@ -209,7 +209,9 @@ fn seed() -> u64 {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RenderSettings {
-    /// Where exitance is gathered: at mesh vertices (interpolated when shading) or per pixel.
+    /// Where exitance is gathered: `vertex` (at every mesh vertex, interpolated when shading),
+    /// `pixel` (at every visible pixel) or `sparse` (at the sample points, blended to the
+    /// vertices: fastest, smooths detail finer than the sample spacing).
     #[serde(default = "gather")]
     pub gather: String,
     /// Exposure multiplier applied before the tone map.

@@ -245,8 +245,8 @@ fn check(scene: &SceneFile) -> Check {
         return Err(("sampling.count".into(), format!("{} must be 1 to 1000000", s.count)));
     }
     let r = &scene.render;
-    if !["vertex", "pixel"].contains(&r.gather.as_str()) {
-        return Err(("render.gather".into(), format!("{:?} is not vertex or pixel", r.gather)));
+    if !["vertex", "pixel", "sparse"].contains(&r.gather.as_str()) {
+        return Err(("render.gather".into(), format!("{:?} is not vertex, pixel or sparse", r.gather)));
     }
     if !(r.exposure.is_finite() && r.exposure > 0.0) {
         return Err(("render.exposure".into(), format!("{} must be positive", r.exposure)));
