@@ -4,8 +4,9 @@
 
 pub mod bvh;
 
+use crate::optics::Dipole;
 use crate::optics::{fresnel, kernel};
-use crate::scene::build::{PreparedScene, ResolvedMaterial};
+use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
 use crate::scene::lights::{LIGHT_DIRECTIONAL, LIGHT_SPOT, LightGpu};
 use bvh::Bvh;
 use glam::DVec3;
@@ -84,110 +85,111 @@ pub fn splat(scene: &PreparedScene, occluders: &Bvh) -> Vec<[f64; 3]> {
 /// transmitted irradiance in scene order: the far kernel summed plus the near field blended
 /// over neighbouring samples (`optics::kernel::far_kernel` explains the split).
 pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3]>> {
-    let mut offset = 0;
-    scene
-        .objects
-        .iter()
-        .map(|o| {
-            let first = offset;
-            offset += o.samples.len();
-            let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else {
-                return vec![[0.0; 3]; o.mesh.positions().len()];
-            };
-            let samples: Vec<(DVec3, f64, [f64; 3], [f64; 3])> = o
-                .samples
-                .iter()
-                .enumerate()
-                .map(|(k, s)| {
-                    let e = irradiance[first + k];
-                    let b = kernel::B_PER_SQRT_AREA * s.area.sqrt();
-                    let near = [0, 1, 2].map(|c| e[c] * kernel::near_energy(&dipoles[c], b));
-                    (s.position.as_dvec3(), s.area, e, near)
-                })
-                .collect();
-            o.mesh
-                .positions()
-                .par_iter()
-                .map(|x| {
-                    let x = x.as_dvec3();
-                    let mut far = [0.0; 3];
-                    let (mut near_sum, mut weight_sum) = ([0.0; 3], 0.0);
-                    let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; 3]);
-                    for (p, area, e, near) in &samples {
-                        let r = x.distance(*p);
-                        let w = kernel::near_blend_weight(r, *area);
-                        for c in 0..3 {
-                            far[c] += e[c] * kernel::far_kernel(&dipoles[c], r, *area);
-                            near_sum[c] += w * near[c];
-                        }
-                        weight_sum += w;
-                        if r < nearest_r {
-                            (nearest_r, nearest) = (r, *near);
-                        }
+    per_translucent_object(scene, |o, dipoles, first| {
+        let samples: Vec<(DVec3, f64, [f64; 3], [f64; 3])> = o
+            .samples
+            .iter()
+            .enumerate()
+            .map(|(k, s)| {
+                let e = irradiance[first + k];
+                let b = kernel::B_PER_SQRT_AREA * s.area.sqrt();
+                let near = [0, 1, 2].map(|c| e[c] * kernel::near_energy(&dipoles[c], b));
+                (s.position.as_dvec3(), s.area, e, near)
+            })
+            .collect();
+        o.mesh
+            .positions()
+            .par_iter()
+            .map(|x| {
+                let x = x.as_dvec3();
+                let mut far = [0.0; 3];
+                let (mut near_sum, mut weight_sum) = ([0.0; 3], 0.0);
+                let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; 3]);
+                for (p, area, e, near) in &samples {
+                    let r = x.distance(*p);
+                    let w = kernel::near_blend_weight(r, *area);
+                    for c in 0..3 {
+                        far[c] += e[c] * kernel::far_kernel(&dipoles[c], r, *area);
+                        near_sum[c] += w * near[c];
                     }
-                    let near = if weight_sum > 0.0 { near_sum.map(|v| v / weight_sum) } else { nearest };
-                    [0, 1, 2].map(|c| far[c] + near[c])
-                })
-                .collect()
-        })
-        .collect()
+                    weight_sum += w;
+                    if r < nearest_r {
+                        (nearest_r, nearest) = (r, *near);
+                    }
+                }
+                let near = if weight_sum > 0.0 { near_sum.map(|v| v / weight_sum) } else { nearest };
+                [0, 1, 2].map(|c| far[c] + near[c])
+            })
+            .collect()
+    })
 }
 
 /// The sparse gather (`render.gather = "sparse"`, glsl/gather_sparse.comp) in f64: exitance at
 /// each sample (far sum plus its own near exitance), blended to every vertex with the
 /// near-field Shepard weights.
 pub fn gather_sparse(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3]>> {
-    let mut offset = 0;
+    per_translucent_object(scene, |o, dipoles, first| {
+        let at_samples: Vec<(DVec3, f64, [f64; 3])> = o
+            .samples
+            .par_iter()
+            .enumerate()
+            .map(|(j, sj)| {
+                let x = sj.position.as_dvec3();
+                let mut t = [0.0; 3];
+                for (i, si) in o.samples.iter().enumerate() {
+                    let r = x.distance(si.position.as_dvec3());
+                    for c in 0..3 {
+                        t[c] += irradiance[first + i][c] * kernel::far_kernel(&dipoles[c], r, si.area);
+                    }
+                }
+                let b = kernel::B_PER_SQRT_AREA * sj.area.sqrt();
+                for c in 0..3 {
+                    t[c] = t[c].max(0.0) + irradiance[first + j][c] * kernel::near_energy(&dipoles[c], b);
+                }
+                (x, sj.area, t)
+            })
+            .collect();
+        o.mesh
+            .positions()
+            .par_iter()
+            .map(|x| {
+                let x = x.as_dvec3();
+                let (mut sum, mut weight_sum) = ([0.0; 3], 0.0);
+                let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; 3]);
+                for (p, area, t) in &at_samples {
+                    let r = x.distance(*p);
+                    let w = kernel::near_blend_weight(r, *area);
+                    for c in 0..3 {
+                        sum[c] += w * t[c];
+                    }
+                    weight_sum += w;
+                    if r < nearest_r {
+                        (nearest_r, nearest) = (r, *t);
+                    }
+                }
+                if weight_sum > 0.0 { sum.map(|v| v / weight_sum) } else { nearest }
+            })
+            .collect()
+    })
+}
+
+/// Run `f` on every translucent object with its dipoles and the index of its first sample in
+/// scene order; opaque objects get zero exitance at every vertex.
+fn per_translucent_object(
+    scene: &PreparedScene,
+    f: impl Fn(&PreparedObject, &[Dipole; 3], usize) -> Vec<[f64; 3]>,
+) -> Vec<Vec<[f64; 3]>> {
+    let mut first = 0;
     scene
         .objects
         .iter()
         .map(|o| {
-            let first = offset;
-            offset += o.samples.len();
-            let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else {
-                return vec![[0.0; 3]; o.mesh.positions().len()];
-            };
-            let at_samples: Vec<(DVec3, f64, [f64; 3])> = o
-                .samples
-                .par_iter()
-                .enumerate()
-                .map(|(j, sj)| {
-                    let x = sj.position.as_dvec3();
-                    let mut t = [0.0; 3];
-                    for (i, si) in o.samples.iter().enumerate() {
-                        let r = x.distance(si.position.as_dvec3());
-                        for c in 0..3 {
-                            t[c] += irradiance[first + i][c] * kernel::far_kernel(&dipoles[c], r, si.area);
-                        }
-                    }
-                    let b = kernel::B_PER_SQRT_AREA * sj.area.sqrt();
-                    for c in 0..3 {
-                        t[c] = t[c].max(0.0) + irradiance[first + j][c] * kernel::near_energy(&dipoles[c], b);
-                    }
-                    (x, sj.area, t)
-                })
-                .collect();
-            o.mesh
-                .positions()
-                .par_iter()
-                .map(|x| {
-                    let x = x.as_dvec3();
-                    let (mut sum, mut weight_sum) = ([0.0; 3], 0.0);
-                    let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; 3]);
-                    for (p, area, t) in &at_samples {
-                        let r = x.distance(*p);
-                        let w = kernel::near_blend_weight(r, *area);
-                        for c in 0..3 {
-                            sum[c] += w * t[c];
-                        }
-                        weight_sum += w;
-                        if r < nearest_r {
-                            (nearest_r, nearest) = (r, *t);
-                        }
-                    }
-                    if weight_sum > 0.0 { sum.map(|v| v / weight_sum) } else { nearest }
-                })
-                .collect()
+            let start = first;
+            first += o.samples.len();
+            match &o.material {
+                ResolvedMaterial::Translucent { dipoles, .. } => f(o, dipoles, start),
+                ResolvedMaterial::Opaque { .. } => vec![[0.0; 3]; o.mesh.positions().len()],
+            }
         })
         .collect()
 }
