@@ -217,8 +217,17 @@ pub fn prepare(
         let (forward, half_angle) = match axis {
             Some((a, angle)) => (a.normalize(), angle),
             None => {
-                // Cover the casters' bounding sphere; a light inside it gets a wide frustum.
-                let half = if dist > radius { (radius / dist).asin() * 1.05 } else { 80f32.to_radians() };
+                // Cover the casters' bounding sphere; a light inside it gets a wide frustum and
+                // loses the shadows of casters outside it (one map per light, no cube maps).
+                let half = if dist > radius {
+                    (radius / dist).asin() * 1.05
+                } else {
+                    log::warn!(
+                        "a point light at {position} is inside the shadow casters' bounding sphere: its shadow map \
+                         covers an 80-degree cone towards their centre, casters outside it cast no shadow"
+                    );
+                    80f32.to_radians()
+                };
                 (to_center / dist, half.min(80f32.to_radians()))
             }
         };
