@@ -48,3 +48,13 @@ pub fn image_barrier(
     // SAFETY: as above.
     unsafe { device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&barrier)) };
 }
+
+/// Make a transfer's writes (a copy into a readback buffer) visible to host reads.
+pub fn transfer_to_host(device: &ash::Device, cmd: vk::CommandBuffer) {
+    memory_barrier(
+        device,
+        cmd,
+        (vk::PipelineStageFlags2::COPY, vk::AccessFlags2::TRANSFER_WRITE),
+        (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+    );
+}

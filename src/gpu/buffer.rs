@@ -1,6 +1,6 @@
 //! `Buffer`: a VkBuffer with its memory, freed on Drop.
 
-use super::barrier::memory_barrier;
+use super::barrier::transfer_to_host;
 use super::context::Gpu;
 use super::error::{GpuError, GpuResult, VkContext};
 use ash::vk;
@@ -149,12 +149,7 @@ impl Buffer {
             let region = [vk::BufferCopy { src_offset: 0, dst_offset: 0, size: self.size }];
             // SAFETY: both buffers are alive and of the same size.
             unsafe { device.cmd_copy_buffer(cmd, self.raw, staging.raw, &region) };
-            memory_barrier(
-                device,
-                cmd,
-                (vk::PipelineStageFlags2::COPY, vk::AccessFlags2::TRANSFER_WRITE),
-                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-            );
+            transfer_to_host(device, cmd);
         })?;
         staging.read()
     }

@@ -1,6 +1,6 @@
 //! `Image`: a 2D VkImage with its memory and a view, freed on Drop.
 
-use super::barrier::{image_barrier, memory_barrier};
+use super::barrier::{image_barrier, transfer_to_host};
 use super::buffer::{Buffer, BufferDesc};
 use super::context::Gpu;
 use super::error::{GpuError, GpuResult, VkContext};
@@ -176,12 +176,7 @@ impl Image {
                     &region,
                 )
             };
-            memory_barrier(
-                device,
-                cmd,
-                (vk::PipelineStageFlags2::COPY, vk::AccessFlags2::TRANSFER_WRITE),
-                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-            );
+            transfer_to_host(device, cmd);
         })?;
         staging.read::<u8>()
     }

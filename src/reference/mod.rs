@@ -86,15 +86,14 @@ pub fn splat(scene: &PreparedScene, occluders: &Bvh) -> Vec<[f64; 3]> {
 /// over neighbouring samples (`optics::kernel::far_kernel` explains the split).
 pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3]>> {
     per_translucent_object(scene, |o, dipoles, first| {
-        let samples: Vec<(DVec3, f64, [f64; 3], [f64; 3])> = o
-            .samples
+        let samples: Vec<(DVec3, f64, [f64; 3])> =
+            o.samples.iter().enumerate().map(|(k, s)| (s.position.as_dvec3(), s.area, irradiance[first + k])).collect();
+        // Each sample's near exitance E_i E_near,i, to be blended between samples.
+        let near: Vec<(DVec3, f64, [f64; 3])> = samples
             .iter()
-            .enumerate()
-            .map(|(k, s)| {
-                let e = irradiance[first + k];
-                let b = kernel::B_PER_SQRT_AREA * s.area.sqrt();
-                let near = [0, 1, 2].map(|c| e[c] * kernel::near_energy(&dipoles[c], b));
-                (s.position.as_dvec3(), s.area, e, near)
+            .map(|(p, area, e)| {
+                let b = kernel::B_PER_SQRT_AREA * area.sqrt();
+                (*p, *area, [0, 1, 2].map(|c| e[c] * kernel::near_energy(&dipoles[c], b)))
             })
             .collect();
         o.mesh
@@ -103,25 +102,37 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3
             .map(|x| {
                 let x = x.as_dvec3();
                 let mut far = [0.0; 3];
-                let (mut near_sum, mut weight_sum) = ([0.0; 3], 0.0);
-                let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; 3]);
-                for (p, area, e, near) in &samples {
+                for (p, area, e) in &samples {
                     let r = x.distance(*p);
-                    let w = kernel::near_blend_weight(r, *area);
                     for c in 0..3 {
                         far[c] += e[c] * kernel::far_kernel(&dipoles[c], r, *area);
-                        near_sum[c] += w * near[c];
-                    }
-                    weight_sum += w;
-                    if r < nearest_r {
-                        (nearest_r, nearest) = (r, *near);
                     }
                 }
-                let near = if weight_sum > 0.0 { near_sum.map(|v| v / weight_sum) } else { nearest };
+                let near = near_blend(x, &near);
                 [0, 1, 2].map(|c| far[c] + near[c])
             })
             .collect()
     })
+}
+
+/// Blend per-sample values to `x` with the near-field Shepard weights
+/// (`kernel::near_blend_weight`), or take the nearest sample's where no weight reaches: the twin
+/// of the blend in glsl/common/gather.glsl and glsl/gather_sparse.comp.
+fn near_blend(x: DVec3, values: &[(DVec3, f64, [f64; 3])]) -> [f64; 3] {
+    let (mut sum, mut weight_sum) = ([0.0; 3], 0.0);
+    let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; 3]);
+    for (p, area, v) in values {
+        let r = x.distance(*p);
+        let w = kernel::near_blend_weight(r, *area);
+        for c in 0..3 {
+            sum[c] += w * v[c];
+        }
+        weight_sum += w;
+        if r < nearest_r {
+            (nearest_r, nearest) = (r, *v);
+        }
+    }
+    if weight_sum > 0.0 { sum.map(|v| v / weight_sum) } else { nearest }
 }
 
 /// The sparse gather (`render.gather = "sparse"`, glsl/gather_sparse.comp) in f64: exitance at
@@ -149,27 +160,7 @@ pub fn gather_sparse(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<
                 (x, sj.area, t)
             })
             .collect();
-        o.mesh
-            .positions()
-            .par_iter()
-            .map(|x| {
-                let x = x.as_dvec3();
-                let (mut sum, mut weight_sum) = ([0.0; 3], 0.0);
-                let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; 3]);
-                for (p, area, t) in &at_samples {
-                    let r = x.distance(*p);
-                    let w = kernel::near_blend_weight(r, *area);
-                    for c in 0..3 {
-                        sum[c] += w * t[c];
-                    }
-                    weight_sum += w;
-                    if r < nearest_r {
-                        (nearest_r, nearest) = (r, *t);
-                    }
-                }
-                if weight_sum > 0.0 { sum.map(|v| v / weight_sum) } else { nearest }
-            })
-            .collect()
+        o.mesh.positions().par_iter().map(|x| near_blend(x.as_dvec3(), &at_samples)).collect()
     })
 }
 
