@@ -13,7 +13,7 @@ use std::time::Instant;
 use translucent::gpu::{Gpu, GpuOptions, median};
 use translucent::render::plan::Change;
 use translucent::render::renderer::Renderer;
-use translucent::scene::Scene;
+use translucent::scene::{Scene, lights};
 use translucent::scene::build::{Overrides, PreparedScene};
 
 const WARM_UP: usize = 1;
@@ -31,7 +31,9 @@ fn measure(renderer: &mut Renderer, change: Change) -> Measured {
     let mut walls = Vec::new();
     let step = |renderer: &mut Renderer| {
         if let Change::Light(i) = change {
-            renderer.orbit_light(i, 3.0).expect("orbit");
+            let scene = renderer.scene();
+            let moved = lights::orbit(&scene.scene.file.lights[i], scene.bounds.0, 3.0).expect("a key light");
+            renderer.set_light(i, moved).expect("orbit");
         }
         renderer.plan(change)
     };

@@ -6,22 +6,24 @@
 // load per tile for the whole workgroup); the far sum is Kahan-compensated per channel so
 // that the f32 sum stays within 1e-3 of the f64 reference at any sample count.
 //
-// Bindings: 0 = vertices (float[6] per vertex: position, normal; read), 1 = samples
-// (SampleRecord[], read), 2 = splat (vec4[2] per sample, read), 3 = objects (ObjectRecord[], read),
-// 4 = exitance (vec4 per vertex, write).
-// Push: object index.
+// Bindings: 0 = vertices (VertexRecord[], read), 1 = samples (SampleRecord[], read), 2 = splat
+// (SplatRecord[], read), 3 = objects (ObjectRecord[], read), 4 = exitance (vec4 per vertex, write).
+// Push: GatherPush.
 #include "dipole.glsl"
 #include "scene.glsl"
 #include "gather.glsl"
 
 #define TILE 64u
 layout(local_size_x = 64) in;
-layout(std430, set = 0, binding = 0) readonly buffer Vertices { float vertices[]; };
+layout(std430, set = 0, binding = 0) readonly buffer Vertices { VertexRecord vertices[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Samples { SampleRecord samples[]; };
-layout(std430, set = 0, binding = 2) readonly buffer Splat { vec4 splat[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Splat { SplatRecord splat[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Objects { ObjectRecord objects[]; };
 layout(std430, set = 0, binding = 4) writeonly buffer Exitance { vec4 exitance[]; };
-layout(push_constant) uniform Push { uint object; } push;
+struct GatherPush {
+    uint object;            // the receiving object's index
+};
+layout(push_constant) uniform GatherPushBlock { GatherPush push; };
 
 shared vec4 tile_position_area[TILE];
 shared vec4 tile_irradiance[TILE];
@@ -35,7 +37,7 @@ void main() {
     uint v = gl_GlobalInvocationID.x;
     bool is_receiver = v < vertex_count;
     uint vi = first_vertex + min(v, max(vertex_count, 1u) - 1u);
-    vec3 x = vec3(vertices[6u * vi], vertices[6u * vi + 1u], vertices[6u * vi + 2u]);
+    vec3 x = vertex_position(vertices[vi]);
     DipoleChannel ch[3] = gather_channels(o);
     GatherSum g = gather_begin();
     for (uint base = 0u; base < sample_count; base += TILE) {
@@ -43,8 +45,8 @@ void main() {
         if (j < sample_count) {
             uint s = first_sample + j;
             tile_position_area[local] = samples[s].position_area;
-            tile_irradiance[local] = splat[2u * s];
-            tile_near_energy[local] = splat[2u * s + 1u];
+            tile_irradiance[local] = splat[s].irradiance_area;
+            tile_near_energy[local] = splat[s].near_energy;
         }
         barrier();
         uint n = min(TILE, sample_count - base);

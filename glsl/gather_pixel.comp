@@ -7,7 +7,7 @@
 //
 // Bindings: 0 = surface (combined sampler, rgba32f), 1 = samples (SampleRecord[]), 2 = splat
 // (vec4[2] per sample), 3 = objects (ObjectRecord[]), 4 = HDR radiance (storage image, rgba32f).
-// Push: width, height.
+// Push: GatherPixelPush.
 #include "dipole.glsl"
 #include "scene.glsl"
 #include "gather.glsl"
@@ -15,10 +15,14 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform sampler2D surface;
 layout(std430, set = 0, binding = 1) readonly buffer Samples { SampleRecord samples[]; };
-layout(std430, set = 0, binding = 2) readonly buffer Splat { vec4 splat[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Splat { SplatRecord splat[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Objects { ObjectRecord objects[]; };
 layout(set = 0, binding = 4, rgba32f) uniform image2D hdr;
-layout(push_constant) uniform Push { uint width; uint height; } push;
+struct GatherPixelPush {
+    uint width;
+    uint height;
+};
+layout(push_constant) uniform GatherPixelPushBlock { GatherPixelPush push; };
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -35,7 +39,7 @@ void main() {
     DipoleChannel ch[3] = gather_channels(o);
     GatherSum g = gather_begin();
     for (uint i = first; i < first + count; ++i) {
-        gather_add(g, ch, s.xyz, samples[i].position_area, splat[2u * i].rgb, splat[2u * i + 1u].rgb);
+        gather_add(g, ch, s.xyz, samples[i].position_area, splat[i].irradiance_area.rgb, splat[i].near_energy.rgb);
     }
     imageStore(hdr, p, vec4(radiance.rgb + gather_end(g) * radiance.a, 1.0));
 }

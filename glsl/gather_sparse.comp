@@ -12,19 +12,23 @@
 // Bindings: 0 = vertices (float[6] per vertex), 1 = samples (SampleRecord[]), 2 = splat
 // (vec4[2] per sample), 3 = objects (ObjectRecord[]), 4 = sample exitance (vec4 per sample,
 // written by stage 0, read by stage 1), 5 = exitance (vec4 per vertex, written by stage 1).
-// Push: object index, stage.
+// Push: GatherSparsePush.
 #include "dipole.glsl"
 #include "scene.glsl"
 #include "gather.glsl"
 
 layout(local_size_x = 64) in;
-layout(std430, set = 0, binding = 0) readonly buffer Vertices { float vertices[]; };
+layout(std430, set = 0, binding = 0) readonly buffer Vertices { VertexRecord vertices[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Samples { SampleRecord samples[]; };
-layout(std430, set = 0, binding = 2) readonly buffer Splat { vec4 splat[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Splat { SplatRecord splat[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Objects { ObjectRecord objects[]; };
 layout(std430, set = 0, binding = 4) buffer SampleExitance { vec4 sample_exitance[]; };
 layout(std430, set = 0, binding = 5) writeonly buffer Exitance { vec4 exitance[]; };
-layout(push_constant) uniform Push { uint object; uint stage; } push;
+struct GatherSparsePush {
+    uint object;            // the receiving object's index
+    uint stage;             // 0: exitance at the samples; 1: blended to the vertices
+};
+layout(push_constant) uniform GatherSparsePushBlock { GatherSparsePush push; };
 
 void main() {
     ObjectRecord o = objects[push.object];
@@ -37,14 +41,14 @@ void main() {
         DipoleChannel ch[3] = gather_channels(o);
         GatherSum g = gather_begin();
         for (uint i = first_sample; i < first_sample + sample_count; ++i) {
-            gather_add(g, ch, x, samples[i].position_area, splat[2u * i].rgb, vec3(0.0));
+            gather_add(g, ch, x, samples[i].position_area, splat[i].irradiance_area.rgb, vec3(0.0));
         }
-        sample_exitance[j] = vec4(max(g.far, vec3(0.0)) + splat[2u * j].rgb * splat[2u * j + 1u].rgb, 0.0);
+        sample_exitance[j] = vec4(max(g.far, vec3(0.0)) + splat[j].irradiance_area.rgb * splat[j].near_energy.rgb, 0.0);
         return;
     }
     if (k >= o.ranges.y) return;
     uint v = o.ranges.x + k;
-    vec3 x = vec3(vertices[6u * v], vertices[6u * v + 1u], vertices[6u * v + 2u]);
+    vec3 x = vertex_position(vertices[v]);
     vec3 sum = vec3(0.0);
     float weight_sum = 0.0;
     float nearest_r = 3.4e38;

@@ -5,9 +5,13 @@
 // Depth only, no fragment shader. Vertex input: binding 0 = position (vec3) + normal.
 // Push: the light's world -> clip matrix and its layer.
 layout(location = 0) in vec3 position;
-layout(push_constant) uniform Push { mat4 light_matrix; uint layer; uint pad0; uint pad1; uint pad2; } push;
+struct ShadowPush {
+    mat4 light_matrix;      // world -> the light's clip space
+    uvec4 layer;            // x: the shadow-map layer (gl_Layer); yzw: unused
+};
+layout(push_constant) uniform ShadowPushBlock { ShadowPush push; };
 
 void main() {
     gl_Position = push.light_matrix * vec4(position, 1.0);
-    gl_Layer = int(push.layer);
+    gl_Layer = int(push.layer.x);
 }

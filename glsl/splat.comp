@@ -7,8 +7,8 @@
 //
 // Bindings: 0 = samples (SampleRecord[], read), 1 = objects (ObjectRecord[], read),
 // 2 = lights (Light[], read), 3 = shadow maps (sampler2DArrayShadow),
-// 4 = splat output (vec4[2] per sample: rgb irradiance E_i and area; rgb near energy), write.
-// Push: sample count, light count.
+// 4 = splat output (SplatRecord[]), write.
+// Push: SplatPush.
 #include "dipole.glsl"
 #include "lights.glsl"
 #include "scene.glsl"
@@ -18,8 +18,12 @@ layout(std430, set = 0, binding = 0) readonly buffer Samples { SampleRecord samp
 layout(std430, set = 0, binding = 1) readonly buffer Objects { ObjectRecord objects[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Lights { Light lights[]; };
 layout(set = 0, binding = 3) uniform sampler2DArrayShadow shadow_maps;
-layout(std430, set = 0, binding = 4) writeonly buffer Splat { vec4 splat[]; };
-layout(push_constant) uniform Push { uint sample_count; uint light_count; } push;
+layout(std430, set = 0, binding = 4) writeonly buffer Splat { SplatRecord splat[]; };
+struct SplatPush {
+    uint sample_count;
+    uint light_count;
+};
+layout(push_constant) uniform SplatPushBlock { SplatPush push; };
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
@@ -42,9 +46,7 @@ void main() {
     float b = DIPOLE_B_PER_SQRT_AREA * sqrt(area);
     vec3 near_energy;
     for (int c = 0; c < 3; ++c) {
-        vec4 d = o.dipole[c];
-        near_energy[c] = dipole_near_energy(DipoleChannel(d.x, d.y, d.z, d.w), b);
+        near_energy[c] = dipole_near_energy(o.dipole[c], b);
     }
-    splat[2u * i] = vec4(e, area);
-    splat[2u * i + 1u] = vec4(near_energy, 0.0);
+    splat[i] = SplatRecord(vec4(e, area), vec4(near_energy, 0.0));
 }

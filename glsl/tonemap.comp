@@ -3,12 +3,17 @@
 // Exposure, then the ACES filmic curve fit of Narkowicz (2015), then the sRGB transfer function.
 // Non-finite input is mapped to black so a NaN can never reach an image (and is counted).
 // Bindings: 0 = HDR image (combined sampler, nearest), 1 = packed RGBA8 output (storage),
-// 2 = counters (storage): [0] = non-finite pixels seen. Push: width, height, exposure.
+// 2 = counters (storage): [0] = non-finite pixels seen. Push: TonemapPush.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform sampler2D hdr;
 layout(std430, set = 0, binding = 1) writeonly buffer Out { uint rgba8[]; };
 layout(std430, set = 0, binding = 2) buffer Counters { uint non_finite; };
-layout(push_constant) uniform Push { uint width; uint height; float exposure; } push;
+struct TonemapPush {
+    uint width;
+    uint height;
+    float exposure;
+};
+layout(push_constant) uniform TonemapPushBlock { TonemapPush push; };
 
 vec3 aces_narkowicz(vec3 x) {
     const float a = 2.51, b = 0.03, c = 2.43, d = 0.59, e = 0.14;

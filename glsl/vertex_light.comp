@@ -5,23 +5,28 @@
 // key light reuses it; the shading pass interpolates it for diffuse surfaces instead of looking
 // up every environment shadow map at every pixel.
 //
-// Bindings: 0 = vertices (float[6] per vertex: position, normal), 1 = lights (Light[]),
+// Bindings: 0 = vertices (VertexRecord[]), 1 = lights (Light[]),
 // 2 = shadow maps (sampler2DArrayShadow), 3 = output (vec4 per vertex: rgb irradiance).
-// Push: vertex count, light count.
+// Push: VertexLightPush.
 #include "lights.glsl"
+#include "scene.glsl"
 
 layout(local_size_x = 64) in;
-layout(std430, set = 0, binding = 0) readonly buffer Vertices { float vertices[]; };
+layout(std430, set = 0, binding = 0) readonly buffer Vertices { VertexRecord vertices[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Lights { Light lights[]; };
 layout(set = 0, binding = 2) uniform sampler2DArrayShadow shadow_maps;
 layout(std430, set = 0, binding = 3) writeonly buffer Irradiance { vec4 irradiance_out[]; };
-layout(push_constant) uniform Push { uint vertex_count; uint light_count; } push;
+struct VertexLightPush {
+    uint vertex_count;
+    uint light_count;
+};
+layout(push_constant) uniform VertexLightPushBlock { VertexLightPush push; };
 
 void main() {
     uint v = gl_GlobalInvocationID.x;
     if (v >= push.vertex_count) return;
-    vec3 p = vec3(vertices[6u * v], vertices[6u * v + 1u], vertices[6u * v + 2u]);
-    vec3 n = normalize(vec3(vertices[6u * v + 3u], vertices[6u * v + 4u], vertices[6u * v + 5u]));
+    vec3 p = vertex_position(vertices[v]);
+    vec3 n = normalize(vertex_normal(vertices[v]));
     vec3 e = vec3(0.0);
     for (uint l = 0u; l < push.light_count; ++l) {
         if (!light_is_environment(lights[l])) continue;

@@ -5,7 +5,7 @@ mod common;
 use ash::vk;
 use common::with_gpu;
 use translucent::gpu::{
-    Binding, BindingKind, Buffer, GpuTimer, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, image_barrier, shaders,
+    Access, Binding, Buffer, GpuTimer, GraphicsDesc, GraphicsPipeline, Image, ImageBarrier, ImageDesc, shaders,
 };
 use translucent::render::smoke;
 
@@ -90,8 +90,6 @@ fn graphics_pipeline_draws_a_triangle() {
         )
         .unwrap();
         let mut desc = GraphicsDesc::new("test/triangle.vert", Some("test/triangle.frag"));
-        desc.bindings = vec![BindingKind::StorageBuffer];
-        desc.push_bytes = 4;
         desc.vertex_bindings = vec![vk::VertexInputBindingDescription {
             binding: 0,
             stride: std::mem::size_of::<Vertex>() as u32,
@@ -117,27 +115,14 @@ fn graphics_pipeline_draws_a_triangle() {
         let set = pipeline.descriptor_set(&[Binding::Buffer(&tint)]).unwrap();
         let device = gpu.device();
         gpu.one_shot("draw", |cmd| {
-            image_barrier(
-                device,
-                cmd,
-                color.raw(),
-                vk::ImageAspectFlags::COLOR,
-                (vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
-                (vk::PipelineStageFlags2::TOP_OF_PIPE, vk::AccessFlags2::NONE),
-                (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
-            );
-            image_barrier(
-                device,
-                cmd,
-                depth.raw(),
-                vk::ImageAspectFlags::DEPTH,
-                (vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL),
-                (vk::PipelineStageFlags2::TOP_OF_PIPE, vk::AccessFlags2::NONE),
-                (
-                    vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
-                    vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ,
-                ),
-            );
+            ImageBarrier::new(color.raw(), vk::ImageAspectFlags::COLOR, &[Access::Nothing], &[
+                Access::ColorAttachmentWrite,
+            ])
+            .record(device, cmd);
+            ImageBarrier::new(depth.raw(), vk::ImageAspectFlags::DEPTH, &[Access::Nothing], &[
+                Access::DepthAttachmentReadWrite,
+            ])
+            .record(device, cmd);
             let colors = [vk::RenderingAttachmentInfo::default()
                 .image_view(color.view())
                 .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
@@ -157,14 +142,14 @@ fn graphics_pipeline_draws_a_triangle() {
                 .depth_attachment(&depth_attachment);
             unsafe {
                 device.cmd_begin_rendering(cmd, &rendering);
-                pipeline.bind(cmd, Some(&set), bytemuck::bytes_of(&0.5f32), color.extent());
+                pipeline.bind(cmd, Some(&set), &0.5f32, color.extent());
                 device.cmd_bind_vertex_buffers(cmd, 0, &[vbuf.raw()], &[0]);
                 device.cmd_draw(cmd, 3, 1, 0, 0);
                 device.cmd_end_rendering(cmd);
             }
         })
         .unwrap();
-        let pixels = color.read(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL).unwrap();
+        let pixels = color.read(Access::ColorAttachmentWrite).unwrap();
         let at = |x: u32, y: u32| {
             let i = 4 * (y * SIZE + x) as usize;
             [pixels[i], pixels[i + 1], pixels[i + 2], pixels[i + 3]]

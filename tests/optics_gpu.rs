@@ -14,13 +14,12 @@ mod common;
 use ash::vk;
 use common::with_gpu;
 use std::collections::HashMap;
-use translucent::gpu::{Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, memory_barrier};
+use translucent::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, memory_barrier};
 use translucent::optics::fresnel::{self, fresnel_reflectance, fresnel_transmittance};
 use translucent::optics::gpu::{DipoleEvalInput, DipoleEvalOutput};
 use translucent::optics::kernel::{self, footprint_kernel, near_energy, r_d_far};
 use translucent::optics::{Dipole, Material, presets};
 
-const LOCAL_SIZE: u32 = 64;
 const REL_TOLERANCE: f64 = 1e-4;
 const PEAK_FRACTION: f64 = 1e-30;
 const F32_FLOOR: f64 = 1e-35;
@@ -179,9 +178,7 @@ const NAMES: [&str; 16] = [
 fn run_on_gpu(inputs: &[DipoleEvalInput]) -> Vec<DipoleEvalOutput> {
     with_gpu(|gpu| {
         let count = inputs.len() as u32;
-        let pipeline =
-            ComputePipeline::new(gpu, "dipole_eval.comp", &[BindingKind::StorageBuffer, BindingKind::StorageBuffer], 4)
-                .expect("dipole_eval pipeline");
+        let pipeline = ComputePipeline::new(gpu, "dipole_eval.comp").expect("dipole_eval pipeline");
         let src = Buffer::from_slice(gpu, "dipole_eval inputs", inputs, vk::BufferUsageFlags::STORAGE_BUFFER)
             .expect("input buffer");
         let bytes = (inputs.len() * std::mem::size_of::<DipoleEvalOutput>()) as u64;
@@ -190,13 +187,8 @@ fn run_on_gpu(inputs: &[DipoleEvalInput]) -> Vec<DipoleEvalOutput> {
                 .expect("output buffer");
         let set = pipeline.descriptor_set(&[Binding::Buffer(&src), Binding::Buffer(&dst)]).expect("descriptor set");
         gpu.one_shot("dipole_eval", |cmd| {
-            pipeline.dispatch(cmd, &set, bytemuck::bytes_of(&count), [count.div_ceil(LOCAL_SIZE), 1, 1]);
-            memory_barrier(
-                gpu.device(),
-                cmd,
-                (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_WRITE),
-                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-            );
+            pipeline.dispatch(cmd, &set, &count, [count, 1, 1]);
+            memory_barrier(gpu.device(), cmd, &[Access::ComputeWrite], &[Access::HostRead]);
         })
         .expect("dispatch");
         dst.read().expect("readback")

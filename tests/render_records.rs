@@ -3,12 +3,20 @@
 //! headers themselves so a field added on one side only fails here.
 
 use std::mem::{offset_of, size_of};
-use translucent::render::records::{ObjectRecord, SampleRecord, Vertex};
+use translucent::gpu::ShaderInterface;
+use translucent::render::gather::GatherPush;
+use translucent::render::gather_pixel::GatherPixelPush;
+use translucent::render::gather_sparse::GatherSparsePush;
+use translucent::render::records::{LightGpu, ObjectRecord, SampleRecord, SplatRecord, Vertex};
 use translucent::render::shade::ShadePush;
-use translucent::scene::lights::LightGpu;
+use translucent::render::shadow::ShadowPush;
+use translucent::render::splat::SplatPush;
+use translucent::render::tonemap::TonemapPush;
+use translucent::render::vertex_light::VertexLightPush;
 
 /// (field name, std430 offset) of `struct NAME { ... };` in `source`, for the member types used
-/// here (all 16-byte aligned: vec4, uvec4, mat4 and arrays of them).
+/// here: 4-byte scalars and arrays of them, and 16-byte vec4, uvec4, mat4, DipoleChannel and
+/// arrays of them, in an order that needs no padding.
 fn glsl_layout(source: &str, name: &str) -> (Vec<(String, usize)>, usize) {
     let start = source.find(&format!("struct {name} {{")).unwrap_or_else(|| panic!("struct {name} not found"));
     let body = &source[start..source[start..].find("};").unwrap() + start];
@@ -28,7 +36,8 @@ fn glsl_layout(source: &str, name: &str) -> (Vec<(String, usize)>, usize) {
             None => (decl.to_string(), 1),
         };
         let size = match ty {
-            "vec4" | "uvec4" => 16,
+            "float" | "uint" => 4,
+            "vec4" | "uvec4" | "DipoleChannel" => 16,
             "mat4" => 64,
             other => panic!("type {other} of {name}.{field} is not handled here"),
         };
@@ -84,6 +93,64 @@ fn vertex_and_push_layouts() {
     assert_eq!(size_of::<ShadePush>(), 96);
     assert_eq!(offset_of!(ShadePush, eye_object), 64);
     assert_eq!(offset_of!(ShadePush, counts), 80);
-    let frag = include_str!("../glsl/common/shade.glsl");
+    let frag = include_str!("../glsl/common/shade_push.glsl");
     assert!(frag.contains("mat4 view_proj;") && frag.contains("vec4 eye_object;") && frag.contains("uvec4 counts;"));
+}
+
+#[test]
+fn splat_and_vertex_records_match_glsl() {
+    let scene = include_str!("../glsl/common/scene.glsl");
+    let (fields, size) = glsl_layout(scene, "SplatRecord");
+    assert_eq!(size, size_of::<SplatRecord>());
+    let rust = [
+        ("irradiance_area", offset_of!(SplatRecord, irradiance_area)),
+        ("near_energy", offset_of!(SplatRecord, near_energy)),
+    ];
+    assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
+    let (fields, size) = glsl_layout(scene, "VertexRecord");
+    assert_eq!(size, size_of::<Vertex>());
+    let rust = [("position", offset_of!(Vertex, position)), ("normal", offset_of!(Vertex, normal))];
+    assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
+}
+
+/// Every pass's push struct: its GLSL declaration has the Rust struct's field names and
+/// offsets, and the compiled shader's reflected push block has its size.
+#[test]
+fn push_blocks_match_glsl_and_spirv() {
+    let cases: [(&str, &str, &str, usize, &[&str]); 8] = [
+        ("splat.comp", include_str!("../glsl/splat.comp"), "SplatPush", size_of::<SplatPush>(), &[
+            "sample_count",
+            "light_count",
+        ]),
+        ("vertex_light.comp", include_str!("../glsl/vertex_light.comp"), "VertexLightPush", size_of::<VertexLightPush>(), &[
+            "vertex_count",
+            "light_count",
+        ]),
+        ("gather.comp", include_str!("../glsl/gather.comp"), "GatherPush", size_of::<GatherPush>(), &["object"]),
+        ("gather_sparse.comp", include_str!("../glsl/gather_sparse.comp"), "GatherSparsePush", size_of::<GatherSparsePush>(), &[
+            "object", "stage",
+        ]),
+        ("gather_pixel.comp", include_str!("../glsl/gather_pixel.comp"), "GatherPixelPush", size_of::<GatherPixelPush>(), &[
+            "width", "height",
+        ]),
+        ("tonemap.comp", include_str!("../glsl/tonemap.comp"), "TonemapPush", size_of::<TonemapPush>(), &[
+            "width", "height", "exposure",
+        ]),
+        ("shadow.vert", include_str!("../glsl/shadow.vert"), "ShadowPush", size_of::<ShadowPush>(), &["light_matrix", "layer"]),
+        ("shade.vert", include_str!("../glsl/common/shade_push.glsl"), "ShadePush", size_of::<ShadePush>(), &[
+            "view_proj", "eye_object", "counts",
+        ]),
+    ];
+    for (shader, source, name, rust_size, rust_fields) in cases {
+        let (fields, size) = glsl_layout(source, name);
+        assert_eq!(size, rust_size, "{name}: GLSL and Rust sizes differ");
+        let names: Vec<&str> = fields.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, rust_fields, "{name}: fields differ");
+        let reflected = ShaderInterface::of(shader).unwrap();
+        assert_eq!(reflected.push_bytes as usize, rust_size, "{shader}: reflected push block");
+    }
+    // Offsets of the multi-field structs, against repr(C).
+    assert_eq!(offset_of!(SplatPush, light_count), 4);
+    assert_eq!(offset_of!(TonemapPush, exposure), 8);
+    assert_eq!(offset_of!(ShadowPush, layer), 64);
 }

@@ -20,12 +20,7 @@ GatherSum gather_begin() {
 }
 
 DipoleChannel[3] gather_channels(ObjectRecord o) {
-    DipoleChannel ch[3];
-    for (int c = 0; c < 3; ++c) {
-        vec4 d = o.dipole[c];
-        ch[c] = DipoleChannel(d.x, d.y, d.z, d.w);
-    }
-    return ch;
+    return o.dipole;
 }
 
 // Add one sample (position and area, transmitted irradiance E, near energy per channel).

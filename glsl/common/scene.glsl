@@ -1,7 +1,8 @@
 // Scene records (std430) shared by the splat, gather and shade passes, mirrored in Rust by
-// `src/render/records.rs` (a test pins sizes and offsets).
+// `src/render/records.rs` (tests/render_records.rs pins sizes and offsets against this file).
 #ifndef SCENE_GLSL
 #define SCENE_GLSL
+#include "dipole.glsl"
 
 const uint MATERIAL_OPAQUE = 0u;
 const uint MATERIAL_TRANSLUCENT = 1u;
@@ -11,7 +12,7 @@ struct ObjectRecord {
     vec4 eta_norm_kind;     // x: relative index of refraction eta; y: BSSRDF normalization
                             // 1 / (pi T(eta)), T(eta) = 1 - 2 FM1(eta) (optics::Dipole::s_d);
                             // z: kind (MATERIAL_*); w: unused
-    vec4 dipole[3];         // per channel: alpha', sigma_tr, z_r, z_v in scene units
+    DipoleChannel dipole[3]; // per channel: alpha', sigma_tr, z_r, z_v in scene units
     uvec4 ranges;           // x: first vertex, y: vertex count, z: first sample, w: sample count
 };
 
@@ -19,5 +20,26 @@ struct SampleRecord {
     vec4 position_area;     // xyz: world position; w: area weight (scene units^2)
     vec4 normal_object;     // xyz: unit normal; w: object index (as float)
 };
+
+// One sample's splat output (splat.comp writes it, the gathers read it).
+struct SplatRecord {
+    vec4 irradiance_area;   // rgb: transmitted irradiance E_i; w: area weight
+    vec4 near_energy;       // rgb: near-field energy per channel (dipole_near_energy); w: 0
+};
+
+// One mesh vertex as compute passes read it (the raster passes read the same buffer as vertex
+// attributes): tightly packed, 24 bytes.
+struct VertexRecord {
+    float position[3];
+    float normal[3];
+};
+
+vec3 vertex_position(VertexRecord v) {
+    return vec3(v.position[0], v.position[1], v.position[2]);
+}
+
+vec3 vertex_normal(VertexRecord v) {
+    return vec3(v.normal[0], v.normal[1], v.normal[2]);
+}
 
 #endif

@@ -27,11 +27,7 @@ layout(location = 1) out vec4 out_surface;  // xyz: world position; w: object in
 layout(std430, set = 0, binding = 0) readonly buffer Objects { ObjectRecord objects[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Lights { Light lights[]; };
 layout(set = 0, binding = 2) uniform sampler2DArrayShadow shadow_maps;
-layout(push_constant) uniform Push {
-    mat4 view_proj;
-    vec4 eye_object;
-    uvec4 counts;
-} push;
+#include "shade_push.glsl"
 
 // GGX / Trowbridge-Reitz microfacet specular (Walter et al. 2007) with the height-correlated
 // Smith visibility term (Heitz 2014); returns f_s cos(theta_i) without the Fresnel factor.

@@ -9,7 +9,7 @@ use translucent::output;
 use translucent::render::plan::Change;
 use translucent::render::renderer::Renderer;
 use translucent::scene::build::{Overrides, PreparedScene};
-use translucent::scene::{Light, Scene};
+use translucent::scene::{Light, Scene, lights};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -76,6 +76,14 @@ impl Default for Args {
             export_exitance: None,
         }
     }
+}
+
+/// Turn scene light `index` by `degrees` about the vertical axis through the scene's centre.
+fn orbit_light(renderer: &mut Renderer, index: usize, degrees: f32) -> Result<()> {
+    let scene = renderer.scene();
+    let light = &scene.scene.file.lights[index];
+    let moved = lights::orbit(light, scene.bounds.0, degrees).context("an environment light cannot orbit")?;
+    Ok(renderer.set_light(index, moved)?)
 }
 
 fn parse_resolution(s: &str) -> Result<[u32; 2], String> {
@@ -145,7 +153,7 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     for frame in 0..args.frames {
         let change = if frame == 0 { Change::Everything } else { moving };
         if let Change::Light(i) = change {
-            renderer.orbit_light(i, 3.0)?;
+            orbit_light(&mut renderer, i, 3.0)?;
         }
         let plan = renderer.plan(change);
         if args.plan && frame < 2 {

@@ -7,7 +7,7 @@ use super::error::{GpuError, GpuResult, VkContext};
 use ash::vk;
 use std::sync::Arc;
 
-/// The kind of one binding, in binding order (binding i is the i-th entry).
+/// The kind of one binding, as reflected from a shader's SPIR-V (`shaders::ShaderInterface`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BindingKind {
     StorageBuffer,
@@ -25,9 +25,20 @@ impl BindingKind {
             BindingKind::StorageImage => vk::DescriptorType::STORAGE_IMAGE,
         }
     }
+
+    pub(crate) fn from_reflected(ty: rspirv_reflect::DescriptorType) -> Option<BindingKind> {
+        use rspirv_reflect::DescriptorType as T;
+        match ty {
+            T::STORAGE_BUFFER => Some(BindingKind::StorageBuffer),
+            T::UNIFORM_BUFFER => Some(BindingKind::UniformBuffer),
+            T::COMBINED_IMAGE_SAMPLER => Some(BindingKind::CombinedImageSampler),
+            T::STORAGE_IMAGE => Some(BindingKind::StorageImage),
+            _ => None,
+        }
+    }
 }
 
-/// What to bind at one binding.
+/// What to bind at one binding; a set is given as a list, binding i being the i-th entry.
 pub enum Binding<'a> {
     Buffer(&'a Buffer),
     Image { view: vk::ImageView, layout: vk::ImageLayout, sampler: vk::Sampler },
@@ -35,12 +46,13 @@ pub enum Binding<'a> {
 
 pub(crate) fn create_set_layout(
     gpu: &Gpu,
-    kinds: &[BindingKind],
+    kinds: &[Option<BindingKind>],
     stages: vk::ShaderStageFlags,
 ) -> GpuResult<vk::DescriptorSetLayout> {
     let bindings: Vec<_> = kinds
         .iter()
         .enumerate()
+        .filter_map(|(i, k)| k.map(|k| (i, k)))
         .map(|(i, k)| {
             vk::DescriptorSetLayoutBinding::default()
                 .binding(i as u32)
@@ -64,18 +76,21 @@ impl DescriptorSet {
     pub(crate) fn new(
         gpu: &Arc<Gpu>,
         layout: vk::DescriptorSetLayout,
-        kinds: &[BindingKind],
+        kinds: &[Option<BindingKind>],
         bindings: &[Binding<'_>],
     ) -> GpuResult<DescriptorSet> {
-        if kinds.len() != bindings.len() {
+        // A resource for a binding the shader does not declare (or that the optimiser removed
+        // as unused) is dropped; a declared binding without a resource is an error.
+        if let Some(missing) = kinds.iter().enumerate().skip(bindings.len()).find(|(_, k)| k.is_some()) {
             return Err(GpuError::Invalid(format!(
-                "descriptor set needs {} bindings, {} given",
-                kinds.len(),
+                "the shader declares binding {}, only {} resources were given",
+                missing.0,
                 bindings.len()
             )));
         }
         let device = gpu.device();
-        let sizes: Vec<_> = kinds.iter().map(|k| vk::DescriptorPoolSize { ty: k.vk(), descriptor_count: 1 }).collect();
+        let sizes: Vec<_> =
+            kinds.iter().flatten().map(|k| vk::DescriptorPoolSize { ty: k.vk(), descriptor_count: 1 }).collect();
         let info = vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes);
         // SAFETY: valid create info; destroyed in Drop.
         let pool = unsafe { device.create_descriptor_pool(&info, None) }.vk("vkCreateDescriptorPool")?;
@@ -88,10 +103,11 @@ impl DescriptorSet {
     }
 
     /// Point the bindings at other resources (same kinds). Not while the set is in use by the GPU.
-    pub(crate) fn update(&mut self, kinds: &[BindingKind], bindings: &[Binding<'_>]) -> GpuResult<()> {
+    pub(crate) fn update(&mut self, kinds: &[Option<BindingKind>], bindings: &[Binding<'_>]) -> GpuResult<()> {
         let mut buffer_infos = Vec::new();
         let mut image_infos = Vec::new();
         for (i, (kind, binding)) in kinds.iter().zip(bindings).enumerate() {
+            let Some(kind) = kind else { continue };
             match (kind, binding) {
                 (BindingKind::StorageBuffer | BindingKind::UniformBuffer, Binding::Buffer(b)) => buffer_infos
                     .push((i, [vk::DescriptorBufferInfo { buffer: b.raw(), offset: 0, range: vk::WHOLE_SIZE }])),
@@ -111,7 +127,7 @@ impl DescriptorSet {
                 vk::WriteDescriptorSet::default()
                     .dst_set(self.set)
                     .dst_binding(*i as u32)
-                    .descriptor_type(kinds[*i].vk())
+                    .descriptor_type(kinds[*i].expect("declared").vk())
                     .buffer_info(info),
             );
         }
@@ -120,7 +136,7 @@ impl DescriptorSet {
                 vk::WriteDescriptorSet::default()
                     .dst_set(self.set)
                     .dst_binding(*i as u32)
-                    .descriptor_type(kinds[*i].vk())
+                    .descriptor_type(kinds[*i].expect("declared").vk())
                     .image_info(info),
             );
         }

@@ -31,6 +31,8 @@ pub enum GpuError {
     Timeout { what: String, seconds: f64 },
     #[error("no shader named {0:?} is embedded (shaders are compiled from glsl/ by build.rs)")]
     UnknownShader(String),
+    #[error("{what} is {value}, more than this device allows ({limit}, its {name})")]
+    Limit { what: String, value: u64, limit: u64, name: &'static str },
     #[error("{0}")]
     Invalid(String),
 }

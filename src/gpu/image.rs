@@ -1,6 +1,6 @@
 //! `Image`: a 2D VkImage with its memory and a view, freed on Drop.
 
-use super::barrier::{image_barrier, transfer_to_host};
+use super::barrier::{Access, ImageBarrier, transfer_to_host};
 use super::buffer::{Buffer, BufferDesc};
 use super::context::Gpu;
 use super::error::{GpuError, GpuResult, VkContext};
@@ -144,8 +144,9 @@ impl Image {
     }
 
     /// Copy layer 0 into host memory: tightly packed rows of texels as the format stores them.
-    /// `layout` is the image's current layout; it is left in TRANSFER_SRC_OPTIMAL.
-    pub fn read(&self, layout: vk::ImageLayout) -> GpuResult<Vec<u8>> {
+    /// `previous` is the last access to the image (its layout follows); it is left in
+    /// TRANSFER_SRC_OPTIMAL.
+    pub fn read(&self, previous: Access) -> GpuResult<Vec<u8>> {
         let bytes_per_texel = bytes_per_texel(self.desc.format)
             .ok_or_else(|| GpuError::Invalid(format!("reading back {:?} images is not supported", self.desc.format)))?;
         let size = self.desc.width as u64 * self.desc.height as u64 * bytes_per_texel;
@@ -154,15 +155,14 @@ impl Image {
         let device = self.gpu.device();
         let aspect = aspect_of(self.desc.format);
         self.gpu.one_shot("image readback", |cmd| {
-            image_barrier(
-                device,
-                cmd,
-                self.raw,
+            ImageBarrier {
+                image: self.raw,
                 aspect,
-                (layout, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
-                (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_WRITE),
-                (vk::PipelineStageFlags2::COPY, vk::AccessFlags2::TRANSFER_READ),
-            );
+                previous: &[previous],
+                next: &[Access::TransferRead],
+                discard: false,
+            }
+            .record(device, cmd);
             let region = [vk::BufferImageCopy::default()
                 .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(aspect).layer_count(1))
                 .image_extent(vk::Extent3D { width: self.desc.width, height: self.desc.height, depth: 1 })];

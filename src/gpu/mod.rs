@@ -18,9 +18,10 @@ mod instance;
 mod pipeline;
 mod sampler;
 pub mod shaders;
+pub use shaders::ShaderInterface;
 mod timer;
 
-pub use barrier::{image_barrier, memory_barrier};
+pub use barrier::{Access, ImageBarrier, memory_barrier};
 pub use buffer::{Buffer, BufferDesc};
 pub use context::{Gpu, HostVulkan};
 pub use debug::ValidationCounters;

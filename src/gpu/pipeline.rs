@@ -1,10 +1,11 @@
 //! Compute and graphics pipelines built from embedded SPIR-V, each with one descriptor set
-//! (set 0) and an optional push-constant block visible to every stage.
+//! (set 0) and an optional push-constant block visible to every stage. Bindings, push-block size
+//! and workgroup size are reflected from the SPIR-V (`shaders::ShaderInterface`).
 
 use super::context::Gpu;
 use super::descriptor::{Binding, BindingKind, DescriptorSet, create_set_layout};
 use super::error::{GpuError, GpuResult, VkContext};
-use super::shaders;
+use super::shaders::{self, ShaderInterface};
 use ash::vk;
 use std::sync::Arc;
 
@@ -13,13 +14,14 @@ struct Layout {
     gpu: Arc<Gpu>,
     set_layout: vk::DescriptorSetLayout,
     pipeline_layout: vk::PipelineLayout,
-    kinds: Vec<BindingKind>,
+    kinds: Vec<Option<BindingKind>>,
     stages: vk::ShaderStageFlags,
     push_bytes: u32,
 }
 
 impl Layout {
-    fn new(gpu: &Arc<Gpu>, kinds: &[BindingKind], stages: vk::ShaderStageFlags, push_bytes: u32) -> GpuResult<Layout> {
+    fn new(gpu: &Arc<Gpu>, interface: &ShaderInterface, stages: vk::ShaderStageFlags) -> GpuResult<Layout> {
+        let (kinds, push_bytes) = (&interface.bindings, interface.push_bytes);
         if !push_bytes.is_multiple_of(4) || push_bytes > gpu.properties().limits.max_push_constants_size {
             return Err(GpuError::Invalid(format!("push-constant block of {push_bytes} bytes is not allowed")));
         }
@@ -57,8 +59,14 @@ impl Layout {
         }
     }
 
-    fn check_push(&self, push: &[u8]) {
-        assert_eq!(push.len() as u32, self.push_bytes, "push-constant block size differs from the pipeline's");
+    /// The push bytes to record: the shader's block must have the Rust struct's size (a
+    /// block the optimiser removed as unused takes nothing).
+    fn check_push<'p>(&self, push: &'p [u8]) -> &'p [u8] {
+        if self.push_bytes == 0 {
+            return &[];
+        }
+        assert_eq!(push.len() as u32, self.push_bytes, "push-constant block size differs from the shader's");
+        push
     }
 }
 
@@ -99,12 +107,14 @@ pub struct ComputePipeline {
     pipeline: vk::Pipeline,
     layout: Layout,
     name: String,
+    local_size: [u32; 3],
 }
 
 impl ComputePipeline {
-    /// `shader` is a path under `glsl/` ("smoke.comp"); `bindings` are set 0's bindings in order.
-    pub fn new(gpu: &Arc<Gpu>, shader: &str, bindings: &[BindingKind], push_bytes: u32) -> GpuResult<ComputePipeline> {
-        let layout = Layout::new(gpu, bindings, vk::ShaderStageFlags::COMPUTE, push_bytes)?;
+    /// `shader` is a path under `glsl/` ("smoke.comp"); its interface is reflected.
+    pub fn new(gpu: &Arc<Gpu>, shader: &str) -> GpuResult<ComputePipeline> {
+        let interface = ShaderInterface::of(shader)?;
+        let layout = Layout::new(gpu, &interface, vk::ShaderStageFlags::COMPUTE)?;
         let module = Module::new(gpu, shader)?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
@@ -114,7 +124,27 @@ impl ComputePipeline {
         // SAFETY: valid create info referencing live module and layout.
         let pipeline = unsafe { gpu.device().create_compute_pipelines(vk::PipelineCache::null(), &info, None) }
             .map_err(|(_, result)| GpuError::Vk { what: "vkCreateComputePipelines", result })?[0];
-        Ok(ComputePipeline { pipeline, layout, name: shader.to_string() })
+        Ok(ComputePipeline { pipeline, layout, name: shader.to_string(), local_size: interface.local_size })
+    }
+
+    /// Workgroups that cover `threads` invocations in each dimension.
+    pub fn groups(&self, threads: [u32; 3]) -> [u32; 3] {
+        [0, 1, 2].map(|i| threads[i].div_ceil(self.local_size[i]))
+    }
+
+    /// An error naming `what` when `threads` needs more workgroups than the device dispatches.
+    pub fn check_threads(&self, threads: [u32; 3], what: &str) -> GpuResult<()> {
+        let max = self.layout.gpu.properties().limits.max_compute_work_group_count;
+        let groups = self.groups(threads);
+        match (0..3).find(|&i| groups[i] > max[i]) {
+            Some(i) => Err(GpuError::Limit {
+                what: what.to_string(),
+                value: threads[i] as u64,
+                limit: max[i] as u64 * self.local_size[i] as u64,
+                name: "maxComputeWorkGroupCount x local size",
+            }),
+            None => Ok(()),
+        }
     }
 
     /// A descriptor set for this pipeline's set 0.
@@ -122,10 +152,14 @@ impl ComputePipeline {
         DescriptorSet::new(&self.layout.gpu, self.layout.set_layout, &self.layout.kinds, bindings)
     }
 
-    /// Record a dispatch of `groups` workgroups.
-    pub fn dispatch(&self, cmd: vk::CommandBuffer, set: &DescriptorSet, push: &[u8], groups: [u32; 3]) {
-        self.layout.check_push(push);
+    /// Record a dispatch of enough workgroups for `threads` invocations, with push block `push`.
+    pub fn dispatch<P: bytemuck::Pod>(&self, cmd: vk::CommandBuffer, set: &DescriptorSet, push: &P, threads: [u32; 3]) {
+        if threads.contains(&0) {
+            return;
+        }
+        let push = self.layout.check_push(bytemuck::bytes_of(push));
         let device = self.layout.gpu.device();
+        let groups = self.groups(threads);
         // SAFETY: `cmd` is recording, outside a render pass.
         unsafe { device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline) };
         self.layout.bind(cmd, vk::PipelineBindPoint::COMPUTE, Some(set), push);
@@ -150,8 +184,6 @@ pub struct GraphicsDesc {
     pub vertex: String,
     /// `None` for depth-only passes (shadow maps).
     pub fragment: Option<String>,
-    pub bindings: Vec<BindingKind>,
-    pub push_bytes: u32,
     pub vertex_bindings: Vec<vk::VertexInputBindingDescription>,
     pub vertex_attributes: Vec<vk::VertexInputAttributeDescription>,
     pub color_formats: Vec<vk::Format>,
@@ -166,8 +198,6 @@ impl GraphicsDesc {
         Self {
             vertex: vertex.into(),
             fragment: fragment.map(Into::into),
-            bindings: Vec::new(),
-            push_bytes: 0,
             vertex_bindings: Vec::new(),
             vertex_attributes: Vec::new(),
             color_formats: Vec::new(),
@@ -186,7 +216,11 @@ pub struct GraphicsPipeline {
 impl GraphicsPipeline {
     pub fn new(gpu: &Arc<Gpu>, desc: &GraphicsDesc) -> GpuResult<GraphicsPipeline> {
         let stages_flags = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-        let layout = Layout::new(gpu, &desc.bindings, stages_flags, desc.push_bytes)?;
+        let mut interfaces = vec![ShaderInterface::of(&desc.vertex)?];
+        if let Some(f) = &desc.fragment {
+            interfaces.push(ShaderInterface::of(f)?);
+        }
+        let layout = Layout::new(gpu, &ShaderInterface::merge(&interfaces)?, stages_flags)?;
         let vertex = Module::new(gpu, &desc.vertex)?;
         let fragment = desc.fragment.as_deref().map(|f| Module::new(gpu, f)).transpose()?;
         let mut stages = vec![
@@ -258,8 +292,14 @@ impl GraphicsPipeline {
 
     /// Bind the pipeline, its set and push block, and set a full-extent viewport and scissor.
     /// Call inside `cmd_begin_rendering`.
-    pub fn bind(&self, cmd: vk::CommandBuffer, set: Option<&DescriptorSet>, push: &[u8], extent: vk::Extent2D) {
-        self.layout.check_push(push);
+    pub fn bind<P: bytemuck::Pod>(
+        &self,
+        cmd: vk::CommandBuffer,
+        set: Option<&DescriptorSet>,
+        push: &P,
+        extent: vk::Extent2D,
+    ) {
+        let push = self.layout.check_push(bytemuck::bytes_of(push));
         let device = self.layout.gpu.device();
         let viewport = vk::Viewport {
             x: 0.0,

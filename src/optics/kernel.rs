@@ -56,19 +56,12 @@
 use super::Dipole;
 use std::f64::consts::PI;
 
-/// Regularization length `b` in units of `sqrt(dA)`: the lattice-sum error of the far part
-/// falls as `e^(-2 pi b / h)` (3e-4 here), while larger `b` puts more light into the footprint.
-pub const B_PER_SQRT_AREA: f64 = 1.5;
-/// Half-width of the footprint's smooth edge, in units of `rho`.
-pub const BUMP_DELTA: f64 = 0.25;
-/// Where the blend into the point kernel starts, in units of `b`.
-pub const FAR_BLEND_START: f64 = 8.0;
-/// Where the kernel is the point kernel alone, in units of `b`.
-pub const FAR_BLEND_END: f64 = 16.0;
-/// [`second_difference`] integrates the second derivative when `(d2 - z) / z` is at most this...
-pub const SECOND_DIFF_MAX_SPREAD: f64 = 0.1;
-/// ... and `sigma_tr (d2 - z)` is at most this; otherwise the difference cancels little.
-pub const SECOND_DIFF_MAX_DECAY: f64 = 0.5;
+/// Defines each constant of `kernel_constants.rs` as `pub const NAME: f64` (build.rs reads the
+/// same file for the GLSL twin).
+macro_rules! kernel_constants {
+    ($($(#[$doc:meta])* $name:ident = $value:expr;)*) => { $($(#[$doc])* pub const $name: f64 = $value;)* };
+}
+include!("kernel_constants.rs");
 
 /// The point kernel `R_d(r) dA` of the seed's discrete sum (seed Eq. 11 with Eq. 8): right far
 /// from a sample, wrong near it when `z_r` or the diffusion length is small next to the spacing.
@@ -205,12 +198,6 @@ pub fn far_kernel(dipole: &Dipole, r: f64, area: f64) -> f64 {
     }
     far + smoothstep((r - start) / (end - start)) * (point_kernel(dipole, r, area) - far)
 }
-
-/// Radius of a sample's near-field blend weight, in units of `sqrt(dA)`: wide enough that
-/// neighbours overlap (spacing is about `sqrt(dA)`), narrow enough to keep light local. Across a
-/// shadow edge on marble (tests/render.rs) 2.0 bleeds 7.7% of the lit level too far, 1.5 2.3%,
-/// 1.25 1.75%; 1.5 keeps more overlap for irregular sample sets.
-pub const NEAR_BLEND_RADIUS: f64 = 1.5;
 
 /// Shepard weight of a sample in the near-field blend at distance `r`: `(1 - (r/R)^2)^3` inside
 /// `R = NEAR_BLEND_RADIUS sqrt(dA)`, 0 outside; smooth (C2) at the rim.

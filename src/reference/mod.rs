@@ -7,7 +7,7 @@ pub mod bvh;
 use crate::optics::Dipole;
 use crate::optics::{fresnel, kernel};
 use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
-use crate::scene::lights::{LIGHT_DIRECTIONAL, LIGHT_SPOT, LightGpu};
+use crate::scene::lights::{LightKind, PreparedLight};
 use bvh::Bvh;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -23,25 +23,25 @@ pub fn occluders(scene: &PreparedScene) -> Bvh {
     Bvh::new(triangles)
 }
 
-/// Direction towards the light and the irradiance it brings to a surface facing it, in f64:
-/// the twin of `light_incidence` in glsl/common/lights.glsl.
-pub fn light_incidence(l: &LightGpu, p: DVec3) -> (DVec3, DVec3, f64) {
-    let kind = l.position_kind[3];
-    let power = DVec3::new(l.power_layer[0] as f64, l.power_layer[1] as f64, l.power_layer[2] as f64);
-    if kind == LIGHT_DIRECTIONAL {
-        let d = DVec3::new(l.direction_cos[0] as f64, l.direction_cos[1] as f64, l.direction_cos[2] as f64);
-        return (d, power, f64::INFINITY);
-    }
-    let pos = DVec3::new(l.position_kind[0] as f64, l.position_kind[1] as f64, l.position_kind[2] as f64);
-    let d = pos - p;
+/// Direction towards the light and the irradiance it brings to a surface facing it, and the
+/// distance to the light, in f64: the twin of `light_incidence` in glsl/common/lights.glsl.
+pub fn light_incidence(light: &PreparedLight, p: DVec3) -> (DVec3, DVec3, f64) {
+    let (position, power, spot) = match light.kind {
+        LightKind::Directional { direction, irradiance } => {
+            return (direction.as_dvec3(), irradiance.as_dvec3(), f64::INFINITY);
+        }
+        LightKind::Point { position, intensity } => (position, intensity, None),
+        LightKind::Spot { position, axis, intensity, cos_outer, cos_inner } => {
+            (position, intensity, Some((axis.as_dvec3(), cos_outer as f64, cos_inner as f64)))
+        }
+    };
+    let d = position.as_dvec3() - p;
     let dist2 = d.length_squared().max(1e-24);
     let dist = dist2.sqrt();
     let wi = d / dist;
-    let mut irradiance = power / dist2;
-    if kind == LIGHT_SPOT {
-        let axis = DVec3::new(l.direction_cos[0] as f64, l.direction_cos[1] as f64, l.direction_cos[2] as f64);
+    let mut irradiance = power.as_dvec3() / dist2;
+    if let Some((axis, outer, inner)) = spot {
         let c = (-wi).dot(axis);
-        let (outer, inner) = (l.direction_cos[3] as f64, l.spot_texel[0] as f64);
         let t = ((c - outer) / (inner - outer)).clamp(0.0, 1.0);
         irradiance *= t * t * (3.0 - 2.0 * t);
     }
@@ -66,12 +66,12 @@ pub fn splat(scene: &PreparedScene, occluders: &Bvh) -> Vec<[f64; 3]> {
             let n = s.normal.as_dvec3().normalize();
             let mut e = DVec3::ZERO;
             for l in &scene.lights {
-                let (wi, irradiance, dist) = light_incidence(&l.record, p);
+                let (wi, irradiance, dist) = light_incidence(l, p);
                 let cos_i = n.dot(wi);
                 if cos_i <= 0.0 {
                     continue;
                 }
-                if l.record.power_layer[3] >= 0.0 && occluders.occluded(p + n * eps, wi, eps, dist) {
+                if l.shadow_layer.is_some() && occluders.occluded(p + n * eps, wi, eps, dist) {
                     continue;
                 }
                 e += irradiance * (cos_i * fresnel::fresnel_transmittance(cos_i, *eta));

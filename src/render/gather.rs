@@ -2,47 +2,53 @@
 //! object, the discrete dipole sum of seed Eq. 11 with the energy-conserving near-field kernel
 //! (`optics::kernel`), samples staged through shared memory, Kahan-compensated f32 sums.
 //!
-//! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = exitance. Push: object index.
+//! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = exitance. Push: `GatherPush`.
 //! One dispatch per translucent object, over its vertex range.
 
-use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, DescriptorSet, Gpu, GpuResult};
+use super::gpu_scene::GpuScene;
+use super::pass::{FrameInputs, RenderPass};
+use crate::gpu::{Access, Binding, ComputePipeline, DescriptorSet, Gpu, GpuResult, memory_barrier};
 use ash::vk;
 use std::sync::Arc;
+
+/// `GatherPush` in glsl/gather.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GatherPush {
+    pub object: u32,
+}
 
 pub struct GatherPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
-    /// (object index, vertex count) of every translucent object.
-    receivers: Vec<(u32, u32)>,
 }
 
 impl GatherPass {
-    pub fn new(
-        gpu: &Arc<Gpu>,
-        vertices: &Buffer,
-        samples: &Buffer,
-        splat: &Buffer,
-        objects: &Buffer,
-        exitance: &Buffer,
-        receivers: Vec<(u32, u32)>,
-    ) -> GpuResult<GatherPass> {
-        let s = BindingKind::StorageBuffer;
-        let pipeline = ComputePipeline::new(gpu, "gather.comp", &[s, s, s, s, s], 4)?;
+    pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene) -> GpuResult<GatherPass> {
+        let pipeline = ComputePipeline::new(gpu, "gather.comp")?;
         let set = pipeline.descriptor_set(&[
-            Binding::Buffer(vertices),
-            Binding::Buffer(samples),
-            Binding::Buffer(splat),
-            Binding::Buffer(objects),
-            Binding::Buffer(exitance),
+            Binding::Buffer(&scene.vertices),
+            Binding::Buffer(&scene.samples),
+            Binding::Buffer(&scene.splat),
+            Binding::Buffer(&scene.objects),
+            Binding::Buffer(&scene.exitance),
         ])?;
-        Ok(GatherPass { pipeline, set, receivers })
+        Ok(GatherPass { pipeline, set })
     }
+}
 
-    pub fn record(&self, cmd: vk::CommandBuffer) {
-        for &(object, vertex_count) in &self.receivers {
-            if vertex_count > 0 {
-                self.pipeline.dispatch(cmd, &self.set, bytemuck::bytes_of(&object), [vertex_count.div_ceil(64), 1, 1]);
-            }
+impl RenderPass for GatherPass {
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        for r in &frame.scene.receivers {
+            self.pipeline.dispatch(cmd, &self.set, &GatherPush { object: r.object }, [r.vertex_count, 1, 1]);
         }
+        exitance_written(frame, cmd);
     }
+}
+
+/// After a gather into the per-vertex exitance buffer: shading reads it as a vertex attribute,
+/// the host may read it back.
+pub(super) fn exitance_written(frame: &FrameInputs, cmd: vk::CommandBuffer) {
+    let next = [Access::VertexAttributeRead, Access::HostRead];
+    memory_barrier(frame.gpu.device(), cmd, &[Access::ComputeWrite], &next);
 }

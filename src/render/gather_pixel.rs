@@ -5,38 +5,34 @@
 //! the view changes.
 //!
 //! Bindings: 0 = surface (sampled), 1 = samples, 2 = splat, 3 = objects, 4 = HDR (storage image).
-//! Push: width, height.
+//! Push: `GatherPixelPush`.
 
-use crate::gpu::{
-    Binding, BindingKind, Buffer, ComputePipeline, DescriptorSet, Gpu, GpuResult, Image, Sampler, image_barrier,
-};
+use super::gpu_scene::GpuScene;
+use super::pass::{FrameInputs, RenderPass};
+use crate::gpu::{Access, Binding, ComputePipeline, DescriptorSet, Gpu, GpuResult, Image, ImageBarrier, Sampler};
 use ash::vk;
 use std::sync::Arc;
+
+/// `GatherPixelPush` in glsl/gather_pixel.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GatherPixelPush {
+    pub width: u32,
+    pub height: u32,
+}
 
 pub struct GatherPixelPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
     _sampler: Sampler,
     hdr: vk::Image,
-    extent: vk::Extent2D,
+    push: GatherPixelPush,
 }
 
 impl GatherPixelPass {
-    pub fn new(
-        gpu: &Arc<Gpu>,
-        surface: &Image,
-        samples: &Buffer,
-        splat: &Buffer,
-        objects: &Buffer,
-        hdr: &Image,
-    ) -> GpuResult<GatherPixelPass> {
-        let s = BindingKind::StorageBuffer;
-        let pipeline = ComputePipeline::new(
-            gpu,
-            "gather_pixel.comp",
-            &[BindingKind::CombinedImageSampler, s, s, s, BindingKind::StorageImage],
-            8,
-        )?;
+    /// `surface` and `hdr` are the shading pass's images, which it leaves readable by compute.
+    pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene, surface: &Image, hdr: &Image) -> GpuResult<GatherPixelPass> {
+        let pipeline = ComputePipeline::new(gpu, "gather_pixel.comp")?;
         let sampler = Sampler::new(gpu, vk::Filter::NEAREST)?;
         let set = pipeline.descriptor_set(&[
             Binding::Image {
@@ -44,32 +40,25 @@ impl GatherPixelPass {
                 layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
                 sampler: sampler.raw(),
             },
-            Binding::Buffer(samples),
-            Binding::Buffer(splat),
-            Binding::Buffer(objects),
+            Binding::Buffer(&scene.samples),
+            Binding::Buffer(&scene.splat),
+            Binding::Buffer(&scene.objects),
             Binding::Image { view: hdr.view(), layout: vk::ImageLayout::GENERAL, sampler: vk::Sampler::null() },
         ])?;
-        Ok(GatherPixelPass { pipeline, set, _sampler: sampler, hdr: hdr.raw(), extent: hdr.extent() })
+        let extent = hdr.extent();
+        let push = GatherPixelPush { width: extent.width, height: extent.height };
+        Ok(GatherPixelPass { pipeline, set, _sampler: sampler, hdr: hdr.raw(), push })
     }
+}
 
-    /// Record: HDR to GENERAL, the gather, HDR back to SHADER_READ_ONLY_OPTIMAL for the tone map.
-    pub fn record(&self, gpu: &Gpu, cmd: vk::CommandBuffer) {
-        let device = gpu.device();
-        let read = (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_SAMPLED_READ);
-        let storage = (
-            vk::PipelineStageFlags2::COMPUTE_SHADER,
-            vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
-        );
+impl RenderPass for GatherPixelPass {
+    /// HDR to GENERAL, the gather adding in place, HDR back to sampled reads for the tone map.
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        let device = frame.gpu.device();
+        let (sampled, storage) = ([Access::ComputeSampledRead], [Access::ComputeImageReadWrite]);
         let color = vk::ImageAspectFlags::COLOR;
-        let (ro, general) = (vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, vk::ImageLayout::GENERAL);
-        image_barrier(device, cmd, self.hdr, color, (ro, general), read, storage);
-        let push = [self.extent.width, self.extent.height];
-        self.pipeline.dispatch(
-            cmd,
-            &self.set,
-            bytemuck::bytes_of(&push),
-            [self.extent.width.div_ceil(8), self.extent.height.div_ceil(8), 1],
-        );
-        image_barrier(device, cmd, self.hdr, color, (general, ro), storage, read);
+        ImageBarrier::new(self.hdr, color, &sampled, &storage).record(device, cmd);
+        self.pipeline.dispatch(cmd, &self.set, &self.push, [self.push.width, self.push.height, 1]);
+        ImageBarrier::new(self.hdr, color, &storage, &sampled).record(device, cmd);
     }
 }

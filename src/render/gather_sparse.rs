@@ -5,73 +5,60 @@
 //! far kernel smooths at that scale anyway. `tests/render.rs` measures the difference.
 //!
 //! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = sample exitance,
-//! 5 = exitance. Push: object index, stage (0: at samples, 1: blend to vertices).
+//! 5 = exitance. Push: `GatherSparsePush`.
 
-use crate::gpu::{
-    Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuResult, memory_barrier,
-};
+use super::gather::exitance_written;
+use super::gpu_scene::GpuScene;
+use super::pass::{FrameInputs, RenderPass};
+use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuResult, memory_barrier};
 use ash::vk;
 use std::sync::Arc;
+
+/// `GatherSparsePush` in glsl/gather_sparse.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GatherSparsePush {
+    pub object: u32,
+    /// 0: exitance at the samples; 1: blended to the vertices.
+    pub stage: u32,
+}
 
 pub struct GatherSparsePass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
     _sample_exitance: Buffer,
-    /// (object index, vertex count, sample count) of every translucent object.
-    receivers: Vec<(u32, u32, u32)>,
 }
 
 impl GatherSparsePass {
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        gpu: &Arc<Gpu>,
-        vertices: &Buffer,
-        samples: &Buffer,
-        sample_count: u32,
-        splat: &Buffer,
-        objects: &Buffer,
-        exitance: &Buffer,
-        receivers: Vec<(u32, u32, u32)>,
-    ) -> GpuResult<GatherSparsePass> {
-        let s = BindingKind::StorageBuffer;
-        let pipeline = ComputePipeline::new(gpu, "gather_sparse.comp", &[s, s, s, s, s, s], 8)?;
-        let sample_exitance = Buffer::new(
-            gpu,
-            &BufferDesc::gpu_only(
-                "sample exitance",
-                16 * sample_count.max(1) as u64,
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-            ),
-        )?;
+    pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene) -> GpuResult<GatherSparsePass> {
+        let pipeline = ComputePipeline::new(gpu, "gather_sparse.comp")?;
+        let bytes = 16 * scene.sample_count.max(1) as u64;
+        let sample_exitance =
+            Buffer::new(gpu, &BufferDesc::gpu_only("sample exitance", bytes, vk::BufferUsageFlags::STORAGE_BUFFER))?;
         let set = pipeline.descriptor_set(&[
-            Binding::Buffer(vertices),
-            Binding::Buffer(samples),
-            Binding::Buffer(splat),
-            Binding::Buffer(objects),
+            Binding::Buffer(&scene.vertices),
+            Binding::Buffer(&scene.samples),
+            Binding::Buffer(&scene.splat),
+            Binding::Buffer(&scene.objects),
             Binding::Buffer(&sample_exitance),
-            Binding::Buffer(exitance),
+            Binding::Buffer(&scene.exitance),
         ])?;
-        Ok(GatherSparsePass { pipeline, set, _sample_exitance: sample_exitance, receivers })
+        Ok(GatherSparsePass { pipeline, set, _sample_exitance: sample_exitance })
     }
+}
 
-    pub fn record(&self, gpu: &Gpu, cmd: vk::CommandBuffer) {
-        for stage in [0u32, 1] {
-            for &(object, vertex_count, sample_count) in &self.receivers {
-                let count = if stage == 0 { sample_count } else { vertex_count };
-                if count > 0 {
-                    let push = [object, stage];
-                    self.pipeline.dispatch(cmd, &self.set, bytemuck::bytes_of(&push), [count.div_ceil(64), 1, 1]);
-                }
-            }
-            if stage == 0 {
-                // Stage 1 reads what stage 0 wrote.
-                memory_barrier(
-                    gpu.device(),
-                    cmd,
-                    (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_STORAGE_WRITE),
-                    (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_STORAGE_READ),
-                );
-            }
+impl RenderPass for GatherSparsePass {
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        for r in &frame.scene.receivers {
+            let push = GatherSparsePush { object: r.object, stage: 0 };
+            self.pipeline.dispatch(cmd, &self.set, &push, [r.sample_count, 1, 1]);
         }
+        // Stage 1 reads what stage 0 wrote.
+        memory_barrier(frame.gpu.device(), cmd, &[Access::ComputeWrite], &[Access::ComputeRead]);
+        for r in &frame.scene.receivers {
+            let push = GatherSparsePush { object: r.object, stage: 1 };
+            self.pipeline.dispatch(cmd, &self.set, &push, [r.vertex_count, 1, 1]);
+        }
+        exitance_written(frame, cmd);
     }
 }

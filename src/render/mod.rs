@@ -3,6 +3,8 @@
 pub mod gather;
 pub mod gather_pixel;
 pub mod gather_sparse;
+pub mod gpu_scene;
+pub mod pass;
 pub mod plan;
 pub mod records;
 pub mod renderer;

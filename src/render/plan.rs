@@ -1,9 +1,10 @@
 //! Pass planning: which GPU passes a frame needs, and why. A scene simulates only what it calls
 //! for (no shadow maps without a shadow-casting light and caster, no splat or gather without a
-//! translucent object), and a frame recomputes only what its change invalidates: light or
-//! geometry changes rerun shadows, splat and gather; a camera move reruns only shading (vertex
-//! gather: exitance lives on the surface and does not depend on the view).
+//! translucent object), and a frame recomputes only what its change invalidates: light changes
+//! rerun shadows, splat and gather; a camera move reruns only shading (vertex gather: exitance
+//! lives on the surface and does not depend on the view).
 
+pub use crate::scene::needs::SceneNeeds;
 use std::fmt;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -41,19 +42,6 @@ pub enum Change {
     Light(usize),
     /// Only the camera moved.
     Camera,
-}
-
-/// What a scene contains that decides its passes.
-#[derive(Clone, Debug)]
-pub struct SceneNeeds {
-    pub shadow_layers: u32,
-    pub translucent_objects: usize,
-    /// Scene lights that own at least one shadow-map layer.
-    pub shadowed_lights: Vec<usize>,
-    /// The scene's environment light, if any (cached per vertex by the vertex-light pass).
-    pub environment: Option<usize>,
-    /// Exitance gathered per pixel (after shading, every frame) instead of per vertex.
-    pub pixel_gather: bool,
 }
 
 #[derive(Clone, Debug, Default)]

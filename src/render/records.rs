@@ -1,11 +1,22 @@
-//! `#[repr(C)]` mirrors of the std430 records in `glsl/common/scene.glsl`, and the vertex layout
-//! every raster pass reads. Only 4-byte scalars and 16-byte vectors, so std430 and repr(C) agree;
-//! `tests/render_records.rs` pins sizes and offsets.
+//! The GPU's view of a prepared scene: `#[repr(C)]` mirrors of the std430 records in
+//! `glsl/common/scene.glsl` and `glsl/common/lights.glsl`, and the vertex layout every raster pass
+//! reads. Every record is packed here, and only here, from the typed scene values. Only 4-byte
+//! scalars and 16-byte vectors, so std430 and repr(C) agree; `tests/render_records.rs` pins sizes
+//! and offsets against the GLSL declarations.
 
+use crate::optics::fresnel;
+use crate::optics::gpu::DipoleChannelGpu;
+use crate::sampling::SamplePoint;
+use crate::scene::build::{PreparedObject, ResolvedMaterial};
+use crate::scene::lights::{LightKind, PreparedLight};
 use ash::vk;
 
 pub const MATERIAL_OPAQUE: f32 = 0.0;
 pub const MATERIAL_TRANSLUCENT: f32 = 1.0;
+
+pub const LIGHT_DIRECTIONAL: f32 = 0.0;
+pub const LIGHT_POINT: f32 = 1.0;
+pub const LIGHT_SPOT: f32 = 2.0;
 
 /// `ObjectRecord` in glsl/common/scene.glsl.
 #[repr(C)]
@@ -14,9 +25,38 @@ pub struct ObjectRecord {
     pub albedo_roughness: [f32; 4],
     pub eta_norm_kind: [f32; 4],
     /// Per channel: alpha', sigma_tr, z_r, z_v, with lengths in scene units.
-    pub dipole: [[f32; 4]; 3],
+    pub dipole: [DipoleChannelGpu; 3],
     /// First vertex, vertex count, first sample, sample count.
     pub ranges: [u32; 4],
+}
+
+impl ObjectRecord {
+    /// `ranges`: first vertex, vertex count, first sample, sample count in the shared buffers.
+    pub fn new(object: &PreparedObject, ranges: [u32; 4]) -> ObjectRecord {
+        match &object.material {
+            ResolvedMaterial::Translucent { material, dipoles, roughness, .. } => {
+                let t_eta = fresnel::diffuse_transmittance(material.eta);
+                ObjectRecord {
+                    albedo_roughness: [0.0, 0.0, 0.0, *roughness],
+                    eta_norm_kind: [
+                        material.eta as f32,
+                        // The BSSRDF's normalization 1 / (pi T(eta)) (optics::Dipole::s_d).
+                        (1.0 / (std::f64::consts::PI * t_eta)) as f32,
+                        MATERIAL_TRANSLUCENT,
+                        0.0,
+                    ],
+                    dipole: dipoles.each_ref().map(DipoleChannelGpu::from),
+                    ranges,
+                }
+            }
+            ResolvedMaterial::Opaque { albedo, roughness } => ObjectRecord {
+                albedo_roughness: [albedo[0], albedo[1], albedo[2], *roughness],
+                eta_norm_kind: [1.5, 0.0, MATERIAL_OPAQUE, 0.0],
+                dipole: [DipoleChannelGpu::default(); 3],
+                ranges,
+            },
+        }
+    }
 }
 
 /// `SampleRecord` in glsl/common/scene.glsl.
@@ -27,8 +67,68 @@ pub struct SampleRecord {
     pub normal_object: [f32; 4],
 }
 
-/// One mesh vertex as the raster passes read it (binding 0). Exitance is a second vertex
-/// buffer (binding 1, `[f32; 4]` per vertex) written by the gather pass.
+impl SampleRecord {
+    pub fn new(sample: &SamplePoint, object: usize) -> SampleRecord {
+        let (p, n) = (sample.position, sample.normal);
+        SampleRecord { position_area: [p.x, p.y, p.z, sample.area as f32], normal_object: [n.x, n.y, n.z, object as f32] }
+    }
+}
+
+/// `SplatRecord` in glsl/common/scene.glsl: what the splat pass writes for one sample.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SplatRecord {
+    /// rgb: transmitted irradiance E_i; w: the sample's area.
+    pub irradiance_area: [f32; 4],
+    /// rgb: near-field energy per channel (`optics::kernel::near_energy`).
+    pub near_energy: [f32; 4],
+}
+
+impl SplatRecord {
+    pub fn new(irradiance: [f32; 3], area: f32, near_energy: [f32; 3]) -> SplatRecord {
+        let [e0, e1, e2] = irradiance;
+        let [n0, n1, n2] = near_energy;
+        SplatRecord { irradiance_area: [e0, e1, e2, area], near_energy: [n0, n1, n2, 0.0] }
+    }
+}
+
+/// `struct Light` in glsl/common/lights.glsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LightGpu {
+    pub position_kind: [f32; 4],
+    pub direction_cos: [f32; 4],
+    pub power_layer: [f32; 4],
+    pub spot_texel: [f32; 4],
+    pub shadow_matrix: [[f32; 4]; 4],
+}
+
+impl LightGpu {
+    pub fn new(light: &PreparedLight) -> LightGpu {
+        let (position_kind, direction_cos, power, cos_inner) = match light.kind {
+            LightKind::Directional { direction: d, irradiance } => {
+                ([0.0, 0.0, 0.0, LIGHT_DIRECTIONAL], [d.x, d.y, d.z, 0.0], irradiance, 0.0)
+            }
+            LightKind::Point { position: p, intensity } => ([p.x, p.y, p.z, LIGHT_POINT], [0.0; 4], intensity, 0.0),
+            LightKind::Spot { position: p, axis: a, intensity, cos_outer, cos_inner } => {
+                ([p.x, p.y, p.z, LIGHT_SPOT], [a.x, a.y, a.z, cos_outer], intensity, cos_inner)
+            }
+        };
+        // A negative layer tells the shaders the light casts no shadow.
+        let layer = light.shadow_layer.map_or(-1.0, |l| l as f32);
+        LightGpu {
+            position_kind,
+            direction_cos,
+            power_layer: [power.x, power.y, power.z, layer],
+            spot_texel: [cos_inner, light.shadow_texel, light.normal_offset, if light.environment { 1.0 } else { 0.0 }],
+            shadow_matrix: light.shadow_matrix.to_cols_array_2d(),
+        }
+    }
+}
+
+/// One mesh vertex as the raster passes read it (binding 0) and as `VertexRecord` in
+/// glsl/common/scene.glsl for compute passes. Exitance is a second vertex buffer (binding 1,
+/// `[f32; 4]` per vertex) written by the gather pass.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Vertex {

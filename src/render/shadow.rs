@@ -2,33 +2,29 @@
 //! light into one layer of a D16 array image, which the splat and shade passes sample with a
 //! compare sampler (percentage-closer filtering, `glsl/common/lights.glsl`).
 //!
-//! Vertex input: binding 0 = `records::Vertex`. Push: the light's world -> clip matrix, its layer.
+//! Vertex input: binding 0 = `records::Vertex`. Push: `ShadowPush`.
 
+use super::pass::{FrameInputs, RenderPass};
 use super::records::Vertex;
 use crate::gpu::{
-    Binding, Buffer, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline, Image, ImageDesc, Sampler, image_barrier,
+    Access, Binding, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline, Image, ImageBarrier, ImageDesc, Sampler,
 };
 use ash::vk;
 use std::sync::Arc;
 
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D16_UNORM;
 
-/// The push block of shadow.vert.
+/// `ShadowPush` in glsl/shadow.vert.
 #[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct ShadowPush {
-    light_matrix: [[f32; 4]; 4],
-    layer: u32,
-    _pad: [u32; 3],
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ShadowPush {
+    pub light_matrix: [[f32; 4]; 4],
+    /// x: the layer; yzw: unused.
+    pub layer: [u32; 4],
 }
 
-/// A draw of one caster: index range and vertex offset in the shared buffers.
-#[derive(Clone, Copy, Debug)]
-pub struct DrawRange {
-    pub first_index: u32,
-    pub index_count: u32,
-    pub vertex_offset: i32,
-}
+/// Who reads the maps between redraws.
+const READERS: [Access; 2] = [Access::FragmentSampledRead, Access::ComputeSampledRead];
 
 pub struct ShadowPass {
     pipeline: GraphicsPipeline,
@@ -42,7 +38,6 @@ impl ShadowPass {
     /// bound even when nothing casts a shadow).
     pub fn new(gpu: &Arc<Gpu>, size: u32, layers: u32) -> GpuResult<ShadowPass> {
         let mut desc = GraphicsDesc::new("shadow.vert", None);
-        desc.push_bytes = std::mem::size_of::<ShadowPush>() as u32;
         desc.vertex_bindings = vec![Vertex::binding()];
         desc.vertex_attributes = vec![Vertex::position_attribute()];
         desc.depth_format = Some(DEPTH_FORMAT);
@@ -67,16 +62,9 @@ impl ShadowPass {
         // Start cleared to the far plane (everything lit) and readable, so the passes that sample
         // the maps are valid even when the plan never renders them (no shadow caster).
         let device = gpu.device();
+        let depth = vk::ImageAspectFlags::DEPTH;
         gpu.one_shot("shadow map init", |cmd| {
-            image_barrier(
-                device,
-                cmd,
-                maps.raw(),
-                vk::ImageAspectFlags::DEPTH,
-                (vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL),
-                (vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE),
-                (vk::PipelineStageFlags2::CLEAR, vk::AccessFlags2::TRANSFER_WRITE),
-            );
+            ImageBarrier::new(maps.raw(), depth, &[Access::Nothing], &[Access::TransferWrite]).record(device, cmd);
             let range = [vk::ImageSubresourceRange::default()
                 .aspect_mask(vk::ImageAspectFlags::DEPTH)
                 .level_count(1)
@@ -92,18 +80,7 @@ impl ShadowPass {
                     &range,
                 )
             };
-            image_barrier(
-                device,
-                cmd,
-                maps.raw(),
-                vk::ImageAspectFlags::DEPTH,
-                (vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
-                (vk::PipelineStageFlags2::CLEAR, vk::AccessFlags2::TRANSFER_WRITE),
-                (
-                    vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COMPUTE_SHADER,
-                    vk::AccessFlags2::SHADER_SAMPLED_READ,
-                ),
-            );
+            ImageBarrier::new(maps.raw(), depth, &[Access::TransferWrite], &READERS).record(device, cmd);
         })?;
         Ok(ShadowPass { pipeline, maps, sampler, layers })
     }
@@ -116,41 +93,20 @@ impl ShadowPass {
             sampler: self.sampler.raw(),
         }
     }
+}
 
-    /// Record: render every layer (`matrices[i]` into layer i), or with `only` just those
-    /// layers (the others keep their contents), then leave the maps in SHADER_READ_ONLY_OPTIMAL
-    /// for compute and fragment shaders.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
-        &self,
-        gpu: &Gpu,
-        cmd: vk::CommandBuffer,
-        vertices: &Buffer,
-        indices: &Buffer,
-        casters: &[DrawRange],
-        matrices: &[[[f32; 4]; 4]],
-        only: Option<&[u32]>,
-    ) {
-        let device = gpu.device();
-        image_barrier(
-            device,
-            cmd,
-            self.maps.raw(),
-            vk::ImageAspectFlags::DEPTH,
-            // Redrawing some layers keeps the others: their contents must survive the transition.
-            (
-                if only.is_some() { vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL } else { vk::ImageLayout::UNDEFINED },
-                vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL,
-            ),
-            (
-                vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_SAMPLED_READ,
-            ),
-            (
-                vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
-                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
-            ),
-        );
+impl RenderPass for ShadowPass {
+    /// Render every layer (`light_matrices[i]` into layer i), or only `frame.shadow_layers` (the
+    /// others keep their contents), then leave the maps readable by compute and fragment shaders.
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        let device = frame.gpu.device();
+        let scene = frame.scene;
+        let only = frame.shadow_layers;
+        // Redrawing some layers keeps the others: their contents must survive the transition.
+        let depth = vk::ImageAspectFlags::DEPTH;
+        ImageBarrier::new(self.maps.raw(), depth, &READERS, &[Access::DepthAttachmentReadWrite])
+            .discard(only.is_none())
+            .record(device, cmd);
         let extent = self.maps.extent();
         // One layered render: each light's draws pick its layer with gl_Layer (shadow.vert). A
         // full redraw clears every layer on load; a partial one loads and clears only its layers.
@@ -184,32 +140,21 @@ impl ShadowPass {
             unsafe { device.cmd_clear_attachments(cmd, &clear, &rects) };
         }
         let redraw = |layer: u32| only.is_none_or(|l| l.contains(&layer));
-        for (layer, matrix) in matrices.iter().enumerate().take(self.layers as usize) {
+        for (layer, matrix) in scene.light_matrices.iter().enumerate().take(self.layers as usize) {
             if !redraw(layer as u32) {
                 continue;
             }
-            let push = ShadowPush { light_matrix: *matrix, layer: layer as u32, _pad: [0; 3] };
-            self.pipeline.bind(cmd, None, bytemuck::bytes_of(&push), extent);
+            let push = ShadowPush { light_matrix: *matrix, layer: [layer as u32, 0, 0, 0] };
+            self.pipeline.bind(cmd, None, &push, extent);
             unsafe {
-                device.cmd_bind_vertex_buffers(cmd, 0, &[vertices.raw()], &[0]);
-                device.cmd_bind_index_buffer(cmd, indices.raw(), 0, vk::IndexType::UINT32);
-                for d in casters {
+                device.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.raw()], &[0]);
+                device.cmd_bind_index_buffer(cmd, scene.indices.raw(), 0, vk::IndexType::UINT32);
+                for d in &scene.casters {
                     device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0);
                 }
             }
         }
         unsafe { device.cmd_end_rendering(cmd) };
-        image_barrier(
-            device,
-            cmd,
-            self.maps.raw(),
-            vk::ImageAspectFlags::DEPTH,
-            (vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
-            (vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS, vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE),
-            (
-                vk::PipelineStageFlags2::FRAGMENT_SHADER | vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_SAMPLED_READ,
-            ),
-        );
+        ImageBarrier::new(self.maps.raw(), depth, &[Access::DepthAttachmentReadWrite], &READERS).record(device, cmd);
     }
 }

@@ -3,11 +3,9 @@
 //!
 //! Bindings: 0 = input f32 (storage, read), 1 = output f32 (storage, write). Push: u32 count.
 
-use crate::gpu::{Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, Gpu, GpuResult, GpuTimer, memory_barrier};
+use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, Gpu, GpuResult, GpuTimer, memory_barrier};
 use ash::vk;
 use std::sync::Arc;
-
-const LOCAL_SIZE: u32 = 64;
 
 pub struct SmokeResult {
     pub output: Vec<f32>,
@@ -22,8 +20,7 @@ pub fn expected(input: &[f32]) -> Vec<f32> {
 
 pub fn run(gpu: &Arc<Gpu>, input: &[f32]) -> GpuResult<SmokeResult> {
     let count = input.len() as u32;
-    let pipeline =
-        ComputePipeline::new(gpu, "smoke.comp", &[BindingKind::StorageBuffer, BindingKind::StorageBuffer], 4)?;
+    let pipeline = ComputePipeline::new(gpu, "smoke.comp")?;
     let src = Buffer::from_slice(gpu, "smoke input", input, vk::BufferUsageFlags::STORAGE_BUFFER)?;
     let dst = Buffer::new(
         gpu,
@@ -34,14 +31,9 @@ pub fn run(gpu: &Arc<Gpu>, input: &[f32]) -> GpuResult<SmokeResult> {
     gpu.one_shot("smoke dispatch", |cmd| {
         timer.reset(cmd);
         timer.begin(cmd, "smoke");
-        pipeline.dispatch(cmd, &set, bytemuck::bytes_of(&count), [count.div_ceil(LOCAL_SIZE), 1, 1]);
+        pipeline.dispatch(cmd, &set, &count, [count, 1, 1]);
         timer.end(cmd);
-        memory_barrier(
-            gpu.device(),
-            cmd,
-            (vk::PipelineStageFlags2::COMPUTE_SHADER, vk::AccessFlags2::SHADER_WRITE),
-            (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-        );
+        memory_barrier(gpu.device(), cmd, &[Access::ComputeWrite], &[Access::HostRead]);
     })?;
     let gpu_ms = timer.results()?.first().map(|(_, ms)| *ms).unwrap_or(0.0);
     Ok(SmokeResult { output: dst.read()?, gpu_ms })

@@ -4,52 +4,47 @@
 //! near-field energy per channel, which the gather's kernel needs once per sample.
 //!
 //! Bindings: 0 = samples, 1 = objects, 2 = lights, 3 = shadow maps, 4 = splat output
-//! (2 x vec4 per sample). Push: sample count, light count.
+//! (`SplatRecord` per sample). Push: `SplatPush`.
 
+use super::gpu_scene::GpuScene;
+use super::pass::{FrameInputs, RenderPass};
 use super::shadow::ShadowPass;
-use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, DescriptorSet, Gpu, GpuResult};
+use crate::gpu::{Access, Binding, ComputePipeline, DescriptorSet, Gpu, GpuResult, memory_barrier};
 use ash::vk;
 use std::sync::Arc;
+
+/// `SplatPush` in glsl/splat.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SplatPush {
+    pub sample_count: u32,
+    pub light_count: u32,
+}
 
 pub struct SplatPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
-    sample_count: u32,
-    light_count: u32,
+    push: SplatPush,
 }
 
-/// Bytes of splat output per sample: vec4 (E rgb, area) + vec4 (near energy rgb, 0).
-pub const SPLAT_STRIDE: u64 = 32;
-
 impl SplatPass {
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        gpu: &Arc<Gpu>,
-        samples: &Buffer,
-        sample_count: u32,
-        objects: &Buffer,
-        lights: &Buffer,
-        light_count: u32,
-        shadow: &ShadowPass,
-        output: &Buffer,
-    ) -> GpuResult<SplatPass> {
-        let s = BindingKind::StorageBuffer;
-        let pipeline = ComputePipeline::new(gpu, "splat.comp", &[s, s, s, BindingKind::CombinedImageSampler, s], 8)?;
+    pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene, shadow: &ShadowPass) -> GpuResult<SplatPass> {
+        let pipeline = ComputePipeline::new(gpu, "splat.comp")?;
         let set = pipeline.descriptor_set(&[
-            Binding::Buffer(samples),
-            Binding::Buffer(objects),
-            Binding::Buffer(lights),
+            Binding::Buffer(&scene.samples),
+            Binding::Buffer(&scene.objects),
+            Binding::Buffer(&scene.lights),
             shadow.binding(),
-            Binding::Buffer(output),
+            Binding::Buffer(&scene.splat),
         ])?;
-        Ok(SplatPass { pipeline, set, sample_count, light_count })
+        let push = SplatPush { sample_count: scene.sample_count, light_count: scene.light_count };
+        Ok(SplatPass { pipeline, set, push })
     }
+}
 
-    pub fn record(&self, cmd: vk::CommandBuffer) {
-        if self.sample_count == 0 {
-            return;
-        }
-        let push = [self.sample_count, self.light_count];
-        self.pipeline.dispatch(cmd, &self.set, bytemuck::bytes_of(&push), [self.sample_count.div_ceil(64), 1, 1]);
+impl RenderPass for SplatPass {
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        self.pipeline.dispatch(cmd, &self.set, &self.push, [self.push.sample_count, 1, 1]);
+        memory_barrier(frame.gpu.device(), cmd, &[Access::ComputeWrite], &[Access::ComputeRead]);
     }
 }

@@ -2,13 +2,22 @@
 //! of Narkowicz 2015, sRGB transfer), counting non-finite pixels so a NaN is caught, not drawn.
 //!
 //! Bindings: 0 = HDR image (combined sampler), 1 = packed RGBA8 output, 2 = counters.
-//! Push: width, height, exposure.
+//! Push: `TonemapPush`.
 
-use crate::gpu::{
-    Binding, BindingKind, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuResult, Image, Sampler,
-};
+use super::pass::{FrameInputs, RenderPass};
+use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuResult, Image, Sampler};
+use crate::gpu::memory_barrier;
 use ash::vk;
 use std::sync::Arc;
+
+/// `TonemapPush` in glsl/tonemap.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct TonemapPush {
+    pub width: u32,
+    pub height: u32,
+    pub exposure: f32,
+}
 
 pub struct TonemapPass {
     pipeline: ComputePipeline,
@@ -20,35 +29,16 @@ pub struct TonemapPass {
     height: u32,
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-struct Push {
-    width: u32,
-    height: u32,
-    exposure: f32,
-}
-
 impl TonemapPass {
-    /// `hdr` must be in SHADER_READ_ONLY_OPTIMAL when the pass runs.
+    /// `hdr` must be readable by compute (sampled) when the pass runs.
     pub fn new(gpu: &Arc<Gpu>, hdr: &Image) -> GpuResult<TonemapPass> {
-        let pipeline = ComputePipeline::new(
-            gpu,
-            "tonemap.comp",
-            &[BindingKind::CombinedImageSampler, BindingKind::StorageBuffer, BindingKind::StorageBuffer],
-            12,
-        )?;
+        let pipeline = ComputePipeline::new(gpu, "tonemap.comp")?;
         let extent = hdr.extent();
         let sampler = Sampler::new(gpu, vk::Filter::NEAREST)?;
-        let output = Buffer::new(
-            gpu,
-            &BufferDesc::readback(
-                "tonemapped rgba8",
-                4 * extent.width as u64 * extent.height as u64,
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-            ),
-        )?;
-        let counters =
-            Buffer::new(gpu, &BufferDesc::readback("tonemap counters", 16, vk::BufferUsageFlags::STORAGE_BUFFER))?;
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let pixels = extent.width as u64 * extent.height as u64;
+        let output = Buffer::new(gpu, &BufferDesc::readback("tonemapped rgba8", 4 * pixels, usage))?;
+        let counters = Buffer::new(gpu, &BufferDesc::readback("tonemap counters", 16, usage))?;
         let set = pipeline.descriptor_set(&[
             Binding::Image {
                 view: hdr.view(),
@@ -69,32 +59,23 @@ impl TonemapPass {
         })
     }
 
-    /// Record the pass; zeroes the non-finite counter first.
-    pub fn record(&self, gpu: &Gpu, cmd: vk::CommandBuffer, exposure: f32) {
-        // SAFETY: `cmd` is recording outside a render pass; the counter buffer is ours.
-        unsafe { gpu.device().cmd_fill_buffer(cmd, self.counters.raw(), 0, vk::WHOLE_SIZE, 0) };
-        crate::gpu::memory_barrier(
-            gpu.device(),
-            cmd,
-            (vk::PipelineStageFlags2::CLEAR, vk::AccessFlags2::TRANSFER_WRITE),
-            (
-                vk::PipelineStageFlags2::COMPUTE_SHADER,
-                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE,
-            ),
-        );
-        let push = Push { width: self.width, height: self.height, exposure };
-        self.pipeline.dispatch(
-            cmd,
-            &self.set,
-            bytemuck::bytes_of(&push),
-            [self.width.div_ceil(8), self.height.div_ceil(8), 1],
-        );
-    }
-
     /// The tone-mapped image, rows top to bottom, RGBA8, and the count of non-finite pixels.
     /// Call after the submission that recorded the pass has finished.
     pub fn read(&self) -> GpuResult<(Vec<u8>, u32)> {
         let counters: Vec<u32> = self.counters.read()?;
         Ok((self.output.read::<u8>()?, counters[0]))
+    }
+}
+
+impl RenderPass for TonemapPass {
+    /// Zero the non-finite counter, tone-map, and hand both buffers to the host.
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        let device = frame.gpu.device();
+        // SAFETY: `cmd` is recording outside a render pass; the counter buffer is ours.
+        unsafe { device.cmd_fill_buffer(cmd, self.counters.raw(), 0, vk::WHOLE_SIZE, 0) };
+        memory_barrier(device, cmd, &[Access::TransferWrite], &[Access::ComputeRead, Access::ComputeWrite]);
+        let push = TonemapPush { width: self.width, height: self.height, exposure: frame.exposure };
+        self.pipeline.dispatch(cmd, &self.set, &push, [self.width, self.height, 1]);
+        memory_barrier(device, cmd, &[Access::ComputeWrite], &[Access::HostRead]);
     }
 }

@@ -4,44 +4,46 @@
 //! of the other (key) lights; the cache is recomputed only when the environment changes.
 //!
 //! Bindings: 0 = vertices, 1 = lights, 2 = shadow maps, 3 = output (vec4 per vertex).
-//! Push: vertex count, light count.
+//! Push: `VertexLightPush`.
 
+use super::gpu_scene::GpuScene;
+use super::pass::{FrameInputs, RenderPass};
 use super::shadow::ShadowPass;
-use crate::gpu::{Binding, BindingKind, Buffer, ComputePipeline, DescriptorSet, Gpu, GpuResult};
+use crate::gpu::{Access, Binding, ComputePipeline, DescriptorSet, Gpu, GpuResult, memory_barrier};
 use ash::vk;
 use std::sync::Arc;
+
+/// `VertexLightPush` in glsl/vertex_light.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct VertexLightPush {
+    pub vertex_count: u32,
+    pub light_count: u32,
+}
 
 pub struct VertexLightPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
-    vertex_count: u32,
-    light_count: u32,
+    push: VertexLightPush,
 }
 
 impl VertexLightPass {
-    pub fn new(
-        gpu: &Arc<Gpu>,
-        vertices: &Buffer,
-        vertex_count: u32,
-        lights: &Buffer,
-        light_count: u32,
-        shadow: &ShadowPass,
-        output: &Buffer,
-    ) -> GpuResult<VertexLightPass> {
-        let s = BindingKind::StorageBuffer;
-        let pipeline =
-            ComputePipeline::new(gpu, "vertex_light.comp", &[s, s, BindingKind::CombinedImageSampler, s], 8)?;
+    pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene, shadow: &ShadowPass) -> GpuResult<VertexLightPass> {
+        let pipeline = ComputePipeline::new(gpu, "vertex_light.comp")?;
         let set = pipeline.descriptor_set(&[
-            Binding::Buffer(vertices),
-            Binding::Buffer(lights),
+            Binding::Buffer(&scene.vertices),
+            Binding::Buffer(&scene.lights),
             shadow.binding(),
-            Binding::Buffer(output),
+            Binding::Buffer(&scene.environment_irradiance),
         ])?;
-        Ok(VertexLightPass { pipeline, set, vertex_count, light_count })
+        let push = VertexLightPush { vertex_count: scene.vertex_count, light_count: scene.light_count };
+        Ok(VertexLightPass { pipeline, set, push })
     }
+}
 
-    pub fn record(&self, cmd: vk::CommandBuffer) {
-        let push = [self.vertex_count, self.light_count];
-        self.pipeline.dispatch(cmd, &self.set, bytemuck::bytes_of(&push), [self.vertex_count.div_ceil(64), 1, 1]);
+impl RenderPass for VertexLightPass {
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        self.pipeline.dispatch(cmd, &self.set, &self.push, [self.push.vertex_count, 1, 1]);
+        memory_barrier(frame.gpu.device(), cmd, &[Access::ComputeWrite], &[Access::VertexAttributeRead]);
     }
 }

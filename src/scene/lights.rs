@@ -2,26 +2,12 @@
 //! reduced to directional lights by median cut (Debevec 2006, "A median cut algorithm for light
 //! probe sampling"): regions of equal energy on the equirectangular map, each replaced by one
 //! directional light carrying the region's irradiance, each with its own shadow map. Together
-//! they give the soft environment shadows of the seed paper's Figure 6.
+//! they give the soft environment shadows of the seed paper's Figure 6. The GPU record of a
+//! light (`render::records::LightGpu`) is packed from these typed values.
 
 use super::format::Light;
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use glam::camera::rh::{proj::vulkan, view::look_at_mat4};
-
-/// std430 mirror of `struct Light` in glsl/common/lights.glsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct LightGpu {
-    pub position_kind: [f32; 4],
-    pub direction_cos: [f32; 4],
-    pub power_layer: [f32; 4],
-    pub spot_texel: [f32; 4],
-    pub shadow_matrix: [[f32; 4]; 4],
-}
-
-pub const LIGHT_DIRECTIONAL: f32 = 0.0;
-pub const LIGHT_POINT: f32 = 1.0;
-pub const LIGHT_SPOT: f32 = 2.0;
 
 /// An environment as an equirectangular grid of linear radiance (W/m^2/sr). Row 0 looks at
 /// +y (up); column u covers azimuth phi = 2 pi (u + 0.5) / width, direction
@@ -171,17 +157,41 @@ impl Environment {
     }
 }
 
-/// A light ready for the GPU, before shadow layers are assigned.
+/// What a light is and how much it gives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// `direction`: unit vector towards the light; `irradiance` (W/m^2) on a surface facing it.
+    Directional { direction: Vec3, irradiance: Vec3 },
+    /// `intensity` in W/sr, falling off with the inverse square of the distance.
+    Point { position: Vec3, intensity: Vec3 },
+    /// A point light inside a cone about `axis` (pointing away from the light), smooth between
+    /// the cosines of its inner and outer half-angles.
+    Spot { position: Vec3, axis: Vec3, intensity: Vec3, cos_outer: f32, cos_inner: f32 },
+}
+
+/// A scene light ready to render: its kind, its shadow map, and where it came from.
 #[derive(Clone, Debug)]
 pub struct PreparedLight {
-    pub record: LightGpu,
+    pub kind: LightKind,
+    /// One of the environment light's median-cut directions (lights diffuse surfaces through
+    /// the per-vertex cache; no specular lobe).
+    pub environment: bool,
     pub casts_shadow: bool,
+    /// Its layer in the shadow-map array, when it casts shadows onto something.
+    pub shadow_layer: Option<u32>,
+    /// World -> the shadow map's clip space (depth 0..1).
+    pub shadow_matrix: Mat4,
+    /// One shadow-map texel in uv.
+    pub shadow_texel: f32,
+    /// Normal offset of shadow lookups (world units), half a texel's footprint.
+    pub normal_offset: f32,
     /// Which scene light it came from (several for an environment).
     pub source: usize,
 }
 
-/// Turn scene lights into GPU records. `bounds` is the bounding sphere (centre, radius) of the
-/// shadow casters, which every shadow frustum must cover; `environment` is the loaded map or sky.
+/// Turn scene lights into prepared lights. `bounds` is the bounding sphere (centre, radius) of
+/// the shadow casters, which every shadow frustum must cover; `environment` is the loaded map or
+/// sky. Shadow layers are assigned by [`assign_shadow_layers`].
 pub fn prepare(
     lights: &[Light],
     environment: Option<&Environment>,
@@ -196,18 +206,25 @@ pub fn prepare(
     // 1%, 2 texels 2.25%; 1024^2 maps with 0.5 texel: 1.5%.
     let offset_ortho = 0.5 * (2.0 * radius) * texel;
     let mut out = Vec::new();
-    let directional = |dir: Vec3, irradiance: Vec3, environment: bool| {
+    let shadowed = |kind: LightKind, matrix: Mat4, offset: f32, environment: bool, casts_shadow: bool, source| {
+        PreparedLight {
+            kind,
+            environment,
+            casts_shadow,
+            shadow_layer: None,
+            shadow_matrix: matrix,
+            shadow_texel: texel,
+            normal_offset: offset,
+            source,
+        }
+    };
+    let directional = |dir: Vec3, irradiance: Vec3, environment: bool, casts_shadow: bool, source: usize| {
         let dir = dir.normalize();
         let eye = center + dir * (2.0 * radius);
         let view = look_at_mat4(eye, center, any_up(dir));
         let proj = vulkan::orthographic(-radius, radius, -radius, radius, 0.0, 4.0 * radius);
-        LightGpu {
-            position_kind: [0.0, 0.0, 0.0, LIGHT_DIRECTIONAL],
-            direction_cos: [dir.x, dir.y, dir.z, 0.0],
-            power_layer: [irradiance.x, irradiance.y, irradiance.z, -1.0],
-            spot_texel: [0.0, texel, offset_ortho, if environment { 1.0 } else { 0.0 }],
-            shadow_matrix: (proj * view).to_cols_array_2d(),
-        }
+        let kind = LightKind::Directional { direction: dir, irradiance };
+        shadowed(kind, proj * view, offset_ortho, environment, casts_shadow, source)
     };
     let local_offset =
         |position: Vec3, half_angle: f32| 0.5 * (2.0 * (center - position).length() * half_angle.tan()) * texel;
@@ -241,25 +258,14 @@ pub fn prepare(
     };
     for (source, light) in lights.iter().enumerate() {
         match light {
-            Light::Directional { direction, irradiance, shadows } => out.push(PreparedLight {
-                record: directional(Vec3::from(*direction), Vec3::from(*irradiance), false),
-                casts_shadow: *shadows,
-                source,
-            }),
+            Light::Directional { direction, irradiance, shadows } => {
+                out.push(directional(Vec3::from(*direction), Vec3::from(*irradiance), false, *shadows, source))
+            }
             Light::Point { position, intensity, shadows } => {
                 let p = Vec3::from(*position);
                 let (matrix, offset) = local(p, None);
-                out.push(PreparedLight {
-                    record: LightGpu {
-                        position_kind: [p.x, p.y, p.z, LIGHT_POINT],
-                        direction_cos: [0.0; 4],
-                        power_layer: [intensity[0], intensity[1], intensity[2], -1.0],
-                        spot_texel: [0.0, texel, offset, 0.0],
-                        shadow_matrix: matrix.to_cols_array_2d(),
-                    },
-                    casts_shadow: *shadows,
-                    source,
-                })
+                let kind = LightKind::Point { position: p, intensity: Vec3::from(*intensity) };
+                out.push(shadowed(kind, matrix, offset, false, *shadows, source))
             }
             Light::Spot { position, direction, intensity, angle, softness, shadows } => {
                 let p = Vec3::from(*position);
@@ -267,26 +273,19 @@ pub fn prepare(
                 let outer = angle.to_radians();
                 let inner = outer * (1.0 - softness);
                 let (matrix, offset) = local(p, Some((axis, (outer * 1.05).min(85f32.to_radians()))));
-                out.push(PreparedLight {
-                    record: LightGpu {
-                        position_kind: [p.x, p.y, p.z, LIGHT_SPOT],
-                        direction_cos: [axis.x, axis.y, axis.z, outer.cos()],
-                        power_layer: [intensity[0], intensity[1], intensity[2], -1.0],
-                        spot_texel: [inner.cos(), texel, offset, 0.0],
-                        shadow_matrix: matrix.to_cols_array_2d(),
-                    },
-                    casts_shadow: *shadows,
-                    source,
-                })
+                let kind = LightKind::Spot {
+                    position: p,
+                    axis,
+                    intensity: Vec3::from(*intensity),
+                    cos_outer: outer.cos(),
+                    cos_inner: inner.cos(),
+                };
+                out.push(shadowed(kind, matrix, offset, false, *shadows, source))
             }
             Light::Environment { scale, directions, shadows, .. } => {
                 if let Some(env) = environment {
                     for (dir, irradiance) in env.median_cut(*directions as usize) {
-                        out.push(PreparedLight {
-                            record: directional(dir, irradiance * *scale, true),
-                            casts_shadow: *shadows,
-                            source,
-                        });
+                        out.push(directional(dir, irradiance * *scale, true, *shadows, source));
                     }
                 }
             }
@@ -294,27 +293,45 @@ pub fn prepare(
     }
     // Key lights first, the environment's directions after: shading loops over the key lights
     // only (`key_light_count`), the environment reaching it through the per-vertex cache.
-    out.sort_by_key(|l| l.record.spot_texel[3] > 0.5);
+    out.sort_by_key(|l| l.environment);
     out
 }
 
 /// How many of `lights` (as `prepare` orders them) are not environment directions.
 pub fn key_light_count(lights: &[PreparedLight]) -> usize {
-    lights.iter().take_while(|l| l.record.spot_texel[3] <= 0.5).count()
+    lights.iter().take_while(|l| !l.environment).count()
 }
 
 /// Assign shadow-map layers to the lights that cast shadows; returns the layer count.
 pub fn assign_shadow_layers(lights: &mut [PreparedLight], any_caster: bool) -> u32 {
     let mut layers = 0;
     for l in lights.iter_mut() {
-        l.record.power_layer[3] = if l.casts_shadow && any_caster {
+        l.shadow_layer = (l.casts_shadow && any_caster).then(|| {
             layers += 1;
-            (layers - 1) as f32
-        } else {
-            -1.0
-        };
+            layers - 1
+        });
     }
     layers
+}
+
+/// `light` turned by `degrees` about the vertical axis through `centre` (directional lights
+/// turn their direction, point and spot lights their position and axis), for animation
+/// drivers; `None` for an environment light, which does not move.
+pub fn orbit(light: &Light, centre: Vec3, degrees: f32) -> Option<Light> {
+    let rotation = glam::Quat::from_rotation_y(degrees.to_radians());
+    let turn = |v: [f32; 3]| (rotation * Vec3::from(v)).to_array();
+    let turn_point = |p: [f32; 3]| (centre + rotation * (Vec3::from(p) - centre)).to_array();
+    let mut light = light.clone();
+    match &mut light {
+        Light::Directional { direction, .. } => *direction = turn(*direction),
+        Light::Point { position, .. } => *position = turn_point(*position),
+        Light::Spot { position, direction, .. } => {
+            *position = turn_point(*position);
+            *direction = turn(*direction);
+        }
+        Light::Environment { .. } => return None,
+    }
+    Some(light)
 }
 
 fn any_up(dir: Vec3) -> Vec3 {

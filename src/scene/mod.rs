@@ -5,6 +5,7 @@ pub mod build;
 mod camera;
 pub mod format;
 pub mod lights;
+pub mod needs;
 
 pub use format::*;
 use std::path::{Path, PathBuf};

@@ -1,0 +1,13 @@
+// The push block of the shading pass (shade.vert, shade.frag, shade_pixel.frag), mirrored by
+// `ShadePush` in src/render/shade.rs (tests/render_records.rs pins the layout).
+#ifndef SHADE_PUSH_GLSL
+#define SHADE_PUSH_GLSL
+
+struct ShadePush {
+    mat4 view_proj;
+    vec4 eye_object;        // xyz: camera position; w: object index
+    uvec4 counts;           // x: light count; y: key (non-environment) lights, first in the buffer
+};
+layout(push_constant) uniform ShadePushBlock { ShadePush push; };
+
+#endif

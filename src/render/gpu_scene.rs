@@ -1,0 +1,150 @@
+//! `GpuScene`: a prepared scene's data on the GPU, packed once (`records`) and uploaded: the
+//! shared vertex and index buffers, object, sample and light records, and the buffers the passes
+//! write and read between frames (splat output, exitance, cached environment irradiance). The
+//! passes get their inputs from here; only lights change after creation.
+
+use super::records::{LightGpu, ObjectRecord, SampleRecord, SplatRecord, Vertex};
+use crate::gpu::{Buffer, BufferDesc, Gpu, GpuResult};
+use crate::scene::build::PreparedScene;
+use ash::vk;
+use std::sync::Arc;
+
+/// A draw of one object: index range and vertex offset in the shared buffers.
+#[derive(Clone, Copy, Debug)]
+pub struct DrawRange {
+    pub first_index: u32,
+    pub index_count: u32,
+    pub vertex_offset: i32,
+}
+
+/// A translucent object as the gathers see it.
+#[derive(Clone, Copy, Debug)]
+pub struct Receiver {
+    /// Index of the object (its `ObjectRecord`).
+    pub object: u32,
+    pub vertex_count: u32,
+    pub sample_count: u32,
+}
+
+pub struct GpuScene {
+    /// `records::Vertex` per vertex of every object, objects one after another.
+    pub vertices: Buffer,
+    pub indices: Buffer,
+    /// Radiant exitance per vertex (vec4), written by the vertex and sparse gathers; zero on
+    /// opaque objects.
+    pub exitance: Buffer,
+    /// Irradiance from the environment's directions per vertex (vec4), from the vertex-light pass.
+    pub environment_irradiance: Buffer,
+    pub objects: Buffer,
+    pub samples: Buffer,
+    /// `SplatRecord` per sample, from the splat pass.
+    pub splat: Buffer,
+    pub lights: Buffer,
+    /// One per object, in scene order.
+    pub draws: Vec<DrawRange>,
+    /// The objects that cast shadows.
+    pub casters: Vec<DrawRange>,
+    /// World -> clip matrix of each shadow-map layer.
+    pub light_matrices: Vec<[[f32; 4]; 4]>,
+    pub receivers: Vec<Receiver>,
+    /// First vertex of each object in the shared buffers.
+    pub vertex_offsets: Vec<u32>,
+    pub vertex_count: u32,
+    pub sample_count: u32,
+    pub light_count: u32,
+    /// Lights that are not environment directions; they come first in the light buffer.
+    pub key_light_count: u32,
+}
+
+fn storage(gpu: &Arc<Gpu>, name: &str, bytes: u64, extra: vk::BufferUsageFlags) -> GpuResult<Buffer> {
+    Buffer::new(gpu, &BufferDesc::gpu_only(name, bytes.max(16), vk::BufferUsageFlags::STORAGE_BUFFER | extra))
+}
+
+fn upload<T: bytemuck::Pod>(gpu: &Arc<Gpu>, name: &str, data: &[T], usage: vk::BufferUsageFlags) -> GpuResult<Buffer> {
+    let bytes = std::mem::size_of_val(data) as u64;
+    let mut buffer = storage(gpu, name, bytes, usage)?;
+    if bytes > 0 {
+        buffer.write(0, data)?;
+    }
+    Ok(buffer)
+}
+
+impl GpuScene {
+    pub fn new(gpu: &Arc<Gpu>, scene: &PreparedScene) -> GpuResult<GpuScene> {
+        let (mut vertices, mut indices, mut objects, mut samples) = (Vec::new(), Vec::<u32>::new(), Vec::new(), Vec::new());
+        let (mut draws, mut casters, mut receivers, mut vertex_offsets) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for (i, o) in scene.objects.iter().enumerate() {
+            let first_vertex = vertices.len() as u32;
+            let first_sample = samples.len() as u32;
+            vertex_offsets.push(first_vertex);
+            let normals = o.mesh.vertex_normals();
+            vertices.extend(
+                o.mesh.positions().iter().zip(normals).map(|(p, n)| Vertex { position: p.to_array(), normal: n.to_array() }),
+            );
+            let draw = DrawRange {
+                first_index: indices.len() as u32,
+                index_count: 3 * o.mesh.triangles().len() as u32,
+                vertex_offset: first_vertex as i32,
+            };
+            indices.extend(o.mesh.triangles().iter().flatten());
+            draws.push(draw);
+            if o.casts_shadow {
+                casters.push(draw);
+            }
+            samples.extend(o.samples.iter().map(|s| SampleRecord::new(s, i)));
+            let vertex_count = o.mesh.positions().len() as u32;
+            let sample_count = o.samples.len() as u32;
+            objects.push(ObjectRecord::new(o, [first_vertex, vertex_count, first_sample, sample_count]));
+            if matches!(o.material, crate::scene::build::ResolvedMaterial::Translucent { .. }) {
+                receivers.push(Receiver { object: i as u32, vertex_count, sample_count });
+            }
+        }
+        let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER;
+        let zeros = vec![[0f32; 4]; vertices.len()];
+        let mut gpu_scene = GpuScene {
+            vertices: upload(gpu, "vertices", &vertices, vertex_usage)?,
+            indices: upload(gpu, "indices", &indices, vk::BufferUsageFlags::INDEX_BUFFER)?,
+            // Opaque vertices keep zero exitance; translucent ones are written by the gather.
+            exitance: upload(gpu, "exitance", &zeros, vertex_usage)?,
+            environment_irradiance: upload(gpu, "environment irradiance", &zeros, vertex_usage)?,
+            objects: upload(gpu, "objects", &objects, vk::BufferUsageFlags::empty())?,
+            samples: upload(gpu, "samples", &samples, vk::BufferUsageFlags::empty())?,
+            splat: storage(
+                gpu,
+                "splat",
+                (std::mem::size_of::<SplatRecord>() * samples.len()) as u64,
+                vk::BufferUsageFlags::empty(),
+            )?,
+            lights: storage(
+                gpu,
+                "lights",
+                (std::mem::size_of::<LightGpu>() * scene.lights.len()) as u64,
+                vk::BufferUsageFlags::empty(),
+            )?,
+            draws,
+            casters,
+            light_matrices: Vec::new(),
+            receivers,
+            vertex_offsets,
+            vertex_count: vertices.len() as u32,
+            sample_count: samples.len() as u32,
+            light_count: scene.lights.len() as u32,
+            key_light_count: crate::scene::lights::key_light_count(&scene.lights) as u32,
+        };
+        gpu_scene.upload_lights(scene)?;
+        Ok(gpu_scene)
+    }
+
+    /// Pack and upload the scene's lights and their shadow matrices (after a light moved; the
+    /// number of lights and their shadow layers stay as they were).
+    pub fn upload_lights(&mut self, scene: &PreparedScene) -> GpuResult<()> {
+        self.light_matrices = vec![[[0.0; 4]; 4]; scene.shadow_layers as usize];
+        for l in &scene.lights {
+            if let Some(layer) = l.shadow_layer {
+                self.light_matrices[layer as usize] = l.shadow_matrix.to_cols_array_2d();
+            }
+        }
+        let records: Vec<LightGpu> = scene.lights.iter().map(LightGpu::new).collect();
+        if records.is_empty() { Ok(()) } else { self.lights.write(0, &records) }
+    }
+}

@@ -1,0 +1,31 @@
+//! The one interface every GPU pass records through. A pass is built once from the scene's GPU
+//! data (`GpuScene`) and records each frame from `FrameInputs`, followed by the barriers that
+//! make its own writes visible to whatever reads them next (later passes, the next frame, or the
+//! host after the fence). Adding a pass: one GLSL file, one module implementing `RenderPass`,
+//! one entry in `plan::Pass` and in `Renderer::pass`.
+
+use super::gpu_scene::GpuScene;
+use super::plan::Plan;
+use crate::gpu::Gpu;
+use ash::vk;
+use glam::{Mat4, Vec3};
+
+/// What one frame gives the passes besides the scene data they were built with.
+pub struct FrameInputs<'a> {
+    pub gpu: &'a Gpu,
+    pub scene: &'a GpuScene,
+    pub plan: &'a Plan,
+    /// Shadow-map layers to redraw; `None` redraws every layer.
+    pub shadow_layers: Option<&'a [u32]>,
+    /// World -> clip of the camera, and its position.
+    pub view_proj: Mat4,
+    pub eye: Vec3,
+    /// Clear colour of the HDR image.
+    pub background: [f32; 3],
+    pub exposure: f32,
+}
+
+pub trait RenderPass {
+    /// Record the pass into `cmd` (recording, outside any rendering), then its barriers.
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs);
+}
