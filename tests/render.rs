@@ -7,8 +7,8 @@ use translucent::optics::{Material, fresnel};
 use translucent::reference;
 use translucent::render::plan::{Change, Pass};
 use translucent::render::renderer::Renderer;
-use translucent::scene::Scene;
 use translucent::scene::build::{Overrides, PreparedScene};
+use translucent::scene::{GatherMode, Scene};
 
 fn prepare(toml: &str, overrides: &Overrides) -> PreparedScene {
     let scene = Scene::parse(toml, "test scene", None).expect("test scene parses");
@@ -55,11 +55,11 @@ fn run_all(gpu: &std::sync::Arc<translucent::gpu::Gpu>, prepared: PreparedScene)
 fn uniformly_lit_plane_reflects_total_diffuse_reflectance() {
     with_gpu(|gpu| {
         let cases = ["marble", "skimmilk", "ketchup", "spectralon"]
-            .map(|p| (p, "vertex"))
+            .map(|p| (p, GatherMode::Vertex))
             .into_iter()
-            .chain([("marble", "sparse"), ("skimmilk", "sparse")]);
+            .chain([("marble", GatherMode::Sparse), ("skimmilk", GatherMode::Sparse)]);
         for (preset, gather) in cases {
-            let overrides = Overrides { gather: Some(gather.into()), ..Default::default() };
+            let overrides = Overrides { gather: Some(gather), ..Default::default() };
             let prepared = prepare(&plane_scene(preset, 1000.0, 3000, ""), &overrides);
             let material = Material::preset(preset).unwrap();
             let dipoles = material.dipoles(1.0).unwrap();
@@ -298,19 +298,18 @@ fn pixel_gather_agrees_with_the_vertex_gather() {
     // Per-pixel exitance is exact where vertex exitance is interpolated; on the 37.7k-vertex
     // bunny the two pictures must agree closely, and the pixel mode must follow the camera.
     with_gpu(|gpu| {
-        let image = |gather: &str| {
-            let overrides =
-                Overrides { resolution: Some([128, 128]), gather: Some(gather.into()), ..Default::default() };
+        let image = |gather: GatherMode| {
+            let overrides = Overrides { resolution: Some([128, 128]), gather: Some(gather), ..Default::default() };
             let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
             let mut renderer = Renderer::new(gpu, prepared).unwrap();
             renderer.frame(&renderer.plan(Change::Everything)).unwrap();
             let plan = renderer.plan(Change::Camera);
-            assert_eq!(plan.runs(Pass::Gather), gather == "pixel", "{gather}: {plan}");
+            assert_eq!(plan.runs(Pass::Gather), gather == GatherMode::Pixel, "{gather}: {plan}");
             let (rgba, non_finite) = renderer.image().unwrap();
             assert_eq!(non_finite, 0);
             rgba
         };
-        let (vertex, pixel) = (image("vertex"), image("pixel"));
+        let (vertex, pixel) = (image(GatherMode::Vertex), image(GatherMode::Pixel));
         let mean = vertex.iter().zip(&pixel).map(|(a, b)| a.abs_diff(*b) as f64).sum::<f64>() / vertex.len() as f64;
         let worst = vertex.iter().zip(&pixel).map(|(a, b)| a.abs_diff(*b)).max().unwrap();
         eprintln!("pixel vs vertex gather: mean difference {mean:.3}/255, worst {worst}/255");
@@ -321,7 +320,8 @@ fn pixel_gather_agrees_with_the_vertex_gather() {
 #[test]
 fn sparse_gather_matches_its_reference_and_stays_close_to_the_vertex_gather() {
     with_gpu(|gpu| {
-        let overrides = Overrides { resolution: Some([64, 64]), gather: Some("sparse".into()), ..Default::default() };
+        let overrides =
+            Overrides { resolution: Some([64, 64]), gather: Some(GatherMode::Sparse), ..Default::default() };
         let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
         let occluders = reference::occluders(&prepared);
         let irradiance = reference::splat(&prepared, &occluders);

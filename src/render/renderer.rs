@@ -205,14 +205,14 @@ impl Renderer {
             &splat_buffer,
         )?;
         let [width, height] = scene.scene.file.camera.resolution;
-        let pixel_gather = settings.gather == "pixel";
+        let pixel_gather = settings.gather == crate::scene::GatherMode::Pixel;
         let shade = ShadePass::new(gpu, width, height, &object_buffer, &light_buffer, &shadow, pixel_gather)?;
         let sparse_receivers: Vec<(u32, u32, u32)> = receivers
             .iter()
             .map(|&(object, vertex_count)| (object, vertex_count, scene.objects[object as usize].samples.len() as u32))
             .collect();
         let gather = match shade.surface() {
-            None if settings.gather == "sparse" => Gather::Sparse(GatherSparsePass::new(
+            None if settings.gather == crate::scene::GatherMode::Sparse => Gather::Sparse(GatherSparsePass::new(
                 gpu,
                 &vertex_buffer,
                 &sample_buffer,
@@ -276,7 +276,7 @@ impl Renderer {
             translucent_objects: scene.objects.iter().filter(|o| !o.samples.is_empty()).count(),
             shadowed_lights,
             environment: scene.lights.iter().find(|l| l.record.spot_texel[3] > 0.5).map(|l| l.source),
-            pixel_gather: settings.gather == "pixel",
+            pixel_gather: settings.gather == crate::scene::GatherMode::Pixel,
         };
         Ok(Renderer {
             gpu: gpu.clone(),

@@ -43,12 +43,18 @@ use crate::mesh::Mesh;
 /// typo cannot exhaust memory.
 pub const MAX_COUNT: usize = 1 << 24;
 
-/// How sample points are placed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// How sample points are placed: `sampling.method` in a scene, `--sampler` and `--method` on
+/// the command line (lowercase names in both).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
 pub enum Method {
+    /// Uniform by area
     Random,
+    /// Turk's point repulsion (1992)
     Turk,
+    /// The seed paper's geometric feature sampling (Algorithm 1, Eq. 12), then curvature-adaptive repulsion
     Feature,
+    /// Poisson-disk blue noise by sample elimination (Yuksel 2015)
     Poisson,
 }
 
@@ -67,7 +73,7 @@ impl Method {
 
 impl fmt::Display for Method {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
+        f.pad(self.name())
     }
 }
 

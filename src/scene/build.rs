@@ -3,13 +3,12 @@
 //! prepared with shadow layers. Everything here is CPU work done once per scene.
 
 use super::lights::{self, Environment, PreparedLight};
-use super::{AssetSource, Light, MaterialSpec, Scene, Shape};
+use super::{AssetSource, GatherMode, Light, MaterialSpec, Scene, Shape};
 use crate::mesh::{LoadOptions, Mesh};
 use crate::optics::{Dipole, Material};
 use crate::sampling::{self, Method, SampleOptions, SamplePoint};
 use anyhow::{Context, Result, bail};
 use glam::{EulerRot, Mat4, Quat, Vec3};
-use std::str::FromStr;
 
 /// An object's material, resolved.
 #[derive(Clone, Debug)]
@@ -49,8 +48,8 @@ pub struct PreparedScene {
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
     pub samples: Option<usize>,
-    pub sampler: Option<String>,
-    pub gather: Option<String>,
+    pub sampler: Option<Method>,
+    pub gather: Option<GatherMode>,
     pub resolution: Option<[u32; 2]>,
 }
 
@@ -63,20 +62,16 @@ impl PreparedScene {
             }
             scene.file.sampling.count = n;
         }
-        if let Some(m) = &overrides.sampler {
-            scene.file.sampling.method = m.clone();
+        if let Some(m) = overrides.sampler {
+            scene.file.sampling.method = m;
         }
-        if let Some(g) = &overrides.gather {
-            if !["vertex", "pixel", "sparse"].contains(&g.as_str()) {
-                bail!("--gather {g:?} is not vertex, pixel or sparse");
-            }
-            scene.file.render.gather = g.clone();
+        if let Some(g) = overrides.gather {
+            scene.file.render.gather = g;
         }
         if let Some(r) = overrides.resolution {
             scene.file.camera.resolution = r;
         }
-        let method = Method::from_str(&scene.file.sampling.method)
-            .map_err(|e| anyhow::anyhow!("{}: `sampling.method`: {e}", scene.name))?;
+        let method = scene.file.sampling.method;
 
         let mut objects = Vec::new();
         for (i, o) in scene.file.objects.iter().enumerate() {

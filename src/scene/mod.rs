@@ -238,16 +238,10 @@ fn check(scene: &SceneFile) -> Check {
         return Err(("light".into(), "at most one environment light".into()));
     }
     let s = &scene.sampling;
-    if !["random", "turk", "feature", "poisson"].contains(&s.method.as_str()) {
-        return Err(("sampling.method".into(), format!("{:?} is not one of random, turk, feature, poisson", s.method)));
-    }
     if s.count == 0 || s.count > 1_000_000 {
         return Err(("sampling.count".into(), format!("{} must be 1 to 1000000", s.count)));
     }
     let r = &scene.render;
-    if !["vertex", "pixel", "sparse"].contains(&r.gather.as_str()) {
-        return Err(("render.gather".into(), format!("{:?} is not vertex, pixel or sparse", r.gather)));
-    }
     if !(r.exposure.is_finite() && r.exposure > 0.0) {
         return Err(("render.exposure".into(), format!("{} must be positive", r.exposure)));
     }
