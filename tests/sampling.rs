@@ -13,8 +13,8 @@ use translucent::sampling::feature::{feature_point_count, feature_points};
 use translucent::sampling::walk::walk;
 use translucent::sampling::weights::{WeightParams, area_weights};
 use translucent::sampling::{
-    GpuSample, MAX_COUNT, Method, SampleOptions, SampleSet, SamplingError, SpatialHash, SurfacePoint,
-    nearest_neighbour_distances, sample,
+    MAX_COUNT, Method, SampleOptions, SampleSet, SamplingError, SpatialHash, SurfacePoint, nearest_neighbour_distances,
+    sample,
 };
 
 fn asset(name: &str) -> PathBuf {
@@ -435,24 +435,6 @@ fn zero_count_too_many_and_no_area_are_clear_errors() {
     let err = Mesh::from_triangles(vec![Vec3::ZERO, Vec3::X, Vec3::X * 3.0], vec![[0, 1, 2]]).unwrap_err();
     assert!(matches!(err, MeshError::NoArea { .. }));
     assert!(err.to_string().contains("no area"), "{err}");
-}
-
-#[test]
-fn gpu_records_have_a_pinned_std430_layout() {
-    assert_eq!(std::mem::size_of::<GpuSample>(), 32);
-    assert_eq!(std::mem::offset_of!(GpuSample, position), 0);
-    assert_eq!(std::mem::offset_of!(GpuSample, area), 12);
-    assert_eq!(std::mem::offset_of!(GpuSample, normal), 16);
-    assert_eq!(std::mem::offset_of!(GpuSample, pad), 28);
-    let set = run(small_bunny(), Method::Turk, 10, 0);
-    let records = set.gpu_records();
-    let floats: &[f32] = bytemuck::cast_slice(&records);
-    assert_eq!(floats.len(), 80);
-    for (k, p) in set.points.iter().enumerate() {
-        assert_eq!(&floats[k * 8..k * 8 + 3], &p.position.to_array());
-        assert_eq!(floats[k * 8 + 3], p.area as f32);
-        assert_eq!(&floats[k * 8 + 4..k * 8 + 7], &p.normal.to_array());
-    }
 }
 
 #[test]
