@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::with_gpu;
+use common::{builtin, gather_from, run_all, with_gpu};
 use translucent::optics::{Material, fresnel};
 use translucent::reference;
 use translucent::render::plan::{Change, Pass};
@@ -44,13 +44,6 @@ count = {samples}
     )
 }
 
-fn run_all(gpu: &std::sync::Arc<translucent::gpu::Gpu>, prepared: PreparedScene) -> Renderer {
-    let mut renderer = Renderer::new(gpu, prepared).expect("renderer");
-    let plan = renderer.plan(Change::Everything);
-    renderer.frame(&plan).expect("frame");
-    renderer
-}
-
 #[test]
 fn uniformly_lit_plane_reflects_total_diffuse_reflectance() {
     with_gpu(|gpu| {
@@ -88,17 +81,11 @@ fn uniformly_lit_plane_reflects_total_diffuse_reflectance() {
 fn gather_matches_the_f64_reference_on_the_default_scene() {
     with_gpu(|gpu| {
         let overrides = Overrides { resolution: Some([64, 64]), ..Default::default() };
-        let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+        let prepared = builtin(&overrides);
         let occluders = reference::occluders(&prepared);
         let irradiance = reference::splat(&prepared, &occluders);
         let expected = reference::gather(&prepared, &irradiance);
-        let mut renderer = Renderer::new(gpu, prepared).unwrap();
-        let as_f32: Vec<[f32; 3]> = irradiance.iter().map(|e| e.map(|v| v as f32)).collect();
-        renderer.set_splat_irradiance(&as_f32).unwrap();
-        let mut plan = renderer.plan(Change::Everything);
-        plan.passes.retain(|(p, _)| *p == Pass::Gather);
-        renderer.frame(&plan).unwrap();
-        let got = renderer.exitance(0).unwrap();
+        let got = gather_from(gpu, prepared, &irradiance);
         let peak = expected[0].iter().flat_map(|m| m.iter()).fold(0.0f64, |a, b| a.max(*b));
         let mut worst = 0.0f64;
         for (g, e) in got.iter().zip(&expected[0]) {
@@ -117,7 +104,7 @@ fn gather_matches_the_f64_reference_on_the_default_scene() {
 fn splat_visibility_matches_ray_casting() {
     with_gpu(|gpu| {
         let overrides = Overrides { resolution: Some([64, 64]), ..Default::default() };
-        let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+        let prepared = builtin(&overrides);
         let occluders = reference::occluders(&prepared);
         let expected = reference::splat(&prepared, &occluders);
         let renderer = run_all(gpu, prepared);
@@ -271,7 +258,7 @@ count = 1500
 fn moving_one_light_redraws_only_its_shadows_and_matches_a_full_render() {
     with_gpu(|gpu| {
         let overrides = Overrides { resolution: Some([64, 64]), ..Default::default() };
-        let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+        let prepared = builtin(&overrides);
         // A: full first frame, then the key light orbits and only its layer is redrawn.
         let mut a = Renderer::new(gpu, prepared.clone()).unwrap();
         a.frame(&a.plan(Change::Everything)).unwrap();
@@ -287,7 +274,7 @@ fn moving_one_light_redraws_only_its_shadows_and_matches_a_full_render() {
         assert_eq!(sa, sb, "partial shadow redraw differs from a full one");
         assert_eq!(a.image().unwrap(), b.image().unwrap());
         // And the light really moved: the splat differs from the unmoved scene's.
-        let mut c = Renderer::new(gpu, PreparedScene::new(&Scene::builtin(), &overrides).unwrap()).unwrap();
+        let mut c = Renderer::new(gpu, builtin(&overrides)).unwrap();
         c.frame(&c.plan(Change::Everything)).unwrap();
         assert_ne!(c.splat_irradiance().unwrap(), sa);
     });
@@ -300,7 +287,7 @@ fn pixel_gather_agrees_with_the_vertex_gather() {
     with_gpu(|gpu| {
         let image = |gather: GatherMode| {
             let overrides = Overrides { resolution: Some([128, 128]), gather: Some(gather), ..Default::default() };
-            let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+            let prepared = builtin(&overrides);
             let mut renderer = Renderer::new(gpu, prepared).unwrap();
             renderer.frame(&renderer.plan(Change::Everything)).unwrap();
             let plan = renderer.plan(Change::Camera);
@@ -322,18 +309,12 @@ fn sparse_gather_matches_its_reference_and_stays_close_to_the_vertex_gather() {
     with_gpu(|gpu| {
         let overrides =
             Overrides { resolution: Some([64, 64]), gather: Some(GatherMode::Sparse), ..Default::default() };
-        let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+        let prepared = builtin(&overrides);
         let occluders = reference::occluders(&prepared);
         let irradiance = reference::splat(&prepared, &occluders);
         let sparse = reference::gather_sparse(&prepared, &irradiance);
         let full = reference::gather(&prepared, &irradiance);
-        let mut renderer = Renderer::new(gpu, prepared).unwrap();
-        let as_f32: Vec<[f32; 3]> = irradiance.iter().map(|e| e.map(|v| v as f32)).collect();
-        renderer.set_splat_irradiance(&as_f32).unwrap();
-        let mut plan = renderer.plan(Change::Everything);
-        plan.passes.retain(|(p, _)| *p == Pass::Gather);
-        renderer.frame(&plan).unwrap();
-        let got = renderer.exitance(0).unwrap();
+        let got = gather_from(gpu, prepared, &irradiance);
         let peak = full[0].iter().flat_map(|m| m.iter()).fold(0.0f64, |a, b| a.max(*b));
         let rel = |a: f64, b: f64| (a - b).abs() / b.max(1e-3 * peak);
         let mut worst_gpu = 0.0f64;
