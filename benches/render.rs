@@ -13,8 +13,10 @@ use std::time::Instant;
 use translucent::gpu::{Gpu, GpuOptions, median};
 use translucent::render::plan::Change;
 use translucent::render::renderer::Renderer;
+use translucent::sampling::Method;
 use translucent::scene::{Scene, lights};
 use translucent::scene::build::{Overrides, PreparedScene};
+use translucent::scene::GatherMode;
 
 const WARM_UP: usize = 1;
 const FRAMES: usize = 5;
@@ -111,8 +113,8 @@ fn main() {
         "gather", "gather ms", "frame ms", "frames/s", "image diff (of 255)"
     );
     let mut reference_image: Option<Vec<u8>> = None;
-    for gather in ["vertex", "sparse", "pixel"] {
-        let overrides = Overrides { gather: Some(gather.into()), resolution: Some([512, 512]), ..Default::default() };
+    for gather in [GatherMode::Vertex, GatherMode::Sparse, GatherMode::Pixel] {
+        let overrides = Overrides { gather: Some(gather), resolution: Some([512, 512]), ..Default::default() };
         let prepared = PreparedScene::new(&scene, &overrides).expect("scene");
         let mut renderer = Renderer::new(&gpu, prepared).expect("renderer");
         renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
@@ -137,11 +139,11 @@ fn main() {
 
     println!("\nFPS against sample count (key light moving every frame, 512x512), seed Figure 7:");
     println!("  {:<8} {:>8} {:>12} {:>12} {:>10}", "sampler", "samples", "gather ms", "frame ms", "frames/s");
-    for method in ["turk", "feature"] {
+    for method in [Method::Turk, Method::Feature] {
         for count in [100, 200, 400, 800, 1600] {
             let overrides = Overrides {
                 samples: Some(count),
-                sampler: Some(method.into()),
+                sampler: Some(method),
                 resolution: Some([512, 512]),
                 ..Default::default()
             };

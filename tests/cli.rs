@@ -1,19 +1,9 @@
 //! The binary as a user runs it: device listing and the errors when no device fits.
 
-use std::process::{Command, Output};
+mod common;
 
-fn translucent(args: &[&str], env: &[(&str, &str)]) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_translucent"));
-    cmd.args(args).env("TRANSLUCENT_VALIDATION", "1").env_remove("TRANSLUCENT_DEVICE");
-    for (k, v) in env {
-        cmd.env(k, v);
-    }
-    cmd.output().expect("run translucent")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
+use common::{temp_dir, text, translucent};
+use std::process::Output;
 
 fn assert_clean_failure(out: &Output) -> String {
     let stderr = text(&out.stderr);
@@ -39,8 +29,7 @@ fn devices_lists_llvmpipe() {
 
 #[test]
 fn default_render_runs_clean_under_validation() {
-    let dir = std::env::temp_dir().join(format!("translucent-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("cli");
     let png = dir.join("default.png");
     let out = translucent(&["render", "--resolution", "96x64", "-o", png.to_str().unwrap(), "--timings"], &[]);
     let stderr = text(&out.stderr);
@@ -57,8 +46,7 @@ fn default_render_runs_clean_under_validation() {
 
 #[test]
 fn bad_scene_input_fails_cleanly_without_output() {
-    let dir = std::env::temp_dir().join(format!("translucent-cli-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("cli-bad");
     let png = dir.join("out.png");
     let scene = dir.join("scene.toml");
     std::fs::write(&scene, "[camera]\neye = [0.0, 1.0, 3.0]\ntarget = [0.0, 0.0, 0.0]\nzoom = 2\n").unwrap();
@@ -119,8 +107,7 @@ fn help_is_everywhere() {
 
 #[test]
 fn exr_and_exitance_exports_are_complete_files() {
-    let dir = std::env::temp_dir().join(format!("translucent-cli-exports-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = temp_dir("cli-exports");
     let (png, exr, ply) = (dir.join("a.png"), dir.join("a.exr"), dir.join("a.ply"));
     let out = translucent(
         &[

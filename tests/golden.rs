@@ -6,23 +6,15 @@
 
 mod common;
 
-use common::with_gpu;
-use std::path::PathBuf;
-use translucent::render::plan::Change;
-use translucent::render::renderer::Renderer;
-use translucent::scene::Scene;
-use translucent::scene::build::{Overrides, PreparedScene};
+use common::{builtin, repo_path, run_all, with_gpu};
+use translucent::scene::build::Overrides;
 
 #[test]
 fn default_scene_matches_the_golden_image() {
-    let golden = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden/default-256.png");
+    let golden = repo_path("tests/golden/default-256.png");
     let (rgba, non_finite) = with_gpu(|gpu| {
         let overrides = Overrides { resolution: Some([256, 256]), ..Default::default() };
-        let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
-        let mut renderer = Renderer::new(gpu, prepared).unwrap();
-        let plan = renderer.plan(Change::Everything);
-        renderer.frame(&plan).unwrap();
-        renderer.image().unwrap()
+        run_all(gpu, builtin(&overrides)).image().unwrap()
     });
     assert_eq!(non_finite, 0, "{non_finite} NaN or infinite pixels before tone mapping");
     if std::env::var("TRANSLUCENT_BLESS").is_ok_and(|v| v == "1") {

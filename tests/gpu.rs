@@ -175,7 +175,7 @@ fn device_info_names_the_device() {
 fn validation_counts_a_leaked_object() {
     // The machinery every other test relies on: a VkBuffer left alive when the device is
     // destroyed must be reported and counted.
-    let gpu = translucent::gpu::Gpu::new(&translucent::gpu::GpuOptions { validation: true, ..Default::default() })
+    let gpu = translucent::gpu::Gpu::new(&common::validated_options())
         .expect("a Vulkan device with validation layers (run `bash scripts/setup`)");
     let counters = gpu.validation();
     let info = vk::BufferCreateInfo::default().size(256).usage(vk::BufferUsageFlags::STORAGE_BUFFER);

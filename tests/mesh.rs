@@ -1,6 +1,9 @@
 //! Mesh loading, validation and derived geometry: curvature against analytic surfaces, topology
 //! counts, and clear errors for bad OBJ files.
 
+mod common;
+
+use common::{grid, load_asset, temp_dir};
 use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -99,34 +102,6 @@ fn torus(big: f64, small: f64, nu: usize, nv: usize) -> (Vec<Vec3>, Vec<[u32; 3]
     (pos, tris, angle_v)
 }
 
-/// A flat n x n grid in the unit square, optionally jittered in-plane, then placed by `m`.
-fn plane(n: usize, jitter: f64, m: Mat4) -> (Vec<Vec3>, Vec<[u32; 3]>) {
-    let mut pos = Vec::new();
-    let mut state = 12345u64;
-    let mut rnd = || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
-    let h = 1.0 / (n - 1) as f64;
-    for i in 0..n {
-        for j in 0..n {
-            let interior = i > 0 && j > 0 && i < n - 1 && j < n - 1;
-            let (dx, dy) = if interior { (rnd() * jitter * h, rnd() * jitter * h) } else { (0.0, 0.0) };
-            let p = Vec3::new((i as f64 * h + dx) as f32, (j as f64 * h + dy) as f32, 0.0);
-            pos.push(m.transform_point3(p));
-        }
-    }
-    let id = |i: usize, j: usize| (i * n + j) as u32;
-    let mut tris = Vec::new();
-    for i in 0..n - 1 {
-        for j in 0..n - 1 {
-            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    (pos, tris)
-}
-
 #[test]
 fn sphere_curvature_within_two_percent() {
     let radius = 2.0;
@@ -176,7 +151,7 @@ fn plane_curvature_is_zero_everywhere() {
     // In the z = 0 plane, with jittered interior vertices (irregular, some obtuse triangles): the
     // Laplacian has no normal component and the angles around each vertex sum to 2 pi, so both
     // curvatures vanish up to f64 rounding, boundary vertices included.
-    let (pos, tris) = plane(60, 0.4, Mat4::IDENTITY);
+    let (pos, tris) = grid(60, 0.4, Mat4::IDENTITY);
     let mesh = Mesh::from_triangles(pos, tris).unwrap();
     let r = mesh.report();
     assert_eq!(r.boundary_edges, 4 * 59);
@@ -198,7 +173,7 @@ fn tilted_plane_curvature_is_zero_up_to_f32_rounding() {
     // 1e-4. Far below the curvature of anything the size of the plane (about 1).
     let m = Mat4::from_translation(Vec3::new(0.3, -0.2, 0.1))
         * Mat4::from_axis_angle(Vec3::new(1.0, 2.0, 0.5).normalize(), 0.7);
-    let (pos, tris) = plane(60, 0.4, m);
+    let (pos, tris) = grid(60, 0.4, m);
     let mesh = Mesh::from_triangles(pos, tris).unwrap();
     let h = max_abs(mesh.mean_curvature());
     let k = max_abs(mesh.gaussian_curvature());
@@ -294,7 +269,7 @@ fn check_adjacency(mesh: &Mesh) -> usize {
 
 #[test]
 fn edge_adjacency_is_symmetric_and_shares_vertices() {
-    let mesh = Mesh::load(asset("bunny-1.8k.obj"), &LoadOptions::default()).unwrap();
+    let mesh = load_asset("bunny-1.8k.obj");
     assert_eq!(check_adjacency(&mesh), 0);
     assert!(mesh.vertex_neighbours(0).windows(2).all(|w| w[0] < w[1]));
 
@@ -314,13 +289,9 @@ fn edge_adjacency_is_symmetric_and_shares_vertices() {
     }
 }
 
-fn asset(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets").join(name)
-}
-
 #[test]
 fn bunnies_load_with_their_documented_sizes() {
-    let big = Mesh::load(asset("bunny-37k.obj"), &LoadOptions::default()).unwrap();
+    let big = load_asset("bunny-37k.obj");
     assert_eq!(big.positions().len(), 37_706);
     assert_eq!(big.triangles().len(), 75_408);
     assert!(big.report().is_closed_manifold(), "{:?}", big.report());
@@ -332,7 +303,7 @@ fn bunnies_load_with_their_documented_sizes() {
     assert!((total_k - 4.0 * PI).abs() < 1e-6, "sum K A = {total_k}");
     assert!(big.vertex_normals().iter().all(|n| (n.length() - 1.0).abs() < 1e-5));
 
-    let small = Mesh::load(asset("bunny-1.8k.obj"), &LoadOptions::default()).unwrap();
+    let small = load_asset("bunny-1.8k.obj");
     // Closed after all (Euler characteristic 1,839 - 5,511 + 3,674 = 2), the base included.
     assert_eq!(small.positions().len(), 1_839);
     assert_eq!(small.triangles().len(), 3_674);
@@ -402,14 +373,6 @@ fn memory_meshes_are_validated() {
 
 // ---------------------------------------------------------------------------------------------
 // OBJ files
-
-/// A fresh directory under the system temp dir for one test.
-fn temp_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("translucent-mesh-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn write_obj(dir: &std::path::Path, name: &str, text: &str) -> PathBuf {
     let path = dir.join(name);

@@ -4,6 +4,8 @@
 //!
 //! Run `cargo test --test optics -- --nocapture` to see the tables the tests print.
 
+mod common;
+
 use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -609,11 +611,7 @@ fn bad_input_is_refused_with_the_value_named() {
 // ---------------------------------------------------------------- the CLI
 
 fn cli(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_translucent"))
-        .arg("material")
-        .args(args)
-        .output()
-        .expect("the translucent binary runs")
+    common::subcommand("material", args)
 }
 
 #[test]

@@ -2,14 +2,13 @@
 
 mod common;
 
-use common::with_gpu;
-use translucent::optics::{Material, fresnel, kernel};
+use common::{builtin, gather_from, run_all, with_gpu};
+use translucent::optics::{Material, fresnel};
 use translucent::reference;
 use translucent::render::plan::{Change, Pass};
-use translucent::render::records::SplatRecord;
 use translucent::render::renderer::Renderer;
-use translucent::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
-use translucent::scene::{Scene, lights};
+use translucent::scene::build::{Overrides, PreparedScene};
+use translucent::scene::{GatherMode, Scene, lights};
 
 fn prepare(toml: &str, overrides: &Overrides) -> PreparedScene {
     let scene = Scene::parse(toml, "test scene", None).expect("test scene parses");
@@ -45,22 +44,15 @@ count = {samples}
     )
 }
 
-fn run_all(gpu: &std::sync::Arc<translucent::gpu::Gpu>, prepared: PreparedScene) -> Renderer {
-    let mut renderer = Renderer::new(gpu, prepared).expect("renderer");
-    let plan = renderer.plan(Change::Everything);
-    renderer.frame(&plan).expect("frame");
-    renderer
-}
-
 #[test]
 fn uniformly_lit_plane_reflects_total_diffuse_reflectance() {
     with_gpu(|gpu| {
         let cases = ["marble", "skimmilk", "ketchup", "spectralon"]
-            .map(|p| (p, "vertex"))
+            .map(|p| (p, GatherMode::Vertex))
             .into_iter()
-            .chain([("marble", "sparse"), ("skimmilk", "sparse")]);
+            .chain([("marble", GatherMode::Sparse), ("skimmilk", GatherMode::Sparse)]);
         for (preset, gather) in cases {
-            let overrides = Overrides { gather: Some(gather.into()), ..Default::default() };
+            let overrides = Overrides { gather: Some(gather), ..Default::default() };
             let prepared = prepare(&plane_scene(preset, 1000.0, 3000, ""), &overrides);
             let material = Material::preset(preset).unwrap();
             let dipoles = material.dipoles(1.0).unwrap();
@@ -89,17 +81,11 @@ fn uniformly_lit_plane_reflects_total_diffuse_reflectance() {
 fn gather_matches_the_f64_reference_on_the_default_scene() {
     with_gpu(|gpu| {
         let overrides = Overrides { resolution: Some([64, 64]), ..Default::default() };
-        let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+        let prepared = builtin(&overrides);
         let occluders = reference::occluders(&prepared);
         let irradiance = reference::splat(&prepared, &occluders);
         let expected = reference::gather(&prepared, &irradiance);
-        let mut renderer = Renderer::new(gpu, prepared).unwrap();
-        let as_f32: Vec<[f32; 3]> = irradiance.iter().map(|e| e.map(|v| v as f32)).collect();
-        set_splat_irradiance(&mut renderer, &as_f32);
-        let mut plan = renderer.plan(Change::Everything);
-        plan.passes.retain(|(p, _)| *p == Pass::Gather);
-        renderer.frame(&plan).unwrap();
-        let got = renderer.exitance(0).unwrap();
+        let got = gather_from(gpu, prepared, &irradiance);
         let peak = expected[0].iter().flat_map(|m| m.iter()).fold(0.0f64, |a, b| a.max(*b));
         let mut worst = 0.0f64;
         for (g, e) in got.iter().zip(&expected[0]) {
@@ -118,7 +104,7 @@ fn gather_matches_the_f64_reference_on_the_default_scene() {
 fn splat_visibility_matches_ray_casting() {
     with_gpu(|gpu| {
         let overrides = Overrides { resolution: Some([64, 64]), ..Default::default() };
-        let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+        let prepared = builtin(&overrides);
         let occluders = reference::occluders(&prepared);
         let expected = reference::splat(&prepared, &occluders);
         let renderer = run_all(gpu, prepared);
@@ -272,7 +258,7 @@ count = 1500
 fn moving_one_light_redraws_only_its_shadows_and_matches_a_full_render() {
     with_gpu(|gpu| {
         let overrides = Overrides { resolution: Some([64, 64]), ..Default::default() };
-        let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+        let prepared = builtin(&overrides);
         // A: full first frame, then the key light orbits and only its layer is redrawn.
         let mut a = Renderer::new(gpu, prepared.clone()).unwrap();
         a.frame(&a.plan(Change::Everything)).unwrap();
@@ -288,7 +274,7 @@ fn moving_one_light_redraws_only_its_shadows_and_matches_a_full_render() {
         assert_eq!(sa, sb, "partial shadow redraw differs from a full one");
         assert_eq!(a.image().unwrap(), b.image().unwrap());
         // And the light really moved: the splat differs from the unmoved scene's.
-        let mut c = Renderer::new(gpu, PreparedScene::new(&Scene::builtin(), &overrides).unwrap()).unwrap();
+        let mut c = Renderer::new(gpu, builtin(&overrides)).unwrap();
         c.frame(&c.plan(Change::Everything)).unwrap();
         assert_ne!(c.splat_irradiance().unwrap(), sa);
     });
@@ -299,19 +285,18 @@ fn pixel_gather_agrees_with_the_vertex_gather() {
     // Per-pixel exitance is exact where vertex exitance is interpolated; on the 37.7k-vertex
     // bunny the two pictures must agree closely, and the pixel mode must follow the camera.
     with_gpu(|gpu| {
-        let image = |gather: &str| {
-            let overrides =
-                Overrides { resolution: Some([128, 128]), gather: Some(gather.into()), ..Default::default() };
-            let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+        let image = |gather: GatherMode| {
+            let overrides = Overrides { resolution: Some([128, 128]), gather: Some(gather), ..Default::default() };
+            let prepared = builtin(&overrides);
             let mut renderer = Renderer::new(gpu, prepared).unwrap();
             renderer.frame(&renderer.plan(Change::Everything)).unwrap();
             let plan = renderer.plan(Change::Camera);
-            assert_eq!(plan.runs(Pass::Gather), gather == "pixel", "{gather}: {plan}");
+            assert_eq!(plan.runs(Pass::Gather), gather == GatherMode::Pixel, "{gather}: {plan}");
             let (rgba, non_finite) = renderer.image().unwrap();
             assert_eq!(non_finite, 0);
             rgba
         };
-        let (vertex, pixel) = (image("vertex"), image("pixel"));
+        let (vertex, pixel) = (image(GatherMode::Vertex), image(GatherMode::Pixel));
         let mean = vertex.iter().zip(&pixel).map(|(a, b)| a.abs_diff(*b) as f64).sum::<f64>() / vertex.len() as f64;
         let worst = vertex.iter().zip(&pixel).map(|(a, b)| a.abs_diff(*b)).max().unwrap();
         eprintln!("pixel vs vertex gather: mean difference {mean:.3}/255, worst {worst}/255");
@@ -322,19 +307,14 @@ fn pixel_gather_agrees_with_the_vertex_gather() {
 #[test]
 fn sparse_gather_matches_its_reference_and_stays_close_to_the_vertex_gather() {
     with_gpu(|gpu| {
-        let overrides = Overrides { resolution: Some([64, 64]), gather: Some("sparse".into()), ..Default::default() };
-        let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+        let overrides =
+            Overrides { resolution: Some([64, 64]), gather: Some(GatherMode::Sparse), ..Default::default() };
+        let prepared = builtin(&overrides);
         let occluders = reference::occluders(&prepared);
         let irradiance = reference::splat(&prepared, &occluders);
         let sparse = reference::gather_sparse(&prepared, &irradiance);
         let full = reference::gather(&prepared, &irradiance);
-        let mut renderer = Renderer::new(gpu, prepared).unwrap();
-        let as_f32: Vec<[f32; 3]> = irradiance.iter().map(|e| e.map(|v| v as f32)).collect();
-        set_splat_irradiance(&mut renderer, &as_f32);
-        let mut plan = renderer.plan(Change::Everything);
-        plan.passes.retain(|(p, _)| *p == Pass::Gather);
-        renderer.frame(&plan).unwrap();
-        let got = renderer.exitance(0).unwrap();
+        let got = gather_from(gpu, prepared, &irradiance);
         let peak = full[0].iter().flat_map(|m| m.iter()).fold(0.0f64, |a, b| a.max(*b));
         let rel = |a: f64, b: f64| (a - b).abs() / b.max(1e-3 * peak);
         let mut worst_gpu = 0.0f64;
@@ -357,25 +337,6 @@ fn sparse_gather_matches_its_reference_and_stays_close_to_the_vertex_gather() {
         assert!(worst_gpu < 0.01, "GPU sparse gather vs its f64 reference: {worst_gpu}");
         assert!(mean_dev < 0.03, "sparse gather strays {:.2}% on average from the vertex gather", 100.0 * mean_dev);
     });
-}
-
-/// Replace the splat output by `irradiance` (RGB per sample, scene order) with the near energies
-/// computed on the CPU, so the gather gets the same input as the reference.
-fn set_splat_irradiance(renderer: &mut Renderer, irradiance: &[[f32; 3]]) {
-    let mut records = Vec::with_capacity(irradiance.len());
-    for o in &renderer.scene().objects {
-        for s in &o.samples {
-            let near = match &o.material {
-                ResolvedMaterial::Translucent { dipoles, .. } => {
-                    let b = kernel::B_PER_SQRT_AREA * s.area.sqrt();
-                    [0, 1, 2].map(|c| kernel::near_energy(&dipoles[c], b) as f32)
-                }
-                ResolvedMaterial::Opaque { .. } => [0.0; 3],
-            };
-            records.push(SplatRecord::new(irradiance[records.len()], s.area as f32, near));
-        }
-    }
-    renderer.buffers_mut().splat.write(0, &records).unwrap();
 }
 
 /// Turn scene light `index` by `degrees` about the vertical axis through the scene's centre.

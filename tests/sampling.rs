@@ -2,33 +2,31 @@
 //! curvature-following density, unbiased integrals, hard inputs, and the `translucent sample`
 //! command.
 
+mod common;
+
+use common::{asset, load_asset, temp_dir};
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 use std::sync::OnceLock;
 
-use glam::{DVec3, Vec3};
-use translucent::mesh::{LoadOptions, Mesh, MeshError};
+use glam::{DVec3, Mat4, Vec3};
+use translucent::mesh::{Mesh, MeshError};
 use translucent::sampling::feature::{feature_point_count, feature_points};
 use translucent::sampling::walk::walk;
 use translucent::sampling::weights::{WeightParams, area_weights};
 use translucent::sampling::{
-    GpuSample, MAX_COUNT, Method, SampleOptions, SampleSet, SamplingError, SpatialHash, SurfacePoint,
-    nearest_neighbour_distances, sample,
+    MAX_COUNT, Method, SampleOptions, SampleSet, SamplingError, SpatialHash, SurfacePoint, nearest_neighbour_distances,
+    sample,
 };
-
-fn asset(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets").join(name)
-}
 
 fn bunny() -> &'static Mesh {
     static MESH: OnceLock<Mesh> = OnceLock::new();
-    MESH.get_or_init(|| Mesh::load(asset("bunny-37k.obj"), &LoadOptions::default()).unwrap())
+    MESH.get_or_init(|| load_asset("bunny-37k.obj"))
 }
 
 fn small_bunny() -> &'static Mesh {
     static MESH: OnceLock<Mesh> = OnceLock::new();
-    MESH.get_or_init(|| Mesh::load(asset("bunny-1.8k.obj"), &LoadOptions::default()).unwrap())
+    MESH.get_or_init(|| load_asset("bunny-1.8k.obj"))
 }
 
 fn run(mesh: &Mesh, method: Method, n: usize, seed: u64) -> SampleSet {
@@ -285,21 +283,7 @@ fn spatial_hash_agrees_with_brute_force() {
 #[test]
 fn walking_follows_the_surface_across_edges() {
     // Flat: the walk ends where a straight line ends, across many triangles.
-    let n = 12;
-    let mut pos = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            pos.push(Vec3::new(i as f32 / (n - 1) as f32, j as f32 / (n - 1) as f32, 0.0));
-        }
-    }
-    let id = |i: usize, j: usize| (i * n + j) as u32;
-    let mut tris = Vec::new();
-    for i in 0..n - 1 {
-        for j in 0..n - 1 {
-            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
+    let (pos, tris) = common::grid(12, 0.0, Mat4::IDENTITY);
     let grid = Mesh::from_triangles(pos, tris).unwrap();
     let start = SurfacePoint { triangle: 0, bary: [0.6, 0.3, 0.1] };
     let p0 = start.position(&grid);
@@ -438,24 +422,6 @@ fn zero_count_too_many_and_no_area_are_clear_errors() {
 }
 
 #[test]
-fn gpu_records_have_a_pinned_std430_layout() {
-    assert_eq!(std::mem::size_of::<GpuSample>(), 32);
-    assert_eq!(std::mem::offset_of!(GpuSample, position), 0);
-    assert_eq!(std::mem::offset_of!(GpuSample, area), 12);
-    assert_eq!(std::mem::offset_of!(GpuSample, normal), 16);
-    assert_eq!(std::mem::offset_of!(GpuSample, pad), 28);
-    let set = run(small_bunny(), Method::Turk, 10, 0);
-    let records = set.gpu_records();
-    let floats: &[f32] = bytemuck::cast_slice(&records);
-    assert_eq!(floats.len(), 80);
-    for (k, p) in set.points.iter().enumerate() {
-        assert_eq!(&floats[k * 8..k * 8 + 3], &p.position.to_array());
-        assert_eq!(floats[k * 8 + 3], p.area as f32);
-        assert_eq!(&floats[k * 8 + 4..k * 8 + 7], &p.normal.to_array());
-    }
-}
-
-#[test]
 fn methods_parse_from_their_names() {
     for m in Method::ALL {
         assert_eq!(m.name().parse::<Method>().unwrap(), m);
@@ -466,15 +432,8 @@ fn methods_parse_from_their_names() {
 // ---------------------------------------------------------------------------------------------
 // The command line
 
-fn temp_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("translucent-sampling-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 fn cli(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_translucent")).arg("sample").args(args).output().unwrap()
+    common::subcommand("sample", args)
 }
 
 fn leftovers(dir: &Path) -> Vec<String> {

@@ -1,6 +1,7 @@
 //! The scene format: the built-in scene parses; mistakes name the key path and line.
 
-use translucent::scene::{Light, MaterialSpec, Scene, SceneError, Shape};
+use translucent::sampling::Method;
+use translucent::scene::{GatherMode, Light, MaterialSpec, Scene, SceneError, Shape};
 
 fn error_of(text: &str) -> String {
     match Scene::parse(text, "test.toml", None) {
@@ -41,8 +42,8 @@ fn builtin_scene_is_the_marble_bunny() {
 fn defaults_fill_what_is_left_out() {
     let scene = Scene::parse(MINIMAL, "test.toml", None).unwrap();
     assert_eq!(scene.file.camera.resolution, [512, 512]);
-    assert_eq!(scene.file.sampling.method, "turk");
-    assert_eq!(scene.file.render.gather, "vertex");
+    assert_eq!(scene.file.sampling.method, Method::Turk);
+    assert_eq!(scene.file.render.gather, GatherMode::Vertex);
 }
 
 #[test]

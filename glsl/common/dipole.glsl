@@ -41,7 +41,8 @@ float dipole_fresnel_transmittance(float cos_theta_i, float eta) {
     return 1.0 - dipole_fresnel_reflectance(cos_theta_i, eta);
 }
 
-// Diffuse Fresnel reflectance fits (Jensen et al. 2001 after Egan & Hilgeman; DESIGN.md),
+// Diffuse Fresnel reflectance fits (Jensen et al. 2001 after Egan & Hilgeman; docs/optics.md,
+// "Per colour channel"),
 // the same polynomials expanded about eta = 1, where their terms cancel to 0.0016 (see F_dr in
 // fresnel.rs).
 float dipole_F_dr(float eta) {
@@ -99,7 +100,8 @@ float dipole_r_d(DipoleChannel ch, float r) {
 }
 
 // Total diffuse reflectance (alpha'/2)(e^(-sigma_tr z_r) + e^(-sigma_tr z_v)), which is the closed
-// form of DESIGN.md since sigma_tr z_r = sqrt(3(1 - alpha')) and z_v = z_r (1 + 4A/3).
+// form of R_d,total in docs/optics.md ("Reflectance profile, its integrals, and the BSSRDF")
+// since sigma_tr z_r = sqrt(3(1 - alpha')) and z_v = z_r (1 + 4A/3).
 float dipole_r_d_total(DipoleChannel ch) {
     return 0.5 * ch.alpha_prime * (exp(-ch.sigma_tr * ch.z_r) + exp(-ch.sigma_tr * ch.z_v));
 }
@@ -119,7 +121,8 @@ float dipole_r_d_ring_sq(DipoleChannel ch, float r1_sq, float delta_sq) {
          + dipole_ring_term(ch.z_v, ch.sigma_tr, r1_sq, delta_sq));
 }
 
-// Exact disk integral P(R) of R_d (DESIGN.md).
+// Exact disk integral P(R) of R_d (docs/optics.md, "Reflectance profile, its integrals, and the
+// BSSRDF").
 float dipole_r_d_disk(DipoleChannel ch, float radius) {
     return dipole_r_d_ring_sq(ch, 0.0, radius * radius);
 }

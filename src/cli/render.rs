@@ -8,8 +8,9 @@ use translucent::gpu::{Gpu, median};
 use translucent::output;
 use translucent::render::plan::Change;
 use translucent::render::renderer::Renderer;
+use translucent::sampling::Method;
 use translucent::scene::build::{Overrides, PreparedScene};
-use translucent::scene::{Light, Scene, lights};
+use translucent::scene::{GatherMode, Light, Scene, lights};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -24,25 +25,21 @@ pub struct Args {
     /// Sample points per translucent object (overrides the scene)
     #[arg(long)]
     pub samples: Option<usize>,
-    /// Sampler: random, turk, feature or poisson (overrides the scene)
-    #[arg(long)]
-    pub sampler: Option<String>,
-    /// Where exitance is gathered: vertex, pixel, or sparse (at the samples, blended to the
-    /// vertices) (overrides the scene)
-    #[arg(long)]
-    pub gather: Option<String>,
+    /// Sampler (overrides the scene)
+    #[arg(long, value_enum)]
+    pub sampler: Option<Method>,
+    /// Where exitance is gathered (overrides the scene)
+    #[arg(long, value_enum)]
+    pub gather: Option<GatherMode>,
     /// Image size WIDTHxHEIGHT (overrides the scene)
     #[arg(long, value_parser = parse_resolution)]
     pub resolution: Option<[u32; 2]>,
     /// Frames to render; after the first, each frame recomputes what `--moving` invalidates
     #[arg(long, default_value_t = 1)]
     pub frames: u32,
-    /// What each frame after the first recomputes: `light` (the first non-environment light
-    /// orbits 3 degrees a frame: its shadow maps, splat, gather, shade), `lights` (as if every
-    /// light changed: all shadow maps too) or `camera` (as if the camera moved: shading only,
-    /// plus the gather in pixel mode; the view itself stays put)
-    #[arg(long, default_value = "light")]
-    pub moving: String,
+    /// What each frame after the first recomputes
+    #[arg(long, value_enum, default_value_t = Moving::Light)]
+    pub moving: Moving,
     /// Submit each pass separately and time it from submission to fence (wall clock), for
     /// devices whose timestamps do not wait for asynchronous compute (lavapipe)
     #[arg(long)]
@@ -58,6 +55,17 @@ pub struct Args {
     pub export_exitance: Option<PathBuf>,
 }
 
+/// What changes between frames (`--moving`).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Moving {
+    /// The first non-environment light orbits 3 degrees a frame: its shadow maps, splat, gather, shade
+    Light,
+    /// As if every light changed: all shadow maps too
+    Lights,
+    /// As if the camera moved: shading only, plus the gather in pixel mode; the view itself stays put
+    Camera,
+}
+
 impl Default for Args {
     fn default() -> Self {
         Args {
@@ -69,7 +77,7 @@ impl Default for Args {
             gather: None,
             resolution: None,
             frames: 1,
-            moving: "light".into(),
+            moving: Moving::Light,
             isolate: false,
             timings: false,
             plan: false,
@@ -96,9 +104,6 @@ fn parse_resolution(s: &str) -> Result<[u32; 2], String> {
 }
 
 pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
-    if !["light", "lights", "camera"].contains(&args.moving.as_str()) {
-        bail!("--moving {:?} is not light, lights or camera", args.moving);
-    }
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
@@ -106,12 +111,8 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         Some(path) => Scene::load(path)?,
         None => Scene::builtin(),
     };
-    let overrides = Overrides {
-        samples: args.samples,
-        sampler: args.sampler.clone(),
-        gather: args.gather.clone(),
-        resolution: args.resolution,
-    };
+    let overrides =
+        Overrides { samples: args.samples, sampler: args.sampler, gather: args.gather, resolution: args.resolution };
     let spinner = ProgressBar::new_spinner().with_message(format!("preparing {} (meshes, sample points)", scene.name));
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
     let prepared = PreparedScene::new(&scene, &overrides);
@@ -129,8 +130,8 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     );
     let [width, height] = prepared.scene.file.camera.resolution;
     let mut renderer = Renderer::new(&gpu, prepared).context("creating GPU resources")?;
-    let moving = match args.moving.as_str() {
-        "light" => {
+    let moving = match args.moving {
+        Moving::Light => {
             let key = renderer.scene().scene.file.lights.iter().position(|l| !matches!(l, Light::Environment { .. }));
             match key {
                 Some(i) => Change::Light(i),
@@ -138,8 +139,8 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
                 None => Change::Lights,
             }
         }
-        "lights" => Change::Lights,
-        _ => Change::Camera,
+        Moving::Lights => Change::Lights,
+        Moving::Camera => Change::Camera,
     };
 
     let progress = if args.frames > 1 {

@@ -9,36 +9,13 @@ use indicatif::ProgressBar;
 use translucent::mesh::{LoadOptions, Mesh};
 use translucent::sampling::{self, Method, SampleOptions, SamplePoint, SampleStats};
 
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MethodArg {
-    /// Uniform by area
-    Random,
-    /// Turk's point repulsion (1992)
-    Turk,
-    /// The seed paper's geometric feature sampling (Algorithm 1, Eq. 12), then curvature-adaptive repulsion
-    Feature,
-    /// Poisson-disk blue noise by sample elimination (Yuksel 2015)
-    Poisson,
-}
-
-impl From<MethodArg> for Method {
-    fn from(m: MethodArg) -> Method {
-        match m {
-            MethodArg::Random => Method::Random,
-            MethodArg::Turk => Method::Turk,
-            MethodArg::Feature => Method::Feature,
-            MethodArg::Poisson => Method::Poisson,
-        }
-    }
-}
-
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// Mesh to sample (Wavefront OBJ)
     pub mesh: PathBuf,
     /// Placement method
     #[arg(long, value_enum)]
-    pub method: MethodArg,
+    pub method: Method,
     /// Number of sample points
     #[arg(long, short = 'n')]
     pub count: usize,
@@ -82,7 +59,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mesh = Mesh::load(&args.mesh, &LoadOptions::default().with_scale(args.scale))?;
     let load_seconds = t0.elapsed().as_secs_f64();
 
-    let mut options = SampleOptions::new(args.method.into(), args.count).with_seed(args.seed);
+    let mut options = SampleOptions::new(args.method, args.count).with_seed(args.seed);
     if let Some(it) = args.iterations {
         options.turk.iterations = it;
         options.feature.turk.iterations = it;

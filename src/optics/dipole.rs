@@ -1,6 +1,7 @@
 //! The dipole: per colour channel, the derived quantities and the diffuse reflectance profile
 //! `R_d(r)` (seed Eq. 8, from Jensen et al. 2001), its exact disk and ring integrals
-//! (DESIGN.md, "The dipole model"), its total, and the BSSRDF `S_d` (seed Eq. 9).
+//! (docs/optics.md, "Reflectance profile, its integrals, and the BSSRDF"), its total, and the
+//! BSSRDF `S_d` (seed Eq. 9).
 //!
 //! Lengths are in scene units and coefficients per scene unit; [`crate::optics::Material`]
 //! converts from 1/mm with the scene scale.
@@ -101,7 +102,8 @@ impl Dipole {
     }
 
     /// Total diffuse reflectance `R_d,total = integral R_d(r) 2 pi r dr` in closed form
-    /// (DESIGN.md; Jensen and Buhler 2002 use it to map reflectance to albedo):
+    /// (docs/optics.md, "Reflectance profile, its integrals, and the BSSRDF"; Jensen and Buhler
+    /// 2002 use it to map reflectance to albedo):
     /// `(alpha'/2) (1 + e^(-(4/3) A sqrt(3(1-alpha')))) e^(-sqrt(3(1-alpha')))`.
     /// Exactly `alpha' = 1` without absorption.
     pub fn r_d_total(&self) -> f64 {
@@ -109,7 +111,8 @@ impl Dipole {
         0.5 * self.alpha_prime * (1.0 + (-4.0 / 3.0 * self.A * s).exp()) * (-s).exp()
     }
 
-    /// Exact disk integral `P(R) = integral_0^R R_d(r) 2 pi r dr` (DESIGN.md):
+    /// Exact disk integral `P(R) = integral_0^R R_d(r) 2 pi r dr` (docs/optics.md,
+    /// "Reflectance profile, its integrals, and the BSSRDF"):
     /// `(alpha'/2) sum_{z in z_r, z_v} [e^(-sigma_tr z) - z e^(-sigma_tr d(R)) / d(R)]`.
     /// Rises monotonically from 0 to [`Self::r_d_total`]. Evaluated without cancellation (see
     /// [`ring_term`]), so it is accurate even for `R` far below `z_r`.
@@ -193,7 +196,8 @@ impl Dipole {
 
 /// One pole's share of a ring integral of `R_d`, without the factor `alpha'/2`:
 /// `z [e^(-s d1)/d1 - e^(-s d2)/d2]` with `d_i = sqrt(r_i^2 + z^2)` (from
-/// `d/dr [e^(-s d)/d] = -(s + 1/d) e^(-s d) r / d^2`, DESIGN.md).
+/// `d/dr [e^(-s d)/d] = -(s + 1/d) e^(-s d) r / d^2`; docs/optics.md, "Reflectance profile, its
+/// integrals, and the BSSRDF").
 ///
 /// The difference cancels catastrophically for thin rings and for disks much smaller than `z`.
 /// Rewritten as `(z/d1) e^(-s d1) [(d2 - d1)/d2 + (d1/d2)(1 - e^(-s (d2 - d1)))]`, with

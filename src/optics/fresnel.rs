@@ -42,7 +42,7 @@ pub fn fresnel_transmittance(cos_theta_i: f64, eta: f64) -> f64 {
 }
 
 /// Diffuse Fresnel reflectance `F_dr`: the polynomial fits used by Jensen et al. 2001 (after Egan
-/// & Hilgeman 1979), as given in DESIGN.md:
+/// & Hilgeman 1979), as docs/optics.md gives them ("Per colour channel"):
 /// `eta >= 1`: `-1.440/eta^2 + 0.710/eta + 0.668 + 0.0636 eta`;
 /// `eta < 1`: `-0.4399 + 0.7099/eta - 0.3319/eta^2 + 0.0636/eta^3`.
 /// `eta` is the relative index of the material (inside over outside). The fits are not exactly

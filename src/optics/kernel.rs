@@ -28,10 +28,11 @@
 //!   diffusion length are (the plane test measures at most 2.1e-4). The combination `2 R_b - R_{sqrt2 b}` (Richardson in `b^2`) cancels the
 //!   `O(b^2)` change, so `R_far = R_d (1 + O(b^4/r^4))` away from the footprint.
 //! - `integral R_b 2 pi r dr = (alpha'/2) sum_z z e^(-sigma_tr d1)/d1` by the same antiderivative
-//!   as the exact disk integral (DESIGN.md), so `E_near` is exact and closed-form. It is a second
-//!   difference of `z e^(-sigma_tr sqrt(D))/sqrt(D)` in `D`, which is completely monotone, so
-//!   `R_near >= 0` and `E_near >= 0`. When `b << z` it cancels catastrophically; there it is
-//!   evaluated as the integral of the second derivative ([`second_difference`]).
+//!   as the exact disk integral ([`crate::optics::Dipole::r_d_disk`]; docs/optics.md,
+//!   "Reflectance profile, its integrals, and the BSSRDF"), so `E_near` is exact and closed-form.
+//!   It is a second difference of `z e^(-sigma_tr sqrt(D))/sqrt(D)` in `D`, which is completely
+//!   monotone, so `R_near >= 0` and `E_near >= 0`. When `b << z` it cancels catastrophically;
+//!   there it is evaluated as the integral of the second derivative ([`second_difference`]).
 //! - `w` is the footprint: 1 inside, 0 outside, with a smoothstep edge of half-width
 //!   `BUMP_DELTA rho` centred so that `integral w 2 pi r dr = dA` exactly. It ends at
 //!   `1.244 rho`, short of any neighbour at the sample spacing (`>= 1.77 rho`), so each sample's

@@ -3,7 +3,7 @@
 //! Provenance:
 //! - [`JENSEN_2001`]: Jensen, Marschner, Levoy, Hanrahan, "A Practical Model for Subsurface Light
 //!   Transport", SIGGRAPH 2001, the table of measured parameters: `sigma_s'` and `sigma_a` in 1/mm
-//!   for R, G, B; eta 1.3, except marble 1.5 (as DESIGN.md gives them).
+//!   for R, G, B; eta 1.3, except marble 1.5 (as docs/optics.md, "Measured materials", gives them).
 //! - [`NARASIMHAN_2006`]: Narasimhan, Gupta, Donner, Ramamoorthi, Nayar, Jensen, "Acquiring
 //!   Scattering Properties of Participating Media by Dilution", SIGGRAPH 2006, in 1/mm, as pbrt-v3
 //!   lists them (src/core/medium.cpp), in the same `sigma_s'` column as Jensen's values; we use

@@ -14,7 +14,7 @@ use super::splat::SplatPass;
 use super::tonemap::TonemapPass;
 use super::vertex_light::VertexLightPass;
 use crate::gpu::{Access, Gpu, GpuError, GpuTimer, ShaderInterface};
-use crate::scene::Light;
+use crate::scene::{GatherMode, Light};
 use crate::scene::build::PreparedScene;
 use crate::scene::needs::SceneNeeds;
 use glam::Vec3;
@@ -74,7 +74,7 @@ impl Renderer {
         let shade = ShadePass::new(gpu, scene.scene.file.camera.resolution, &buffers, &shadow, needs.pixel_gather)?;
         let gather: Box<dyn RenderPass> = match shade.surface() {
             Some(surface) => Box::new(GatherPixelPass::new(gpu, &buffers, surface, shade.hdr())?),
-            None if settings.gather == "sparse" => Box::new(GatherSparsePass::new(gpu, &buffers)?),
+            None if settings.gather == GatherMode::Sparse => Box::new(GatherSparsePass::new(gpu, &buffers)?),
             None => Box::new(GatherPass::new(gpu, &buffers)?),
         };
         // Timing is optional: a queue without timestamps still renders.

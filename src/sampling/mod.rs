@@ -10,8 +10,6 @@
 //!
 //! Every point then gets the area of the surface nearer to it than to any other sample
 //! ([`weights`]), so the weights sum to the mesh area and follow the local density.
-//!
-//! For the GPU, [`SampleSet::gpu_records`] packs points as [`GpuSample`] (std430-compatible).
 
 pub mod feature;
 pub mod hash;
@@ -43,12 +41,18 @@ use crate::mesh::Mesh;
 /// typo cannot exhaust memory.
 pub const MAX_COUNT: usize = 1 << 24;
 
-/// How sample points are placed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// How sample points are placed: `sampling.method` in a scene, `--sampler` and `--method` on
+/// the command line (lowercase names in both).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
 pub enum Method {
+    /// Uniform by area
     Random,
+    /// Turk's point repulsion (1992)
     Turk,
+    /// The seed paper's geometric feature sampling (Algorithm 1, Eq. 12), then curvature-adaptive repulsion
     Feature,
+    /// Poisson-disk blue noise by sample elimination (Yuksel 2015)
     Poisson,
 }
 
@@ -67,7 +71,7 @@ impl Method {
 
 impl fmt::Display for Method {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
+        f.pad(self.name())
     }
 }
 
@@ -136,28 +140,6 @@ pub struct SamplePoint {
     pub area: f64,
 }
 
-/// A sample as the GPU reads it: std430 `struct Sample { vec4 position_area; vec4 normal_pad; }`,
-/// 32 bytes, the area in the w of the first vec4.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct GpuSample {
-    pub position: [f32; 3],
-    pub area: f32,
-    pub normal: [f32; 3],
-    pub pad: f32,
-}
-
-impl SamplePoint {
-    pub fn gpu(&self) -> GpuSample {
-        GpuSample {
-            position: self.position.to_array(),
-            area: self.area as f32,
-            normal: self.normal.to_array(),
-            pad: 0.0,
-        }
-    }
-}
-
 /// The result of a sampler.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SampleSet {
@@ -182,11 +164,6 @@ impl SampleSet {
 
     pub fn positions(&self) -> Vec<Vec3> {
         self.points.iter().map(|p| p.position).collect()
-    }
-
-    /// The points packed for a GPU storage buffer.
-    pub fn gpu_records(&self) -> Vec<GpuSample> {
-        self.points.iter().map(SamplePoint::gpu).collect()
     }
 }
 

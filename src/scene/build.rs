@@ -3,13 +3,22 @@
 //! prepared with shadow layers. Everything here is CPU work done once per scene.
 
 use super::lights::{self, Environment, PreparedLight};
-use super::{AssetSource, Light, MaterialSpec, Scene, Shape};
-use crate::mesh::{LoadOptions, Mesh};
+use super::{AssetSource, GatherMode, Light, MaterialSpec, Scene, SceneError, Shape};
+use crate::mesh::{LoadOptions, Mesh, MeshError};
 use crate::optics::{Dipole, Material};
 use crate::sampling::{self, Method, SampleOptions, SamplePoint};
-use anyhow::{Context, Result, bail};
 use glam::{EulerRot, Mat4, Quat, Vec3};
-use std::str::FromStr;
+
+/// `.with_context(|| where)`: wrap an error in [`SceneError::Context`].
+trait WithContext<T> {
+    fn with_context(self, context: impl FnOnce() -> String) -> Result<T, SceneError>;
+}
+
+impl<T, E: Into<SceneError>> WithContext<T> for Result<T, E> {
+    fn with_context(self, context: impl FnOnce() -> String) -> Result<T, SceneError> {
+        self.map_err(|e| SceneError::Context { context: context(), source: Box::new(e.into()) })
+    }
+}
 
 /// An object's material, resolved.
 #[derive(Clone, Debug)]
@@ -49,34 +58,30 @@ pub struct PreparedScene {
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
     pub samples: Option<usize>,
-    pub sampler: Option<String>,
-    pub gather: Option<String>,
+    pub sampler: Option<Method>,
+    pub gather: Option<GatherMode>,
     pub resolution: Option<[u32; 2]>,
 }
 
 impl PreparedScene {
-    pub fn new(scene: &Scene, overrides: &Overrides) -> Result<PreparedScene> {
+    pub fn new(scene: &Scene, overrides: &Overrides) -> Result<PreparedScene, SceneError> {
         let mut scene = scene.clone();
         if let Some(n) = overrides.samples {
             if n == 0 {
-                bail!("--samples must be at least 1");
+                return Err(SceneError::ZeroSamples);
             }
             scene.file.sampling.count = n;
         }
-        if let Some(m) = &overrides.sampler {
-            scene.file.sampling.method = m.clone();
+        if let Some(m) = overrides.sampler {
+            scene.file.sampling.method = m;
         }
-        if let Some(g) = &overrides.gather {
-            if !["vertex", "pixel", "sparse"].contains(&g.as_str()) {
-                bail!("--gather {g:?} is not vertex, pixel or sparse");
-            }
-            scene.file.render.gather = g.clone();
+        if let Some(g) = overrides.gather {
+            scene.file.render.gather = g;
         }
         if let Some(r) = overrides.resolution {
             scene.file.camera.resolution = r;
         }
-        let method = Method::from_str(&scene.file.sampling.method)
-            .map_err(|e| anyhow::anyhow!("{}: `sampling.method`: {e}", scene.name))?;
+        let method = scene.file.sampling.method;
 
         let mut objects = Vec::new();
         for (i, o) in scene.file.objects.iter().enumerate() {
@@ -139,8 +144,8 @@ impl PreparedScene {
             .map(|map| match map {
                 None => Ok(Environment::procedural_sky(128, 64)),
                 Some(path) => match scene.resolve(&path)? {
-                    AssetSource::File(p) => Environment::load(&p).map_err(anyhow::Error::msg),
-                    AssetSource::Embedded(_) => bail!("embedded environment maps are not supported"),
+                    AssetSource::File(p) => Ok(Environment::load(&p)?),
+                    AssetSource::Embedded(_) => Err(SceneError::EmbeddedEnvironment),
                 },
             })
             .transpose()
@@ -180,13 +185,13 @@ impl PreparedScene {
     }
 }
 
-fn load_shape(scene: &Scene, shape: &Shape) -> Result<(String, Mesh)> {
+fn load_shape(scene: &Scene, shape: &Shape) -> Result<(String, Mesh), SceneError> {
     match shape {
         Shape::Mesh { path } => {
             let mesh = match scene.resolve(path)? {
                 AssetSource::File(p) => Mesh::load(&p, &LoadOptions::default())?,
                 AssetSource::Embedded(bytes) => {
-                    let text = std::str::from_utf8(bytes).context("embedded mesh is not UTF-8")?;
+                    let text = std::str::from_utf8(bytes).map_err(SceneError::EmbeddedMeshNotUtf8)?;
                     Mesh::from_obj_text(text, path, &LoadOptions::default())?
                 }
             };
@@ -198,13 +203,13 @@ fn load_shape(scene: &Scene, shape: &Shape) -> Result<(String, Mesh)> {
 }
 
 /// Apply fit, scale, rotation (degrees, x then y then z) and translation, in that order.
-fn transform_mesh(mesh: Mesh, t: &super::Transform) -> Result<Mesh> {
+fn transform_mesh(mesh: Mesh, t: &super::Transform) -> Result<Mesh, SceneError> {
     let mut m = Mat4::IDENTITY;
     if let Some(fit) = t.fit {
         let (lo, hi) = mesh.bounds();
         let extent = (hi - lo).max_element();
         if extent.is_nan() || extent <= 0.0 {
-            bail!("cannot fit a mesh with an empty bounding box");
+            return Err(SceneError::EmptyBounds);
         }
         let centre = Vec3::new(0.5 * (lo.x + hi.x), lo.y, 0.5 * (lo.z + hi.z));
         m = Mat4::from_scale(Vec3::splat(fit / extent)) * Mat4::from_translation(-centre);
@@ -227,7 +232,7 @@ fn transform_mesh(mesh: Mesh, t: &super::Transform) -> Result<Mesh> {
 }
 
 /// A square in the xz plane at y = 0, facing +y.
-pub fn plane(size: f32, divisions: u32) -> Result<Mesh> {
+pub fn plane(size: f32, divisions: u32) -> Result<Mesh, MeshError> {
     let n = divisions as usize;
     let mut positions = Vec::with_capacity((n + 1) * (n + 1));
     for j in 0..=n {
@@ -246,11 +251,11 @@ pub fn plane(size: f32, divisions: u32) -> Result<Mesh> {
             triangles.push([at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)]);
         }
     }
-    Ok(Mesh::from_triangles(positions, triangles)?)
+    Mesh::from_triangles(positions, triangles)
 }
 
 /// A UV sphere centred at the origin (outward-facing).
-pub fn sphere(radius: f32, divisions: u32) -> Result<Mesh> {
+pub fn sphere(radius: f32, divisions: u32) -> Result<Mesh, MeshError> {
     let rings = divisions.max(3) as usize;
     let segments = 2 * rings;
     let mut positions = vec![Vec3::new(0.0, radius, 0.0)];
@@ -275,7 +280,7 @@ pub fn sphere(radius: f32, divisions: u32) -> Result<Mesh> {
             triangles.push([ring(r, s + 1), ring(r + 1, s + 1), ring(r + 1, s)]);
         }
     }
-    Ok(Mesh::from_triangles(positions, triangles)?)
+    Mesh::from_triangles(positions, triangles)
 }
 
 fn bounding_sphere<'a>(meshes: impl Iterator<Item = &'a Mesh>) -> (Vec3, f32) {

@@ -4,6 +4,7 @@
 //! Units: positions in scene units; a translucent material says how many millimetres one scene
 //! unit is (`mm_per_unit`), because its coefficients are per millimetre.
 
+use crate::sampling::Method;
 use serde::Deserialize;
 
 #[derive(Clone, Debug, Deserialize)]
@@ -183,7 +184,7 @@ fn env_directions() -> u32 {
 #[serde(deny_unknown_fields)]
 pub struct Sampling {
     #[serde(default = "method")]
-    pub method: String,
+    pub method: Method,
     #[serde(default = "count")]
     pub count: usize,
     #[serde(default = "seed")]
@@ -196,8 +197,8 @@ impl Default for Sampling {
     }
 }
 
-fn method() -> String {
-    "turk".into()
+fn method() -> Method {
+    Method::Turk
 }
 fn count() -> usize {
     400
@@ -209,11 +210,9 @@ fn seed() -> u64 {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RenderSettings {
-    /// Where exitance is gathered: `vertex` (at every mesh vertex, interpolated when shading),
-    /// `pixel` (at every visible pixel) or `sparse` (at the sample points, blended to the
-    /// vertices: fastest, smooths detail finer than the sample spacing).
-    #[serde(default = "gather")]
-    pub gather: String,
+    /// Where exitance is gathered.
+    #[serde(default)]
+    pub gather: GatherMode,
     /// Exposure multiplier applied before the tone map.
     #[serde(default = "one")]
     pub exposure: f32,
@@ -224,15 +223,42 @@ pub struct RenderSettings {
     pub background: Option<[f32; 3]>,
 }
 
-impl Default for RenderSettings {
-    fn default() -> Self {
-        Self { gather: gather(), exposure: 1.0, shadow_map_size: shadow_size(), background: None }
+/// Where exitance is gathered: `render.gather` in a scene, `--gather` on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum GatherMode {
+    /// At every mesh vertex, interpolated when shading
+    #[default]
+    Vertex,
+    /// At every visible pixel
+    Pixel,
+    /// At the sample points, blended to the vertices: fastest, smooths detail finer than the
+    /// sample spacing
+    Sparse,
+}
+
+impl GatherMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            GatherMode::Vertex => "vertex",
+            GatherMode::Pixel => "pixel",
+            GatherMode::Sparse => "sparse",
+        }
     }
 }
 
-fn gather() -> String {
-    "vertex".into()
+impl std::fmt::Display for GatherMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.name())
+    }
 }
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self { gather: GatherMode::default(), exposure: 1.0, shadow_map_size: shadow_size(), background: None }
+    }
+}
+
 fn shadow_size() -> u32 {
     1024
 }

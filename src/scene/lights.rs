@@ -19,6 +19,18 @@ pub struct Environment {
     pub radiance: Vec<Vec3>,
 }
 
+/// Why an environment map was refused; every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum EnvironmentError {
+    // The image error is the source (shown by `{:#}` and error reporters), not repeated here.
+    #[error("cannot read environment map {}", path.display())]
+    Read { path: std::path::PathBuf, source: image::ImageError },
+    #[error("environment map {} is only {width}x{height}", path.display())]
+    TooSmall { path: std::path::PathBuf, width: usize, height: usize },
+    #[error("environment map {} has a negative or non-finite texel", path.display())]
+    BadTexel { path: std::path::PathBuf },
+}
+
 impl Environment {
     /// The built-in sky: a blue zenith fading to a bright horizon; nothing from below the
     /// horizon (light bounced off the ground is not simulated, and would reach objects through
@@ -38,18 +50,18 @@ impl Environment {
     }
 
     /// Load an equirectangular .hdr or .exr map (through the `image` crate).
-    pub fn load(path: &std::path::Path) -> Result<Environment, String> {
-        let img = image::open(path).map_err(|e| format!("cannot read environment map {}: {e}", path.display()))?;
+    pub fn load(path: &std::path::Path) -> Result<Environment, EnvironmentError> {
+        let img = image::open(path).map_err(|source| EnvironmentError::Read { path: path.to_path_buf(), source })?;
         let rgb = img.to_rgb32f();
         let (width, height) = (rgb.width() as usize, rgb.height() as usize);
         if width < 2 || height < 2 {
-            return Err(format!("environment map {} is only {width}x{height}", path.display()));
+            return Err(EnvironmentError::TooSmall { path: path.to_path_buf(), width, height });
         }
         let mut radiance = Vec::with_capacity(width * height);
         for p in rgb.pixels() {
             let v = Vec3::new(p[0], p[1], p[2]);
             if !v.is_finite() || v.min_element() < 0.0 {
-                return Err(format!("environment map {} has a negative or non-finite texel", path.display()));
+                return Err(EnvironmentError::BadTexel { path: path.to_path_buf() });
             }
             radiance.push(v);
         }

@@ -16,12 +16,35 @@ pub const DEFAULT_SCENE: &str = include_str!("../../assets/scenes/default.toml")
 /// Assets embedded in the binary, so the default scene renders from any working directory.
 pub const EMBEDDED_ASSETS: &[(&str, &[u8])] = &[("bunny-37k.obj", include_bytes!("../../assets/bunny-37k.obj"))];
 
+/// Why a scene could not be read, checked or prepared. A prepared scene's errors come wrapped in
+/// [`SceneError::Context`], which says where (scene file, object, key); the cause is its
+/// source, shown after it by `{:#}` and error reporters.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    #[error("cannot read scene {path}: {source}")]
+    // The io::Error is the source, not repeated here.
+    #[error("cannot read scene {}", path.display())]
     Read { path: PathBuf, source: std::io::Error },
     #[error("{file}: {message}")]
     Invalid { file: String, message: String },
+    #[error("--samples must be at least 1")]
+    ZeroSamples,
+    #[error("cannot fit a mesh with an empty bounding box")]
+    EmptyBounds,
+    #[error("embedded mesh is not UTF-8")]
+    EmbeddedMeshNotUtf8(#[source] std::str::Utf8Error),
+    #[error("embedded environment maps are not supported")]
+    EmbeddedEnvironment,
+    #[error(transparent)]
+    Mesh(#[from] crate::mesh::MeshError),
+    #[error(transparent)]
+    Optics(#[from] crate::optics::OpticsError),
+    #[error(transparent)]
+    Sampling(#[from] crate::sampling::SamplingError),
+    #[error(transparent)]
+    Environment(#[from] lights::EnvironmentError),
+    /// `context` names where (e.g. "scene.toml: object[0] (bunny.obj): sampling").
+    #[error("{context}")]
+    Context { context: String, source: Box<SceneError> },
 }
 
 /// A parsed, checked scene and where its relative paths resolve.
@@ -239,16 +262,10 @@ fn check(scene: &SceneFile) -> Check {
         return Err(("light".into(), "at most one environment light".into()));
     }
     let s = &scene.sampling;
-    if !["random", "turk", "feature", "poisson"].contains(&s.method.as_str()) {
-        return Err(("sampling.method".into(), format!("{:?} is not one of random, turk, feature, poisson", s.method)));
-    }
     if s.count == 0 || s.count > 1_000_000 {
         return Err(("sampling.count".into(), format!("{} must be 1 to 1000000", s.count)));
     }
     let r = &scene.render;
-    if !["vertex", "pixel", "sparse"].contains(&r.gather.as_str()) {
-        return Err(("render.gather".into(), format!("{:?} is not vertex, pixel or sparse", r.gather)));
-    }
     if !(r.exposure.is_finite() && r.exposure > 0.0) {
         return Err(("render.exposure".into(), format!("{} must be positive", r.exposure)));
     }

@@ -29,7 +29,7 @@ impl PreparedScene {
             translucent_objects: self.objects.iter().filter(|o| !o.samples.is_empty()).count(),
             shadowed_lights,
             environment: self.lights.iter().find(|l| l.environment).map(|l| l.source),
-            pixel_gather: self.scene.file.render.gather == "pixel",
+            pixel_gather: self.scene.file.render.gather == super::GatherMode::Pixel,
         }
     }
 

@@ -1,16 +1,117 @@
-//! Shared by the GPU tests: a validated context on lavapipe (or whatever TRANSLUCENT_DEVICE
-//! names) that fails the test on any validation message, leaks at device destruction included.
+//! Helpers shared by the integration tests: paths in the repository, fresh temporary folders, the
+//! `translucent` binary, a grid mesh, and a validated GPU context on lavapipe (or whatever
+//! TRANSLUCENT_DEVICE names) that fails the test on any validation message, leaks at device
+//! destruction included.
 #![allow(dead_code)]
 
+use glam::{Mat4, Vec3};
+use std::path::PathBuf;
+use std::process::{Command, Output};
 use std::sync::Arc;
 use translucent::gpu::{Gpu, GpuOptions};
+use translucent::mesh::{LoadOptions, Mesh};
+use translucent::render::plan::{Change, Pass};
+use translucent::render::renderer::Renderer;
+use translucent::scene::Scene;
+use translucent::optics::kernel;
+use translucent::render::records::SplatRecord;
+use translucent::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
+
+// ---------------------------------------------------------------------------------------------
+// Files
+
+/// A path relative to the repository root.
+pub fn repo_path(relative: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(relative)
+}
+
+/// A file in `assets/`.
+pub fn asset(name: &str) -> PathBuf {
+    repo_path("assets").join(name)
+}
+
+/// A mesh from `assets/`, loaded with the default options.
+pub fn load_asset(name: &str) -> Mesh {
+    Mesh::load(asset(name), &LoadOptions::default()).unwrap()
+}
+
+/// A fresh, empty folder under the system temp dir, for one test (`name` must be unique within
+/// the test file; the process id keeps test files apart).
+pub fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("translucent-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+// ---------------------------------------------------------------------------------------------
+// The binary
+
+/// Run the `translucent` binary with `args` and extra environment variables, validation on and
+/// the device left to its default choice.
+pub fn translucent(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_translucent"));
+    cmd.args(args).env("TRANSLUCENT_VALIDATION", "1").env_remove("TRANSLUCENT_DEVICE");
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    cmd.output().expect("run translucent")
+}
+
+/// Run `translucent SUBCOMMAND ARGS...`.
+pub fn subcommand(subcommand: &str, args: &[&str]) -> Output {
+    translucent(&[&[subcommand], args].concat(), &[])
+}
+
+/// Captured output as text.
+pub fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+// ---------------------------------------------------------------------------------------------
+// Meshes
+
+/// A flat n x n grid of vertices in the unit square of the xy plane, interior vertices jittered
+/// in-plane by up to `jitter` of the spacing (a fixed sequence), then placed by `m`.
+pub fn grid(n: usize, jitter: f64, m: Mat4) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let mut pos = Vec::new();
+    let mut state = 12345u64;
+    let mut rnd = || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let h = 1.0 / (n - 1) as f64;
+    for i in 0..n {
+        for j in 0..n {
+            let interior = i > 0 && j > 0 && i < n - 1 && j < n - 1;
+            let (dx, dy) = if interior { (rnd() * jitter * h, rnd() * jitter * h) } else { (0.0, 0.0) };
+            let p = Vec3::new((i as f64 * h + dx) as f32, (j as f64 * h + dy) as f32, 0.0);
+            pos.push(m.transform_point3(p));
+        }
+    }
+    let id = |i: usize, j: usize| (i * n + j) as u32;
+    let mut tris = Vec::new();
+    for i in 0..n - 1 {
+        for j in 0..n - 1 {
+            tris.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            tris.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    (pos, tris)
+}
+
+// ---------------------------------------------------------------------------------------------
+// The GPU
+
+/// Options for a validated device: TRANSLUCENT_DEVICE if set, else the default choice.
+pub fn validated_options() -> GpuOptions {
+    GpuOptions { device: std::env::var("TRANSLUCENT_DEVICE").ok(), validation: true, ..GpuOptions::default() }
+}
 
 /// Run `f` with a fresh validated `Gpu`; after it returns, destroy the device and assert that
 /// the validation layer said nothing. `f` must not keep clones of the `Arc<Gpu>`.
 pub fn with_gpu<R>(f: impl FnOnce(&Arc<Gpu>) -> R) -> R {
-    let options =
-        GpuOptions { device: std::env::var("TRANSLUCENT_DEVICE").ok(), validation: true, ..GpuOptions::default() };
-    let gpu = Gpu::new(&options).unwrap_or_else(|e| {
+    let gpu = Gpu::new(&validated_options()).unwrap_or_else(|e| {
         panic!(
             "GPU tests need a Vulkan device with validation layers: {e}\n\
              run `bash scripts/setup` (installs mesa-vulkan-drivers and vulkan-validationlayers)"
@@ -30,3 +131,51 @@ pub fn with_gpu<R>(f: impl FnOnce(&Arc<Gpu>) -> R) -> R {
     );
     result
 }
+
+// ---------------------------------------------------------------------------------------------
+// Scenes and frames
+
+/// The built-in scene, prepared with `overrides`.
+pub fn builtin(overrides: &Overrides) -> PreparedScene {
+    PreparedScene::new(&Scene::builtin(), overrides).unwrap()
+}
+
+/// A renderer for `prepared` that has drawn one full frame.
+pub fn run_all(gpu: &Arc<Gpu>, prepared: PreparedScene) -> Renderer {
+    let mut renderer = Renderer::new(gpu, prepared).expect("renderer");
+    let plan = renderer.plan(Change::Everything);
+    renderer.frame(&plan).expect("frame");
+    renderer
+}
+
+/// The GPU gather alone, fed the given per-sample irradiance (from the f64 reference): the
+/// exitance of object 0's vertices.
+pub fn gather_from(gpu: &Arc<Gpu>, prepared: PreparedScene, irradiance: &[[f64; 3]]) -> Vec<[f32; 3]> {
+    let mut renderer = Renderer::new(gpu, prepared).unwrap();
+    let as_f32: Vec<[f32; 3]> = irradiance.iter().map(|e| e.map(|v| v as f32)).collect();
+    set_splat_irradiance(&mut renderer, &as_f32);
+    let mut plan = renderer.plan(Change::Everything);
+    plan.passes.retain(|(p, _)| *p == Pass::Gather);
+    renderer.frame(&plan).unwrap();
+    renderer.exitance(0).unwrap()
+}
+
+/// Replace the splat output by `irradiance` (RGB per sample, scene order) with the near energies
+/// computed on the CPU, so the gather gets the same input as the reference.
+fn set_splat_irradiance(renderer: &mut Renderer, irradiance: &[[f32; 3]]) {
+    let mut records = Vec::with_capacity(irradiance.len());
+    for o in &renderer.scene().objects {
+        for s in &o.samples {
+            let near = match &o.material {
+                ResolvedMaterial::Translucent { dipoles, .. } => {
+                    let b = kernel::B_PER_SQRT_AREA * s.area.sqrt();
+                    [0, 1, 2].map(|c| kernel::near_energy(&dipoles[c], b) as f32)
+                }
+                ResolvedMaterial::Opaque { .. } => [0.0; 3],
+            };
+            records.push(SplatRecord::new(irradiance[records.len()], s.area as f32, near));
+        }
+    }
+    renderer.buffers_mut().splat.write(0, &records).unwrap();
+}
+
