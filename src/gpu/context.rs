@@ -73,7 +73,8 @@ impl Gpu {
         // SAFETY: queue 0 of `family` was requested in create_logical.
         let queue = unsafe { device.get_device_queue(family, 0) };
         let instance = owned.instance.clone();
-        Self::assemble(entry, instance, Some(owned), info.handle, device, true, queue, family, counters, options)
+        let parts = HostVulkan { entry, instance, physical_device: info.handle, device, queue, queue_family: family };
+        Self::assemble(parts, Some(owned), counters, options)
     }
 
     /// Wrap Vulkan objects a host engine owns. Nothing of theirs is destroyed on Drop; only what
@@ -89,33 +90,19 @@ impl Gpu {
             .find(|d| d.handle == host.physical_device)
             .ok_or_else(|| GpuError::Invalid("the host's physical device is not one of its instance's".into()))?;
         let counters = Arc::new(ValidationCounters::default());
-        Self::assemble(
-            host.entry,
-            host.instance,
-            None,
-            info.handle,
-            host.device,
-            false,
-            host.queue,
-            host.queue_family,
-            counters,
-            options,
-        )
+        Self::assemble(HostVulkan { physical_device: info.handle, ..host }, None, counters, options)
     }
 
-    #[allow(clippy::too_many_arguments)]
+    /// The `Gpu` over `parts`; with `owned_instance` it owns (and destroys) the instance and
+    /// the device, without it they are the host's.
     fn assemble(
-        entry: ash::Entry,
-        instance: ash::Instance,
+        parts: HostVulkan,
         owned_instance: Option<OwnedInstance>,
-        physical: vk::PhysicalDevice,
-        device: ash::Device,
-        owns_device: bool,
-        queue: vk::Queue,
-        queue_family: u32,
         counters: Arc<ValidationCounters>,
         options: &GpuOptions,
     ) -> GpuResult<Arc<Gpu>> {
+        let HostVulkan { entry, instance, physical_device: physical, device, queue, queue_family } = parts;
+        let owns_device = owned_instance.is_some();
         let info = device::enumerate(&instance)?.into_iter().find(|d| d.handle == physical).unwrap();
         // SAFETY: plain queries.
         let properties = unsafe { instance.get_physical_device_properties(physical) };
