@@ -7,6 +7,16 @@ pub mod sample;
 
 use translucent::gpu::GpuOptions;
 
+/// A parser that accepts one of `names` (listed in `--help` and in errors) and turns it into a
+/// library type through its `FromStr`, so the library needs no command-line derive.
+pub fn one_of<T>(names: &[&'static str]) -> impl clap::builder::TypedValueParser<Value = T>
+where
+    T: std::str::FromStr<Err = String> + Clone + Send + Sync + 'static,
+{
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(names.to_vec()).map(|s| s.parse::<T>().expect("a listed name parses"))
+}
+
 /// Options shared by every subcommand that touches the GPU.
 #[derive(clap::Args, Clone, Debug, Default)]
 pub struct GpuArgs {

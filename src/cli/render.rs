@@ -26,10 +26,11 @@ pub struct Args {
     #[arg(long)]
     pub samples: Option<usize>,
     /// Sampler (overrides the scene)
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::one_of::<Method>(&Method::ALL.map(Method::name)))]
     pub sampler: Option<Method>,
-    /// Where exitance is gathered (overrides the scene)
-    #[arg(long, value_enum)]
+    /// Where exitance is gathered: at every vertex, at every visible pixel, or at the samples
+    /// blended to the vertices (overrides the scene)
+    #[arg(long, value_parser = super::one_of::<GatherMode>(&GatherMode::ALL.map(GatherMode::name)))]
     pub gather: Option<GatherMode>,
     /// Image size WIDTHxHEIGHT (overrides the scene)
     #[arg(long, value_parser = parse_resolution)]

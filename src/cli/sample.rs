@@ -14,7 +14,7 @@ pub struct Args {
     /// Mesh to sample (Wavefront OBJ)
     pub mesh: PathBuf,
     /// Placement method
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = super::one_of::<Method>(&Method::ALL.map(Method::name)))]
     pub method: Method,
     /// Number of sample points
     #[arg(long, short = 'n')]

@@ -43,7 +43,7 @@ pub const MAX_COUNT: usize = 1 << 24;
 
 /// How sample points are placed: `sampling.method` in a scene, `--sampler` and `--method` on
 /// the command line (lowercase names in both).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Method {
     /// Uniform by area

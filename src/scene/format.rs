@@ -224,7 +224,7 @@ pub struct RenderSettings {
 }
 
 /// Where exitance is gathered: `render.gather` in a scene, `--gather` on the command line.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum GatherMode {
     /// At every mesh vertex, interpolated when shading
@@ -238,12 +238,24 @@ pub enum GatherMode {
 }
 
 impl GatherMode {
+    pub const ALL: [GatherMode; 3] = [GatherMode::Vertex, GatherMode::Pixel, GatherMode::Sparse];
+
     pub fn name(self) -> &'static str {
         match self {
             GatherMode::Vertex => "vertex",
             GatherMode::Pixel => "pixel",
             GatherMode::Sparse => "sparse",
         }
+    }
+}
+
+impl std::str::FromStr for GatherMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        GatherMode::ALL
+            .into_iter()
+            .find(|m| m.name().eq_ignore_ascii_case(s))
+            .ok_or_else(|| format!("unknown gather mode `{s}` (expected vertex, pixel or sparse)"))
     }
 }
 
