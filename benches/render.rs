@@ -14,9 +14,9 @@ use translucent::gpu::{Gpu, GpuOptions, median};
 use translucent::render::plan::Change;
 use translucent::render::renderer::Renderer;
 use translucent::sampling::Method;
-use translucent::scene::{Scene, lights};
-use translucent::scene::build::{Overrides, PreparedScene};
 use translucent::scene::GatherMode;
+use translucent::scene::build::{Overrides, PreparedScene};
+use translucent::scene::{Scene, lights};
 
 const WARM_UP: usize = 1;
 const FRAMES: usize = 5;

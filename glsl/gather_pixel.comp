@@ -6,7 +6,7 @@
 // in the HDR alpha; this pass adds the exitance times that factor to the HDR radiance.
 //
 // Bindings: 0 = surface (combined sampler, rgba32f), 1 = samples (SampleRecord[]), 2 = splat
-// (vec4[2] per sample), 3 = objects (ObjectRecord[]), 4 = HDR radiance (storage image, rgba32f).
+// (SplatRecord[]), 3 = objects (ObjectRecord[]), 4 = HDR radiance (storage image, rgba32f).
 // Push: GatherPixelPush.
 #include "dipole.glsl"
 #include "scene.glsl"

@@ -9,8 +9,8 @@
 // the samples loses little, and the per-vertex work drops from four exponentials per channel
 // and pair to one weight per pair. Under uniform light every vertex still gets E R_d,total.
 //
-// Bindings: 0 = vertices (float[6] per vertex), 1 = samples (SampleRecord[]), 2 = splat
-// (vec4[2] per sample), 3 = objects (ObjectRecord[]), 4 = sample exitance (vec4 per sample,
+// Bindings: 0 = vertices (VertexRecord[]), 1 = samples (SampleRecord[]), 2 = splat
+// (SplatRecord[]), 3 = objects (ObjectRecord[]), 4 = sample exitance (vec4 per sample,
 // written by stage 0, read by stage 1), 5 = exitance (vec4 per vertex, written by stage 1).
 // Push: GatherSparsePush.
 #include "dipole.glsl"

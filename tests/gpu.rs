@@ -115,13 +115,19 @@ fn graphics_pipeline_draws_a_triangle() {
         let set = pipeline.descriptor_set(&[Binding::Buffer(&tint)]).unwrap();
         let device = gpu.device();
         gpu.one_shot("draw", |cmd| {
-            ImageBarrier::new(color.raw(), vk::ImageAspectFlags::COLOR, &[Access::Nothing], &[
-                Access::ColorAttachmentWrite,
-            ])
+            ImageBarrier::new(
+                color.raw(),
+                vk::ImageAspectFlags::COLOR,
+                &[Access::Nothing],
+                &[Access::ColorAttachmentWrite],
+            )
             .record(device, cmd);
-            ImageBarrier::new(depth.raw(), vk::ImageAspectFlags::DEPTH, &[Access::Nothing], &[
-                Access::DepthAttachmentReadWrite,
-            ])
+            ImageBarrier::new(
+                depth.raw(),
+                vk::ImageAspectFlags::DEPTH,
+                &[Access::Nothing],
+                &[Access::DepthAttachmentReadWrite],
+            )
             .record(device, cmd);
             let colors = [vk::RenderingAttachmentInfo::default()
                 .image_view(color.view())

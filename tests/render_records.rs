@@ -85,7 +85,7 @@ fn light_record_matches_glsl() {
 
 #[test]
 fn vertex_and_push_layouts() {
-    // The raster passes read `Vertex` as two vec3 attributes, and the gather as float[6].
+    // The raster passes read `Vertex` as two vec3 attributes, compute passes as `VertexRecord`.
     assert_eq!(size_of::<Vertex>(), 24);
     assert_eq!(offset_of!(Vertex, normal), 12);
     assert_eq!(Vertex::normal_attribute().offset, 12);
@@ -118,28 +118,56 @@ fn splat_and_vertex_records_match_glsl() {
 #[test]
 fn push_blocks_match_glsl_and_spirv() {
     let cases: [(&str, &str, &str, usize, &[&str]); 8] = [
-        ("splat.comp", include_str!("../glsl/splat.comp"), "SplatPush", size_of::<SplatPush>(), &[
-            "sample_count",
-            "light_count",
-        ]),
-        ("vertex_light.comp", include_str!("../glsl/vertex_light.comp"), "VertexLightPush", size_of::<VertexLightPush>(), &[
-            "vertex_count",
-            "light_count",
-        ]),
+        (
+            "splat.comp",
+            include_str!("../glsl/splat.comp"),
+            "SplatPush",
+            size_of::<SplatPush>(),
+            &["sample_count", "light_count"],
+        ),
+        (
+            "vertex_light.comp",
+            include_str!("../glsl/vertex_light.comp"),
+            "VertexLightPush",
+            size_of::<VertexLightPush>(),
+            &["vertex_count", "light_count"],
+        ),
         ("gather.comp", include_str!("../glsl/gather.comp"), "GatherPush", size_of::<GatherPush>(), &["object"]),
-        ("gather_sparse.comp", include_str!("../glsl/gather_sparse.comp"), "GatherSparsePush", size_of::<GatherSparsePush>(), &[
-            "object", "stage",
-        ]),
-        ("gather_pixel.comp", include_str!("../glsl/gather_pixel.comp"), "GatherPixelPush", size_of::<GatherPixelPush>(), &[
-            "width", "height",
-        ]),
-        ("tonemap.comp", include_str!("../glsl/tonemap.comp"), "TonemapPush", size_of::<TonemapPush>(), &[
-            "width", "height", "exposure",
-        ]),
-        ("shadow.vert", include_str!("../glsl/shadow.vert"), "ShadowPush", size_of::<ShadowPush>(), &["light_matrix", "layer"]),
-        ("shade.vert", include_str!("../glsl/common/shade_push.glsl"), "ShadePush", size_of::<ShadePush>(), &[
-            "view_proj", "eye_object", "counts",
-        ]),
+        (
+            "gather_sparse.comp",
+            include_str!("../glsl/gather_sparse.comp"),
+            "GatherSparsePush",
+            size_of::<GatherSparsePush>(),
+            &["object", "stage"],
+        ),
+        (
+            "gather_pixel.comp",
+            include_str!("../glsl/gather_pixel.comp"),
+            "GatherPixelPush",
+            size_of::<GatherPixelPush>(),
+            &["width", "height"],
+        ),
+        (
+            "tonemap.comp",
+            include_str!("../glsl/tonemap.comp"),
+            "TonemapPush",
+            size_of::<TonemapPush>(),
+            &["width", "height", "exposure"],
+        ),
+        (
+            "shadow.vert",
+            include_str!("../glsl/shadow.vert"),
+            "ShadowPush",
+            size_of::<ShadowPush>(),
+            &["light_matrix", "layer"],
+        ),
+        (
+            "shade.vert",
+            include_str!("../glsl/common/shade_push.glsl"),
+            "ShadePush",
+            size_of::<ShadePush>(),
+            &["view_proj", "eye_object", "counts"],
+        ),
     ];
     for (shader, source, name, rust_size, rust_fields) in cases {
         let (fields, size) = glsl_layout(source, name);

@@ -87,9 +87,9 @@ impl Access {
 }
 
 fn masks(accesses: &[Access]) -> (vk::PipelineStageFlags2, vk::AccessFlags2) {
-    accesses.iter().fold((vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE), |(s, a), x| {
-        (s | x.stage(), a | x.access())
-    })
+    accesses
+        .iter()
+        .fold((vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE), |(s, a), x| (s | x.stage(), a | x.access()))
 }
 
 /// The one layout a set of image accesses shares (they must agree).

@@ -55,7 +55,8 @@ impl ShaderInterface {
             }
             bindings[i] = Some(kind);
         }
-        let push_bytes = reflection.get_push_constant_range().map_err(|e| invalid(&e))?.map_or(0, |p| p.offset + p.size);
+        let push_bytes =
+            reflection.get_push_constant_range().map_err(|e| invalid(&e))?.map_or(0, |p| p.offset + p.size);
         let local_size = reflection.get_compute_group_size().map_or([1, 1, 1], |(x, y, z)| [x, y, z]);
         Ok(ShaderInterface { bindings, push_bytes, local_size })
     }
@@ -71,7 +72,9 @@ impl ShaderInterface {
             for (i, kind) in s.bindings.iter().enumerate() {
                 match (merged.bindings[i], kind) {
                     (Some(a), Some(b)) if a != *b => {
-                        return Err(GpuError::Invalid(format!("binding {i} is {a:?} in one stage and {b:?} in another")));
+                        return Err(GpuError::Invalid(format!(
+                            "binding {i} is {a:?} in one stage and {b:?} in another"
+                        )));
                     }
                     (None, Some(b)) => merged.bindings[i] = Some(*b),
                     _ => {}

@@ -71,15 +71,21 @@ fn upload<T: bytemuck::Pod>(gpu: &Arc<Gpu>, name: &str, data: &[T], usage: vk::B
 
 impl GpuScene {
     pub fn new(gpu: &Arc<Gpu>, scene: &PreparedScene) -> GpuResult<GpuScene> {
-        let (mut vertices, mut indices, mut objects, mut samples) = (Vec::new(), Vec::<u32>::new(), Vec::new(), Vec::new());
-        let (mut draws, mut casters, mut receivers, mut vertex_offsets) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut vertices, mut indices, mut objects, mut samples) =
+            (Vec::new(), Vec::<u32>::new(), Vec::new(), Vec::new());
+        let (mut draws, mut casters, mut receivers, mut vertex_offsets) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         for (i, o) in scene.objects.iter().enumerate() {
             let first_vertex = vertices.len() as u32;
             let first_sample = samples.len() as u32;
             vertex_offsets.push(first_vertex);
             let normals = o.mesh.vertex_normals();
             vertices.extend(
-                o.mesh.positions().iter().zip(normals).map(|(p, n)| Vertex { position: p.to_array(), normal: n.to_array() }),
+                o.mesh
+                    .positions()
+                    .iter()
+                    .zip(normals)
+                    .map(|(p, n)| Vertex { position: p.to_array(), normal: n.to_array() }),
             );
             let draw = DrawRange {
                 first_index: indices.len() as u32,

@@ -70,7 +70,10 @@ pub struct SampleRecord {
 impl SampleRecord {
     pub fn new(sample: &SamplePoint, object: usize) -> SampleRecord {
         let (p, n) = (sample.position, sample.normal);
-        SampleRecord { position_area: [p.x, p.y, p.z, sample.area as f32], normal_object: [n.x, n.y, n.z, object as f32] }
+        SampleRecord {
+            position_area: [p.x, p.y, p.z, sample.area as f32],
+            normal_object: [n.x, n.y, n.z, object as f32],
+        }
     }
 }
 

@@ -14,9 +14,9 @@ use super::splat::SplatPass;
 use super::tonemap::TonemapPass;
 use super::vertex_light::VertexLightPass;
 use crate::gpu::{Access, Gpu, GpuError, GpuTimer, ShaderInterface};
-use crate::scene::{GatherMode, Light};
 use crate::scene::build::PreparedScene;
 use crate::scene::needs::SceneNeeds;
+use crate::scene::{GatherMode, Light};
 use glam::Vec3;
 use std::sync::Arc;
 
@@ -205,7 +205,10 @@ impl Renderer {
     /// Splat output of every sample, in scene order: (irradiance RGB, area).
     pub fn splat_irradiance(&self) -> Result<Vec<([f32; 3], f32)>, RenderError> {
         let all: Vec<super::records::SplatRecord> = self.buffers.splat.read()?;
-        Ok(all.iter().map(|s| ([s.irradiance_area[0], s.irradiance_area[1], s.irradiance_area[2]], s.irradiance_area[3])).collect())
+        Ok(all
+            .iter()
+            .map(|s| ([s.irradiance_area[0], s.irradiance_area[1], s.irradiance_area[2]], s.irradiance_area[3]))
+            .collect())
     }
 
     /// Replace scene light `index` by `light` of the same kind (moved, re-aimed or re-coloured),

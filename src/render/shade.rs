@@ -44,7 +44,10 @@ pub struct ShadePass {
 }
 
 /// A per-vertex vec4 stream (exitance, cached irradiance) at `binding`, read at `location`.
-fn vec4_stream(binding: u32, location: u32) -> (vk::VertexInputBindingDescription, vk::VertexInputAttributeDescription) {
+fn vec4_stream(
+    binding: u32,
+    location: u32,
+) -> (vk::VertexInputBindingDescription, vk::VertexInputAttributeDescription) {
     (
         vk::VertexInputBindingDescription { binding, stride: 16, input_rate: vk::VertexInputRate::VERTEX },
         vk::VertexInputAttributeDescription { location, binding, format: vk::Format::R32G32B32A32_SFLOAT, offset: 0 },
@@ -79,7 +82,10 @@ impl ShadePass {
         ])?;
         use vk::ImageUsageFlags as U;
         // STORAGE: the pixel gather adds its exitance in place.
-        let hdr = Image::new(gpu, &attachment("hdr radiance", size, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED | U::STORAGE))?;
+        let hdr = Image::new(
+            gpu,
+            &attachment("hdr radiance", size, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED | U::STORAGE),
+        )?;
         let surface = pixel_gather
             .then(|| Image::new(gpu, &attachment("surface", size, SURFACE_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED)))
             .transpose()?;

@@ -5,8 +5,8 @@
 //! Push: `TonemapPush`.
 
 use super::pass::{FrameInputs, RenderPass};
-use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuResult, Image, Sampler};
 use crate::gpu::memory_barrier;
+use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuResult, Image, Sampler};
 use ash::vk;
 use std::sync::Arc;
 

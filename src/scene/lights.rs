@@ -6,8 +6,8 @@
 //! light (`render::records::LightGpu`) is packed from these typed values.
 
 use super::format::Light;
-use glam::{Mat4, Vec3};
 use glam::camera::rh::{proj::vulkan, view::look_at_mat4};
+use glam::{Mat4, Vec3};
 
 /// An environment as an equirectangular grid of linear radiance (W/m^2/sr). Row 0 looks at
 /// +y (up); column u covers azimuth phi = 2 pi (u + 0.5) / width, direction
@@ -218,8 +218,8 @@ pub fn prepare(
     // 1%, 2 texels 2.25%; 1024^2 maps with 0.5 texel: 1.5%.
     let offset_ortho = 0.5 * (2.0 * radius) * texel;
     let mut out = Vec::new();
-    let shadowed = |kind: LightKind, matrix: Mat4, offset: f32, environment: bool, casts_shadow: bool, source| {
-        PreparedLight {
+    let shadowed =
+        |kind: LightKind, matrix: Mat4, offset: f32, environment: bool, casts_shadow: bool, source| PreparedLight {
             kind,
             environment,
             casts_shadow,
@@ -228,8 +228,7 @@ pub fn prepare(
             shadow_texel: texel,
             normal_offset: offset,
             source,
-        }
-    };
+        };
     let directional = |dir: Vec3, irradiance: Vec3, environment: bool, casts_shadow: bool, source: usize| {
         let dir = dir.normalize();
         let eye = center + dir * (2.0 * radius);

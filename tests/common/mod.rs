@@ -10,11 +10,11 @@ use std::process::{Command, Output};
 use std::sync::Arc;
 use translucent::gpu::{Gpu, GpuOptions};
 use translucent::mesh::{LoadOptions, Mesh};
+use translucent::optics::kernel;
 use translucent::render::plan::{Change, Pass};
+use translucent::render::records::SplatRecord;
 use translucent::render::renderer::Renderer;
 use translucent::scene::Scene;
-use translucent::optics::kernel;
-use translucent::render::records::SplatRecord;
 use translucent::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
 
 // ---------------------------------------------------------------------------------------------
@@ -178,4 +178,3 @@ fn set_splat_irradiance(renderer: &mut Renderer, irradiance: &[[f32; 3]]) {
     }
     renderer.buffers_mut().splat.write(0, &records).unwrap();
 }
-
