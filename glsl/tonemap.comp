@@ -15,6 +15,10 @@ struct TonemapPush {
 };
 layout(push_constant) uniform TonemapPushBlock { TonemapPush push; };
 
+// The curve reaches 1 at x = 7.25 and clamps there; inputs are capped at 64 first so that its
+// x^2 terms cannot overflow f32 (a radiance of 1e30 would give inf / inf = NaN, drawn black).
+const float TONE_SATURATION = 64.0;
+
 vec3 aces_narkowicz(vec3 x) {
     const float a = 2.51, b = 0.03, c = 2.43, d = 0.59, e = 0.14;
     return clamp((x * (a * x + b)) / (x * (c * x + d) + e), 0.0, 1.0);
@@ -35,6 +39,6 @@ void main() {
         atomicAdd(non_finite, 1u);
         c.rgb = vec3(0.0);
     }
-    vec3 display = srgb_encode(aces_narkowicz(max(c.rgb, vec3(0.0)) * push.exposure));
+    vec3 display = srgb_encode(aces_narkowicz(min(max(c.rgb, vec3(0.0)) * push.exposure, vec3(TONE_SATURATION))));
     rgba8[p.y * push.width + p.x] = packUnorm4x8(vec4(display, 1.0));
 }

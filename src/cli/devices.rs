@@ -9,19 +9,29 @@ pub struct Args {
     json: bool,
 }
 
-pub fn run(_gpu: &super::GpuArgs, args: &Args) -> anyhow::Result<()> {
-    let devices = gpu::list_devices()?;
+pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> anyhow::Result<()> {
+    let mut devices = gpu::list_devices()?;
     if devices.is_empty() {
         return Err(gpu::GpuError::NoDevice(String::new()).into());
     }
+    // `--device` (or TRANSLUCENT_DEVICE) narrows the list to the device it picks, with the
+    // same error as every other command when nothing matches.
+    if let Some(wanted) = &gpu_args.device {
+        devices = vec![gpu::select_device(&devices, Some(wanted))?];
+    }
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&devices)?);
+        out!("{}", serde_json::to_string_pretty(&devices)?);
     } else {
-        println!("{:<5} {:<36} {:<15} {:<10} {:<8} driver info", "index", "name", "type", "driver", "vulkan");
+        out!("{:<5} {:<36} {:<15} {:<10} {:<8} driver info", "index", "name", "type", "driver", "vulkan");
         for d in &devices {
-            println!(
+            out!(
                 "{:<5} {:<36} {:<15} {:<10} {:<8} {}",
-                d.index, d.name, d.kind, d.driver, d.api_version, d.driver_info
+                d.index,
+                d.name,
+                d.kind,
+                d.driver,
+                d.api_version,
+                d.driver_info
             );
         }
     }

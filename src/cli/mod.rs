@@ -1,5 +1,14 @@
 //! Subcommands of the `translucent` binary, one module each.
 
+/// `println!` that returns the write error instead of panicking, so a closed stdout
+/// (`translucent devices | head -1`) ends the command quietly (see `main`).
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*)?
+    }};
+}
+
 pub mod devices;
 pub mod material;
 pub mod render;
@@ -38,4 +47,20 @@ impl GpuArgs {
             ..GpuOptions::default()
         }
     }
+}
+
+/// On SIGINT or SIGTERM, remove the hidden temporary files of `outputs` (a write cut short
+/// leaves none behind) and exit with 130. The destinations themselves are never touched.
+pub fn remove_on_interrupt(outputs: &[&std::path::PathBuf]) -> anyhow::Result<()> {
+    let temporaries: Vec<std::path::PathBuf> =
+        outputs.iter().map(|p| translucent::output::temporary_path(p)).collect::<Result<_, _>>()?;
+    // Only one handler per process; a second command in the same process keeps the first.
+    let _ = ctrlc::set_handler(move || {
+        for t in &temporaries {
+            let _ = std::fs::remove_file(t);
+        }
+        eprintln!("interrupted: no output written");
+        std::process::exit(130);
+    });
+    Ok(())
 }

@@ -5,7 +5,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::sync::Arc;
 use translucent::gpu::{Gpu, median};
-use translucent::output;
+use translucent::output::OutputSet;
 use translucent::render::plan::Change;
 use translucent::render::renderer::Renderer;
 use translucent::sampling::Method;
@@ -108,6 +108,19 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
+    let outputs: Vec<&PathBuf> = std::iter::once(&args.output).chain(&args.exr).chain(&args.export_exitance).collect();
+    for (i, a) in outputs.iter().enumerate() {
+        if outputs[..i].contains(a) {
+            bail!("{} is named as two outputs", a.display());
+        }
+    }
+    for path in &outputs {
+        let folder = path.parent().filter(|f| !f.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+        if !folder.is_dir() {
+            bail!("cannot write {}: the folder {} does not exist", path.display(), folder.display());
+        }
+    }
+    super::remove_on_interrupt(&outputs)?;
     let scene = match &args.scene {
         Some(path) => Scene::load(path)?,
         None => Scene::builtin(),
@@ -119,6 +132,12 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let prepared = PreparedScene::new(&scene, &overrides);
     spinner.finish_and_clear();
     let prepared = prepared?;
+    if args.export_exitance.is_some() && prepared.scene.file.render.gather == GatherMode::Pixel {
+        bail!(
+            "--export-exitance needs exitance at the vertices, and the pixel gather computes it only at \
+             visible pixels: use --gather vertex or sparse"
+        );
+    }
     let gpu: Arc<Gpu> = Gpu::new(&gpu_args.options())?;
     eprintln!(
         "device: {} | {} vertices, {} samples ({}), {} lights ({} shadow maps)",
@@ -178,14 +197,25 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
 
     let (rgba8, non_finite) = renderer.image()?;
     if non_finite > 0 {
-        bail!("{non_finite} pixels were NaN or infinite before tone mapping; no image written");
+        let causes: Vec<String> = renderer
+            .find_non_finite()?
+            .iter()
+            .map(|n| {
+                let o = &renderer.scene().objects[n.object];
+                let what = if n.pass == "splat" { "samples" } else { "vertices" };
+                format!("the {} pass left {} {what} of object[{}] ({}) non-finite", n.pass, n.count, n.object, o.name)
+            })
+            .collect();
+        let cause = if causes.is_empty() { "the shade pass produced them".to_string() } else { causes.join("; ") };
+        bail!("{non_finite} pixels were NaN or infinite before tone mapping ({cause}); no output written");
     }
-    output::write_png(&args.output, width, height, &rgba8)?;
-    eprintln!("wrote {}", args.output.display());
+    // Every output is written to a temporary file first and renamed only once all were written.
+    let mut outputs = OutputSet::new();
+    outputs.png(&args.output, width, height, &rgba8)?;
     if let Some(exr) = &args.exr {
-        output::write_exr(exr, width, height, &renderer.hdr_image()?)?;
-        eprintln!("wrote {}", exr.display());
+        outputs.exr(exr, width, height, &renderer.hdr_image()?)?;
     }
+    let mut exported = 0;
     if let Some(ply) = &args.export_exitance {
         let mut points = Vec::new();
         for (i, o) in renderer.scene().objects.iter().enumerate() {
@@ -196,20 +226,27 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
                 points.push((p.to_array(), e));
             }
         }
-        output::write_exitance_ply(ply, &points)?;
-        eprintln!("wrote {} ({} vertices)", ply.display(), points.len());
+        outputs.exitance_ply(ply, &points)?;
+        exported = points.len();
+    }
+    for path in outputs.commit()? {
+        if Some(&path) == args.export_exitance.as_ref() {
+            eprintln!("wrote {} ({exported} vertices)", path.display());
+        } else {
+            eprintln!("wrote {}", path.display());
+        }
     }
     if args.timings {
         let frames = totals.len();
         let how = if args.isolate { "submission-to-fence wall time" } else { "GPU time (timestamp queries)" };
         let after = if args.frames > 1 { " after the first" } else { "" };
-        println!("{how} per pass on {} (median of {frames} frame(s){after}):", gpu.info().name);
+        out!("{how} per pass on {} (median of {frames} frame(s){after}):", gpu.info().name);
         for (name, mut v) in per_pass {
-            println!("  {name:<8} {:>9.3} ms", median(&mut v));
+            out!("  {name:<8} {:>9.3} ms", median(&mut v));
         }
         let total = median(&mut totals);
-        println!("  {:<8} {:>9.3} ms  ({:.1} frames/s)", "total", total, 1000.0 / total);
-        println!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
+        out!("  {:<8} {:>9.3} ms  ({:.1} frames/s)", "total", total, 1000.0 / total);
+        out!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
     }
     Ok(())
 }

@@ -100,7 +100,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             sample_seconds,
             output: args.output.as_deref(),
         };
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        out!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
 
@@ -108,30 +108,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         eprintln!("warning: {}: {warning}", report.source);
     }
     let fmt_opt = |v: Option<f64>| v.map_or("-".to_string(), num);
-    println!(
-        "mesh         {} ({} vertices, {} triangles)",
-        report.source,
-        mesh.positions().len(),
-        mesh.triangles().len()
-    );
-    println!("method       {} (seed {})", options.method, args.seed);
-    println!("count        {}", stats.count);
-    println!(
+    out!("mesh         {} ({} vertices, {} triangles)", report.source, mesh.positions().len(), mesh.triangles().len());
+    out!("method       {} (seed {})", options.method, args.seed);
+    out!("count        {}", stats.count);
+    out!(
         "total area   {} (weights sum to {}, relative difference {:.1e})",
         num(stats.mesh_area),
         num(stats.total_weight),
         (stats.total_weight - stats.mesh_area).abs() / stats.mesh_area
     );
-    println!(
-        "nn distance  min {}  mean {}  max {}",
-        fmt_opt(stats.nn_min),
-        fmt_opt(stats.nn_mean),
-        fmt_opt(stats.nn_max)
-    );
-    println!("weights      cv {:.4}  min {:.3e}  max {:.3e}", stats.weight_cv, stats.weight_min, stats.weight_max);
-    println!("time         load {load_seconds:.3} s, sampling {sample_seconds:.3} s");
+    out!("nn distance  min {}  mean {}  max {}", fmt_opt(stats.nn_min), fmt_opt(stats.nn_mean), fmt_opt(stats.nn_max));
+    out!("weights      cv {:.4}  min {:.3e}  max {:.3e}", stats.weight_cv, stats.weight_min, stats.weight_max);
+    out!("time         load {load_seconds:.3} s, sampling {sample_seconds:.3} s");
     if let Some(path) = &args.output {
-        println!("written      {}", path.display());
+        out!("written      {}", path.display());
     }
     Ok(())
 }

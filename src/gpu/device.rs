@@ -75,7 +75,7 @@ pub(crate) fn enumerate(instance: &ash::Instance) -> GpuResult<Vec<DeviceInfo>> 
 
 /// `wanted` is an index or a case-insensitive part of a name. Without it: a real GPU if there
 /// is one (discrete before integrated), else the CPU device (lavapipe).
-pub(crate) fn select(devices: &[DeviceInfo], wanted: Option<&str>) -> GpuResult<DeviceInfo> {
+pub fn select(devices: &[DeviceInfo], wanted: Option<&str>) -> GpuResult<DeviceInfo> {
     if devices.is_empty() {
         return Err(GpuError::NoDevice(String::new()));
     }

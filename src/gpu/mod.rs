@@ -26,7 +26,7 @@ pub use buffer::{Buffer, BufferDesc};
 pub use context::{Gpu, HostVulkan};
 pub use debug::ValidationCounters;
 pub use descriptor::{Binding, BindingKind, DescriptorSet};
-pub use device::DeviceInfo;
+pub use device::{DeviceInfo, select as select_device};
 pub use error::{GpuError, GpuResult};
 pub use gpu_allocator::MemoryLocation;
 pub use image::{Image, ImageDesc, aspect_of};

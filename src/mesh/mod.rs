@@ -21,6 +21,10 @@ pub use obj::LoadOptions;
 /// Marks an edge with no single neighbouring triangle (an open boundary or a non-manifold edge).
 pub const NO_NEIGHBOUR: u32 = u32::MAX;
 
+/// Largest coordinate magnitude a mesh may have: beyond it f32 triangle areas (and the sample
+/// areas and kernels built on them) lose all precision or overflow to infinity.
+pub const MAX_COORDINATE: f32 = 1e9;
+
 /// A triangle is dropped as degenerate when its area is at most this fraction of its longest
 /// edge squared: below it the triangle's shape is rounding noise of f32 coordinates, and its
 /// cotangents would poison the curvature of its vertices.
@@ -41,6 +45,11 @@ pub enum MeshError {
     NoFaces { source_name: String },
     #[error("{source_name}: vertex {vertex} has a non-finite position {value:?}")]
     NonFinite { source_name: String, vertex: usize, value: [f32; 3] },
+    #[error(
+        "{source_name}: vertex {vertex} at {value:?} is farther than {limit:e} units from the origin \
+         (f32 areas would overflow or lose all precision; scale the mesh down)"
+    )]
+    TooFar { source_name: String, vertex: usize, value: [f32; 3], limit: f32 },
     #[error("{source_name}: triangle {triangle} refers to vertex {index}, but there are only {count} vertices")]
     IndexOutOfRange { source_name: String, triangle: usize, index: u32, count: usize },
     #[error("{source_name}: the mesh has no area: all {degenerate} triangles have zero area")]
@@ -143,6 +152,9 @@ impl Mesh {
         }
         if let Some((vertex, p)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
             return Err(MeshError::NonFinite { source_name: source, vertex, value: p.to_array() });
+        }
+        if let Some((vertex, p)) = positions.iter().enumerate().find(|(_, p)| p.abs().max_element() > MAX_COORDINATE) {
+            return Err(MeshError::TooFar { source_name: source, vertex, value: p.to_array(), limit: MAX_COORDINATE });
         }
         for (triangle, tri) in triangles.iter().enumerate() {
             if let Some(&index) = tri.iter().find(|&&i| i as usize >= positions.len()) {

@@ -25,11 +25,20 @@ use std::sync::Arc;
 pub enum RenderError {
     /// The scene asks for more than the device has.
     #[error("{setting} = {value} does not fit this device: its {limit_name} is {limit}")]
-    DoesNotFit { setting: &'static str, value: u64, limit_name: &'static str, limit: u64 },
+    DoesNotFit { setting: String, value: u64, limit_name: &'static str, limit: u64 },
     #[error("light {0} cannot be replaced by a light of another kind")]
     LightKindChanged(usize),
     #[error(transparent)]
     Gpu(#[from] GpuError),
+}
+
+/// Non-finite values one pass left on one object.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NonFinite {
+    pub pass: &'static str,
+    pub object: usize,
+    /// Samples (splat) or vertices (gather) with a NaN or infinite value.
+    pub count: usize,
 }
 
 /// Per-pass GPU milliseconds of one frame, in recording order.
@@ -224,6 +233,32 @@ impl Renderer {
         Ok(self.buffers.upload_lights(&self.scene)?)
     }
 
+    /// Where the last frame's non-finite values are, pass by pass and object by object (the
+    /// splat's irradiance at the samples, the gather's exitance at the vertices), so a NaN is
+    /// reported with its cause instead of drawn black. Empty when both are finite: then a
+    /// non-finite pixel comes from shading.
+    pub fn find_non_finite(&self) -> Result<Vec<NonFinite>, RenderError> {
+        let splat = self.splat_irradiance()?;
+        let exitance: Vec<[f32; 4]> = self.buffers.exitance.read()?;
+        let mut found = Vec::new();
+        let mut first_sample = 0;
+        for (object, o) in self.scene.objects.iter().enumerate() {
+            let samples = &splat[first_sample..first_sample + o.samples.len()];
+            first_sample += o.samples.len();
+            let bad = samples.iter().filter(|(e, a)| !(e.iter().all(|v| v.is_finite()) && a.is_finite())).count();
+            if bad > 0 {
+                found.push(NonFinite { pass: "splat", object, count: bad });
+            }
+            let first = self.buffers.vertex_offsets[object] as usize;
+            let vertices = &exitance[first..first + o.mesh.positions().len()];
+            let bad = vertices.iter().filter(|e| !e.iter().all(|v| v.is_finite())).count();
+            if bad > 0 {
+                found.push(NonFinite { pass: "gather", object, count: bad });
+            }
+        }
+        Ok(found)
+    }
+
     /// Bytes of device memory in use by the allocator.
     pub fn device_memory(&self) -> u64 {
         self.gpu.memory_usage().0
@@ -231,7 +266,9 @@ impl Renderer {
 }
 
 /// An error naming the scene setting when the scene needs more than the device allows, before
-/// any GPU work.
+/// any GPU work: dispatch sizes, image sizes and layers, storage-buffer ranges, and memory (the
+/// largest single allocation against `maxMemoryAllocationSize`, the total against the largest
+/// device-local heap).
 fn check_fits(gpu: &Gpu, scene: &PreparedScene) -> Result<(), RenderError> {
     let limits = &gpu.properties().limits;
     // Vertex- and sample-wide passes dispatch along x only.
@@ -240,23 +277,66 @@ fn check_fits(gpu: &Gpu, scene: &PreparedScene) -> Result<(), RenderError> {
     };
     let dispatch = "maxComputeWorkGroupCount x local size";
     let image_side = limits.max_image_dimension2_d as u64;
-    let [width, height] = scene.scene.file.camera.resolution.map(u64::from);
+    let file = &scene.scene.file;
+    let [width, height] = file.camera.resolution.map(u64::from);
+    let pixels = width * height;
+    let (map, layers) = (file.render.shadow_map_size as u64, scene.shadow_layers.max(1) as u64);
+    let (max_allocation, heap) = memory_limits(gpu);
+    // The HDR image (and the surface image of the pixel gather), 16 bytes a pixel, and the
+    // shadow-map array, 2 bytes a texel, are the large allocations; the rest is counted whole.
+    let hdr_bytes = 16 * pixels;
+    let shadow_bytes = 2 * map * map * layers;
+    let vertex_bytes = 56 * scene.vertex_count() as u64 + 64 * scene.sample_count() as u64;
+    let surface = if file.render.gather == GatherMode::Pixel { hdr_bytes } else { 0 };
+    // HDR, surface, depth (4), tone-mapped output (4) and the EXR readback (16) per pixel.
+    let total = hdr_bytes + surface + 24 * pixels + shadow_bytes + vertex_bytes;
     let checks = [
-        ("the meshes' vertex count", scene.vertex_count() as u64, dispatch, dispatchable("vertex_light.comp")?),
-        ("sampling.count x translucent objects", scene.sample_count() as u64, dispatch, dispatchable("splat.comp")?),
-        ("camera.resolution (largest side)", width.max(height), "maxImageDimension2D", image_side),
         (
-            "camera.resolution (width x height x 4 bytes of tone-mapped output)",
-            4 * width * height,
+            "the meshes' vertex count".to_string(),
+            scene.vertex_count() as u64,
+            dispatch,
+            dispatchable("vertex_light.comp")?,
+        ),
+        (
+            "sampling.count x translucent objects".into(),
+            scene.sample_count() as u64,
+            dispatch,
+            dispatchable("splat.comp")?,
+        ),
+        ("camera.resolution (largest side)".into(), width.max(height), "maxImageDimension2D", image_side),
+        (
+            "camera.resolution (width x height x 4 bytes of tone-mapped output)".into(),
+            4 * pixels,
             "maxStorageBufferRange",
             limits.max_storage_buffer_range as u64,
         ),
-        ("render.shadow_map_size", scene.scene.file.render.shadow_map_size as u64, "maxImageDimension2D", image_side),
+        ("render.shadow_map_size".into(), map, "maxImageDimension2D", image_side),
         (
-            "shadow maps (one per shadow-casting light, environment directions included)",
+            "shadow maps (one per shadow-casting light, environment directions included)".into(),
             scene.shadow_layers as u64,
             "maxImageArrayLayers",
             limits.max_image_array_layers as u64,
+        ),
+        (
+            format!("bytes of the HDR image at camera.resolution {width}x{height}"),
+            hdr_bytes,
+            "maxMemoryAllocationSize",
+            max_allocation,
+        ),
+        (
+            format!("bytes of {layers} shadow maps of render.shadow_map_size {map}"),
+            shadow_bytes,
+            "maxMemoryAllocationSize",
+            max_allocation,
+        ),
+        (
+            format!(
+                "bytes of device memory the scene needs (images at camera.resolution {width}x{height}, {layers} \
+                 shadow maps of {map}^2, meshes and samples)"
+            ),
+            total,
+            "largest device-local memory heap",
+            heap,
         ),
     ];
     for (setting, value, limit_name, limit) in checks {
@@ -265,4 +345,18 @@ fn check_fits(gpu: &Gpu, scene: &PreparedScene) -> Result<(), RenderError> {
         }
     }
     Ok(())
+}
+
+/// `maxMemoryAllocationSize` and the size of the largest device-local heap.
+fn memory_limits(gpu: &Gpu) -> (u64, u64) {
+    let mut maintenance3 = ash::vk::PhysicalDeviceMaintenance3Properties::default();
+    let mut properties = ash::vk::PhysicalDeviceProperties2::default().push_next(&mut maintenance3);
+    // SAFETY: plain queries on the device in use (Vulkan 1.1 core).
+    let memory = unsafe {
+        gpu.instance().get_physical_device_properties2(gpu.physical_device(), &mut properties);
+        gpu.instance().get_physical_device_memory_properties(gpu.physical_device())
+    };
+    let heaps = &memory.memory_heaps[..memory.memory_heap_count as usize];
+    let local = heaps.iter().filter(|h| h.flags.contains(ash::vk::MemoryHeapFlags::DEVICE_LOCAL));
+    (maintenance3.max_memory_allocation_size, local.map(|h| h.size).max().unwrap_or(u64::MAX))
 }

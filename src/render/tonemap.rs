@@ -10,6 +10,20 @@ use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, Descripto
 use ash::vk;
 use std::sync::Arc;
 
+/// Where the tone curve's input is capped (`TONE_SATURATION` in glsl/tonemap.comp): the curve
+/// is 1 from 7.25 on, and the cap keeps its squares finite in f32.
+pub const TONE_SATURATION: f64 = 64.0;
+
+/// The tone map of one linear channel in f64, twin of glsl/tonemap.comp: exposure, the ACES fit
+/// of Narkowicz 2015 `x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14)` clamped to [0, 1], the
+/// sRGB transfer function, and 8-bit quantisation as `packUnorm4x8` does it.
+pub fn display_value(linear: f64, exposure: f64) -> u8 {
+    let x = (linear.max(0.0) * exposure).min(TONE_SATURATION);
+    let aces = ((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)).clamp(0.0, 1.0);
+    let srgb = if aces <= 0.0031308 { aces * 12.92 } else { 1.055 * aces.powf(1.0 / 2.4) - 0.055 };
+    (srgb.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
 /// `TonemapPush` in glsl/tonemap.comp.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]

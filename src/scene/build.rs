@@ -67,6 +67,9 @@ impl PreparedScene {
     pub fn new(scene: &Scene, overrides: &Overrides) -> Result<PreparedScene, SceneError> {
         let mut scene = scene.clone();
         if let Some(n) = overrides.samples {
+            if n > crate::scene::MAX_SAMPLE_COUNT {
+                return Err(SceneError::TooManySamples(n));
+            }
             if n == 0 {
                 return Err(SceneError::ZeroSamples);
             }
@@ -129,6 +132,11 @@ impl PreparedScene {
             objects.push(PreparedObject { name, mesh, material, casts_shadow: o.casts_shadow, samples });
         }
 
+        for (i, o) in objects.iter().enumerate() {
+            if let Some(warning) = precision_warning(&o.mesh) {
+                log::warn!("{}: object[{i}] ({}): {warning}", scene.name, o.name);
+            }
+        }
         let bounds = bounding_sphere(objects.iter().map(|o| &o.mesh));
         let casters: Vec<&Mesh> = objects.iter().filter(|o| o.casts_shadow).map(|o| &o.mesh).collect();
         let caster_bounds = if casters.is_empty() { bounds } else { bounding_sphere(casters.iter().copied()) };
@@ -281,6 +289,24 @@ pub fn sphere(radius: f32, divisions: u32) -> Result<Mesh, MeshError> {
         }
     }
     Mesh::from_triangles(positions, triangles)
+}
+
+/// Positions are f32 in world space: an object far from the origin compared with its size has
+/// its vertices quantised to the f32 spacing there. A warning with the figures when that spacing
+/// is above 1e-4 of the object's size (the sample spacing of a few hundred samples is about
+/// 5e-2 of it, the dipole kernels' blend widths a fraction of that).
+pub fn precision_warning(mesh: &Mesh) -> Option<String> {
+    let (lo, hi) = mesh.bounds();
+    let size = (hi - lo).max_element();
+    let distance = lo.abs().max(hi.abs()).max_element();
+    let spacing = distance * f32::EPSILON;
+    (size > 0.0 && spacing > 1e-4 * size).then(|| {
+        format!(
+            "it is {distance:.3e} units from the origin and {size:.3e} across: f32 positions there are \
+             quantised to {spacing:.2e} units ({:.2}% of its size); move the scene near the origin",
+            100.0 * spacing / size
+        )
+    })
 }
 
 fn bounding_sphere<'a>(meshes: impl Iterator<Item = &'a Mesh>) -> (Vec3, f32) {

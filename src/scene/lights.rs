@@ -158,8 +158,11 @@ impl Environment {
                         mean += d * energy(x, y);
                     }
                 }
-                let dir = if mean.length() > 1e-12 {
-                    mean.normalize()
+                // Normalised through its largest component: the length of a sum of very bright
+                // texels (1e20 and up) would overflow f32 and give a zero direction.
+                let largest = mean.abs().max_element();
+                let dir = if largest > 0.0 && largest.is_finite() {
+                    (mean / largest).normalize()
                 } else {
                     Self::direction_of(self.width, self.height, (r[0] + r[1]) as f32 * 0.5, (r[2] + r[3]) as f32 * 0.5)
                 };

@@ -28,6 +28,8 @@ pub enum SceneError {
     Invalid { file: String, message: String },
     #[error("--samples must be at least 1")]
     ZeroSamples,
+    #[error("--samples {0} is above the limit of {MAX_SAMPLE_COUNT} (as for sampling.count)")]
+    TooManySamples(usize),
     #[error("cannot fit a mesh with an empty bounding box")]
     EmptyBounds,
     #[error("embedded mesh is not UTF-8")]
@@ -46,6 +48,9 @@ pub enum SceneError {
     #[error("{context}")]
     Context { context: String, source: Box<SceneError> },
 }
+
+/// Most sample points per translucent object (`sampling.count`, `--samples`).
+pub const MAX_SAMPLE_COUNT: usize = 1_000_000;
 
 /// A parsed, checked scene and where its relative paths resolve.
 #[derive(Clone, Debug)]
@@ -165,7 +170,16 @@ fn check(scene: &SceneFile) -> Check {
     if c.eye == c.target {
         return Err(("camera.target".into(), "equals camera.eye".into()));
     }
-    let forward = (glam::Vec3::from(c.target) - glam::Vec3::from(c.eye)).normalize();
+    // In f64: the distance of far-apart points overflows f32 and would read as "parallel".
+    let view = glam::DVec3::from(c.target.map(f64::from)) - glam::DVec3::from(c.eye.map(f64::from));
+    let far = crate::mesh::MAX_COORDINATE as f64;
+    if view.length() > far {
+        return Err((
+            "camera.eye".into(),
+            format!("is {:e} units from camera.target; at most {far:e} (f32 precision)", view.length()),
+        ));
+    }
+    let forward = view.normalize().as_vec3();
     if forward.cross(glam::Vec3::from(c.up).normalize()).length() < 1e-4 {
         return Err(("camera.up".into(), format!("{:?} is parallel to the view direction", c.up)));
     }
@@ -187,6 +201,12 @@ fn check(scene: &SceneFile) -> Check {
             Shape::Plane { size, divisions } | Shape::Sphere { radius: size, divisions } => {
                 if !(size.is_finite() && *size > 0.0) {
                     return Err((key("shape"), format!("size/radius {size} must be positive")));
+                }
+                if *size > crate::mesh::MAX_COORDINATE {
+                    return Err((
+                        key("shape"),
+                        format!("size/radius {size:e} is above {:e}", crate::mesh::MAX_COORDINATE),
+                    ));
                 }
                 if *divisions == 0 || *divisions > 2048 {
                     return Err((key("shape.divisions"), format!("{divisions} must be 1 to 2048")));
@@ -262,8 +282,8 @@ fn check(scene: &SceneFile) -> Check {
         return Err(("light".into(), "at most one environment light".into()));
     }
     let s = &scene.sampling;
-    if s.count == 0 || s.count > 1_000_000 {
-        return Err(("sampling.count".into(), format!("{} must be 1 to 1000000", s.count)));
+    if s.count == 0 || s.count > MAX_SAMPLE_COUNT {
+        return Err(("sampling.count".into(), format!("{} must be 1 to {MAX_SAMPLE_COUNT}", s.count)));
     }
     let r = &scene.render;
     if !(r.exposure.is_finite() && r.exposure > 0.0) {
