@@ -12,6 +12,8 @@ pub enum OutputError {
     #[error("{} is not a file path", path.display())]
     NotAFilePath { path: PathBuf },
     // The underlying error is the source (shown by `{:#}` and error reporters), not repeated here.
+    #[error("cannot write {}: it is a folder", path.display())]
+    IsAFolder { path: PathBuf },
     #[error("cannot put {} in place", path.display())]
     Rename { path: PathBuf, source: std::io::Error },
     #[error("{}: image size mismatch: {values} values for {width}x{height} pixels", path.display())]
@@ -112,6 +114,10 @@ impl OutputSet {
 
     /// Rename every staged file into place; returns the destinations.
     pub fn commit(mut self) -> Result<Vec<PathBuf>, OutputError> {
+        // A folder in a destination's place would fail its rename after others succeeded.
+        if let Some((_, path)) = self.staged.iter().find(|(_, path)| path.is_dir()) {
+            return Err(OutputError::IsAFolder { path: path.clone() });
+        }
         let staged = std::mem::take(&mut self.staged);
         let mut done = Vec::new();
         for (i, (tmp, path)) in staged.iter().enumerate() {

@@ -119,6 +119,9 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         if !folder.is_dir() {
             bail!("cannot write {}: the folder {} does not exist", path.display(), folder.display());
         }
+        if path.is_dir() {
+            bail!("cannot write {}: it is a folder", path.display());
+        }
     }
     super::remove_on_interrupt(&outputs)?;
     let scene = match &args.scene {

@@ -88,14 +88,27 @@ impl Scene {
             let path = e.path().to_string();
             let inner = e.into_inner().to_string();
             // Inside internally tagged tables toml can only point at the table header; find
-            // the offending key's own line.
-            let line = inner
+            // the offending key's own line (an unknown key by its name, a value of the wrong
+            // type by its text).
+            let unknown = inner
                 .split("unknown field `")
                 .nth(1)
                 .and_then(|rest| rest.split('`').next())
                 .and_then(|key| line_of(text, key))
-                .map(|l| format!("line {l}: "))
-                .unwrap_or_default();
+                .map(|l| (l, None));
+            let wrong = wrong_value(text, &inner);
+            // Found by its value: toml's excerpt of the table header says nothing more.
+            let inner = match (&wrong, inner.lines().last()) {
+                (Some(_), Some(last)) if unknown.is_none() => last.to_string(),
+                _ => inner,
+            };
+            let (line, key) = unknown.or(wrong).unzip();
+            let line = line.map(|l| format!("line {l}: ")).unwrap_or_default();
+            let path = match key.flatten() {
+                Some(key) if !path.is_empty() && path != "." => format!("{path}.{key}"),
+                Some(key) => key,
+                None => path,
+            };
             if path.is_empty() || path == "." {
                 invalid(format!("{line}{inner}"))
             } else {
@@ -126,6 +139,26 @@ impl Scene {
 }
 
 /// The 1-based line where the last segment of a dotted key path is assigned, if it is found.
+/// For a serde "invalid type: string \"x\", expected ..." error inside a table toml reports only
+/// by its header: the line after that header where a key is given that value, and the key.
+fn wrong_value(text: &str, message: &str) -> Option<(usize, Option<String>)> {
+    let value = message.split("invalid type: ").nth(1)?.split(", expected").next()?;
+    // `string "x"`, `integer `5``, `floating point `1.5``, `boolean `true``.
+    let literal = match value.split_once('"') {
+        Some((_, rest)) => format!("\"{}", rest),
+        None => value.split('`').nth(1)?.to_string(),
+    };
+    let header =
+        message.split("at line ").nth(1)?.split(|c: char| !c.is_ascii_digit()).next()?.parse::<usize>().ok()?;
+    text.lines().enumerate().skip(header.saturating_sub(1)).find_map(|(i, l)| {
+        let code = l.split('#').next()?;
+        let at = code.find(&format!("= {literal}")).or_else(|| code.find(&format!("={literal}")))?;
+        let before = code[..at].trim_end();
+        let key = before.rsplit(|c: char| !(c.is_alphanumeric() || c == '_')).next()?.to_string();
+        Some((i + 1, (!key.is_empty()).then_some(key)))
+    })
+}
+
 fn line_of(text: &str, key: &str) -> Option<usize> {
     let last = key.rsplit('.').next()?.split('[').next()?;
     text.lines()
