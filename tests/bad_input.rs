@@ -220,7 +220,8 @@ fn a_closed_stdout_ends_a_command_quietly() {
 fn very_bright_input_stays_finite_and_white_not_black() {
     let dir = temp_dir("bright");
     let count_white = |png: &Path| png_pixels(png).chunks(4).filter(|p| p[0] == 255 && p[1] == 255).count();
-    let cases: [(&str, &[(&str, &str)]); 3] = [
+    type Case<'a> = (&'a str, &'a [(&'a str, &'a str)]);
+    let cases: [Case; 3] = [
         ("irradiance 1e30", &[("irradiance = [1.0, 1.0, 1.0]", "irradiance = [1e30, 1e30, 1e30]")]),
         ("exposure 1e30", &[("exposure = 1.0", "exposure = 1e30")]),
         ("background 3e38", &[("exposure = 1.0", "exposure = 1.0\nbackground = [3e38, 3e38, 3e38]")]),
@@ -318,7 +319,8 @@ fn absurd_sizes_distances_and_devices_are_errors_naming_them() {
     let dir = temp_dir("absurd");
     let png = dir.join("out.png");
     let render = |scene: &Path| translucent(&["render", scene.to_str().unwrap(), "-o", png.to_str().unwrap()], &[]);
-    let cases: [(&str, &[(&str, &str)], &str); 4] = [
+    type Case<'a> = (&'a str, &'a [(&'a str, &'a str)], &'a str);
+    let cases: [Case; 4] = [
         ("radius 1e30", &[("radius = 0.01", "radius = 1e30")], "object[0].shape"),
         ("scale 1e30", &[("divisions = 12 }", "divisions = 12 }\ntransform = { scale = 1e30 }")], "farther than"),
         ("eye 4e19 away", &[("eye = [0.0, 0.0, 0.1]", "eye = [0.0, 0.0, 4e19]")], "camera.eye"),

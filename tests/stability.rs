@@ -11,7 +11,8 @@ use common::{temp_dir, translucent, with_gpu};
 use std::sync::Arc;
 use translucent::gpu::Gpu;
 use translucent::optics::presets::{self, MeasuredMaterial};
-use translucent::render::plan::Change;
+use translucent::render::plan::{Change, Pass};
+use translucent::render::records::SplatRecord;
 use translucent::render::renderer::Renderer;
 use translucent::render::tonemap::display_value;
 use translucent::scene::build::{Overrides, PreparedScene};
@@ -176,4 +177,28 @@ fn the_tone_map_matches_its_f64_twin() {
             assert!(lit > 0 && white == lit, "exposure {exposure:e}: {white} of {lit} lit channels are white");
         }
     }
+}
+
+#[test]
+fn a_non_finite_value_is_traced_to_its_pass_and_object() {
+    let presets = [&presets::JENSEN_2001[5], &presets::JENSEN_2001[7]];
+    let scene = Scene::parse(&scene_text(&presets, 1000.0, 16), "nan", None).unwrap();
+    let prepared = PreparedScene::new(&scene, &Overrides::default()).unwrap();
+    with_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, prepared).unwrap();
+        renderer.frame(&renderer.plan(Change::Everything)).unwrap();
+        assert!(renderer.find_non_finite().unwrap().is_empty(), "a clean frame reports nothing");
+        // Poison one sample of the second object, as a broken splat would, and gather again.
+        let mut splat: Vec<SplatRecord> = renderer.buffers().splat.read().unwrap();
+        splat[16].irradiance_area[0] = f32::NAN;
+        renderer.buffers_mut().splat.write(0, &splat).unwrap();
+        let mut plan = renderer.plan(Change::Everything);
+        plan.passes.retain(|(p, _)| !matches!(p, Pass::Shadow | Pass::Splat));
+        renderer.frame(&plan).unwrap();
+        // The gather's final max(.., 0) may turn the NaN into black (llvmpipe's max returns the
+        // number), so the trace does not wait for a non-finite pixel: it reads the passes' outputs.
+        let found = renderer.find_non_finite().unwrap();
+        assert!(found.iter().any(|n| n.pass == "splat" && n.object == 1 && n.count == 1), "{found:?}");
+        assert!(found.iter().all(|n| n.object == 1), "object 0 is clean: {found:?}");
+    });
 }

@@ -199,9 +199,11 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     progress.finish_and_clear();
 
     let (rgba8, non_finite) = renderer.image()?;
-    if non_finite > 0 {
-        let causes: Vec<String> = renderer
-            .find_non_finite()?
+    // Checked on every render, not only when a pixel shows it: a NaN clamped to black on the
+    // way is still a NaN upstream.
+    let upstream = renderer.find_non_finite()?;
+    if non_finite > 0 || !upstream.is_empty() {
+        let causes: Vec<String> = upstream
             .iter()
             .map(|n| {
                 let o = &renderer.scene().objects[n.object];
