@@ -20,6 +20,10 @@ pub enum Access {
     ComputeImageReadWrite,
     /// Sampled-image reads in a fragment shader.
     FragmentSampledRead,
+    /// Storage-buffer reads in a fragment shader.
+    FragmentRead,
+    /// Anything any earlier or later command does (a frame's start, against the frame before).
+    Everything,
     /// Vertex-buffer reads by the input assembler.
     VertexAttributeRead,
     /// Colour-attachment writes.
@@ -42,7 +46,8 @@ impl Access {
             Access::ComputeWrite | Access::ComputeRead | Access::ComputeSampledRead | Access::ComputeImageReadWrite => {
                 S::COMPUTE_SHADER
             }
-            Access::FragmentSampledRead => S::FRAGMENT_SHADER,
+            Access::FragmentSampledRead | Access::FragmentRead => S::FRAGMENT_SHADER,
+            Access::Everything => S::ALL_COMMANDS,
             Access::VertexAttributeRead => S::VERTEX_ATTRIBUTE_INPUT,
             Access::ColorAttachmentWrite => S::COLOR_ATTACHMENT_OUTPUT,
             Access::DepthAttachmentReadWrite => S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
@@ -58,7 +63,8 @@ impl Access {
         match self {
             Access::Nothing => A::NONE,
             Access::ComputeWrite => A::SHADER_STORAGE_WRITE,
-            Access::ComputeRead => A::SHADER_STORAGE_READ,
+            Access::ComputeRead | Access::FragmentRead => A::SHADER_STORAGE_READ,
+            Access::Everything => A::MEMORY_READ | A::MEMORY_WRITE,
             Access::ComputeSampledRead | Access::FragmentSampledRead => A::SHADER_SAMPLED_READ,
             Access::ComputeImageReadWrite => A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
             Access::VertexAttributeRead => A::VERTEX_ATTRIBUTE_READ,
@@ -75,7 +81,12 @@ impl Access {
         use vk::ImageLayout as L;
         match self {
             Access::Nothing => L::UNDEFINED,
-            Access::ComputeWrite | Access::ComputeImageReadWrite | Access::ComputeRead | Access::HostRead => L::GENERAL,
+            Access::ComputeWrite
+            | Access::ComputeImageReadWrite
+            | Access::ComputeRead
+            | Access::FragmentRead
+            | Access::Everything
+            | Access::HostRead => L::GENERAL,
             Access::ComputeSampledRead | Access::FragmentSampledRead => L::SHADER_READ_ONLY_OPTIMAL,
             Access::VertexAttributeRead => L::GENERAL,
             Access::ColorAttachmentWrite => L::COLOR_ATTACHMENT_OPTIMAL,

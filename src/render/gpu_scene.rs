@@ -4,7 +4,7 @@
 //! passes get their inputs from here; only lights change after creation.
 
 use super::records::{LightGpu, ObjectRecord, SampleRecord, SplatRecord, Vertex};
-use crate::gpu::{Buffer, BufferDesc, Gpu, GpuResult};
+use crate::gpu::{Access, Buffer, BufferDesc, Gpu, GpuResult, memory_barrier};
 use crate::scene::build::PreparedScene;
 use ash::vk;
 use std::sync::Arc;
@@ -54,6 +54,8 @@ pub struct GpuScene {
     pub light_count: u32,
     /// Lights that are not environment directions; they come first in the light buffer.
     pub key_light_count: u32,
+    /// Light records waiting to be copied into `lights` by the next recorded frame.
+    pending_lights: Option<Vec<LightGpu>>,
 }
 
 fn storage(gpu: &Arc<Gpu>, name: &str, bytes: u64, extra: vk::BufferUsageFlags) -> GpuResult<Buffer> {
@@ -136,21 +138,42 @@ impl GpuScene {
             sample_count: samples.len() as u32,
             light_count: scene.lights.len() as u32,
             key_light_count: crate::scene::lights::key_light_count(&scene.lights) as u32,
+            pending_lights: None,
         };
-        gpu_scene.upload_lights(scene)?;
+        gpu_scene.set_lights(scene);
+        // Before any frame the buffer is idle: written from the host directly.
+        if let Some(records) = gpu_scene.pending_lights.take().filter(|r| !r.is_empty()) {
+            gpu_scene.lights.write(0, &records)?;
+        }
         Ok(gpu_scene)
     }
 
-    /// Pack and upload the scene's lights and their shadow matrices (after a light moved; the
-    /// number of lights and their shadow layers stay as they were).
-    pub fn upload_lights(&mut self, scene: &PreparedScene) -> GpuResult<()> {
+    /// Pack the scene's lights and their shadow matrices (after a light moved; the number of
+    /// lights and their shadow layers stay as they were). The records reach the GPU in the next
+    /// recorded frame (`record_uploads`), so frames still in flight keep the lights they had.
+    pub fn set_lights(&mut self, scene: &PreparedScene) {
         self.light_matrices = vec![[[0.0; 4]; 4]; scene.shadow_layers as usize];
         for l in &scene.lights {
             if let Some(layer) = l.shadow_layer {
                 self.light_matrices[layer as usize] = l.shadow_matrix.to_cols_array_2d();
             }
         }
-        let records: Vec<LightGpu> = scene.lights.iter().map(LightGpu::new).collect();
-        if records.is_empty() { Ok(()) } else { self.lights.write(0, &records) }
+        self.pending_lights = Some(scene.lights.iter().map(LightGpu::new).collect());
+    }
+
+    /// Record the copy of pending light records into the light buffer (vkCmdUpdateBuffer, in
+    /// the command buffer rather than through mapped memory), and the barrier to its readers.
+    pub fn record_uploads(&mut self, device: &ash::Device, cmd: vk::CommandBuffer) {
+        let Some(records) = self.pending_lights.take().filter(|r| !r.is_empty()) else {
+            return;
+        };
+        let bytes: &[u8] = bytemuck::cast_slice(&records);
+        // vkCmdUpdateBuffer takes at most 65536 bytes a call.
+        for (i, chunk) in bytes.chunks(65536).enumerate() {
+            // SAFETY: `cmd` is recording outside rendering; the range lies inside the buffer,
+            // which has TRANSFER_DST usage; sizes are multiples of 4 (records are 128 bytes).
+            unsafe { device.cmd_update_buffer(cmd, self.lights.raw(), (i * 65536) as u64, chunk) };
+        }
+        memory_barrier(device, cmd, &[Access::TransferWrite], &[Access::ComputeRead, Access::FragmentRead]);
     }
 }

@@ -6,6 +6,7 @@
 
 use super::gpu_scene::GpuScene;
 use super::plan::Plan;
+use super::shade::HostTarget;
 use crate::gpu::Gpu;
 use ash::vk;
 use glam::{Mat4, Vec3};
@@ -22,6 +23,8 @@ pub struct FrameInputs<'a> {
     pub eye: Vec3,
     /// Clear colour of the HDR image.
     pub background: [f32; 3],
+    /// The host's attachments, when the renderer draws into a host engine's images.
+    pub target: Option<&'a HostTarget>,
     pub exposure: f32,
 }
 

@@ -17,6 +17,20 @@ pub enum Pass {
     Tonemap,
 }
 
+impl Change {
+    /// The change covering both `self` and `other` (what a frame must redo after both).
+    pub fn and(self, other: Change) -> Change {
+        use Change::*;
+        match (self, other) {
+            (Everything, _) | (_, Everything) => Everything,
+            (Lights, _) | (_, Lights) => Lights,
+            (Light(a), Light(b)) if a != b => Lights,
+            (Light(a), _) | (_, Light(a)) => Light(a),
+            (Camera, Camera) => Camera,
+        }
+    }
+}
+
 impl Pass {
     pub fn name(self) -> &'static str {
         match self {
@@ -144,7 +158,12 @@ pub fn plan(needs: &SceneNeeds, change: Change) -> Plan {
         );
         add(Pass::Shade, true, "every frame draws the view", "");
     }
-    add(Pass::Tonemap, true, "every frame's HDR image is tone-mapped", "");
+    add(
+        Pass::Tonemap,
+        !needs.host_target,
+        "every frame's HDR image is tone-mapped",
+        "the host tone-maps its own target",
+    );
     plan
 }
 
@@ -159,6 +178,7 @@ mod tests {
             shadowed_lights: if shadow_layers > 0 { vec![0] } else { vec![] },
             environment: (shadow_layers > 1).then_some(1),
             pixel_gather: false,
+            host_target: false,
         }
     }
 

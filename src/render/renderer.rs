@@ -8,16 +8,17 @@ use super::gather_sparse::GatherSparsePass;
 use super::gpu_scene::GpuScene;
 use super::pass::{FrameInputs, RenderPass};
 use super::plan::{self, Change, Pass, Plan};
-use super::shade::ShadePass;
+use super::shade::{HostTarget, ShadePass, TargetDesc};
 use super::shadow::ShadowPass;
 use super::splat::SplatPass;
 use super::tonemap::TonemapPass;
 use super::vertex_light::VertexLightPass;
-use crate::gpu::{Access, Gpu, GpuError, GpuTimer, ShaderInterface};
+use crate::gpu::{Access, Gpu, GpuError, GpuTimer, ShaderInterface, memory_barrier};
 use crate::scene::build::PreparedScene;
 use crate::scene::needs::SceneNeeds;
 use crate::scene::{GatherMode, Light};
-use glam::Vec3;
+use ash::vk;
+use glam::{Mat4, Vec3};
 use std::sync::Arc;
 
 /// Why a renderer could not be made.
@@ -26,6 +27,9 @@ pub enum RenderError {
     /// The scene asks for more than the device has.
     #[error("{setting} = {value} does not fit this device: its {limit_name} is {limit}")]
     DoesNotFit { setting: String, value: u64, limit_name: &'static str, limit: u64 },
+    /// A call that does not fit the renderer's target (own images or the host's).
+    #[error("{0}")]
+    Target(&'static str),
     #[error("light {0} cannot be replaced by a light of another kind")]
     LightKindChanged(usize),
     #[error(transparent)]
@@ -56,6 +60,38 @@ impl FrameTimings {
     }
 }
 
+/// Where the camera is: world -> view, view -> clip (Vulkan: depth 0..1, y down), and its
+/// position (for the specular lobe).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraView {
+    pub view: Mat4,
+    pub projection: Mat4,
+    pub eye: Vec3,
+}
+
+impl CameraView {
+    /// The scene file's camera, its near and far planes fitted around the scene.
+    pub fn of_scene(scene: &PreparedScene) -> CameraView {
+        let camera = &scene.scene.file.camera;
+        CameraView {
+            view: camera.view(),
+            projection: camera.projection(scene.bounds.0, scene.bounds.1),
+            eye: Vec3::from(camera.eye),
+        }
+    }
+}
+
+/// A frame recorded into a command buffer: which passes, and where its timings will be.
+#[derive(Clone, Debug)]
+pub struct RecordedFrame {
+    /// The passes recorded, in order (what the plan ran, counted as recorded).
+    pub passes: Vec<Pass>,
+    /// Slot of the timer ring that holds its timestamps.
+    slot: Option<usize>,
+}
+
+/// Renders one prepared scene: its passes over its GPU data, recording the passes each frame
+/// needs into a command buffer (the host's, or its own for `frame`).
 pub struct Renderer {
     gpu: Arc<Gpu>,
     scene: PreparedScene,
@@ -67,43 +103,76 @@ pub struct Renderer {
     /// Vertex, sparse or pixel gather (`render.gather`).
     gather: Box<dyn RenderPass>,
     shade: ShadePass,
-    tonemap: TonemapPass,
-    timer: Option<GpuTimer>,
+    /// Own target only: the host tone-maps its own.
+    tonemap: Option<TonemapPass>,
+    /// One timer per frame that may be in flight (empty without timestamps).
+    timers: Vec<GpuTimer>,
+    next_slot: usize,
     buffers: GpuScene,
     background: [f32; 3],
+    target: TargetDesc,
+    camera: CameraView,
+    /// What changed since the last recorded frame; `None` when nothing did.
+    pending: Option<Change>,
 }
 
 impl Renderer {
+    /// Frames a host may have in flight at once: each has its own timestamp queries.
+    pub const FRAMES_IN_FLIGHT: usize = 3;
+
+    /// A renderer drawing into its own HDR image, tone-mapped for readback (the CLI's path).
     pub fn new(gpu: &Arc<Gpu>, scene: PreparedScene) -> Result<Renderer, RenderError> {
+        Renderer::with_target(gpu, scene, TargetDesc::Own)
+    }
+
+    /// A renderer drawing into `target`: its own images, or a host engine's of the given
+    /// formats (then `record_frame` takes the host's attachments, and there is no tone map).
+    pub fn with_target(gpu: &Arc<Gpu>, scene: PreparedScene, target: TargetDesc) -> Result<Renderer, RenderError> {
         check_fits(gpu, &scene)?;
+        let mut needs = scene.needs();
+        needs.host_target = target != TargetDesc::Own;
+        if needs.host_target && needs.pixel_gather {
+            return Err(RenderError::Target(
+                "the pixel gather needs the renderer's own HDR image: use vertex or sparse",
+            ));
+        }
         let buffers = GpuScene::new(gpu, &scene)?;
         let settings = &scene.scene.file.render;
         let shadow = ShadowPass::new(gpu, settings.shadow_map_size, scene.shadow_layers)?;
-        let needs = scene.needs();
-        let shade = ShadePass::new(gpu, scene.scene.file.camera.resolution, &buffers, &shadow, needs.pixel_gather)?;
-        let gather: Box<dyn RenderPass> = match shade.surface() {
-            Some(surface) => Box::new(GatherPixelPass::new(gpu, &buffers, surface, shade.hdr())?),
-            None if settings.gather == GatherMode::Sparse => Box::new(GatherSparsePass::new(gpu, &buffers)?),
-            None => Box::new(GatherPass::new(gpu, &buffers)?),
+        let size = scene.scene.file.camera.resolution;
+        let shade = ShadePass::new(gpu, target, size, &buffers, &shadow, needs.pixel_gather)?;
+        let gather: Box<dyn RenderPass> = match (shade.surface(), shade.hdr()) {
+            (Some(surface), Some(hdr)) => Box::new(GatherPixelPass::new(gpu, &buffers, surface, hdr)?),
+            _ if settings.gather == GatherMode::Sparse => Box::new(GatherSparsePass::new(gpu, &buffers)?),
+            _ => Box::new(GatherPass::new(gpu, &buffers)?),
         };
         // Timing is optional: a queue without timestamps still renders.
-        let timer = GpuTimer::new(gpu, 8).inspect_err(|e| log::warn!("no GPU timings: {e}")).ok();
+        let timers = (0..Self::FRAMES_IN_FLIGHT)
+            .map(|_| GpuTimer::new(gpu, 8))
+            .collect::<Result<Vec<_>, _>>()
+            .inspect_err(|e| log::warn!("no GPU timings: {e}"))
+            .unwrap_or_default();
         Ok(Renderer {
             gpu: gpu.clone(),
             vertex_light: VertexLightPass::new(gpu, &buffers, &shadow)?,
             splat: SplatPass::new(gpu, &buffers, &shadow)?,
-            tonemap: TonemapPass::new(gpu, shade.hdr())?,
+            tonemap: shade.hdr().map(|hdr| TonemapPass::new(gpu, hdr)).transpose()?,
             shadow,
             gather,
             shade,
-            timer,
+            timers,
+            next_slot: 0,
             buffers,
             background: scene.background(),
             needs,
+            target,
+            camera: CameraView::of_scene(&scene),
+            pending: Some(Change::Everything),
             scene,
         })
     }
 
+    /// The prepared scene this renderer draws.
     pub fn scene(&self) -> &PreparedScene {
         &self.scene
     }
@@ -123,57 +192,164 @@ impl Renderer {
         plan::plan(&self.needs, change)
     }
 
-    fn pass(&self, pass: Pass) -> &dyn RenderPass {
-        match pass {
+    /// What changed since the last recorded frame (`record_frame` plans from it).
+    pub fn pending_change(&self) -> Option<Change> {
+        self.pending
+    }
+
+    fn mark(&mut self, change: Change) {
+        self.pending = Some(match self.pending {
+            None => change,
+            Some(old) => old.and(change),
+        });
+    }
+
+    /// The camera the next frames are drawn from.
+    pub fn camera(&self) -> CameraView {
+        self.camera
+    }
+
+    /// Move the camera: the next frame re-shades (and, in pixel mode, gathers again); exitance
+    /// at the vertices does not depend on the view.
+    pub fn set_camera(&mut self, camera: CameraView) {
+        self.camera = camera;
+        self.mark(Change::Camera);
+    }
+
+    /// Change the own target's size (the CLI's image): its images are made anew. The camera's
+    /// projection is the caller's (`set_camera`), for the new aspect ratio. A host target takes
+    /// its extent from each frame's `HostTarget` instead.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
+        if self.target != TargetDesc::Own {
+            return Err(RenderError::Target("resize: a host target's size comes with each frame's HostTarget"));
+        }
+        self.scene.scene.file.camera.resolution = [width, height];
+        check_fits(&self.gpu, &self.scene)?;
+        let gpu = self.gpu.clone();
+        let buffers = &self.buffers;
+        let shade = ShadePass::new(&gpu, self.target, [width, height], buffers, &self.shadow, self.needs.pixel_gather)?;
+        if let (Some(surface), Some(hdr)) = (shade.surface(), shade.hdr()) {
+            self.gather = Box::new(GatherPixelPass::new(&gpu, buffers, surface, hdr)?);
+        }
+        self.tonemap = shade.hdr().map(|hdr| TonemapPass::new(&gpu, hdr)).transpose()?;
+        self.shade = shade;
+        self.mark(Change::Camera);
+        Ok(())
+    }
+
+    fn pass(&self, pass: Pass) -> Option<&dyn RenderPass> {
+        Some(match pass {
             Pass::Shadow => &self.shadow,
             Pass::VertexLight => &self.vertex_light,
             Pass::Splat => &self.splat,
             Pass::Gather => self.gather.as_ref(),
             Pass::Shade => &self.shade,
-            Pass::Tonemap => &self.tonemap,
+            Pass::Tonemap => self.tonemap.as_ref()?,
+        })
+    }
+
+    /// Record the frame that what changed since the last one calls for (the first: everything)
+    /// into `cmd`, a primary command buffer the host is recording, outside any rendering. No
+    /// submission and no wait: the host submits, and may read `read_timings` after its fence.
+    /// `target` is the host's attachments for a `TargetDesc::Host` renderer, `None` otherwise.
+    pub fn record_frame(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        target: Option<&HostTarget>,
+    ) -> Result<RecordedFrame, RenderError> {
+        let change = self.pending.unwrap_or(Change::Camera);
+        let plan = self.plan(change);
+        self.record_plan(cmd, &plan, target)
+    }
+
+    /// Record the passes of `plan` into `cmd` (as `record_frame` does, with a plan of the
+    /// caller's), timed in the next slot of the timer ring.
+    pub fn record_plan(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        plan: &Plan,
+        target: Option<&HostTarget>,
+    ) -> Result<RecordedFrame, RenderError> {
+        match (self.target, target) {
+            (TargetDesc::Own, Some(_)) => return Err(RenderError::Target("this renderer draws into its own images")),
+            (TargetDesc::Host { .. }, None) => {
+                return Err(RenderError::Target("a host-target renderer needs a HostTarget"));
+            }
+            _ => {}
         }
+        let slot = (!self.timers.is_empty()).then(|| {
+            let slot = self.next_slot % self.timers.len();
+            self.next_slot += 1;
+            slot
+        });
+        let device = self.gpu.device();
+        // Against the frame before, which may still run: its reads of what this frame writes.
+        memory_barrier(device, cmd, &[Access::Everything], &[Access::Everything]);
+        self.buffers.record_uploads(device, cmd);
+        let passes: Vec<Pass> = plan.passes.iter().map(|(p, _)| *p).collect();
+        // Taken out for the recording, which borrows `self` immutably.
+        let mut timers = std::mem::take(&mut self.timers);
+        let mut timer = slot.map(|s| &mut timers[s]);
+        if let Some(t) = timer.as_deref_mut() {
+            t.reset(cmd);
+        }
+        self.record(cmd, plan, &passes, timer, target);
+        self.timers = timers;
+        self.pending = None;
+        Ok(RecordedFrame { passes, slot })
+    }
+
+    /// GPU milliseconds of each pass of `frame`, from its timestamps: call after the host's
+    /// fence for the submission holding it, and before `FRAMES_IN_FLIGHT` more frames were
+    /// recorded (they reuse its queries). Empty on a queue without timestamps.
+    pub fn read_timings(&self, frame: &RecordedFrame) -> Result<FrameTimings, RenderError> {
+        let passes = match frame.slot {
+            Some(slot) => self.timers[slot].results()?,
+            None => Vec::new(),
+        };
+        Ok(FrameTimings { passes })
     }
 
     /// Record `passes` of `plan` into `cmd`, each between the timer's marks when given.
-    fn record(&self, cmd: ash::vk::CommandBuffer, plan: &Plan, passes: &[Pass], mut timer: Option<&mut GpuTimer>) {
-        let camera = &self.scene.scene.file.camera;
+    fn record(
+        &self,
+        cmd: vk::CommandBuffer,
+        plan: &Plan,
+        passes: &[Pass],
+        mut timer: Option<&mut GpuTimer>,
+        target: Option<&HostTarget>,
+    ) {
         let layers = plan.shadow_light.map(|source| self.scene.shadow_layers_of(source));
         let frame = FrameInputs {
             gpu: &self.gpu,
             scene: &self.buffers,
             plan,
             shadow_layers: layers.as_deref(),
-            view_proj: camera.projection(self.scene.bounds.0, self.scene.bounds.1) * camera.view(),
-            eye: Vec3::from(camera.eye),
+            view_proj: self.camera.projection * self.camera.view,
+            eye: self.camera.eye,
             background: self.background,
             exposure: self.scene.scene.file.render.exposure,
+            target,
         };
         for &pass in passes {
+            let Some(recorder) = self.pass(pass) else { continue };
             if let Some(t) = timer.as_deref_mut() {
                 t.begin(cmd, pass.name());
             }
-            self.pass(pass).record(cmd, &frame);
+            recorder.record(cmd, &frame);
             if let Some(t) = timer.as_deref_mut() {
                 t.end(cmd);
             }
         }
     }
 
-    /// Render one frame: record the passes of `plan` in one submission, wait, and return their
-    /// GPU times from timestamp queries (none on a queue that cannot write timestamps).
+    /// Render one frame: record the passes of `plan` in one submission of its own, wait, and
+    /// return their GPU times from timestamp queries (none on a queue that cannot write
+    /// timestamps). A thin wrapper over `record_plan`.
     pub fn frame(&mut self, plan: &Plan) -> Result<FrameTimings, RenderError> {
-        // Taken out for the recording, which borrows `self` immutably.
-        let mut timer = self.timer.take();
-        let passes: Vec<Pass> = plan.passes.iter().map(|(p, _)| *p).collect();
-        let result = self.gpu.one_shot("frame", |cmd| {
-            if let Some(t) = timer.as_mut() {
-                t.reset(cmd);
-            }
-            self.record(cmd, plan, &passes, timer.as_mut());
-        });
-        let passes = result.and_then(|()| timer.as_ref().map_or(Ok(Vec::new()), GpuTimer::results));
-        self.timer = timer;
-        Ok(FrameTimings { passes: passes? })
+        let gpu = self.gpu.clone();
+        let recorded = gpu.one_shot("frame", |cmd| self.record_plan(cmd, plan, None))??;
+        self.read_timings(&recorded)
     }
 
     /// Render one frame with every pass in a submission of its own, and return each pass's
@@ -181,10 +357,13 @@ impl Renderer {
     /// devices whose timestamps do not wait for compute work (lavapipe runs dispatches
     /// asynchronously), this is the figure that bounds each pass.
     pub fn frame_isolated(&mut self, plan: &Plan) -> Result<FrameTimings, RenderError> {
+        let gpu = self.gpu.clone();
         let mut passes = Vec::new();
-        for (pass, _) in &plan.passes {
+        for (pass, why) in &plan.passes {
+            let alone =
+                Plan { passes: vec![(*pass, why.clone())], skipped: Vec::new(), shadow_light: plan.shadow_light };
             let start = std::time::Instant::now();
-            self.gpu.one_shot(pass.name(), |cmd| self.record(cmd, plan, &[*pass], None))?;
+            gpu.one_shot(pass.name(), |cmd| self.record_plan(cmd, &alone, None))??;
             passes.push((pass.name().to_string(), start.elapsed().as_secs_f64() * 1e3));
         }
         Ok(FrameTimings { passes })
@@ -193,12 +372,14 @@ impl Renderer {
     /// The last tone-mapped image (RGBA8, rows top to bottom) and how many of its HDR pixels
     /// were non-finite (they are drawn black).
     pub fn image(&self) -> Result<(Vec<u8>, u32), RenderError> {
-        Ok(self.tonemap.read()?)
+        let tonemap = self.tonemap.as_ref().ok_or(RenderError::Target("a host target has no tone-mapped image"))?;
+        Ok(tonemap.read()?)
     }
 
     /// The last linear HDR image, RGBA f32, rows top to bottom.
     pub fn hdr_image(&self) -> Result<Vec<f32>, RenderError> {
-        let bytes = self.shade.hdr().read(Access::ComputeSampledRead)?;
+        let hdr = self.shade.hdr().ok_or(RenderError::Target("a host target's image is the host's"))?;
+        let bytes = hdr.read(Access::ComputeSampledRead)?;
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
@@ -230,7 +411,9 @@ impl Renderer {
             _ => return Err(RenderError::LightKindChanged(index)),
         }
         self.scene.reprepare_lights();
-        Ok(self.buffers.upload_lights(&self.scene)?)
+        self.buffers.set_lights(&self.scene);
+        self.mark(Change::Light(index));
+        Ok(())
     }
 
     /// Where the last frame's non-finite values are, pass by pass and object by object (the

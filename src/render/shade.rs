@@ -14,6 +14,7 @@ use super::records::Vertex;
 use super::shadow::ShadowPass;
 use crate::gpu::{
     Access, Binding, DescriptorSet, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline, Image, ImageBarrier, ImageDesc,
+    memory_barrier,
 };
 use ash::vk;
 use std::sync::Arc;
@@ -34,15 +35,47 @@ pub struct ShadePush {
     pub counts: [u32; 4],
 }
 
+/// What the shading pass draws into.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TargetDesc {
+    /// Its own linear HDR image (RGBA32F) and depth, tone-mapped by the tone-map pass.
+    Own,
+    /// A host engine's colour and depth images of these formats, given each frame as a
+    /// `HostTarget`. The pass writes linear radiance (alpha 1) and depth-tests against the host's
+    /// depth (0 near, 1 far, LESS_OR_EQUAL, depth written).
+    Host { color_format: vk::Format, depth_format: vk::Format },
+}
+
+/// A host's attachments for one frame (`TargetDesc::Host`). On entry and on exit the colour
+/// image is in COLOR_ATTACHMENT_OPTIMAL and the depth image in DEPTH_ATTACHMENT_OPTIMAL; the
+/// pass waits for earlier attachment writes, and its own writes are done at the colour-output
+/// and late-fragment-test stages, where the host's next barrier picks them up.
+#[derive(Clone, Copy, Debug)]
+pub struct HostTarget {
+    pub color: vk::ImageView,
+    pub depth: vk::ImageView,
+    pub extent: vk::Extent2D,
+    /// Keep the host's colour and depth (`true`), or clear them to the scene's background and
+    /// the far plane (`false`).
+    pub load: bool,
+}
+
+#[allow(clippy::large_enum_variant)] // one per renderer, never in a hot loop
+enum Attachments {
+    Own {
+        hdr: Image,
+        depth: Image,
+        /// Pixel gather only (shade_pixel.frag's second attachment).
+        surface: Option<Image>,
+    },
+    Host,
+}
+
 pub struct ShadePass {
     pipeline: GraphicsPipeline,
     set: DescriptorSet,
-    hdr: Image,
-    depth: Image,
-    /// Pixel gather only (shade_pixel.frag's second attachment).
-    surface: Option<Image>,
+    attachments: Attachments,
 }
-
 /// A per-vertex vec4 stream (exitance, cached irradiance) at `binding`, read at `location`.
 fn vec4_stream(
     binding: u32,
@@ -59,8 +92,10 @@ fn attachment(name: &str, [width, height]: [u32; 2], format: vk::Format, usage: 
 }
 
 impl ShadePass {
+    /// `size` is the own target's width and height (unused for a host target).
     pub fn new(
         gpu: &Arc<Gpu>,
+        target: TargetDesc,
         size: [u32; 2],
         scene: &GpuScene,
         shadow: &ShadowPass,
@@ -72,14 +107,21 @@ impl ShadePass {
         desc.vertex_bindings = vec![Vertex::binding(), exitance.0, environment.0];
         desc.vertex_attributes =
             vec![Vertex::position_attribute(), Vertex::normal_attribute(), exitance.1, environment.1];
-        desc.color_formats = if pixel_gather { vec![HDR_FORMAT, SURFACE_FORMAT] } else { vec![HDR_FORMAT] };
-        desc.depth_format = Some(DEPTH_FORMAT);
+        let (color, depth) = match target {
+            TargetDesc::Own => (HDR_FORMAT, DEPTH_FORMAT),
+            TargetDesc::Host { color_format, depth_format } => (color_format, depth_format),
+        };
+        desc.color_formats = if pixel_gather { vec![color, SURFACE_FORMAT] } else { vec![color] };
+        desc.depth_format = Some(depth);
         let pipeline = GraphicsPipeline::new(gpu, &desc)?;
         let set = pipeline.descriptor_set(&[
             Binding::Buffer(&scene.objects),
             Binding::Buffer(&scene.lights),
             shadow.binding(),
         ])?;
+        if target != TargetDesc::Own {
+            return Ok(ShadePass { pipeline, set, attachments: Attachments::Host });
+        }
         use vk::ImageUsageFlags as U;
         // STORAGE: the pixel gather adds its exitance in place.
         let hdr = Image::new(
@@ -90,20 +132,27 @@ impl ShadePass {
             .then(|| Image::new(gpu, &attachment("surface", size, SURFACE_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED)))
             .transpose()?;
         let depth = Image::new(gpu, &attachment("camera depth", size, DEPTH_FORMAT, U::DEPTH_STENCIL_ATTACHMENT))?;
-        Ok(ShadePass { pipeline, set, hdr, depth, surface })
+        Ok(ShadePass { pipeline, set, attachments: Attachments::Own { hdr, depth, surface } })
     }
 
-    pub fn hdr(&self) -> &Image {
-        &self.hdr
+    /// The own HDR image (none for a host target).
+    pub fn hdr(&self) -> Option<&Image> {
+        match &self.attachments {
+            Attachments::Own { hdr, .. } => Some(hdr),
+            Attachments::Host => None,
+        }
     }
     /// The surface image (pixel gather only), readable by compute after the pass.
     pub fn surface(&self) -> Option<&Image> {
-        self.surface.as_ref()
+        match &self.attachments {
+            Attachments::Own { surface, .. } => surface.as_ref(),
+            Attachments::Host => None,
+        }
     }
 
-    /// The colour images this pass draws: HDR, and the surface in pixel-gather mode.
+    /// The own colour images: HDR, and the surface in pixel-gather mode.
     fn colors(&self) -> impl Iterator<Item = &Image> {
-        std::iter::once(&self.hdr).chain(&self.surface)
+        self.hdr().into_iter().chain(self.surface())
     }
 }
 
@@ -115,34 +164,52 @@ impl RenderPass for ShadePass {
         let scene = frame.scene;
         let color = vk::ImageAspectFlags::COLOR;
         let (readers, writes) = ([Access::ComputeSampledRead], [Access::ColorAttachmentWrite]);
-        for image in self.colors() {
-            ImageBarrier::new(image.raw(), color, &readers, &writes).discard(true).record(device, cmd);
-        }
         let depth_access = [Access::DepthAttachmentReadWrite];
-        ImageBarrier::new(self.depth.raw(), vk::ImageAspectFlags::DEPTH, &depth_access, &depth_access)
-            .discard(true)
-            .record(device, cmd);
+        // (colour views, depth view, extent, load the host's contents)
+        let (views, depth_view, extent, load) = match (&self.attachments, frame.target) {
+            (Attachments::Own { hdr, depth, .. }, _) => {
+                for image in self.colors() {
+                    ImageBarrier::new(image.raw(), color, &readers, &writes).discard(true).record(device, cmd);
+                }
+                ImageBarrier::new(depth.raw(), vk::ImageAspectFlags::DEPTH, &depth_access, &depth_access)
+                    .discard(true)
+                    .record(device, cmd);
+                (self.colors().map(Image::view).collect::<Vec<_>>(), depth.view(), hdr.extent(), false)
+            }
+            (Attachments::Host, Some(t)) => {
+                // After the host's own drawing into the same attachments.
+                let attachments = [Access::ColorAttachmentWrite, Access::DepthAttachmentReadWrite];
+                memory_barrier(device, cmd, &attachments, &attachments);
+                (vec![t.color], t.depth, t.extent, t.load)
+            }
+            (Attachments::Host, None) => unreachable!("Renderer checks that a host target is given"),
+        };
+        let load_op = if load { vk::AttachmentLoadOp::LOAD } else { vk::AttachmentLoadOp::CLEAR };
         let [r, g, b] = frame.background;
         let clears = [[r, g, b, 1.0], [0.0; 4]];
-        let colors: Vec<_> = self
-            .colors()
+        let colors: Vec<_> = views
+            .iter()
             .zip(clears)
-            .map(|(image, clear)| {
+            .map(|(view, clear)| {
                 vk::RenderingAttachmentInfo::default()
-                    .image_view(image.view())
+                    .image_view(*view)
                     .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                    .load_op(vk::AttachmentLoadOp::CLEAR)
+                    .load_op(load_op)
                     .store_op(vk::AttachmentStoreOp::STORE)
                     .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: clear } })
             })
             .collect();
         let depth = vk::RenderingAttachmentInfo::default()
-            .image_view(self.depth.view())
+            .image_view(depth_view)
             .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::DONT_CARE)
+            .load_op(load_op)
+            // The host may test against its depth again after us; our own is not read.
+            .store_op(if frame.target.is_some() {
+                vk::AttachmentStoreOp::STORE
+            } else {
+                vk::AttachmentStoreOp::DONT_CARE
+            })
             .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
-        let extent = self.hdr.extent();
         let info = vk::RenderingInfo::default()
             .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent })
             .layer_count(1)

@@ -16,6 +16,8 @@ pub struct SceneNeeds {
     pub environment: Option<usize>,
     /// Exitance gathered per pixel (after shading, every frame) instead of per vertex.
     pub pixel_gather: bool,
+    /// Drawn into a host engine's images, which the host tone-maps (set by the renderer).
+    pub host_target: bool,
 }
 
 impl PreparedScene {
@@ -30,6 +32,7 @@ impl PreparedScene {
             shadowed_lights,
             environment: self.lights.iter().find(|l| l.environment).map(|l| l.source),
             pixel_gather: self.scene.file.render.gather == super::GatherMode::Pixel,
+            host_target: false,
         }
     }
 
