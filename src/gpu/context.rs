@@ -34,16 +34,57 @@ pub struct Gpu {
 
 /// Vulkan objects owned by a host engine, for `Gpu::from_host`.
 pub struct HostVulkan {
+    /// The loader the host's instance was created with.
     pub entry: ash::Entry,
+    /// Created with `apiVersion` 1.3 or later.
     pub instance: ash::Instance,
+    /// The physical device `device` was created on.
     pub physical_device: vk::PhysicalDevice,
-    /// Must have been created with Vulkan 1.3 `dynamicRendering` and `synchronization2` and
-    /// Vulkan 1.2 `shaderOutputLayer` enabled.
+    /// Created with the features of `required_features` enabled (chain them into its
+    /// `VkDeviceCreateInfo`), and declared so in `enabled_features`.
     pub device: ash::Device,
     /// A queue that supports graphics and compute. Submissions from `Gpu` lock an internal mutex;
     /// the host must not submit to the same queue concurrently.
     pub queue: vk::Queue,
+    /// The family `queue` belongs to.
     pub queue_family: u32,
+    /// Which of the required features the host enabled when it created `device` (Vulkan cannot
+    /// be asked afterwards); `from_host` refuses a device that lacks one.
+    pub enabled_features: EnabledFeatures,
+}
+
+/// The device features translucent needs, as the host enabled them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct EnabledFeatures {
+    /// Vulkan 1.3 `dynamicRendering`: every raster pass renders without render-pass objects.
+    pub dynamic_rendering: bool,
+    /// Vulkan 1.3 `synchronization2`: every barrier and timestamp.
+    pub synchronization2: bool,
+    /// Vulkan 1.2 `shaderOutputLayer`: the shadow pass picks each light's layer with gl_Layer.
+    pub shader_output_layer: bool,
+}
+
+impl EnabledFeatures {
+    /// All of them, as `required_features` enables them.
+    pub const ALL: EnabledFeatures =
+        EnabledFeatures { dynamic_rendering: true, synchronization2: true, shader_output_layer: true };
+}
+
+/// The feature structs a host chains into its `VkDeviceCreateInfo` (`push_next` both) so that
+/// translucent can run on its device.
+pub struct RequiredFeatures {
+    /// `shaderOutputLayer`.
+    pub vulkan12: vk::PhysicalDeviceVulkan12Features<'static>,
+    /// `dynamicRendering`, `synchronization2`.
+    pub vulkan13: vk::PhysicalDeviceVulkan13Features<'static>,
+}
+
+/// The features translucent needs, to chain into a host's device creation.
+pub fn required_features() -> RequiredFeatures {
+    RequiredFeatures {
+        vulkan12: vk::PhysicalDeviceVulkan12Features::default().shader_output_layer(true),
+        vulkan13: vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true),
+    }
 }
 
 impl Gpu {
@@ -73,22 +114,80 @@ impl Gpu {
         // SAFETY: queue 0 of `family` was requested in create_logical.
         let queue = unsafe { device.get_device_queue(family, 0) };
         let instance = owned.instance.clone();
-        let parts = HostVulkan { entry, instance, physical_device: info.handle, device, queue, queue_family: family };
+        let parts = HostVulkan {
+            entry,
+            instance,
+            physical_device: info.handle,
+            device,
+            queue,
+            queue_family: family,
+            enabled_features: EnabledFeatures::ALL,
+        };
         Self::assemble(parts, Some(owned), counters, options)
     }
 
     /// Wrap Vulkan objects a host engine owns. Nothing of theirs is destroyed on Drop; only what
     /// this `Gpu` allocates (memory, buffers, pipelines) is freed.
     ///
+    /// Checks, before anything is made, and answers `DeviceUnsuitable` naming what is missing:
+    /// the device's Vulkan version (1.3), the instance's (its 1.3 commands must be loadable),
+    /// the features declared in `enabled_features` and their support, and the queue family's
+    /// graphics and compute capability.
+    ///
     /// # Safety
     /// The host's instance, device and queue must outlive the returned `Gpu` and everything made
-    /// from it, and the device must have the features listed on `HostVulkan::device`.
+    /// from it, and `enabled_features` must say truly what the device was created with.
     pub unsafe fn from_host(host: HostVulkan, options: &GpuOptions) -> GpuResult<Arc<Gpu>> {
         let devices = device::enumerate(&host.instance)?;
         let info = devices
             .into_iter()
             .find(|d| d.handle == host.physical_device)
             .ok_or_else(|| GpuError::Invalid("the host's physical device is not one of its instance's".into()))?;
+        let unsuitable = |detail: String| GpuError::DeviceUnsuitable {
+            name: info.name.clone(),
+            version: info.api_version.clone(),
+            detail,
+        };
+        if info.api < vk::API_VERSION_1_3 {
+            return Err(unsuitable(String::new()));
+        }
+        device::check_features(&host.instance, &info)?;
+        let f = host.enabled_features;
+        for (enabled, name) in [
+            (f.dynamic_rendering, "dynamicRendering"),
+            (f.synchronization2, "synchronization2"),
+            (f.shader_output_layer, "shaderOutputLayer"),
+        ] {
+            if !enabled {
+                return Err(unsuitable(format!(
+                    " with the {name} feature enabled at device creation; the host's device was created \
+                     without it (chain translucent::gpu::required_features() into VkDeviceCreateInfo)"
+                )));
+            }
+        }
+        // A device of an instance created for Vulkan 1.2 has no 1.3 commands, whatever the
+        // hardware supports; ash would abort on the first call.
+        for command in [c"vkCmdPipelineBarrier2", c"vkCmdBeginRendering", c"vkQueueSubmit2", c"vkCmdWriteTimestamp2"] {
+            // SAFETY: a plain lookup on the host's live device.
+            let found =
+                unsafe { (host.instance.fp_v1_0().get_device_proc_addr)(host.device.handle(), command.as_ptr()) };
+            if found.is_none() {
+                return Err(unsuitable(format!(
+                    " through an instance created with apiVersion 1.3 or later; {} is not available on the \
+                     host's device (its instance asked for an older version)",
+                    command.to_string_lossy()
+                )));
+            }
+        }
+        // SAFETY: plain query.
+        let families = unsafe { host.instance.get_physical_device_queue_family_properties(info.handle) };
+        let flags = families.get(host.queue_family as usize).map(|f| f.queue_flags).unwrap_or_default();
+        if !flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE) {
+            return Err(unsuitable(format!(
+                " and a queue that does graphics and compute; the host's queue family {} does not",
+                host.queue_family
+            )));
+        }
         let counters = Arc::new(ValidationCounters::default());
         Self::assemble(HostVulkan { physical_device: info.handle, ..host }, None, counters, options)
     }
@@ -101,7 +200,7 @@ impl Gpu {
         counters: Arc<ValidationCounters>,
         options: &GpuOptions,
     ) -> GpuResult<Arc<Gpu>> {
-        let HostVulkan { entry, instance, physical_device: physical, device, queue, queue_family } = parts;
+        let HostVulkan { entry, instance, physical_device: physical, device, queue, queue_family, .. } = parts;
         let owns_device = owned_instance.is_some();
         let info = device::enumerate(&instance)?.into_iter().find(|d| d.handle == physical).unwrap();
         // SAFETY: plain queries.

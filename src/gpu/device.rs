@@ -130,7 +130,7 @@ pub(crate) fn queue_family(instance: &ash::Instance, device: &DeviceInfo) -> Gpu
 }
 
 /// Optional Vulkan 1.2 features translucent relies on.
-pub(crate) fn check_features(instance: &ash::Instance, device: &DeviceInfo) -> GpuResult<()> {
+pub fn check_features(instance: &ash::Instance, device: &DeviceInfo) -> GpuResult<()> {
     let mut v12 = vk::PhysicalDeviceVulkan12Features::default();
     let mut features = vk::PhysicalDeviceFeatures2::default().push_next(&mut v12);
     // SAFETY: plain query with a 1.2-core chained struct.
@@ -148,11 +148,13 @@ pub(crate) fn check_features(instance: &ash::Instance, device: &DeviceInfo) -> G
 pub(crate) fn create_logical(instance: &ash::Instance, device: &DeviceInfo, family: u32) -> GpuResult<ash::Device> {
     let priorities = [1.0f32];
     let queues = [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
-    let mut v13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
-    // shaderOutputLayer: the shadow pass picks each light's array layer with gl_Layer in one
-    // layered render (see render::shadow for why not one single-layer view per light).
-    let mut v12 = vk::PhysicalDeviceVulkan12Features::default().shader_output_layer(true);
-    let info = vk::DeviceCreateInfo::default().queue_create_infos(&queues).push_next(&mut v13).push_next(&mut v12);
+    // The same features a host enables (`required_features`): shaderOutputLayer lets the shadow
+    // pass pick each light's array layer with gl_Layer in one layered render.
+    let mut features = super::context::required_features();
+    let info = vk::DeviceCreateInfo::default()
+        .queue_create_infos(&queues)
+        .push_next(&mut features.vulkan13)
+        .push_next(&mut features.vulkan12);
     // SAFETY: features requested are core in Vulkan 1.3 (`select` checked the version, and
     // `check_features` that shaderOutputLayer is supported).
     unsafe { instance.create_device(device.handle, &info, None) }.vk("vkCreateDevice")

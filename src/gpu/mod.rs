@@ -23,7 +23,7 @@ mod timer;
 
 pub use barrier::{Access, ImageBarrier, memory_barrier};
 pub use buffer::{Buffer, BufferDesc};
-pub use context::{Gpu, HostVulkan};
+pub use context::{EnabledFeatures, Gpu, HostVulkan, RequiredFeatures, required_features};
 pub use debug::ValidationCounters;
 pub use descriptor::{Binding, BindingKind, DescriptorSet};
 pub use device::{DeviceInfo, select as select_device};
