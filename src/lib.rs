@@ -3,6 +3,23 @@
 //! The modules follow the data flow: `optics` (the dipole model, f64 reference), `mesh` (loading
 //! and geometry), `sampling` (sample points with area weights), `gpu` (the Vulkan core, one concept
 //! per file), `render` (one module per GPU pass, each with a GLSL file of the same name).
+//! docs/ARCHITECTURE.md follows one frame through them.
+//!
+//! The types an application or a host engine needs are re-exported here:
+//!
+//! ```no_run
+//! use translucent::{Change, Gpu, GpuOptions, Overrides, PreparedScene, Renderer, Scene};
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let gpu = Gpu::new(&GpuOptions::default())?;
+//! let scene = PreparedScene::new(&Scene::builtin(), &Overrides::default())?;
+//! let mut renderer = Renderer::new(&gpu, scene)?;
+//! let timings = renderer.frame(&renderer.plan(Change::Everything))?;
+//! let (rgba8, _non_finite) = renderer.image()?;
+//! # Ok(()) }
+//! ```
+//!
+//! An engine with its own device wraps it with `Gpu::from_host` and draws into its own images
+//! with `Renderer::with_target` and `Renderer::record_frame` (docs/GPU.md, examples/embed.rs).
 
 pub mod gpu;
 pub mod mesh;
@@ -12,3 +29,12 @@ pub mod reference;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+
+pub use gpu::{EnabledFeatures, Gpu, GpuError, GpuOptions, HostVulkan, RequiredFeatures, required_features};
+pub use optics::Material;
+pub use output::{OutputError, OutputSet};
+pub use render::plan::{Change, Pass, Plan};
+pub use render::renderer::{CameraView, FrameTimings, NonFinite, RecordedFrame, RenderError, Renderer};
+pub use render::shade::{HostTarget, TargetDesc};
+pub use scene::build::{Overrides, PreparedScene};
+pub use scene::{GatherMode, Scene, SceneError};
