@@ -345,3 +345,32 @@ fn orbit_light(renderer: &mut Renderer, index: usize, degrees: f32) {
     let moved = lights::orbit(&scene.scene.file.lights[index], scene.bounds.0, degrees).unwrap();
     renderer.set_light(index, moved).unwrap();
 }
+
+#[test]
+fn resize_and_set_camera_mark_only_shading_and_change_the_image() {
+    with_gpu(|gpu| {
+        let mut renderer = run_all(gpu, builtin(&Overrides { resolution: Some([64, 64]), ..Default::default() }));
+        assert_eq!(renderer.pending_change(), None, "a recorded frame leaves nothing pending");
+        let (before, _) = renderer.image().unwrap();
+        // Resize: the own images are made anew at the new size; only shading reruns.
+        renderer.resize(80, 48).unwrap();
+        assert_eq!(renderer.pending_change(), Some(Change::Camera));
+        let mut camera = renderer.camera();
+        camera.projection = glam::camera::rh::proj::vulkan::perspective(30f32.to_radians(), 80.0 / 48.0, 0.01, 1.0);
+        renderer.set_camera(camera);
+        let plan = renderer.plan(renderer.pending_change().unwrap());
+        assert_eq!(plan.passes.iter().map(|(p, _)| *p).collect::<Vec<_>>(), [Pass::Shade, Pass::Tonemap]);
+        renderer.frame(&plan).unwrap();
+        let (after, non_finite) = renderer.image().unwrap();
+        assert_eq!(non_finite, 0);
+        assert_eq!((before.len(), after.len()), (64 * 64 * 4, 80 * 48 * 4));
+        // Moving the eye changes the picture.
+        let mut moved = renderer.camera();
+        moved.view *= glam::Mat4::from_rotation_y(0.5);
+        renderer.set_camera(moved);
+        renderer.frame(&renderer.plan(Change::Camera)).unwrap();
+        let (turned, _) = renderer.image().unwrap();
+        let differ = after.iter().zip(&turned).filter(|(a, b)| a != b).count();
+        assert!(differ > 1000, "only {differ} bytes changed when the camera turned");
+    });
+}
