@@ -9,21 +9,63 @@ use std::path::{Path, PathBuf};
 /// Why an output file was not written; every variant names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
+    /// The path has no file name (e.g. it ends in `..` or is a root).
     #[error("{} is not a file path", path.display())]
-    NotAFilePath { path: PathBuf },
+    NotAFilePath {
+        /// The destination.
+        path: PathBuf,
+    },
     // The underlying error is the source (shown by `{:#}` and error reporters), not repeated here.
+    /// A folder is where the file should go.
     #[error("cannot write {}: it is a folder", path.display())]
-    IsAFolder { path: PathBuf },
+    IsAFolder {
+        /// The destination.
+        path: PathBuf,
+    },
+    /// Renaming the temporary file onto the destination failed.
     #[error("cannot put {} in place", path.display())]
-    Rename { path: PathBuf, source: std::io::Error },
+    Rename {
+        /// The destination.
+        path: PathBuf,
+        /// Why the rename failed.
+        source: std::io::Error,
+    },
+    /// The pixel buffer's length does not match the image size (four values per pixel).
     #[error("{}: image size mismatch: {values} values for {width}x{height} pixels", path.display())]
-    SizeMismatch { path: PathBuf, width: u32, height: u32, values: usize },
+    SizeMismatch {
+        /// The destination.
+        path: PathBuf,
+        /// Image width in pixels.
+        width: u32,
+        /// Image height in pixels.
+        height: u32,
+        /// Length of the buffer given.
+        values: usize,
+    },
+    /// The image encoder failed (PNG or EXR).
     #[error("cannot write {}", path.display())]
-    Image { path: PathBuf, source: image::ImageError },
+    Image {
+        /// The destination.
+        path: PathBuf,
+        /// The encoder's error.
+        source: image::ImageError,
+    },
+    /// The temporary file could not be created.
     #[error("cannot create {}", path.display())]
-    Create { path: PathBuf, source: std::io::Error },
+    Create {
+        /// The destination.
+        path: PathBuf,
+        /// Why creating failed.
+        source: std::io::Error,
+    },
+    /// Writing the temporary file failed.
     #[error("cannot write {}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        /// The destination.
+        path: PathBuf,
+        /// Why writing failed.
+        source: std::io::Error,
+    },
 }
 
 /// The hidden temporary file `path` is written to before it is renamed into place:
@@ -47,6 +89,7 @@ pub struct OutputSet {
 }
 
 impl OutputSet {
+    /// An empty set.
     pub fn new() -> OutputSet {
         OutputSet::default()
     }

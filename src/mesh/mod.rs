@@ -35,25 +35,86 @@ pub const DEGENERATE_AREA_RATIO: f64 = 1e-10;
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
     // The io::Error is the source (shown by `{:#}` and error reporters), not repeated here.
+    /// The file could not be read.
     #[error("cannot read mesh file {}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        /// The mesh file.
+        path: PathBuf,
+        /// Why reading failed.
+        source: std::io::Error,
+    },
+    /// A malformed OBJ line, found by the pre-scan.
     #[error("{source_name}:{line}: {message} (line: `{text}`)")]
-    Parse { source_name: String, line: usize, message: String, text: String },
+    Parse {
+        /// The file name, or `<memory>`.
+        source_name: String,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong with the line.
+        message: String,
+        /// The line itself, trimmed and cut to 80 characters.
+        text: String,
+    },
+    /// tobj refused the file.
     #[error("{source_name}: OBJ parser (tobj) failed: {error}")]
-    Obj { source_name: String, error: tobj::LoadError },
+    Obj {
+        /// The file name, or `<memory>`.
+        source_name: String,
+        /// tobj's error.
+        error: tobj::LoadError,
+    },
+    /// There are no triangles (faces) at all.
     #[error("{source_name}: the mesh has no faces")]
-    NoFaces { source_name: String },
+    NoFaces {
+        /// The file name, or `<memory>`.
+        source_name: String,
+    },
+    /// A position is infinite or NaN.
     #[error("{source_name}: vertex {vertex} has a non-finite position {value:?}")]
-    NonFinite { source_name: String, vertex: usize, value: [f32; 3] },
+    NonFinite {
+        /// The file name, or `<memory>`.
+        source_name: String,
+        /// 0-based vertex index.
+        vertex: usize,
+        /// Its position.
+        value: [f32; 3],
+    },
+    /// A coordinate's magnitude is above [`MAX_COORDINATE`].
     #[error(
         "{source_name}: vertex {vertex} at {value:?} is farther than {limit:e} units from the origin \
          (f32 areas would overflow or lose all precision; scale the mesh down)"
     )]
-    TooFar { source_name: String, vertex: usize, value: [f32; 3], limit: f32 },
+    TooFar {
+        /// The file name, or `<memory>`.
+        source_name: String,
+        /// 0-based vertex index.
+        vertex: usize,
+        /// Its position.
+        value: [f32; 3],
+        /// The limit, [`MAX_COORDINATE`].
+        limit: f32,
+    },
+    /// A triangle refers to a vertex that does not exist.
     #[error("{source_name}: triangle {triangle} refers to vertex {index}, but there are only {count} vertices")]
-    IndexOutOfRange { source_name: String, triangle: usize, index: u32, count: usize },
+    IndexOutOfRange {
+        /// The file name, or `<memory>`.
+        source_name: String,
+        /// 0-based triangle index.
+        triangle: usize,
+        /// The vertex index it refers to.
+        index: u32,
+        /// How many vertices there are.
+        count: usize,
+    },
+    /// Every triangle is degenerate (see [`DEGENERATE_AREA_RATIO`]).
     #[error("{source_name}: the mesh has no area: all {degenerate} triangles have zero area")]
-    NoArea { source_name: String, degenerate: usize },
+    NoArea {
+        /// The file name, or `<memory>`.
+        source_name: String,
+        /// How many triangles were dropped as degenerate.
+        degenerate: usize,
+    },
+    /// [`LoadOptions`] with a zero or non-finite scale, or a non-finite or singular transform.
     #[error("invalid mesh load options: {0}")]
     InvalidOptions(String),
 }
@@ -66,6 +127,7 @@ pub struct MeshReport {
     pub source: String,
     /// Vertices and triangles as given (after triangulation of polygons).
     pub input_vertices: usize,
+    /// Triangles as given (after triangulation of polygons).
     pub input_triangles: usize,
     /// Vertices merged into another one with a bit-identical position (tobj's single index
     /// splits a position wherever its normal or texture index differs).
@@ -219,10 +281,12 @@ impl Mesh {
         })
     }
 
+    /// Vertex positions (one per vertex, after welding and clean-up).
     pub fn positions(&self) -> &[Vec3] {
         &self.positions
     }
 
+    /// Triangles as three vertex indices each; their winding gives [`Mesh::face_normals`].
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.triangles
     }
@@ -239,10 +303,12 @@ impl Mesh {
         &self.face_normals
     }
 
+    /// Area of each triangle (in f64).
     pub fn triangle_areas(&self) -> &[f64] {
         &self.triangle_areas
     }
 
+    /// Sum of the triangle areas.
     pub fn total_area(&self) -> f64 {
         self.total_area
     }
@@ -294,6 +360,7 @@ impl Mesh {
         (self.bounds.1 - self.bounds.0).as_dvec3().length()
     }
 
+    /// What loading found and changed.
     pub fn report(&self) -> &MeshReport {
         &self.report
     }

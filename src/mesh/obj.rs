@@ -11,7 +11,9 @@ use super::MeshError;
 /// How to place a loaded mesh: each position p becomes `transform * (scale * p)`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LoadOptions {
+    /// Uniform scale applied first (default 1; finite, non-zero).
     pub scale: f32,
+    /// Placement applied after the scale (default identity; finite, invertible).
     pub transform: Mat4,
 }
 
@@ -22,11 +24,13 @@ impl Default for LoadOptions {
 }
 
 impl LoadOptions {
+    /// The same options with another `scale`.
     pub fn with_scale(mut self, scale: f32) -> Self {
         self.scale = scale;
         self
     }
 
+    /// The same options with another `transform`.
     pub fn with_transform(mut self, transform: Mat4) -> Self {
         self.transform = transform;
         self

@@ -10,9 +10,13 @@ use bytemuck::{Pod, Zeroable};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct DipoleChannelGpu {
+    /// Reduced albedo `alpha'` ([`Dipole::alpha_prime`]).
     pub alpha_prime: f32,
+    /// Effective transport coefficient `sigma_tr` per scene unit ([`Dipole::sigma_tr`]).
     pub sigma_tr: f32,
+    /// Depth of the real source, scene units ([`Dipole::z_r`]).
     pub z_r: f32,
+    /// Height of the virtual source, scene units ([`Dipole::z_v`]).
     pub z_v: f32,
 }
 
@@ -32,8 +36,11 @@ impl From<&Dipole> for DipoleChannelGpu {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct DipoleEvalInput {
+    /// Absorption coefficient `sigma_a` (1/mm).
     pub sigma_a: f32,
+    /// Reduced scattering coefficient `sigma_s'` (1/mm).
     pub sigma_s_prime: f32,
+    /// Relative index of refraction.
     pub eta: f32,
     /// Scene scale, mm per scene unit.
     pub mm_per_unit: f32,
@@ -41,10 +48,13 @@ pub struct DipoleEvalInput {
     pub r: f32,
     /// Sample area `dA` (scene units squared) for the kernels.
     pub area: f32,
+    /// Cosine of the incident angle, for `F_r` and `S_d`.
     pub cos_theta_i: f32,
+    /// Cosine of the outgoing angle, for `F_t` and `S_d`.
     pub cos_theta_o: f32,
     /// `T(eta) = 1 - 2 FM1(eta)` computed on the CPU (the BSSRDF normalization).
     pub t_eta: f32,
+    /// Padding to 48 bytes, the GLSL record's `pad0..pad2`.
     pub _pad: [f32; 3],
 }
 
@@ -54,15 +64,23 @@ pub struct DipoleEvalInput {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct DipoleEvalOutput {
+    /// Reduced extinction coefficient `sigma_t'` per scene unit.
     pub sigma_t_prime: f32,
+    /// Reduced albedo `alpha'`.
     pub alpha_prime: f32,
+    /// Effective transport coefficient `sigma_tr` per scene unit (seed Eq. 7).
     pub sigma_tr: f32,
+    /// Diffuse Fresnel reflectance `F_dr`.
     pub F_dr: f32,
+    /// Boundary coefficient `A = (1 + F_dr) / (1 - F_dr)`.
     pub A: f32,
+    /// Depth of the real source, scene units.
     pub z_r: f32,
+    /// Height of the virtual source, scene units.
     pub z_v: f32,
     /// `R_d(r)` (seed Eq. 8).
     pub r_d: f32,
+    /// Total diffuse reflectance `R_d,total`.
     pub r_d_total: f32,
     /// Disk integral `P(r)`.
     pub r_d_disk: f32,

@@ -32,14 +32,24 @@ pub use presets::{MeasuredMaterial, Source};
 pub enum OpticsError {
     /// A coefficient that is NaN, infinite or negative.
     #[error("{name} = {value} in channel {} is not a finite number >= 0 (1/mm)", channel_name(*channel))]
-    BadCoefficient { name: &'static str, channel: usize, value: f64 },
+    BadCoefficient {
+        /// The coefficient: `sigma_a`, `sigma_s'` or `sigma_s`.
+        name: &'static str,
+        /// Colour channel, 0 to 2 (R, G, B).
+        channel: usize,
+        /// The value refused: per mm from a [`Material`], per scene unit from [`Dipole::new`].
+        value: f64,
+    },
     /// Neither absorption nor scattering: there is no medium to diffuse in.
     #[error(
         "sigma_a = 0 and sigma_s' = 0 in channel {}: the medium neither absorbs nor \
          scatters, so the dipole model has nothing to describe",
         channel_name(*channel)
     )]
-    NoExtinction { channel: usize },
+    NoExtinction {
+        /// Colour channel, 0 to 2 (R, G, B).
+        channel: usize,
+    },
     /// The relative index of refraction is not in the range where the `F_dr` fits hold.
     #[error(
         "eta = {0} is not supported: the relative index of refraction must lie in \
@@ -62,7 +72,12 @@ pub enum OpticsError {
         min = material::SIGMA_T_PRIME_MIN,
         max = material::SIGMA_T_PRIME_MAX
     )]
-    OutOfRange { channel: usize, value: f64 },
+    OutOfRange {
+        /// Colour channel, 0 to 2 (R, G, B).
+        channel: usize,
+        /// `sigma_t'` per scene unit.
+        value: f64,
+    },
     /// No measured material has this name.
     #[error("unknown material preset {0:?}: `translucent material --list` shows the presets")]
     UnknownPreset(String),

@@ -36,6 +36,7 @@ impl Source {
 /// One measured material: coefficients in 1/mm per channel (R, G, B).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct MeasuredMaterial {
+    /// The name as published (matched by [`find`] ignoring case, spaces and punctuation).
     pub name: &'static str,
     /// Reduced scattering coefficient `sigma_s'` (1/mm).
     pub sigma_s_prime: [f64; 3],
@@ -43,6 +44,7 @@ pub struct MeasuredMaterial {
     pub sigma_a: [f64; 3],
     /// Relative index of refraction.
     pub eta: f64,
+    /// Which measurement it comes from.
     pub source: Source,
 }
 

@@ -46,6 +46,9 @@ pub struct Bvh {
 const LEAF_SIZE: usize = 4;
 
 impl Bvh {
+    /// Build the hierarchy over `triangles` (world space, f64): median split on the longest
+    /// axis of the centroid bounds, down to leaves of at most 4 triangles (more only where
+    /// their centroids coincide).
     pub fn new(triangles: Vec<[DVec3; 3]>) -> Bvh {
         let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
         let centroids: Vec<DVec3> = triangles.iter().map(|t| (t[0] + t[1] + t[2]) / 3.0).collect();
@@ -93,6 +96,7 @@ impl Bvh {
         Bvh { triangles, nodes, order }
     }
 
+    /// Number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
     }

@@ -7,6 +7,8 @@
 
 use glam::DVec3;
 
+/// Points in uniform cubic cells, hashed into a table, for radius and nearest-neighbour queries.
+/// The default is empty; [`SpatialHash::rebuild`] fills it.
 #[derive(Clone, Debug, Default)]
 pub struct SpatialHash {
     cell: f64,
@@ -79,18 +81,22 @@ impl SpatialHash {
         self.bucket_start[0] = 0;
     }
 
+    /// Number of points.
     pub fn len(&self) -> usize {
         self.positions.len()
     }
 
+    /// True when there are no points.
     pub fn is_empty(&self) -> bool {
         self.positions.is_empty()
     }
 
+    /// Side of the cubic cells.
     pub fn cell_size(&self) -> f64 {
         self.cell
     }
 
+    /// Position of point `i` (in the order given to the build).
     pub fn position(&self, i: u32) -> DVec3 {
         self.positions[i as usize]
     }

@@ -57,8 +57,10 @@ pub enum Method {
 }
 
 impl Method {
+    /// Every method: what `--sampler` and `--method` accept and what parsing a name tries.
     pub const ALL: [Method; 4] = [Method::Random, Method::Turk, Method::Feature, Method::Poisson];
 
+    /// The lowercase name used in scene files and on the command line.
     pub fn name(self) -> &'static str {
         match self {
             Method::Random => "random",
@@ -88,27 +90,46 @@ impl FromStr for Method {
 /// Errors of the samplers.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum SamplingError {
+    /// A sample count of 0.
     #[error("the sample count must be at least 1, got 0")]
     ZeroCount,
+    /// A sample count above [`MAX_COUNT`].
     #[error("the sample count {count} is above the limit of {max}")]
-    TooMany { count: usize, max: usize },
+    TooMany {
+        /// The count asked for.
+        count: usize,
+        /// The limit, [`MAX_COUNT`].
+        max: usize,
+    },
+    /// The mesh's total area is zero, NaN or infinite.
     #[error("the mesh has no surface area to sample (total area {area})")]
-    NoArea { area: f64 },
+    NoArea {
+        /// The mesh's total area.
+        area: f64,
+    },
 }
 
 /// Everything a sampler needs; [`SampleOptions::new`] fills in the defaults.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SampleOptions {
+    /// How points are placed.
     pub method: Method,
+    /// How many points (exactly; 1 to [`MAX_COUNT`]).
     pub count: usize,
+    /// Seed of the random generator (PCG64); the same seed gives the same points.
     pub seed: u64,
+    /// Repulsion settings of [`Method::Turk`].
     pub turk: TurkParams,
+    /// Settings of [`Method::Feature`], its repulsion included.
     pub feature: FeatureParams,
+    /// Settings of [`Method::Poisson`].
     pub poisson: PoissonParams,
+    /// Settings of the area weights, for every method.
     pub weights: WeightParams,
 }
 
 impl SampleOptions {
+    /// `count` points by `method`, seed 0, every other setting at its default.
     pub fn new(method: Method, count: usize) -> SampleOptions {
         SampleOptions {
             method,
@@ -121,6 +142,7 @@ impl SampleOptions {
         }
     }
 
+    /// The same options with another seed.
     pub fn with_seed(mut self, seed: u64) -> SampleOptions {
         self.seed = seed;
         self
@@ -130,9 +152,11 @@ impl SampleOptions {
 /// One sample point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SamplePoint {
+    /// Position on the surface (the mesh's space).
     pub position: Vec3,
     /// Unit shading normal (interpolated vertex normals).
     pub normal: Vec3,
+    /// Index of the mesh triangle it lies on.
     pub triangle: u32,
     /// Weights of the triangle's three corners, non-negative, summing to one.
     pub barycentric: [f32; 3],
@@ -143,16 +167,21 @@ pub struct SamplePoint {
 /// The result of a sampler.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SampleSet {
+    /// How the points were placed.
     pub method: Method,
+    /// The seed they were placed with.
     pub seed: u64,
+    /// The points with their area weights.
     pub points: Vec<SamplePoint>,
 }
 
 impl SampleSet {
+    /// Number of points.
     pub fn len(&self) -> usize {
         self.points.len()
     }
 
+    /// True when there are no points.
     pub fn is_empty(&self) -> bool {
         self.points.is_empty()
     }
@@ -162,6 +191,7 @@ impl SampleSet {
         self.points.iter().map(|p| p.area).sum()
     }
 
+    /// The points' positions, in order.
     pub fn positions(&self) -> Vec<Vec3> {
         self.points.iter().map(|p| p.position).collect()
     }

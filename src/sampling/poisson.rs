@@ -18,6 +18,7 @@ use super::hash::SpatialHash;
 use super::walk::SurfacePoint;
 use crate::mesh::Mesh;
 
+/// Settings of the sample elimination.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PoissonParams {
     /// Candidates drawn per output point (Yuksel uses 5).

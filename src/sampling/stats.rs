@@ -25,6 +25,7 @@ pub fn nearest_neighbour_distances(positions: &[Vec3]) -> Vec<f64> {
 /// Summary printed by `translucent sample`.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct SampleStats {
+    /// Number of points.
     pub count: usize,
     /// Sum of the area weights.
     pub total_weight: f64,
@@ -32,15 +33,20 @@ pub struct SampleStats {
     pub mesh_area: f64,
     /// Nearest-neighbour distances; `None` with fewer than two points.
     pub nn_min: Option<f64>,
+    /// Mean nearest-neighbour distance; `None` with fewer than two points.
     pub nn_mean: Option<f64>,
+    /// Largest nearest-neighbour distance; `None` with fewer than two points.
     pub nn_max: Option<f64>,
     /// Coefficient of variation (standard deviation over mean) of the area weights.
     pub weight_cv: f64,
+    /// Smallest area weight (infinite with no points).
     pub weight_min: f64,
+    /// Largest area weight (0 with no points).
     pub weight_max: f64,
 }
 
 impl SampleStats {
+    /// The statistics of `points`; `mesh_area` is kept for comparison with their total weight.
     pub fn compute(points: &[SamplePoint], mesh_area: f64) -> SampleStats {
         let positions: Vec<Vec3> = points.iter().map(|p| p.position).collect();
         let nn = nearest_neighbour_distances(&positions);

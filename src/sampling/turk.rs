@@ -37,7 +37,12 @@ pub enum Radius<'a> {
     /// The same radius everywhere.
     Uniform(f64),
     /// `base / sqrt(density)`, with `density` given per vertex and interpolated.
-    Density { base: f64, vertex_density: &'a [f64] },
+    Density {
+        /// The radius where the density is 1.
+        base: f64,
+        /// Density per mesh vertex, interpolated over each triangle.
+        vertex_density: &'a [f64],
+    },
 }
 
 impl Radius<'_> {

@@ -10,11 +10,14 @@ use crate::mesh::{Mesh, NO_NEIGHBOUR};
 /// summing to one).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfacePoint {
+    /// Index of the mesh triangle.
     pub triangle: u32,
+    /// Barycentric weights of the triangle's three corners.
     pub bary: [f64; 3],
 }
 
 impl SurfacePoint {
+    /// The point in 3D (f64), in the mesh's space.
     pub fn position(&self, mesh: &Mesh) -> DVec3 {
         mesh.point(self.triangle as usize, self.bary)
     }

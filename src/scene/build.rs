@@ -24,46 +24,81 @@ impl<T, E: Into<SceneError>> WithContext<T> for Result<T, E> {
 #[derive(Clone, Debug)]
 #[allow(clippy::large_enum_variant)] // one per object, never in a hot loop
 pub enum ResolvedMaterial {
-    Translucent { material: Material, dipoles: [Dipole; 3], mm_per_unit: f64, roughness: f32 },
-    Opaque { albedo: [f32; 3], roughness: f32 },
+    /// A dipole-diffusion material with its three channels' dipoles in scene units.
+    Translucent {
+        /// Coefficients in 1/mm (preset or custom, `eta` overridden where the scene gives one).
+        material: Material,
+        /// The R, G, B dipoles, in scene units (`material` scaled by `mm_per_unit`).
+        dipoles: [Dipole; 3],
+        /// Millimetres per scene unit.
+        mm_per_unit: f64,
+        /// GGX roughness of the dielectric specular lobe (0 to 1).
+        roughness: f32,
+    },
+    /// Lambertian with a GGX specular lobe.
+    Opaque {
+        /// Diffuse albedo per channel (0 to 1).
+        albedo: [f32; 3],
+        /// GGX roughness of the specular lobe (0 to 1).
+        roughness: f32,
+    },
 }
 
+/// One scene object ready to upload: world-space mesh, resolved material and sample points.
 #[derive(Clone, Debug)]
 pub struct PreparedObject {
     /// For messages: the mesh path or the built-in shape.
     pub name: String,
     /// World-space mesh.
     pub mesh: Mesh,
+    /// What it is made of.
     pub material: ResolvedMaterial,
+    /// Whether it is drawn into the shadow maps (`casts_shadow` in the scene).
     pub casts_shadow: bool,
     /// World-space sample points with area weights (translucent objects only).
     pub samples: Vec<SamplePoint>,
 }
 
+/// A scene with all its CPU work done: objects loaded, placed and sampled, lights prepared.
+/// The renderer uploads it as it is.
 #[derive(Clone, Debug)]
 pub struct PreparedScene {
+    /// The scene it was prepared from, with the command-line overrides applied.
     pub scene: Scene,
+    /// The objects, in scene order.
     pub objects: Vec<PreparedObject>,
+    /// The lights, key lights first, then the environment's directions (see [`lights::prepare`]).
     pub lights: Vec<PreparedLight>,
+    /// Layers of the shadow-map array: one per light that casts shadows onto something.
     pub shadow_layers: u32,
+    /// The environment light's map or procedural sky, loaded once.
     pub environment: Option<Environment>,
     /// Bounding sphere of everything (centre, radius).
     pub bounds: (Vec3, f32),
     /// Bounding sphere of the shadow casters, which every shadow frustum covers.
     pub caster_bounds: (Vec3, f32),
+    /// Whether any object casts shadows; without one no light gets a shadow layer.
     pub any_caster: bool,
 }
 
 /// Overrides from the command line, applied on top of the scene file.
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
+    /// `--samples`: replaces `sampling.count` (1 to [`crate::scene::MAX_SAMPLE_COUNT`]).
     pub samples: Option<usize>,
+    /// `--sampler`: replaces `sampling.method`.
     pub sampler: Option<Method>,
+    /// `--gather`: replaces `render.gather`.
     pub gather: Option<GatherMode>,
+    /// `--resolution`: replaces `camera.resolution` (width, height in pixels).
     pub resolution: Option<[u32; 2]>,
 }
 
 impl PreparedScene {
+    /// Apply `overrides`, then load, transform and check every object's mesh, resolve its
+    /// material, place its sample points (translucent objects only, seed `sampling.seed + i`
+    /// for object `i`), load the environment and prepare the lights. Errors say which object
+    /// or light and which step.
     pub fn new(scene: &Scene, overrides: &Overrides) -> Result<PreparedScene, SceneError> {
         let mut scene = scene.clone();
         if let Some(n) = overrides.samples {
@@ -182,12 +217,15 @@ impl PreparedScene {
         self.lights = lights;
     }
 
+    /// Sample points over all objects.
     pub fn sample_count(&self) -> usize {
         self.objects.iter().map(|o| o.samples.len()).sum()
     }
+    /// Mesh vertices over all objects.
     pub fn vertex_count(&self) -> usize {
         self.objects.iter().map(|o| o.mesh.positions().len()).sum()
     }
+    /// Whether any object has a translucent material.
     pub fn has_translucent(&self) -> bool {
         self.objects.iter().any(|o| matches!(o.material, ResolvedMaterial::Translucent { .. }))
     }

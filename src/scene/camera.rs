@@ -5,6 +5,7 @@ use glam::camera::rh::{proj::vulkan, view::look_at_mat4};
 use glam::{Mat4, Vec3};
 
 impl Camera {
+    /// World -> view matrix looking from `eye` at `target` with `up` as the image's up.
     pub fn view(&self) -> Mat4 {
         look_at_mat4(Vec3::from(self.eye), Vec3::from(self.target), Vec3::from(self.up).normalize())
     }

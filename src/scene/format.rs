@@ -7,30 +7,45 @@
 use crate::sampling::Method;
 use serde::Deserialize;
 
+/// A whole scene file as deserialized: one `[camera]`, the `[[object]]` and `[[light]]` arrays,
+/// and the optional `[sampling]` and `[render]` tables. [`crate::scene::Scene::parse`] checks
+/// the values after this parse.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
+    /// `[camera]`: where the image is taken from (required).
     pub camera: Camera,
+    /// `[[object]]`: the objects drawn, in file order; at least one.
     #[serde(default, rename = "object")]
     pub objects: Vec<Object>,
+    /// `[[light]]`: the lights, in file order; none by default, at most one environment light.
     #[serde(default, rename = "light")]
     pub lights: Vec<Light>,
+    /// `[sampling]`: how sample points are placed on translucent objects.
     #[serde(default)]
     pub sampling: Sampling,
+    /// `[render]`: gather mode, exposure, shadow maps and background.
     #[serde(default)]
     pub render: RenderSettings,
 }
 
+/// The `[camera]` table: a pinhole camera looking from `eye` at `target`.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Camera {
+    /// Position of the camera (scene units; required, finite, not equal to `target` and at most
+    /// [`crate::mesh::MAX_COORDINATE`] units from it).
     pub eye: [f32; 3],
+    /// The point looked at, at the centre of the image (scene units; required, finite).
     pub target: [f32; 3],
+    /// Which way is up in the image (any length; default `[0, 1, 0]`; finite, non-zero and not
+    /// parallel to the view direction).
     #[serde(default = "up")]
     pub up: [f32; 3],
-    /// Vertical field of view in degrees.
+    /// Vertical field of view in degrees (default 35; strictly between 0 and 180).
     #[serde(default = "fov")]
     pub fov_y: f32,
+    /// Image size `[width, height]` in pixels (default `[512, 512]`; each 1 to 16384).
     #[serde(default = "resolution")]
     pub resolution: [u32; 2],
 }
@@ -45,13 +60,16 @@ fn resolution() -> [u32; 2] {
     [512, 512]
 }
 
+/// One `[[object]]`: a shape, where it goes, and what it is made of.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Object {
     /// What to draw: a mesh file or a built-in shape.
     pub shape: Shape,
+    /// Placement in the world (default: none, the shape as given).
     #[serde(default)]
     pub transform: Transform,
+    /// Translucent or opaque, and its parameters (required).
     pub material: MaterialSpec,
     /// Whether the object casts shadows (default true).
     #[serde(default = "yes")]
@@ -62,22 +80,31 @@ fn yes() -> bool {
     true
 }
 
+/// The `shape` of an object, chosen by its `type` key: `"mesh"`, `"plane"` or `"sphere"`.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields, tag = "type", rename_all = "lowercase")]
 pub enum Shape {
     /// An OBJ file; `path` is relative to the scene file (the built-in scene resolves it among
     /// the embedded assets).
-    Mesh { path: String },
+    Mesh {
+        /// Path of the OBJ file (required, not empty).
+        path: String,
+    },
     /// A square in the xz plane, centred at the origin, facing +y, `size` units wide,
     /// split into `divisions`^2 quads.
     Plane {
+        /// Side length in scene units (required; positive, at most [`crate::mesh::MAX_COORDINATE`]).
         size: f32,
+        /// Quads along each side (default 64; 1 to 2048).
         #[serde(default = "divisions")]
         divisions: u32,
     },
     /// A UV sphere of `radius` at the origin.
     Sphere {
+        /// Radius in scene units (required; positive, at most [`crate::mesh::MAX_COORDINATE`]).
         radius: f32,
+        /// Rings of latitude, with twice as many segments of longitude (default 64; 1 to 2048,
+        /// fewer than 3 are made 3).
         #[serde(default = "divisions")]
         divisions: u32,
     },
@@ -91,32 +118,46 @@ fn divisions() -> u32 {
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Transform {
-    /// Scale the mesh uniformly so its largest bounding-box side is this long, and centre it on
-    /// the origin with its lowest point at y = 0.
+    /// Scale the mesh uniformly so its largest bounding-box side is this long (scene units),
+    /// and centre it on the origin with its lowest point at y = 0 (default none; positive).
     pub fit: Option<f32>,
+    /// Uniform scale factor (default none; positive).
     pub scale: Option<f32>,
+    /// Rotation in degrees about x, then y, then z (default none; finite).
     pub rotate: Option<[f32; 3]>,
+    /// Offset in scene units, applied last (default none; finite).
     pub translate: Option<[f32; 3]>,
 }
 
+/// The `material` of an object, chosen by its `type` key: `"translucent"` or `"opaque"`.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields, tag = "type", rename_all = "lowercase")]
 pub enum MaterialSpec {
     /// A dipole-diffusion material: a measured preset or custom coefficients (per mm).
     Translucent {
+        /// Name of a measured material (`translucent material --list`), matched ignoring case,
+        /// spaces and punctuation. Give either this or both `sigma_a` and `sigma_s_prime`.
         preset: Option<String>,
+        /// Absorption coefficient per channel (R, G, B) in 1/mm; finite and non-negative.
         sigma_a: Option<[f64; 3]>,
+        /// Reduced scattering coefficient `sigma_s'` per channel (R, G, B) in 1/mm; finite and
+        /// non-negative, and not zero together with `sigma_a` in any channel.
         sigma_s_prime: Option<[f64; 3]>,
+        /// Relative index of refraction (default: the preset's, or 1.3 for custom coefficients;
+        /// from 1/3 to 3, where the `F_dr` fits hold).
         eta: Option<f64>,
-        /// Millimetres per scene unit.
+        /// Millimetres per scene unit (required; positive). In every channel `sigma_a +
+        /// sigma_s_prime` times this must lie in [1e-12, 1e12] per scene unit.
         mm_per_unit: f64,
-        /// GGX roughness of the dielectric specular lobe.
+        /// GGX roughness of the dielectric specular lobe (default 0.35; 0 to 1).
         #[serde(default = "roughness")]
         roughness: f32,
     },
     /// Lambertian with a GGX specular lobe.
     Opaque {
+        /// Diffuse albedo per channel (R, G, B) (required; each 0 to 1).
         albedo: [f32; 3],
+        /// GGX roughness of the specular lobe (default 0.35; 0 to 1).
         #[serde(default = "roughness")]
         roughness: f32,
     },
@@ -126,33 +167,49 @@ fn roughness() -> f32 {
     0.35
 }
 
+/// One `[[light]]`, chosen by its `type` key: `"directional"`, `"point"`, `"spot"` or
+/// `"environment"`.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields, tag = "type", rename_all = "lowercase")]
 pub enum Light {
     /// Light arriving from one direction: `direction` points from the scene towards the light;
     /// `irradiance` in W/m^2 per channel on a surface facing it.
     Directional {
+        /// Towards the light, any length (required; finite, non-zero).
         direction: [f32; 3],
+        /// W/m^2 per channel (R, G, B) on a surface facing the light (required; non-negative).
         irradiance: [f32; 3],
+        /// Whether the light casts shadows (default true).
         #[serde(default = "yes")]
         shadows: bool,
     },
     /// `intensity` in W/sr per channel.
     Point {
+        /// Position in scene units (required; finite).
         position: [f32; 3],
+        /// W/sr per channel (R, G, B) (required; non-negative).
         intensity: [f32; 3],
+        /// Whether the light casts shadows (default true).
         #[serde(default = "yes")]
         shadows: bool,
     },
     /// A point light restricted to a cone of half-angle `angle` (degrees) about `direction`,
     /// with a smooth falloff over the outer `softness` fraction.
     Spot {
+        /// Position in scene units (required; finite).
         position: [f32; 3],
+        /// Axis of the cone, pointing away from the light, any length (required; finite,
+        /// non-zero).
         direction: [f32; 3],
+        /// W/sr per channel (R, G, B) on the axis (required; non-negative).
         intensity: [f32; 3],
+        /// Half-angle of the cone in degrees (required; strictly between 0 and 90).
         angle: f32,
+        /// Fraction of `angle`, at its outer edge, over which the light fades to zero
+        /// (default 0.2; above 0, at most 1).
         #[serde(default = "softness")]
         softness: f32,
+        /// Whether the light casts shadows (default true).
         #[serde(default = "yes")]
         shadows: bool,
     },
@@ -160,11 +217,16 @@ pub enum Light {
     /// file) or the built-in procedural sky, reduced to `directions` importance-sampled
     /// directional lights, each with its own shadow map (soft shadows, seed Figure 6).
     Environment {
+        /// Path of the map (default none: the procedural sky). Not available to the built-in
+        /// scene, which has no folder.
         map: Option<String>,
+        /// Multiplier on the map's radiance (default 1; non-negative).
         #[serde(default = "one")]
         scale: f32,
+        /// How many directional lights the map becomes (default 16; 1 to 256).
         #[serde(default = "env_directions")]
         directions: u32,
+        /// Whether the directions cast shadows (default true).
         #[serde(default = "yes")]
         shadows: bool,
     },
@@ -180,13 +242,19 @@ fn env_directions() -> u32 {
     16
 }
 
+/// The `[sampling]` table: how sample points are placed on every translucent object.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Sampling {
+    /// Placement: `"random"`, `"turk"`, `"feature"` or `"poisson"` (default `"turk"`).
     #[serde(default = "method")]
     pub method: Method,
+    /// Sample points per translucent object (default 400; 1 to
+    /// [`crate::scene::MAX_SAMPLE_COUNT`]).
     #[serde(default = "count")]
     pub count: usize,
+    /// Random seed (default 1); object `i` uses `seed + i`, so the same scene gives the same
+    /// points.
     #[serde(default = "seed")]
     pub seed: u64,
 }
@@ -207,19 +275,21 @@ fn seed() -> u64 {
     1
 }
 
+/// The `[render]` table: how the image is made from the prepared scene.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RenderSettings {
-    /// Where exitance is gathered.
+    /// Where exitance is gathered (default `"vertex"`).
     #[serde(default)]
     pub gather: GatherMode,
-    /// Exposure multiplier applied before the tone map.
+    /// Exposure multiplier applied before the tone map (default 1; positive).
     #[serde(default = "one")]
     pub exposure: f32,
-    /// Shadow-map resolution per light.
+    /// Shadow-map resolution per light, in texels per side (default 1024; 16 to 8192).
     #[serde(default = "shadow_size")]
     pub shadow_map_size: u32,
-    /// Linear background radiance where nothing is hit (the sky is drawn when it is a light).
+    /// Linear background radiance where nothing is hit, per channel (non-negative). Default:
+    /// the environment light's radiance at the horizon, or black without one.
     pub background: Option<[f32; 3]>,
 }
 
@@ -238,8 +308,10 @@ pub enum GatherMode {
 }
 
 impl GatherMode {
+    /// Every gather mode: what `--gather` accepts and what parsing a name tries.
     pub const ALL: [GatherMode; 3] = [GatherMode::Vertex, GatherMode::Pixel, GatherMode::Sparse];
 
+    /// The lowercase name used in scene files and on the command line.
     pub fn name(self) -> &'static str {
         match self {
             GatherMode::Vertex => "vertex",

@@ -14,8 +14,11 @@ use glam::{Mat4, Vec3};
 /// (sin theta cos phi, cos theta, sin theta sin phi).
 #[derive(Clone, Debug)]
 pub struct Environment {
+    /// Columns (texels of azimuth).
     pub width: usize,
+    /// Rows (texels of polar angle, from +y down to -y).
     pub height: usize,
+    /// Linear RGB radiance (W/m^2/sr), row by row from the top, `width * height` texels.
     pub radiance: Vec<Vec3>,
 }
 
@@ -23,12 +26,30 @@ pub struct Environment {
 #[derive(Debug, thiserror::Error)]
 pub enum EnvironmentError {
     // The image error is the source (shown by `{:#}` and error reporters), not repeated here.
+    /// The file could not be opened or decoded.
     #[error("cannot read environment map {}", path.display())]
-    Read { path: std::path::PathBuf, source: image::ImageError },
+    Read {
+        /// The map's file.
+        path: std::path::PathBuf,
+        /// The decoder's error.
+        source: image::ImageError,
+    },
+    /// The map is less than 2 texels wide or high.
     #[error("environment map {} is only {width}x{height}", path.display())]
-    TooSmall { path: std::path::PathBuf, width: usize, height: usize },
+    TooSmall {
+        /// The map's file.
+        path: std::path::PathBuf,
+        /// Its width in texels.
+        width: usize,
+        /// Its height in texels.
+        height: usize,
+    },
+    /// A texel is negative, infinite or NaN.
     #[error("environment map {} has a negative or non-finite texel", path.display())]
-    BadTexel { path: std::path::PathBuf },
+    BadTexel {
+        /// The map's file.
+        path: std::path::PathBuf,
+    },
 }
 
 impl Environment {
@@ -176,21 +197,44 @@ impl Environment {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum LightKind {
     /// `direction`: unit vector towards the light; `irradiance` (W/m^2) on a surface facing it.
-    Directional { direction: Vec3, irradiance: Vec3 },
+    Directional {
+        /// Unit vector towards the light.
+        direction: Vec3,
+        /// W/m^2 per channel on a surface facing the light.
+        irradiance: Vec3,
+    },
     /// `intensity` in W/sr, falling off with the inverse square of the distance.
-    Point { position: Vec3, intensity: Vec3 },
+    Point {
+        /// Position in world space (scene units).
+        position: Vec3,
+        /// W/sr per channel.
+        intensity: Vec3,
+    },
     /// A point light inside a cone about `axis` (pointing away from the light), smooth between
     /// the cosines of its inner and outer half-angles.
-    Spot { position: Vec3, axis: Vec3, intensity: Vec3, cos_outer: f32, cos_inner: f32 },
+    Spot {
+        /// Position in world space (scene units).
+        position: Vec3,
+        /// Unit axis of the cone, pointing away from the light.
+        axis: Vec3,
+        /// W/sr per channel on the axis.
+        intensity: Vec3,
+        /// Cosine of the outer half-angle, where the light reaches zero.
+        cos_outer: f32,
+        /// Cosine of the inner half-angle, inside which the light is at full intensity.
+        cos_inner: f32,
+    },
 }
 
 /// A scene light ready to render: its kind, its shadow map, and where it came from.
 #[derive(Clone, Debug)]
 pub struct PreparedLight {
+    /// What the light is, with its direction or position and power.
     pub kind: LightKind,
     /// One of the environment light's median-cut directions (lights diffuse surfaces through
     /// the per-vertex cache; no specular lobe).
     pub environment: bool,
+    /// Whether the scene asks for its shadows (`shadows` of the scene light).
     pub casts_shadow: bool,
     /// Its layer in the shadow-map array, when it casts shadows onto something.
     pub shadow_layer: Option<u32>,

@@ -22,31 +22,58 @@ pub const EMBEDDED_ASSETS: &[(&str, &[u8])] = &[("bunny-37k.obj", include_bytes!
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     // The io::Error is the source, not repeated here.
+    /// The scene file could not be read.
     #[error("cannot read scene {}", path.display())]
-    Read { path: PathBuf, source: std::io::Error },
+    Read {
+        /// The scene file.
+        path: PathBuf,
+        /// Why reading failed.
+        source: std::io::Error,
+    },
+    /// The text is not a valid scene: TOML syntax, an unknown key, a wrong type or a value out
+    /// of range.
     #[error("{file}: {message}")]
-    Invalid { file: String, message: String },
+    Invalid {
+        /// The scene's name: its path or "built-in scene".
+        file: String,
+        /// What is wrong, with the line and key path where they are known.
+        message: String,
+    },
+    /// `--samples 0` on the command line.
     #[error("--samples must be at least 1")]
     ZeroSamples,
+    /// `--samples` above [`MAX_SAMPLE_COUNT`].
     #[error("--samples {0} is above the limit of {MAX_SAMPLE_COUNT} (as for sampling.count)")]
     TooManySamples(usize),
+    /// `transform.fit` on a mesh whose bounding box has no extent.
     #[error("cannot fit a mesh with an empty bounding box")]
     EmptyBounds,
+    /// An OBJ file embedded in the binary is not valid UTF-8.
     #[error("embedded mesh is not UTF-8")]
     EmbeddedMeshNotUtf8(#[source] std::str::Utf8Error),
+    /// The built-in scene names an environment map, and none are embedded.
     #[error("embedded environment maps are not supported")]
     EmbeddedEnvironment,
+    /// A mesh could not be loaded or built.
     #[error(transparent)]
     Mesh(#[from] crate::mesh::MeshError),
+    /// A material was refused.
     #[error(transparent)]
     Optics(#[from] crate::optics::OpticsError),
+    /// Sample points could not be placed.
     #[error(transparent)]
     Sampling(#[from] crate::sampling::SamplingError),
+    /// An environment map was refused.
     #[error(transparent)]
     Environment(#[from] lights::EnvironmentError),
-    /// `context` names where (e.g. "scene.toml: object[0] (bunny.obj): sampling").
+    /// `context` names where (e.g. `scene.toml: object[0] (bunny.obj): sampling`).
     #[error("{context}")]
-    Context { context: String, source: Box<SceneError> },
+    Context {
+        /// Where the error happened: scene file, object, key.
+        context: String,
+        /// The error itself.
+        source: Box<SceneError>,
+    },
 }
 
 /// Most sample points per translucent object (`sampling.count`, `--samples`).
@@ -55,6 +82,7 @@ pub const MAX_SAMPLE_COUNT: usize = 1_000_000;
 /// A parsed, checked scene and where its relative paths resolve.
 #[derive(Clone, Debug)]
 pub struct Scene {
+    /// The scene file's contents, checked.
     pub file: SceneFile,
     /// Folder of the scene file; `None` for the built-in scene (paths resolve to embedded assets).
     pub base: Option<PathBuf>,
@@ -64,15 +92,19 @@ pub struct Scene {
 
 /// Where an asset named in a scene comes from.
 pub enum AssetSource {
+    /// A file on disk, relative to the scene file's folder.
     File(PathBuf),
+    /// The bytes of an asset embedded in the binary ([`EMBEDDED_ASSETS`]).
     Embedded(&'static [u8]),
 }
 
 impl Scene {
+    /// The built-in scene ([`DEFAULT_SCENE`]), whose assets are embedded.
     pub fn builtin() -> Scene {
         Scene::parse(DEFAULT_SCENE, "built-in scene", None).expect("the built-in scene is valid")
     }
 
+    /// Read, parse and check a scene file; its relative paths resolve from its folder.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let text =
             std::fs::read_to_string(path).map_err(|source| SceneError::Read { path: path.to_path_buf(), source })?;

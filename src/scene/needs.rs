@@ -8,7 +8,9 @@ use glam::Vec3;
 /// What a scene contains that decides its passes.
 #[derive(Clone, Debug)]
 pub struct SceneNeeds {
+    /// Layers of the shadow-map array (0: no shadow pass).
     pub shadow_layers: u32,
+    /// Objects with sample points, i.e. translucent ones (0: no splat or gather passes).
     pub translucent_objects: usize,
     /// Scene lights that own at least one shadow-map layer.
     pub shadowed_lights: Vec<usize>,
