@@ -128,10 +128,15 @@ pub fn memory_barrier(device: &ash::Device, cmd: vk::CommandBuffer, previous: &[
 /// drops the contents (old layout UNDEFINED) while still waiting for the previous accesses.
 #[derive(Clone, Copy, Debug)]
 pub struct ImageBarrier<'a> {
+    /// The image whose layout and accesses the barrier covers.
     pub image: vk::Image,
+    /// The aspect the barrier covers: COLOR, or DEPTH for depth formats (`aspect_of`).
     pub aspect: vk::ImageAspectFlags,
+    /// The accesses before the barrier: its source stages and access masks, and the old layout.
     pub previous: &'a [Access],
+    /// The accesses after it: its destination stages and access masks, and the new layout.
     pub next: &'a [Access],
+    /// Drop the contents: the old layout is UNDEFINED whatever `previous` implies.
     pub discard: bool,
 }
 

@@ -11,9 +11,14 @@ use std::sync::Arc;
 /// What to create: a builder-style value, so call sites read as a description.
 #[derive(Clone, Debug)]
 pub struct BufferDesc {
+    /// Debug name, given to the allocator and used in error messages.
     pub name: String,
+    /// Size in bytes; 0 is refused.
     pub size: u64,
+    /// How the buffer is used; `Buffer::new` always adds TRANSFER_SRC and TRANSFER_DST.
     pub usage: vk::BufferUsageFlags,
+    /// Which memory gpu_allocator picks: device-local, host-visible for upload, or host-visible for
+    /// readback.
     pub location: MemoryLocation,
 }
 
@@ -32,6 +37,9 @@ impl BufferDesc {
     }
 }
 
+/// A VkBuffer bound to its own gpu_allocator allocation. It holds an `Arc<Gpu>`, so the device
+/// outlives it, and on Drop destroys the buffer and frees the memory; Vulkan requires that no
+/// pending submission still uses it then.
 pub struct Buffer {
     gpu: Arc<Gpu>,
     raw: vk::Buffer,
@@ -41,6 +49,8 @@ pub struct Buffer {
 }
 
 impl Buffer {
+    /// Create the buffer, allocate its memory and bind it. Fails on size 0; on any failure, what
+    /// was made so far is destroyed.
     pub fn new(gpu: &Arc<Gpu>, desc: &BufferDesc) -> GpuResult<Buffer> {
         if desc.size == 0 {
             return Err(GpuError::Invalid(format!("buffer {:?} has size 0", desc.name)));
@@ -89,12 +99,16 @@ impl Buffer {
         Ok(buffer)
     }
 
+    /// The Vulkan handle, for recording commands and descriptor writes; this `Buffer` still owns
+    /// it.
     pub fn raw(&self) -> vk::Buffer {
         self.raw
     }
+    /// Size in bytes, as asked for (the allocation may be larger).
     pub fn size(&self) -> u64 {
         self.size
     }
+    /// The debug name given at creation.
     pub fn name(&self) -> &str {
         &self.name
     }

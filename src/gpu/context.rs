@@ -14,6 +14,14 @@ use std::mem::ManuallyDrop;
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
+/// The instance, physical and logical device, the one graphics+compute queue and the gpu_allocator
+/// allocator that every buffer, image and pipeline is made through. Built by `Gpu::new` (then it
+/// owns and destroys the instance and device) or wrapped around a host's by `Gpu::from_host` (then
+/// it destroys neither).
+///
+/// Shared as `Arc<Gpu>`: every object made from it holds a clone, so the `Gpu` drops last. Its Drop
+/// waits for the device to go idle, frees the allocator's memory, then destroys the device and the
+/// instance when it owns them.
 pub struct Gpu {
     entry: ash::Entry,
     instance: ash::Instance,
@@ -249,15 +257,19 @@ impl Gpu {
         }))
     }
 
+    /// The Vulkan loader's entry points (ours, or the host's).
     pub fn entry(&self) -> &ash::Entry {
         &self.entry
     }
+    /// The Vulkan instance (ours, or the host's), for physical-device queries.
     pub fn instance(&self) -> &ash::Instance {
         &self.instance
     }
+    /// The logical device every object is created on and every command is recorded through.
     pub fn device(&self) -> &ash::Device {
         &self.device
     }
+    /// The physical device in use, for format, feature and memory queries.
     pub fn physical_device(&self) -> vk::PhysicalDevice {
         self.info.handle
     }
@@ -265,9 +277,12 @@ impl Gpu {
     pub fn info(&self) -> &DeviceInfo {
         &self.info
     }
+    /// The physical device's properties, read once; its `limits` bound push-constant sizes,
+    /// dispatches and images.
     pub fn properties(&self) -> &vk::PhysicalDeviceProperties {
         &self.properties
     }
+    /// The family of the queue in use; command pools are created for it.
     pub fn queue_family(&self) -> u32 {
         self.queue_family
     }
@@ -283,6 +298,9 @@ impl Gpu {
     pub fn validation(&self) -> Arc<ValidationCounters> {
         self.counters.clone()
     }
+    /// Whether this `Gpu` created its instance with the validation layer and messenger
+    /// (`GpuOptions::validation`). Always false over a host's instance, whatever layers the host
+    /// enabled.
     pub fn validation_enabled(&self) -> bool {
         self.owned_instance.as_ref().is_some_and(|o| o.debug.is_some())
     }

@@ -17,9 +17,11 @@ pub struct ValidationCounters {
 }
 
 impl ValidationCounters {
+    /// Validation warnings counted so far.
     pub fn warnings(&self) -> u32 {
         self.warnings.load(Ordering::SeqCst)
     }
+    /// Validation errors counted so far.
     pub fn errors(&self) -> u32 {
         self.errors.load(Ordering::SeqCst)
     }

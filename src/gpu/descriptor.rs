@@ -10,9 +10,15 @@ use std::sync::Arc;
 /// The kind of one binding, as reflected from a shader's SPIR-V (`shaders::ShaderInterface`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BindingKind {
+    /// A std430 storage buffer (STORAGE_BUFFER), bound with `Binding::Buffer`.
     StorageBuffer,
+    /// A uniform buffer (UNIFORM_BUFFER), bound with `Binding::Buffer`.
     UniformBuffer,
+    /// An image read through a sampler (COMBINED_IMAGE_SAMPLER: `sampler2D`,
+    /// `sampler2DArrayShadow`), bound with `Binding::Image`.
     CombinedImageSampler,
+    /// An image read and written with imageLoad/imageStore (STORAGE_IMAGE, GENERAL layout), bound
+    /// with `Binding::Image`.
     StorageImage,
 }
 
@@ -40,8 +46,18 @@ impl BindingKind {
 
 /// What to bind at one binding; a set is given as a list, binding i being the i-th entry.
 pub enum Binding<'a> {
+    /// A whole buffer (offset 0, VK_WHOLE_SIZE) for a storage or uniform binding.
     Buffer(&'a Buffer),
-    Image { view: vk::ImageView, layout: vk::ImageLayout, sampler: vk::Sampler },
+    /// An image view for a combined-image-sampler or storage-image binding.
+    Image {
+        /// The view the shader samples or reads and writes.
+        view: vk::ImageView,
+        /// The layout the image is in whenever the set is used: SHADER_READ_ONLY_OPTIMAL to sample,
+        /// GENERAL for storage.
+        layout: vk::ImageLayout,
+        /// The sampler of a combined image sampler; `vk::Sampler::null()` for a storage image.
+        sampler: vk::Sampler,
+    },
 }
 
 pub(crate) fn create_set_layout(
@@ -66,6 +82,10 @@ pub(crate) fn create_set_layout(
     unsafe { gpu.device().create_descriptor_set_layout(&info, None) }.vk("vkCreateDescriptorSetLayout")
 }
 
+/// One descriptor set for a pipeline's set 0, allocated from a pool of its own sized for exactly
+/// its bindings (`ComputePipeline::descriptor_set`, `GraphicsPipeline::descriptor_set`). Destroying
+/// the pool on Drop frees the set. It holds an `Arc<Gpu>` but not the resources it points at: they
+/// must outlive every use of the set.
 pub struct DescriptorSet {
     gpu: Arc<Gpu>,
     pool: vk::DescriptorPool,
@@ -145,6 +165,7 @@ impl DescriptorSet {
         Ok(())
     }
 
+    /// The Vulkan handle, as vkCmdBindDescriptorSets takes it.
     pub fn raw(&self) -> vk::DescriptorSet {
         self.set
     }

@@ -7,11 +7,17 @@ use std::fmt;
 /// What `translucent devices` shows about a physical device.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct DeviceInfo {
+    /// Position in the loader's list of physical devices; `--device` accepts it.
     pub index: usize,
+    /// The name the driver reports; `--device` also matches part of it.
     pub name: String,
+    /// "discrete GPU", "integrated GPU", "virtual GPU", "CPU" or "other".
     pub kind: String,
+    /// The driver's name (VkPhysicalDeviceDriverProperties::driverName).
     pub driver: String,
+    /// The driver's own version details (driverInfo).
     pub driver_info: String,
+    /// The Vulkan version the device supports, "major.minor.patch".
     pub api_version: String,
     #[serde(skip)]
     pub(crate) api: u32,

@@ -9,12 +9,19 @@ use gpu_allocator::MemoryLocation;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use std::sync::Arc;
 
+/// What to create: a 2D image with one mip level, one sample per texel and optimal tiling, and one
+/// view over all its layers; a builder-style value like `BufferDesc`.
 #[derive(Clone, Debug)]
 pub struct ImageDesc {
+    /// Debug name, given to the allocator and used in error messages.
     pub name: String,
+    /// Width in texels; 0 is refused.
     pub width: u32,
+    /// Height in texels; 0 is refused.
     pub height: u32,
+    /// Texel format; a depth format gets a depth-aspect view (`aspect_of`).
     pub format: vk::Format,
+    /// How the image is used; `Image::new` always adds TRANSFER_SRC so it can be read back.
     pub usage: vk::ImageUsageFlags,
     /// Layers (e.g. one per shadow-casting light); the view is a 2D array when above 1.
     pub layers: u32,
@@ -23,9 +30,11 @@ pub struct ImageDesc {
 }
 
 impl ImageDesc {
+    /// One layer with a plain 2D view.
     pub fn new(name: &str, width: u32, height: u32, format: vk::Format, usage: vk::ImageUsageFlags) -> Self {
         Self { name: name.into(), width, height, format, usage, layers: 1, array_view: false }
     }
+    /// Set the number of array layers; above 1 the view is a 2D array.
     pub fn layers(mut self, layers: u32) -> Self {
         self.layers = layers;
         self
@@ -37,6 +46,10 @@ impl ImageDesc {
     }
 }
 
+/// A 2D VkImage (possibly layered) in device-local memory from gpu_allocator, with one view over
+/// all its layers. It starts in UNDEFINED layout, so its first barrier discards (`Access::Nothing`
+/// before). It holds an `Arc<Gpu>` and on Drop destroys the view, then the image, then frees the
+/// memory; Vulkan requires that no pending submission still uses it then.
 pub struct Image {
     gpu: Arc<Gpu>,
     raw: vk::Image,
@@ -69,6 +82,8 @@ pub fn aspect_of(format: vk::Format) -> vk::ImageAspectFlags {
 }
 
 impl Image {
+    /// Create the image, allocate and bind its memory, and create its view. Fails on an empty
+    /// extent or layer count.
     pub fn new(gpu: &Arc<Gpu>, desc: &ImageDesc) -> GpuResult<Image> {
         if desc.width == 0 || desc.height == 0 || desc.layers == 0 {
             return Err(GpuError::Invalid(format!(
@@ -130,15 +145,20 @@ impl Image {
         Ok(image)
     }
 
+    /// The Vulkan image handle, for barriers, clears and copies.
     pub fn raw(&self) -> vk::Image {
         self.raw
     }
+    /// The view over every layer (2D, or 2D array when layered or `array_view`), for attachments
+    /// and descriptors.
     pub fn view(&self) -> vk::ImageView {
         self.view
     }
+    /// The description it was created from.
     pub fn desc(&self) -> &ImageDesc {
         &self.desc
     }
+    /// Width and height, as render areas and viewports take them.
     pub fn extent(&self) -> vk::Extent2D {
         vk::Extent2D { width: self.desc.width, height: self.desc.height }
     }

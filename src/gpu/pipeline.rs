@@ -103,6 +103,9 @@ impl Drop for Module<'_> {
     }
 }
 
+/// A compute pipeline from one embedded shader, its set-0 layout, push-constant range and workgroup
+/// size reflected from the SPIR-V. The pipeline is destroyed on Drop, before its layout (field
+/// order); no pending submission may use it then.
 pub struct ComputePipeline {
     pipeline: vk::Pipeline,
     layout: Layout,
@@ -166,6 +169,7 @@ impl ComputePipeline {
         unsafe { device.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
     }
 
+    /// The shader path it was built from, e.g. "splat.comp".
     pub fn name(&self) -> &str {
         &self.name
     }
@@ -181,19 +185,28 @@ impl Drop for ComputePipeline {
 /// What a graphics pipeline draws into and how (dynamic rendering, no render-pass objects).
 #[derive(Clone, Debug)]
 pub struct GraphicsDesc {
+    /// Vertex shader path under `glsl/`.
     pub vertex: String,
     /// `None` for depth-only passes (shadow maps).
     pub fragment: Option<String>,
+    /// Vertex buffer bindings: binding number, stride and input rate.
     pub vertex_bindings: Vec<vk::VertexInputBindingDescription>,
+    /// Vertex shader inputs: location, binding, format and offset of each.
     pub vertex_attributes: Vec<vk::VertexInputAttributeDescription>,
+    /// Formats of the colour attachments, in attachment order; empty for depth-only passes.
     pub color_formats: Vec<vk::Format>,
+    /// Format of the depth attachment; with one, depth test (LESS_OR_EQUAL) and depth writes are
+    /// on.
     pub depth_format: Option<vk::Format>,
+    /// Faces to cull (counter-clockwise is front); NONE unless set.
     pub cull: vk::CullModeFlags,
     /// Constant and slope depth bias, for shadow maps.
     pub depth_bias: Option<(f32, f32)>,
 }
 
 impl GraphicsDesc {
+    /// The two shaders and nothing else: no vertex input, no attachments, no culling, no depth
+    /// bias.
     pub fn new(vertex: &str, fragment: Option<&str>) -> Self {
         Self {
             vertex: vertex.into(),
@@ -208,12 +221,18 @@ impl GraphicsDesc {
     }
 }
 
+/// A graphics pipeline for dynamic rendering (no render-pass objects): triangle lists, dynamic
+/// viewport and scissor, one descriptor set and one push-constant block shared by the vertex and
+/// fragment stages, reflected from their SPIR-V. Destroyed on Drop before its layout; no pending
+/// submission may use it then.
 pub struct GraphicsPipeline {
     pipeline: vk::Pipeline,
     layout: Layout,
 }
 
 impl GraphicsPipeline {
+    /// Build the pipeline `desc` describes; the layout is the union of both stages' reflected
+    /// interfaces (`ShaderInterface::merge`).
     pub fn new(gpu: &Arc<Gpu>, desc: &GraphicsDesc) -> GpuResult<GraphicsPipeline> {
         let stages_flags = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         let mut interfaces = vec![ShaderInterface::of(&desc.vertex)?];
@@ -286,6 +305,7 @@ impl GraphicsPipeline {
         Ok(GraphicsPipeline { pipeline, layout })
     }
 
+    /// A descriptor set for this pipeline's set 0, binding i being `bindings[i]`.
     pub fn descriptor_set(&self, bindings: &[Binding<'_>]) -> GpuResult<DescriptorSet> {
         DescriptorSet::new(&self.layout.gpu, self.layout.set_layout, &self.layout.kinds, bindings)
     }

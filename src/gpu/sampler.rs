@@ -5,6 +5,8 @@ use super::error::{GpuResult, VkContext};
 use ash::vk;
 use std::sync::Arc;
 
+/// A VkSampler. It holds an `Arc<Gpu>` and is destroyed on Drop; no pending submission may use it
+/// then.
 pub struct Sampler {
     gpu: Arc<Gpu>,
     raw: vk::Sampler,
@@ -49,6 +51,7 @@ impl Sampler {
         Ok(Sampler { gpu: gpu.clone(), raw })
     }
 
+    /// The Vulkan handle, as `Binding::Image` takes it.
     pub fn raw(&self) -> vk::Sampler {
         self.raw
     }

@@ -9,6 +9,9 @@ use super::error::{GpuError, GpuResult, VkContext};
 use ash::vk;
 use std::sync::Arc;
 
+/// Timestamp queries for up to `max_passes` named passes per command buffer: two per pass, start
+/// and end, both written at ALL_COMMANDS. The query pool is destroyed on Drop. Needs a queue whose
+/// timestampValidBits is above 0.
 pub struct GpuTimer {
     gpu: Arc<Gpu>,
     pool: vk::QueryPool,

@@ -15,15 +15,22 @@ use std::sync::Arc;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GatherPush {
+    /// Index of the receiving translucent object (its `ObjectRecord`); the dispatch covers its
+    /// vertex range.
     pub object: u32,
 }
 
+/// The vertex gather: one dispatch of glsl/gather.comp per translucent object
+/// (`GpuScene::receivers`), writing exitance at its vertices into `GpuScene::exitance`, then a
+/// barrier to vertex-attribute reads by shading and to host reads.
 pub struct GatherPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
 }
 
 impl GatherPass {
+    /// The pipeline and one descriptor set over the scene's vertices, samples, splat, objects and
+    /// exitance buffers.
     pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene) -> GpuResult<GatherPass> {
         let pipeline = ComputePipeline::new(gpu, "gather.comp")?;
         let set = pipeline.descriptor_set(&[

@@ -17,10 +17,16 @@ use std::sync::Arc;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GatherPixelPush {
+    /// HDR image width in pixels; invocations outside the image return.
     pub width: u32,
+    /// HDR image height in pixels.
     pub height: u32,
 }
 
+/// The pixel gather: one dispatch of glsl/gather_pixel.comp over the HDR image, reading the shading
+/// pass's surface image and adding exitance into the HDR image in place (moved to GENERAL for the
+/// dispatch and back to sampled reads after). It owns the nearest sampler it reads the surface
+/// with; both images belong to the `ShadePass`, which must outlive it.
 pub struct GatherPixelPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,

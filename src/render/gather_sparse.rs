@@ -18,11 +18,15 @@ use std::sync::Arc;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GatherSparsePush {
+    /// Index of the receiving translucent object (its `ObjectRecord`).
     pub object: u32,
     /// 0: exitance at the samples; 1: blended to the vertices.
     pub stage: u32,
 }
 
+/// The sparse gather: per translucent object, stage 0 of glsl/gather_sparse.comp over its samples
+/// (exitance into a per-sample buffer this pass owns), a compute-to-compute barrier, then stage 1
+/// over its vertices into `GpuScene::exitance`; it ends with the vertex gather's barrier.
 pub struct GatherSparsePass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
@@ -30,6 +34,8 @@ pub struct GatherSparsePass {
 }
 
 impl GatherSparsePass {
+    /// The pipeline, the per-sample exitance buffer (one vec4 per sample, device-local) and one
+    /// descriptor set over it and the scene's buffers.
     pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene) -> GpuResult<GatherSparsePass> {
         let pipeline = ComputePipeline::new(gpu, "gather_sparse.comp")?;
         let bytes = 16 * scene.sample_count.max(1) as u64;

@@ -12,8 +12,11 @@ use std::sync::Arc;
 /// A draw of one object: index range and vertex offset in the shared buffers.
 #[derive(Clone, Copy, Debug)]
 pub struct DrawRange {
+    /// First index of the object's triangles in the shared index buffer.
     pub first_index: u32,
+    /// Number of indices, three per triangle.
     pub index_count: u32,
+    /// Added to every index: the object's first vertex in the shared vertex buffer.
     pub vertex_offset: i32,
 }
 
@@ -22,23 +25,36 @@ pub struct DrawRange {
 pub struct Receiver {
     /// Index of the object (its `ObjectRecord`).
     pub object: u32,
+    /// Its vertex count: the threads of the vertex gather and of the sparse gather's stage 1.
     pub vertex_count: u32,
+    /// Its sample count: the threads of the sparse gather's stage 0.
     pub sample_count: u32,
 }
 
+/// A prepared scene's data on the GPU: device-local buffers the passes bind, and the ranges and
+/// counts they dispatch and draw with. The passes' descriptor sets point into these buffers, so the
+/// passes must be dropped first (`Renderer` declares its passes before its `GpuScene`). Only the
+/// light records and shadow matrices change after creation (`set_lights`).
 pub struct GpuScene {
     /// `records::Vertex` per vertex of every object, objects one after another.
     pub vertices: Buffer,
+    /// u32 triangle indices of every object, relative to its first vertex
+    /// (`DrawRange::vertex_offset`).
     pub indices: Buffer,
     /// Radiant exitance per vertex (vec4), written by the vertex and sparse gathers; zero on
     /// opaque objects.
     pub exitance: Buffer,
     /// Irradiance from the environment's directions per vertex (vec4), from the vertex-light pass.
     pub environment_irradiance: Buffer,
+    /// `ObjectRecord` per object, in scene order.
     pub objects: Buffer,
+    /// `SampleRecord` per sample point, objects one after another (`ObjectRecord::ranges` says
+    /// where each object's are).
     pub samples: Buffer,
     /// `SplatRecord` per sample, from the splat pass.
     pub splat: Buffer,
+    /// `LightGpu` per prepared light, key lights first; rewritten inside a frame's command buffer
+    /// when lights change (`record_uploads`).
     pub lights: Buffer,
     /// One per object, in scene order.
     pub draws: Vec<DrawRange>,
@@ -46,11 +62,15 @@ pub struct GpuScene {
     pub casters: Vec<DrawRange>,
     /// World -> clip matrix of each shadow-map layer.
     pub light_matrices: Vec<[[f32; 4]; 4]>,
+    /// The translucent objects, in scene order: what the gathers dispatch over.
     pub receivers: Vec<Receiver>,
     /// First vertex of each object in the shared buffers.
     pub vertex_offsets: Vec<u32>,
+    /// Vertices of all objects together.
     pub vertex_count: u32,
+    /// Sample points of all objects together.
     pub sample_count: u32,
+    /// Prepared lights (environment directions included): the records in `lights`.
     pub light_count: u32,
     /// Lights that are not environment directions; they come first in the light buffer.
     pub key_light_count: u32,
@@ -72,6 +92,10 @@ fn upload<T: bytemuck::Pod>(gpu: &Arc<Gpu>, name: &str, data: &[T], usage: vk::B
 }
 
 impl GpuScene {
+    /// Pack the scene's records (`records`) and upload them before any frame: vertices, indices,
+    /// objects, samples and lights. Exitance and environment irradiance start at zero; the splat
+    /// buffer is left for the splat pass. Every buffer has at least 16 bytes, so an empty part of
+    /// the scene still binds.
     pub fn new(gpu: &Arc<Gpu>, scene: &PreparedScene) -> GpuResult<GpuScene> {
         let (mut vertices, mut indices, mut objects, mut samples) =
             (Vec::new(), Vec::<u32>::new(), Vec::new(), Vec::new());

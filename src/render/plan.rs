@@ -7,13 +7,21 @@
 pub use crate::scene::needs::SceneNeeds;
 use std::fmt;
 
+/// A GPU pass the planner can schedule; `Renderer::pass` maps each to its `RenderPass`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Pass {
+    /// Shadow maps of the shadow-casting lights (`ShadowPass`, glsl/shadow.vert).
     Shadow,
+    /// The environment light's irradiance cached per vertex (`VertexLightPass`).
     VertexLight,
+    /// Irradiance transmitted into every sample point (`SplatPass`).
     Splat,
+    /// Exitance summed from the samples' dipoles: per vertex, sparse or per pixel
+    /// (`render.gather`).
     Gather,
+    /// The camera's view rasterised into the HDR image or the host's target (`ShadePass`).
     Shade,
+    /// HDR to 8-bit sRGB for readback (`TonemapPass`); own target only.
     Tonemap,
 }
 
@@ -32,6 +40,7 @@ impl Change {
 }
 
 impl Pass {
+    /// The pass's name in plans, timer marks and `FrameTimings`, e.g. "vertex_light".
     pub fn name(self) -> &'static str {
         match self {
             Pass::Shadow => "shadow",
@@ -58,15 +67,21 @@ pub enum Change {
     Camera,
 }
 
+/// The passes one frame runs, in recording order, and the ones it skips, each with its reason;
+/// `Display` prints one a line.
 #[derive(Clone, Debug, Default)]
 pub struct Plan {
+    /// Passes to record, in order, each with why it runs.
     pub passes: Vec<(Pass, String)>,
+    /// Passes left out, each with why: their last results are reused, or the scene does not need
+    /// them.
     pub skipped: Vec<(Pass, String)>,
     /// When only one light's shadow maps are redrawn: that scene light; `None` redraws all.
     pub shadow_light: Option<usize>,
 }
 
 impl Plan {
+    /// Whether `pass` is among the passes to record.
     pub fn runs(&self, pass: Pass) -> bool {
         self.passes.iter().any(|(p, _)| *p == pass)
     }
@@ -84,6 +99,9 @@ impl fmt::Display for Plan {
     }
 }
 
+/// The plan for a scene with `needs` after `change`: which passes run, in order, and why, and why
+/// the others are skipped (the rules are in the module doc). The pixel gather runs after shading,
+/// the other gathers before it.
 pub fn plan(needs: &SceneNeeds, change: Change) -> Plan {
     let mut plan = Plan::default();
     let lights_stale = matches!(change, Change::Everything | Change::Lights | Change::Light(_));

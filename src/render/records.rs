@@ -11,18 +11,29 @@ use crate::scene::build::{PreparedObject, ResolvedMaterial};
 use crate::scene::lights::{LightKind, PreparedLight};
 use ash::vk;
 
+/// Kind of an opaque (Lambertian) object in `ObjectRecord::eta_norm_kind` z; `MATERIAL_OPAQUE` in
+/// glsl/common/scene.glsl.
 pub const MATERIAL_OPAQUE: f32 = 0.0;
+/// Kind of a translucent (dipole BSSRDF) object in `ObjectRecord::eta_norm_kind` z;
+/// `MATERIAL_TRANSLUCENT` in glsl/common/scene.glsl.
 pub const MATERIAL_TRANSLUCENT: f32 = 1.0;
 
+/// Kind of a directional light in `LightGpu::position_kind` w; `LIGHT_DIRECTIONAL` in
+/// glsl/common/lights.glsl.
 pub const LIGHT_DIRECTIONAL: f32 = 0.0;
+/// Kind of a point light in `LightGpu::position_kind` w; `LIGHT_POINT` in glsl/common/lights.glsl.
 pub const LIGHT_POINT: f32 = 1.0;
+/// Kind of a spot light in `LightGpu::position_kind` w; `LIGHT_SPOT` in glsl/common/lights.glsl.
 pub const LIGHT_SPOT: f32 = 2.0;
 
 /// `ObjectRecord` in glsl/common/scene.glsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct ObjectRecord {
+    /// rgb: albedo of an opaque object (zero for a translucent one); w: GGX roughness (both kinds).
     pub albedo_roughness: [f32; 4],
+    /// x: relative index of refraction eta; y: the BSSRDF normalization 1 / (pi T(eta)) (0 for
+    /// opaque); z: kind (`MATERIAL_*`); w: unused.
     pub eta_norm_kind: [f32; 4],
     /// Per channel: alpha', sigma_tr, z_r, z_v, with lengths in scene units.
     pub dipole: [DipoleChannelGpu; 3],
@@ -63,11 +74,14 @@ impl ObjectRecord {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SampleRecord {
+    /// xyz: world position; w: area weight (scene units^2).
     pub position_area: [f32; 4],
+    /// xyz: unit normal; w: index of the object the sample lies on, as a float.
     pub normal_object: [f32; 4],
 }
 
 impl SampleRecord {
+    /// Pack one sample point of object `object`.
     pub fn new(sample: &SamplePoint, object: usize) -> SampleRecord {
         let (p, n) = (sample.position, sample.normal);
         SampleRecord {
@@ -88,6 +102,7 @@ pub struct SplatRecord {
 }
 
 impl SplatRecord {
+    /// Pack one sample's splat output as splat.comp writes it (the w of `near_energy` is 0).
     pub fn new(irradiance: [f32; 3], area: f32, near_energy: [f32; 3]) -> SplatRecord {
         let [e0, e1, e2] = irradiance;
         let [n0, n1, n2] = near_energy;
@@ -99,14 +114,23 @@ impl SplatRecord {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct LightGpu {
+    /// xyz: position (point, spot); w: kind (`LIGHT_*`).
     pub position_kind: [f32; 4],
+    /// xyz: unit vector towards the light (directional) or the spot axis pointing away from the
+    /// light; w: cosine of the spot's outer angle.
     pub direction_cos: [f32; 4],
+    /// rgb: irradiance in W/m^2 (directional) or intensity in W/sr (point, spot); w: shadow-map
+    /// layer, negative when the light casts no shadow.
     pub power_layer: [f32; 4],
+    /// x: cosine of the spot's inner angle; y: shadow-map texel size in uv; z: normal offset (world
+    /// units) against self-shadowing; w: 1 for a direction of the environment light, else 0.
     pub spot_texel: [f32; 4],
+    /// World -> the light's shadow clip space (depth 0..1), column-major.
     pub shadow_matrix: [[f32; 4]; 4],
 }
 
 impl LightGpu {
+    /// Pack one prepared light.
     pub fn new(light: &PreparedLight) -> LightGpu {
         let (position_kind, direction_cos, power, cos_inner) = match light.kind {
             LightKind::Directional { direction: d, irradiance } => {
@@ -135,11 +159,14 @@ impl LightGpu {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Vertex {
+    /// World-space position (location 0).
     pub position: [f32; 3],
+    /// World-space vertex normal (location 1).
     pub normal: [f32; 3],
 }
 
 impl Vertex {
+    /// Vertex buffer binding 0: one `Vertex` per vertex, 24-byte stride.
     pub fn binding() -> vk::VertexInputBindingDescription {
         vk::VertexInputBindingDescription {
             binding: 0,
@@ -147,9 +174,11 @@ impl Vertex {
             input_rate: vk::VertexInputRate::VERTEX,
         }
     }
+    /// Location 0: `position`, three f32 at offset 0 of binding 0.
     pub fn position_attribute() -> vk::VertexInputAttributeDescription {
         vk::VertexInputAttributeDescription { location: 0, binding: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 0 }
     }
+    /// Location 1: `normal`, three f32 at offset 12 of binding 0.
     pub fn normal_attribute() -> vk::VertexInputAttributeDescription {
         vk::VertexInputAttributeDescription {
             location: 1,

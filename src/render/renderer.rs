@@ -26,12 +26,26 @@ use std::sync::Arc;
 pub enum RenderError {
     /// The scene asks for more than the device has.
     #[error("{setting} = {value} does not fit this device: its {limit_name} is {limit}")]
-    DoesNotFit { setting: String, value: u64, limit_name: &'static str, limit: u64 },
+    DoesNotFit {
+        /// The scene setting that is too large, or the quantity it leads to (e.g. the bytes of the
+        /// HDR image at camera.resolution).
+        setting: String,
+        /// How large it is.
+        value: u64,
+        /// The device limit it exceeds (a VkPhysicalDeviceLimits name, or the largest device-local
+        /// heap).
+        limit_name: &'static str,
+        /// That limit on this device.
+        limit: u64,
+    },
     /// A call that does not fit the renderer's target (own images or the host's).
     #[error("{0}")]
     Target(&'static str),
+    /// `set_light` was given a light of another kind than scene light `index`, or an index past the
+    /// scene's lights.
     #[error("light {0} cannot be replaced by a light of another kind")]
     LightKindChanged(usize),
+    /// An error of the GPU core.
     #[error(transparent)]
     Gpu(#[from] GpuError),
 }
@@ -39,7 +53,9 @@ pub enum RenderError {
 /// Non-finite values one pass left on one object.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct NonFinite {
+    /// "splat" or "gather".
     pub pass: &'static str,
+    /// Index of the object in the scene.
     pub object: usize,
     /// Samples (splat) or vertices (gather) with a NaN or infinite value.
     pub count: usize,
@@ -48,13 +64,16 @@ pub struct NonFinite {
 /// Per-pass GPU milliseconds of one frame, in recording order.
 #[derive(Clone, Debug, Default)]
 pub struct FrameTimings {
+    /// (pass name, GPU milliseconds) per recorded pass.
     pub passes: Vec<(String, f64)>,
 }
 
 impl FrameTimings {
+    /// Sum over the passes, in milliseconds.
     pub fn total(&self) -> f64 {
         self.passes.iter().map(|(_, ms)| ms).sum()
     }
+    /// Milliseconds of the pass named `name` (`Pass::name`), if it was recorded.
     pub fn get(&self, name: &str) -> Option<f64> {
         self.passes.iter().find(|(n, _)| n == name).map(|(_, ms)| *ms)
     }
@@ -64,8 +83,11 @@ impl FrameTimings {
 /// position (for the specular lobe).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraView {
+    /// World -> view.
     pub view: Mat4,
+    /// View -> clip (Vulkan clip space: depth 0..1, y down).
     pub projection: Mat4,
+    /// Camera position in world space.
     pub eye: Vec3,
 }
 

@@ -19,6 +19,8 @@ use crate::gpu::{
 use ash::vk;
 use std::sync::Arc;
 
+/// Format of the own HDR target: linear radiance, RGBA32F. With the pixel gather its alpha holds
+/// the factor gather_pixel.comp multiplies exitance by; otherwise 1.
 pub const HDR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 /// Pixel gather only: world position and translucent object of each pixel.
 pub const SURFACE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
@@ -28,6 +30,7 @@ const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct ShadePush {
+    /// World -> clip of the camera, column-major.
     pub view_proj: [[f32; 4]; 4],
     /// xyz: camera position; w: object index.
     pub eye_object: [f32; 4],
@@ -43,7 +46,12 @@ pub enum TargetDesc {
     /// A host engine's colour and depth images of these formats, given each frame as a
     /// `HostTarget`. The pass writes linear radiance (alpha 1) and depth-tests against the host's
     /// depth (0 near, 1 far, LESS_OR_EQUAL, depth written).
-    Host { color_format: vk::Format, depth_format: vk::Format },
+    Host {
+        /// Format of the host's colour image.
+        color_format: vk::Format,
+        /// Format of the host's depth image.
+        depth_format: vk::Format,
+    },
 }
 
 /// A host's attachments for one frame (`TargetDesc::Host`). On entry and on exit the colour
@@ -52,8 +60,11 @@ pub enum TargetDesc {
 /// and late-fragment-test stages, where the host's next barrier picks them up.
 #[derive(Clone, Copy, Debug)]
 pub struct HostTarget {
+    /// View of the host's colour image.
     pub color: vk::ImageView,
+    /// View of the host's depth image.
     pub depth: vk::ImageView,
+    /// Size of both images: the render area, viewport and scissor.
     pub extent: vk::Extent2D,
     /// Keep the host's colour and depth (`true`), or clear them to the scene's background and
     /// the far plane (`false`).
@@ -71,6 +82,9 @@ enum Attachments {
     Host,
 }
 
+/// The forward-shading pass: a graphics pipeline (shade.vert with shade.frag, or shade_pixel.frag
+/// for the pixel gather), its descriptor set, and its own HDR, depth (and surface) images, or none
+/// when it draws into a host's. One indexed draw per object.
 pub struct ShadePass {
     pipeline: GraphicsPipeline,
     set: DescriptorSet,

@@ -12,12 +12,14 @@ use crate::gpu::{
 use ash::vk;
 use std::sync::Arc;
 
+/// Format of the shadow maps: 16-bit depth, sampled through a compare sampler.
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D16_UNORM;
 
 /// `ShadowPush` in glsl/shadow.vert.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct ShadowPush {
+    /// World -> the light's clip space, column-major.
     pub light_matrix: [[f32; 4]; 4],
     /// x: the layer; yzw: unused.
     pub layer: [u32; 4],
@@ -26,6 +28,9 @@ pub struct ShadowPush {
 /// Who reads the maps between redraws.
 const READERS: [Access; 2] = [Access::FragmentSampledRead, Access::ComputeSampledRead];
 
+/// The shadow-map pass: a depth-only graphics pipeline (glsl/shadow.vert), the D16 array image with
+/// one layer per shadow map, and its compare sampler. Between redraws the maps stay in
+/// SHADER_READ_ONLY_OPTIMAL, readable by fragment and compute shaders.
 pub struct ShadowPass {
     pipeline: GraphicsPipeline,
     maps: Image,

@@ -7,7 +7,9 @@ use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, Gpu, GpuR
 use ash::vk;
 use std::sync::Arc;
 
+/// What the smoke dispatch produced.
 pub struct SmokeResult {
+    /// The output buffer, read back; `expected` gives what it must hold.
     pub output: Vec<f32>,
     /// GPU time of the dispatch, from timestamp queries.
     pub gpu_ms: f64,
@@ -18,6 +20,8 @@ pub fn expected(input: &[f32]) -> Vec<f32> {
     input.iter().enumerate().map(|(i, v)| 2.0 * v + i as f32).collect()
 }
 
+/// Upload `input`, dispatch glsl/smoke.comp over it in one timed one-shot submission, and read the
+/// output back.
 pub fn run(gpu: &Arc<Gpu>, input: &[f32]) -> GpuResult<SmokeResult> {
     let count = input.len() as u32;
     let pipeline = ComputePipeline::new(gpu, "smoke.comp")?;

@@ -17,10 +17,14 @@ use std::sync::Arc;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SplatPush {
+    /// Sample points of all objects; invocations beyond it return.
     pub sample_count: u32,
+    /// Lights in the light buffer; each adds its transmitted irradiance at every sample.
     pub light_count: u32,
 }
 
+/// The irradiance splat: one dispatch of glsl/splat.comp over every sample point, writing
+/// `SplatRecord`s into `GpuScene::splat`, then a barrier to compute reads (the gathers).
 pub struct SplatPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
@@ -28,6 +32,8 @@ pub struct SplatPass {
 }
 
 impl SplatPass {
+    /// The pipeline and one descriptor set over the samples, objects, lights, shadow maps and splat
+    /// buffer.
     pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene, shadow: &ShadowPass) -> GpuResult<SplatPass> {
         let pipeline = ComputePipeline::new(gpu, "splat.comp")?;
         let set = pipeline.descriptor_set(&[

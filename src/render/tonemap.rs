@@ -28,11 +28,16 @@ pub fn display_value(linear: f64, exposure: f64) -> u8 {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct TonemapPush {
+    /// HDR image width in pixels.
     pub width: u32,
+    /// HDR image height in pixels.
     pub height: u32,
+    /// Multiplier on linear radiance before the tone curve (`render.exposure`).
     pub exposure: f32,
 }
 
+/// The tone map: glsl/tonemap.comp over the HDR image into a host-readable RGBA8 buffer and a
+/// non-finite pixel counter, both owned by the pass and read with `read` after the fence.
 pub struct TonemapPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,

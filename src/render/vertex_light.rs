@@ -17,10 +17,14 @@ use std::sync::Arc;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct VertexLightPush {
+    /// Vertices of all objects; invocations beyond it return.
     pub vertex_count: u32,
+    /// Lights in the light buffer; the shader adds only the environment's directions.
     pub light_count: u32,
 }
 
+/// The environment cache: one dispatch of glsl/vertex_light.comp over every vertex, writing
+/// `GpuScene::environment_irradiance`, then a barrier to vertex-attribute reads by shading.
 pub struct VertexLightPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
@@ -28,6 +32,8 @@ pub struct VertexLightPass {
 }
 
 impl VertexLightPass {
+    /// The pipeline and one descriptor set over the vertices, lights, shadow maps and irradiance
+    /// buffer.
     pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene, shadow: &ShadowPass) -> GpuResult<VertexLightPass> {
         let pipeline = ComputePipeline::new(gpu, "vertex_light.comp")?;
         let set = pipeline.descriptor_set(&[
