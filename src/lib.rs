@@ -21,6 +21,8 @@
 //! An engine with its own device wraps it with `Gpu::from_host` and draws into its own images
 //! with `Renderer::with_target` and `Renderer::record_frame` (docs/GPU.md, examples/embed.rs).
 
+#![warn(missing_docs)]
+
 pub mod gpu;
 pub mod mesh;
 pub mod optics;
