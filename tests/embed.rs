@@ -114,3 +114,23 @@ fn a_host_device_without_the_required_features_gets_a_clear_error() {
     let error = run(&Options { api_version: vk::API_VERSION_1_2, ..Options::default() }).err().expect("refused");
     assert!(error.contains("apiVersion 1.3"), "{error}");
 }
+
+#[test]
+fn unusable_host_targets_are_refused_with_the_reason() {
+    let scene = translucent::Scene::parse(SPHERE_SCENE, "sphere", None).unwrap();
+    let prepared = translucent::PreparedScene::new(&scene, &Default::default()).unwrap();
+    common::with_gpu(|gpu| {
+        let host = |color_format, depth_format| translucent::TargetDesc::Host { color_format, depth_format };
+        let refused = |target, prepared: &translucent::PreparedScene| {
+            translucent::Renderer::with_target(gpu, prepared.clone(), target).err().expect("refused").to_string()
+        };
+        let error = refused(host(vk::Format::D32_SFLOAT, vk::Format::D32_SFLOAT), &prepared);
+        assert!(error.contains("colour format"), "{error}");
+        let error = refused(host(vk::Format::R8G8B8A8_UNORM, vk::Format::R8G8B8A8_UNORM), &prepared);
+        assert!(error.contains("depth format"), "{error}");
+        let mut pixel = prepared.clone();
+        pixel.scene.file.render.gather = translucent::GatherMode::Pixel;
+        let error = refused(host(vk::Format::R16G16B16A16_SFLOAT, vk::Format::D32_SFLOAT), &pixel);
+        assert!(error.contains("pixel gather"), "{error}");
+    });
+}

@@ -38,6 +38,14 @@ pub enum RenderError {
         /// That limit on this device.
         limit: u64,
     },
+    /// A host target's format this device cannot render to as that attachment.
+    #[error("the host's {which} format {format:?} is not usable as a {which} attachment on this device")]
+    Format {
+        /// "colour" or "depth".
+        which: &'static str,
+        /// The format given.
+        format: vk::Format,
+    },
     /// A call that does not fit the renderer's target (own images or the host's).
     #[error("{0}")]
     Target(&'static str),
@@ -151,6 +159,9 @@ impl Renderer {
     /// formats (then `record_frame` takes the host's attachments, and there is no tone map).
     pub fn with_target(gpu: &Arc<Gpu>, scene: PreparedScene, target: TargetDesc) -> Result<Renderer, RenderError> {
         check_fits(gpu, &scene)?;
+        if let TargetDesc::Host { color_format, depth_format } = target {
+            check_host_formats(gpu, color_format, depth_format)?;
+        }
         let mut needs = scene.needs();
         needs.host_target = target != TargetDesc::Own;
         if needs.host_target && needs.pixel_gather {
@@ -548,6 +559,24 @@ fn check_fits(gpu: &Gpu, scene: &PreparedScene) -> Result<(), RenderError> {
         if value > limit {
             return Err(RenderError::DoesNotFit { setting, value, limit_name, limit });
         }
+    }
+    Ok(())
+}
+
+/// A host target's formats must be renderable: colour attachment (optimal tiling) for the colour
+/// format, depth-stencil attachment with a depth aspect for the depth format.
+fn check_host_formats(gpu: &Gpu, color: vk::Format, depth: vk::Format) -> Result<(), RenderError> {
+    let features = |format| {
+        // SAFETY: a plain query on the device in use.
+        unsafe { gpu.instance().get_physical_device_format_properties(gpu.physical_device(), format) }
+            .optimal_tiling_features
+    };
+    if !features(color).contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT) {
+        return Err(RenderError::Format { which: "colour", format: color });
+    }
+    let has_depth = crate::gpu::aspect_of(depth).contains(vk::ImageAspectFlags::DEPTH);
+    if !has_depth || !features(depth).contains(vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT) {
+        return Err(RenderError::Format { which: "depth", format: depth });
     }
     Ok(())
 }
