@@ -31,7 +31,13 @@ fn main() {
     for (name, value) in KERNEL_CONSTANTS {
         writeln!(header, "const float DIPOLE_{name} = {value:?};").unwrap();
     }
-    fs::write(generated.join("kernel_constants.glsl"), header).unwrap();
+    // Written only when it changed: shaders include it, so it is a rerun-if-changed input, and a
+    // fresh mtime on every run would make cargo rerun this script (and rebuild the crate) on
+    // every invocation.
+    let constants = generated.join("kernel_constants.glsl");
+    if fs::read_to_string(&constants).ok().as_deref() != Some(header.as_str()) {
+        fs::write(&constants, header).unwrap();
+    }
 
     let mut files = Vec::new();
     walk(&root, &mut files);
