@@ -49,9 +49,32 @@ impl Environment {
         Environment { width, height, radiance }
     }
 
-    /// Load an equirectangular .hdr or .exr map (through the `image` crate).
+    /// Load an equirectangular .hdr or .exr map (through the `image` crate). The format comes
+    /// from the extension, or from the content when the extension names none.
     pub fn load(path: &std::path::Path) -> Result<Environment, EnvironmentError> {
-        let img = image::open(path).map_err(|source| EnvironmentError::Read { path: path.to_path_buf(), source })?;
+        let read = |source| EnvironmentError::Read { path: path.to_path_buf(), source };
+        let bytes = std::fs::read(path).map_err(|e| read(image::ImageError::IoError(e)))?;
+        Self::decode(&bytes, image::ImageFormat::from_path(path).ok(), path)
+    }
+
+    /// Decode an equirectangular .hdr or .exr map already in memory, the format guessed from
+    /// its content; `name` names it in errors.
+    pub fn from_bytes(bytes: &[u8], name: impl AsRef<std::path::Path>) -> Result<Environment, EnvironmentError> {
+        Self::decode(bytes, None, name.as_ref())
+    }
+
+    fn decode(
+        bytes: &[u8],
+        format: Option<image::ImageFormat>,
+        path: &std::path::Path,
+    ) -> Result<Environment, EnvironmentError> {
+        let read = |source| EnvironmentError::Read { path: path.to_path_buf(), source };
+        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+        match format {
+            Some(format) => reader.set_format(format),
+            None => reader = reader.with_guessed_format().map_err(|e| read(image::ImageError::IoError(e)))?,
+        }
+        let img = reader.decode().map_err(read)?;
         let rgb = img.to_rgb32f();
         let (width, height) = (rgb.width() as usize, rgb.height() as usize);
         if width < 2 || height < 2 {
