@@ -42,7 +42,10 @@ fuzz_target!(|data: &[u8]| {
             LightKind::Directional { direction, irradiance } => direction.is_finite() && irradiance.is_finite(),
             LightKind::Point { position, intensity } => position.is_finite() && intensity.is_finite(),
             LightKind::Spot { position, axis, intensity, cos_outer, cos_inner } => {
-                position.is_finite() && axis.is_finite() && intensity.is_finite() && cos_outer.is_finite()
+                position.is_finite()
+                    && axis.is_finite()
+                    && intensity.is_finite()
+                    && cos_outer.is_finite()
                     && cos_inner.is_finite()
             }
         };

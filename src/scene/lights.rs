@@ -27,9 +27,20 @@ pub enum EnvironmentError {
     Read { path: std::path::PathBuf, source: image::ImageError },
     #[error("environment map {} is only {width}x{height}", path.display())]
     TooSmall { path: std::path::PathBuf, width: usize, height: usize },
-    #[error("environment map {} has a negative or non-finite texel", path.display())]
-    BadTexel { path: std::path::PathBuf },
+    #[error("environment map {}: texel ({x}, {y}) is {value:?}, negative or not finite", path.display())]
+    BadTexel { path: std::path::PathBuf, x: usize, y: usize, value: [f32; 3] },
+    #[error(
+        "environment map {}: texel ({x}, {y}) is {value:?}, above the limit of {limit:e} \
+         (sums over the map would overflow)",
+        path.display(), limit = MAX_RADIANCE
+    )]
+    TooBright { path: std::path::PathBuf, x: usize, y: usize, value: [f32; 3] },
 }
+
+/// The largest radiance an environment map may hold: the median cut sums radiance times solid
+/// angle over the whole map (at most 4 pi sr) in f32, so larger texels (an RGBE exponent near
+/// 255 gives 1.7e38) would overflow to infinite lights.
+pub const MAX_RADIANCE: f32 = 1e30;
 
 impl Environment {
     /// The built-in sky: a blue zenith fading to a bright horizon; nothing from below the
@@ -81,10 +92,14 @@ impl Environment {
             return Err(EnvironmentError::TooSmall { path: path.to_path_buf(), width, height });
         }
         let mut radiance = Vec::with_capacity(width * height);
-        for p in rgb.pixels() {
+        for (x, y, p) in rgb.enumerate_pixels() {
             let v = Vec3::new(p[0], p[1], p[2]);
+            let (x, y, path, value) = (x as usize, y as usize, path.to_path_buf(), v.to_array());
             if !v.is_finite() || v.min_element() < 0.0 {
-                return Err(EnvironmentError::BadTexel { path: path.to_path_buf() });
+                return Err(EnvironmentError::BadTexel { path, x, y, value });
+            }
+            if v.max_element() > MAX_RADIANCE {
+                return Err(EnvironmentError::TooBright { path, x, y, value });
             }
             radiance.push(v);
         }
@@ -254,7 +269,7 @@ pub fn prepare(
         }
     };
     let directional = |dir: Vec3, irradiance: Vec3, environment: bool, casts_shadow: bool, source: usize| {
-        let dir = dir.normalize();
+        let dir = unit(dir);
         let eye = center + dir * (2.0 * radius);
         let view = look_at_mat4(eye, center, any_up(dir));
         let proj = vulkan::orthographic(-radius, radius, -radius, radius, 0.0, 4.0 * radius);
@@ -267,7 +282,7 @@ pub fn prepare(
         let to_center = center - position;
         let dist = to_center.length().max(1e-6);
         let (forward, half_angle) = match axis {
-            Some((a, angle)) => (a.normalize(), angle),
+            Some((a, angle)) => (unit(a), angle),
             None => {
                 // Cover the casters' bounding sphere; a light inside it gets a wide frustum and
                 // loses the shadows of casters outside it (one map per light, no cube maps).
@@ -280,7 +295,8 @@ pub fn prepare(
                     );
                     80f32.to_radians()
                 };
-                (to_center / dist, half.min(80f32.to_radians()))
+                // A light at the very centre looks down (any direction would do).
+                (to_center.normalize_or(Vec3::NEG_Y), half.min(80f32.to_radians()))
             }
         };
         // Along the view axis: a spot looks along its own axis, not at the casters' centre.
@@ -304,7 +320,7 @@ pub fn prepare(
             }
             Light::Spot { position, direction, intensity, angle, softness, shadows } => {
                 let p = Vec3::from(*position);
-                let axis = Vec3::from(*direction).normalize();
+                let axis = unit(Vec3::from(*direction));
                 let outer = angle.to_radians();
                 let inner = outer * (1.0 - softness);
                 let (matrix, offset) = local(p, Some((axis, (outer * 1.05).min(85f32.to_radians()))));
@@ -367,6 +383,13 @@ pub fn orbit(light: &Light, centre: Vec3, degrees: f32) -> Option<Light> {
         Light::Environment { .. } => return None,
     }
     Some(light)
+}
+
+/// `v` scaled to unit length, in f64: a non-zero vector whose squared length under- or
+/// overflows f32 (components like 1e-30 or 1e30, which the scene checks allow) still gives a
+/// finite direction.
+pub fn unit(v: Vec3) -> Vec3 {
+    v.as_dvec3().normalize().as_vec3()
 }
 
 fn any_up(dir: Vec3) -> Vec3 {
