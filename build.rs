@@ -76,7 +76,12 @@ fn main() {
             for dir in [from_dir, common.clone(), generated.clone()] {
                 let candidate = dir.join(name);
                 if let Ok(content) = fs::read_to_string(&candidate) {
-                    println!("cargo:rerun-if-changed={}", candidate.display());
+                    // The generated header is this script's own output (its input,
+                    // kernel_constants.rs, is tracked above): tracking it would rerun the script
+                    // once more after every fresh build.
+                    if !candidate.starts_with(&generated) {
+                        println!("cargo:rerun-if-changed={}", candidate.display());
+                    }
                     return Ok(shaderc::ResolvedInclude {
                         resolved_name: candidate.to_string_lossy().into_owned(),
                         content,
