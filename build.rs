@@ -31,7 +31,13 @@ fn main() {
     for (name, value) in KERNEL_CONSTANTS {
         writeln!(header, "const float DIPOLE_{name} = {value:?};").unwrap();
     }
-    fs::write(generated.join("kernel_constants.glsl"), header).unwrap();
+    // Written only when it changed: shaders include it, so it is a rerun-if-changed input, and a
+    // fresh mtime on every run would make cargo rerun this script (and rebuild the crate) on
+    // every invocation.
+    let constants = generated.join("kernel_constants.glsl");
+    if fs::read_to_string(&constants).ok().as_deref() != Some(header.as_str()) {
+        fs::write(&constants, header).unwrap();
+    }
 
     let mut files = Vec::new();
     walk(&root, &mut files);
@@ -70,7 +76,12 @@ fn main() {
             for dir in [from_dir, common.clone(), generated.clone()] {
                 let candidate = dir.join(name);
                 if let Ok(content) = fs::read_to_string(&candidate) {
-                    println!("cargo:rerun-if-changed={}", candidate.display());
+                    // The generated header is this script's own output (its input,
+                    // kernel_constants.rs, is tracked above): tracking it would rerun the script
+                    // once more after every fresh build.
+                    if !candidate.starts_with(&generated) {
+                        println!("cargo:rerun-if-changed={}", candidate.display());
+                    }
                     return Ok(shaderc::ResolvedInclude {
                         resolved_name: candidate.to_string_lossy().into_owned(),
                         content,

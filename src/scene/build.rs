@@ -126,6 +126,18 @@ impl PreparedScene {
             let (name, mesh) = load_shape(&scene, &o.shape).with_context(|| format!("{}: object[{i}]", scene.name))?;
             let mesh = transform_mesh(mesh, &o.transform)
                 .with_context(|| format!("{}: object[{i}] ({name}): transform", scene.name))?;
+            let (lo, hi) = mesh.bounds();
+            let reach = lo.abs().max(hi.abs()).max_element();
+            if reach > super::MAX_SCENE_COORDINATE {
+                return Err(SceneError::Invalid {
+                    file: scene.name.clone(),
+                    message: format!(
+                        "`object[{i}]` ({name}): placed by its shape and transform it reaches {reach:e} scene units \
+                         from the origin, beyond the limit of {:e}",
+                        super::MAX_SCENE_COORDINATE
+                    ),
+                });
+            }
             let material = match &o.material {
                 MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, eta, mm_per_unit, roughness } => {
                     let key = format!("{}: object[{i}].material", scene.name);
@@ -204,6 +216,22 @@ impl PreparedScene {
             any_caster,
         };
         prepared.reprepare_lights();
+        // Each value was checked finite, but products can overflow (an environment's `scale`
+        // times the irradiance of one of its directions).
+        if let Some(light) = prepared.lights.iter().find(|l| !light_is_finite(l)) {
+            let key = match &prepared.scene.file.lights[light.source] {
+                Light::Environment { .. } => "scale",
+                Light::Directional { .. } => "irradiance",
+                _ => "intensity",
+            };
+            return Err(SceneError::Invalid {
+                file: prepared.scene.name.clone(),
+                message: format!(
+                    "`light[{}].{key}`: the light is not finite once prepared ({:?}); lower it",
+                    light.source, light.kind
+                ),
+            });
+        }
         Ok(prepared)
     }
 
@@ -229,6 +257,21 @@ impl PreparedScene {
     pub fn has_translucent(&self) -> bool {
         self.objects.iter().any(|o| matches!(o.material, ResolvedMaterial::Translucent { .. }))
     }
+}
+
+fn light_is_finite(l: &PreparedLight) -> bool {
+    let kind = match l.kind {
+        lights::LightKind::Directional { direction, irradiance } => direction.is_finite() && irradiance.is_finite(),
+        lights::LightKind::Point { position, intensity } => position.is_finite() && intensity.is_finite(),
+        lights::LightKind::Spot { position, axis, intensity, cos_outer, cos_inner } => {
+            position.is_finite()
+                && axis.is_finite()
+                && intensity.is_finite()
+                && cos_outer.is_finite()
+                && cos_inner.is_finite()
+        }
+    };
+    kind && l.shadow_matrix.is_finite() && l.normal_offset.is_finite()
 }
 
 fn load_shape(scene: &Scene, shape: &Shape) -> Result<(String, Mesh), SceneError> {

@@ -7,7 +7,9 @@ use glam::{Mat4, Vec3};
 impl Camera {
     /// World -> view matrix looking from `eye` at `target` with `up` as the image's up.
     pub fn view(&self) -> Mat4 {
-        look_at_mat4(Vec3::from(self.eye), Vec3::from(self.target), Vec3::from(self.up).normalize())
+        // `up` is normalised in f64: the checks allow any non-zero finite vector, even one whose
+        // squared length is 0 or infinite in f32.
+        look_at_mat4(Vec3::from(self.eye), Vec3::from(self.target), super::lights::unit(Vec3::from(self.up)))
     }
 
     /// Perspective projection with near and far planes fitted around a scene bounding sphere.

@@ -45,12 +45,39 @@ pub enum EnvironmentError {
         height: usize,
     },
     /// A texel is negative, infinite or NaN.
-    #[error("environment map {} has a negative or non-finite texel", path.display())]
+    #[error("environment map {}: texel ({x}, {y}) is {value:?}, negative or not finite", path.display())]
     BadTexel {
         /// The map's file.
         path: std::path::PathBuf,
+        /// The texel's column.
+        x: usize,
+        /// The texel's row.
+        y: usize,
+        /// Its radiance.
+        value: [f32; 3],
+    },
+    /// A texel is brighter than `MAX_RADIANCE`: sums over the map would overflow f32.
+    #[error(
+        "environment map {}: texel ({x}, {y}) is {value:?}, above the limit of {limit:e} \
+         (sums over the map would overflow)",
+        path.display(), limit = MAX_RADIANCE
+    )]
+    TooBright {
+        /// The map's file.
+        path: std::path::PathBuf,
+        /// The texel's column.
+        x: usize,
+        /// The texel's row.
+        y: usize,
+        /// Its radiance.
+        value: [f32; 3],
     },
 }
+
+/// The largest radiance an environment map may hold: the median cut sums radiance times solid
+/// angle over the whole map (at most 4 pi sr) in f32, so larger texels (an RGBE exponent near
+/// 255 gives 1.7e38) would overflow to infinite lights.
+pub const MAX_RADIANCE: f32 = 1e30;
 
 impl Environment {
     /// The built-in sky: a blue zenith fading to a bright horizon; nothing from below the
@@ -70,19 +97,46 @@ impl Environment {
         Environment { width, height, radiance }
     }
 
-    /// Load an equirectangular .hdr or .exr map (through the `image` crate).
+    /// Load an equirectangular .hdr or .exr map (through the `image` crate). The format comes
+    /// from the extension, or from the content when the extension names none.
     pub fn load(path: &std::path::Path) -> Result<Environment, EnvironmentError> {
-        let img = image::open(path).map_err(|source| EnvironmentError::Read { path: path.to_path_buf(), source })?;
+        let read = |source| EnvironmentError::Read { path: path.to_path_buf(), source };
+        let bytes = std::fs::read(path).map_err(|e| read(image::ImageError::IoError(e)))?;
+        Self::decode(&bytes, image::ImageFormat::from_path(path).ok(), path)
+    }
+
+    /// Decode an equirectangular .hdr or .exr map already in memory, the format guessed from
+    /// its content; `name` names it in errors.
+    pub fn from_bytes(bytes: &[u8], name: impl AsRef<std::path::Path>) -> Result<Environment, EnvironmentError> {
+        Self::decode(bytes, None, name.as_ref())
+    }
+
+    fn decode(
+        bytes: &[u8],
+        format: Option<image::ImageFormat>,
+        path: &std::path::Path,
+    ) -> Result<Environment, EnvironmentError> {
+        let read = |source| EnvironmentError::Read { path: path.to_path_buf(), source };
+        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+        match format {
+            Some(format) => reader.set_format(format),
+            None => reader = reader.with_guessed_format().map_err(|e| read(image::ImageError::IoError(e)))?,
+        }
+        let img = reader.decode().map_err(read)?;
         let rgb = img.to_rgb32f();
         let (width, height) = (rgb.width() as usize, rgb.height() as usize);
         if width < 2 || height < 2 {
             return Err(EnvironmentError::TooSmall { path: path.to_path_buf(), width, height });
         }
         let mut radiance = Vec::with_capacity(width * height);
-        for p in rgb.pixels() {
+        for (x, y, p) in rgb.enumerate_pixels() {
             let v = Vec3::new(p[0], p[1], p[2]);
+            let (x, y, path, value) = (x as usize, y as usize, path.to_path_buf(), v.to_array());
             if !v.is_finite() || v.min_element() < 0.0 {
-                return Err(EnvironmentError::BadTexel { path: path.to_path_buf() });
+                return Err(EnvironmentError::BadTexel { path, x, y, value });
+            }
+            if v.max_element() > MAX_RADIANCE {
+                return Err(EnvironmentError::TooBright { path, x, y, value });
             }
             radiance.push(v);
         }
@@ -277,7 +331,7 @@ pub fn prepare(
             source,
         };
     let directional = |dir: Vec3, irradiance: Vec3, environment: bool, casts_shadow: bool, source: usize| {
-        let dir = dir.normalize();
+        let dir = unit(dir);
         let eye = center + dir * (2.0 * radius);
         let view = look_at_mat4(eye, center, any_up(dir));
         let proj = vulkan::orthographic(-radius, radius, -radius, radius, 0.0, 4.0 * radius);
@@ -290,7 +344,7 @@ pub fn prepare(
         let to_center = center - position;
         let dist = to_center.length().max(1e-6);
         let (forward, half_angle) = match axis {
-            Some((a, angle)) => (a.normalize(), angle),
+            Some((a, angle)) => (unit(a), angle),
             None => {
                 // Cover the casters' bounding sphere; a light inside it gets a wide frustum and
                 // loses the shadows of casters outside it (one map per light, no cube maps).
@@ -303,7 +357,8 @@ pub fn prepare(
                     );
                     80f32.to_radians()
                 };
-                (to_center / dist, half.min(80f32.to_radians()))
+                // A light at the very centre looks down (any direction would do).
+                (to_center.normalize_or(Vec3::NEG_Y), half.min(80f32.to_radians()))
             }
         };
         // Along the view axis: a spot looks along its own axis, not at the casters' centre.
@@ -327,7 +382,7 @@ pub fn prepare(
             }
             Light::Spot { position, direction, intensity, angle, softness, shadows } => {
                 let p = Vec3::from(*position);
-                let axis = Vec3::from(*direction).normalize();
+                let axis = unit(Vec3::from(*direction));
                 let outer = angle.to_radians();
                 let inner = outer * (1.0 - softness);
                 let (matrix, offset) = local(p, Some((axis, (outer * 1.05).min(85f32.to_radians()))));
@@ -390,6 +445,13 @@ pub fn orbit(light: &Light, centre: Vec3, degrees: f32) -> Option<Light> {
         Light::Environment { .. } => return None,
     }
     Some(light)
+}
+
+/// `v` scaled to unit length, in f64: a non-zero vector whose squared length under- or
+/// overflows f32 (components like 1e-30 or 1e30, which the scene checks allow) still gives a
+/// finite direction.
+pub fn unit(v: Vec3) -> Vec3 {
+    v.as_dvec3().normalize().as_vec3()
 }
 
 fn any_up(dir: Vec3) -> Vec3 {

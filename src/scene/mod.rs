@@ -203,6 +203,26 @@ fn line_of(text: &str, key: &str) -> Option<usize> {
 
 type Check = Result<(), (String, String)>;
 
+/// The largest coordinate (and camera distance) a scene may use, in scene units: squared
+/// lengths of positions and distances up to this stay finite in f32 (they overflow near
+/// 1.8e19), so the camera, the light frusta and the bounding spheres stay finite.
+pub const MAX_SCENE_COORDINATE: f32 = 1e18;
+/// The smallest distance between `camera.eye` and `camera.target`: below it the view
+/// direction's squared length underflows f32.
+pub const MIN_CAMERA_DISTANCE: f32 = 1e-18;
+/// The smallest vertical field of view, in degrees: below it the projection's focal length
+/// is not finite.
+pub const MIN_FOV_Y: f32 = 1e-3;
+
+/// Finite, and within [`MAX_SCENE_COORDINATE`] of the origin on every axis.
+fn coordinates(key: &str, values: &[f32]) -> Check {
+    finite(key, values)?;
+    match values.iter().find(|v| v.abs() > MAX_SCENE_COORDINATE) {
+        Some(v) => Err((key.into(), format!("{v} is beyond the limit of {MAX_SCENE_COORDINATE:e} scene units"))),
+        None => Ok(()),
+    }
+}
+
 fn finite(key: &str, values: &[f32]) -> Check {
     match values.iter().find(|v| !v.is_finite()) {
         Some(v) => Err((key.into(), format!("{v} is not a finite number"))),
@@ -229,27 +249,29 @@ fn unit_interval(key: &str, v: f32) -> Check {
 
 fn check(scene: &SceneFile) -> Check {
     let c = &scene.camera;
-    finite("camera.eye", &c.eye)?;
-    finite("camera.target", &c.target)?;
+    coordinates("camera.eye", &c.eye)?;
+    coordinates("camera.target", &c.target)?;
     nonzero("camera.up", c.up)?;
     if c.eye == c.target {
         return Err(("camera.target".into(), "equals camera.eye".into()));
     }
-    // In f64: the distance of far-apart points overflows f32 and would read as "parallel".
-    let view = glam::DVec3::from(c.target.map(f64::from)) - glam::DVec3::from(c.eye.map(f64::from));
-    let far = crate::mesh::MAX_COORDINATE as f64;
-    if view.length() > far {
+    // In f64: the f32 difference of two allowed points can still overflow when squared.
+    let view = glam::Vec3::from(c.target).as_dvec3() - glam::Vec3::from(c.eye).as_dvec3();
+    let distance = view.length();
+    if !(MIN_CAMERA_DISTANCE as f64..=MAX_SCENE_COORDINATE as f64).contains(&distance) {
         return Err((
-            "camera.eye".into(),
-            format!("is {:e} units from camera.target; at most {far:e} (f32 precision)", view.length()),
+            "camera.target".into(),
+            format!(
+                "is {distance:e} from camera.eye; the distance must be {MIN_CAMERA_DISTANCE:e} to {MAX_SCENE_COORDINATE:e} \
+                 scene units"
+            ),
         ));
     }
-    let forward = view.normalize().as_vec3();
-    if forward.cross(glam::Vec3::from(c.up).normalize()).length() < 1e-4 {
+    if view.normalize().cross(glam::Vec3::from(c.up).as_dvec3().normalize()).length() < 1e-4 {
         return Err(("camera.up".into(), format!("{:?} is parallel to the view direction", c.up)));
     }
-    if !(c.fov_y > 0.0 && c.fov_y < 180.0) {
-        return Err(("camera.fov_y".into(), format!("{} must be between 0 and 180 degrees", c.fov_y)));
+    if !(c.fov_y >= MIN_FOV_Y && c.fov_y < 180.0) {
+        return Err(("camera.fov_y".into(), format!("{} must be at least {MIN_FOV_Y} and below 180 degrees", c.fov_y)));
     }
     if c.resolution.iter().any(|r| *r == 0 || *r > 16384) {
         return Err(("camera.resolution".into(), format!("{:?} must be 1 to 16384 pixels each", c.resolution)));
@@ -288,7 +310,7 @@ fn check(scene: &SceneFile) -> Check {
             }
         }
         finite(&key("transform.rotate"), &t.rotate.unwrap_or_default())?;
-        finite(&key("transform.translate"), &t.translate.unwrap_or_default())?;
+        coordinates(&key("transform.translate"), &t.translate.unwrap_or_default())?;
         match &o.material {
             MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, mm_per_unit, roughness, .. } => {
                 if preset.is_none() && (sigma_a.is_none() || sigma_s_prime.is_none()) {
@@ -320,11 +342,11 @@ fn check(scene: &SceneFile) -> Check {
                 non_negative(&key("irradiance"), irradiance)?;
             }
             Light::Point { position, intensity, .. } => {
-                finite(&key("position"), position)?;
+                coordinates(&key("position"), position)?;
                 non_negative(&key("intensity"), intensity)?;
             }
             Light::Spot { position, direction, intensity, angle, softness, .. } => {
-                finite(&key("position"), position)?;
+                coordinates(&key("position"), position)?;
                 nonzero(&key("direction"), *direction)?;
                 non_negative(&key("intensity"), intensity)?;
                 if !(*angle > 0.0 && *angle < 90.0) {
