@@ -141,3 +141,26 @@ fn exr_and_exitance_exports_are_complete_files() {
     assert!(exitance.iter().any(|e| *e > 0.0));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_moving_camera_really_moves_and_only_reshades() {
+    let dir = temp_dir("moving-camera");
+    let (still, moved) = (dir.join("still.png"), dir.join("moved.png"));
+    let render = |frames: &str, out: &std::path::Path| {
+        let args = ["render", "--resolution", "64x64", "--samples", "50", "--frames", frames, "--moving", "camera"];
+        translucent(&[&args[..], &["--plan", "-o", out.to_str().unwrap()]].concat(), &[])
+    };
+    let out = render("1", &still);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = render("4", &moved);
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let frame1 = stderr.split("frame 1 (Camera):").nth(1).expect("frame 1's plan");
+    assert!(
+        frame1.contains("run  shade") && frame1.contains("skip splat") && frame1.contains("skip gather"),
+        "{frame1}"
+    );
+    let (a, b) = (image::open(&still).unwrap().to_rgba8(), image::open(&moved).unwrap().to_rgba8());
+    let differ = a.as_raw().iter().zip(b.as_raw()).filter(|(x, y)| x != y).count();
+    assert!(differ > 500, "the view did not move: {differ} bytes differ");
+}

@@ -63,7 +63,8 @@ pub enum Moving {
     Light,
     /// As if every light changed: all shadow maps too
     Lights,
-    /// As if the camera moved: shading only, plus the gather in pixel mode; the view itself stays put
+    /// The camera orbits the scene's centre 3 degrees a frame: shading only, plus the gather in
+    /// pixel mode
     Camera,
 }
 
@@ -93,6 +94,18 @@ fn orbit_light(renderer: &mut Renderer, index: usize, degrees: f32) -> Result<()
     let light = &scene.scene.file.lights[index];
     let moved = lights::orbit(light, scene.bounds.0, degrees).context("an environment light cannot orbit")?;
     Ok(renderer.set_light(index, moved)?)
+}
+
+/// Turn the camera by `degrees` about the vertical axis through the scene's centre.
+fn orbit_camera(renderer: &mut Renderer, degrees: f32) {
+    let centre = renderer.scene().bounds.0;
+    let turn = glam::Mat4::from_translation(centre)
+        * glam::Mat4::from_rotation_y(degrees.to_radians())
+        * glam::Mat4::from_translation(-centre);
+    let mut camera = renderer.camera();
+    camera.eye = turn.transform_point3(camera.eye);
+    camera.view *= turn.inverse();
+    renderer.set_camera(camera);
 }
 
 fn parse_resolution(s: &str) -> Result<[u32; 2], String> {
@@ -176,8 +189,10 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let mut totals = Vec::new();
     for frame in 0..args.frames {
         let change = if frame == 0 { Change::Everything } else { moving };
-        if let Change::Light(i) = change {
-            orbit_light(&mut renderer, i, 3.0)?;
+        match change {
+            Change::Light(i) => orbit_light(&mut renderer, i, 3.0)?,
+            Change::Camera => orbit_camera(&mut renderer, 3.0),
+            _ => {}
         }
         let plan = renderer.plan(change);
         if args.plan && frame < 2 {
