@@ -441,11 +441,7 @@ fn barrier(
 
 /// The camera of frame `i`: the scene's, turned 10 degrees a frame about the vertical axis.
 fn camera_of(prepared: &PreparedScene, i: usize) -> CameraView {
-    let mut camera = CameraView::of_scene(prepared);
-    let turn = Mat4::from_rotation_y((10.0 * i as f32).to_radians());
-    camera.eye = turn.transform_point3(camera.eye);
-    camera.view *= turn.inverse();
-    camera
+    CameraView::of_scene(prepared).orbited(glam::Vec3::ZERO, 10.0 * i as f32)
 }
 
 /// Run the engine. An error is translucent's or the host's setup failing, as text.

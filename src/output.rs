@@ -16,6 +16,14 @@ pub enum OutputError {
         path: PathBuf,
     },
     // The underlying error is the source (shown by `{:#}` and error reporters), not repeated here.
+    /// The destination's folder does not exist.
+    #[error("cannot write {}: the folder {} does not exist", path.display(), folder.display())]
+    NoFolder {
+        /// The destination.
+        path: PathBuf,
+        /// Its folder.
+        folder: PathBuf,
+    },
     /// A folder is where the file should go.
     #[error("cannot write {}: it is a folder", path.display())]
     IsAFolder {
@@ -76,6 +84,18 @@ pub fn temporary_path(path: &Path) -> Result<PathBuf, OutputError> {
     tmp_name.push(name);
     tmp_name.push(".partial");
     Ok(path.with_file_name(tmp_name))
+}
+
+/// Whether `path` can receive an output: its folder exists and `path` is not itself a folder.
+pub fn check_destination(path: &Path) -> Result<(), OutputError> {
+    let folder = path.parent().filter(|f| !f.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    if !folder.is_dir() {
+        return Err(OutputError::NoFolder { path: path.to_path_buf(), folder: folder.to_path_buf() });
+    }
+    if path.is_dir() {
+        return Err(OutputError::IsAFolder { path: path.to_path_buf() });
+    }
+    Ok(())
 }
 
 /// Outputs that appear together or not at all: each is written to its temporary file first,
@@ -158,8 +178,8 @@ impl OutputSet {
     /// Rename every staged file into place; returns the destinations.
     pub fn commit(mut self) -> Result<Vec<PathBuf>, OutputError> {
         // A folder in a destination's place would fail its rename after others succeeded.
-        if let Some((_, path)) = self.staged.iter().find(|(_, path)| path.is_dir()) {
-            return Err(OutputError::IsAFolder { path: path.clone() });
+        for (_, path) in &self.staged {
+            check_destination(path)?;
         }
         let staged = std::mem::take(&mut self.staged);
         let mut done = Vec::new();

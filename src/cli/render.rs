@@ -98,13 +98,7 @@ fn orbit_light(renderer: &mut Renderer, index: usize, degrees: f32) -> Result<()
 
 /// Turn the camera by `degrees` about the vertical axis through the scene's centre.
 fn orbit_camera(renderer: &mut Renderer, degrees: f32) {
-    let centre = renderer.scene().bounds.0;
-    let turn = glam::Mat4::from_translation(centre)
-        * glam::Mat4::from_rotation_y(degrees.to_radians())
-        * glam::Mat4::from_translation(-centre);
-    let mut camera = renderer.camera();
-    camera.eye = turn.transform_point3(camera.eye);
-    camera.view *= turn.inverse();
+    let camera = renderer.camera().orbited(renderer.scene().bounds.0, degrees);
     renderer.set_camera(camera);
 }
 
@@ -127,14 +121,9 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
             bail!("{} is named as two outputs", a.display());
         }
     }
+    // Before any work: a render that cannot be written is not started.
     for path in &outputs {
-        let folder = path.parent().filter(|f| !f.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
-        if !folder.is_dir() {
-            bail!("cannot write {}: the folder {} does not exist", path.display(), folder.display());
-        }
-        if path.is_dir() {
-            bail!("cannot write {}: it is a folder", path.display());
-        }
+        translucent::output::check_destination(path)?;
     }
     super::remove_on_interrupt(&outputs)?;
     let scene = match &args.scene {

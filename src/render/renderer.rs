@@ -109,6 +109,19 @@ impl CameraView {
             eye: Vec3::from(camera.eye),
         }
     }
+
+    /// This camera turned by `degrees` about the vertical axis through `centre` (the world
+    /// turning the other way in its view).
+    pub fn orbited(self, centre: Vec3, degrees: f32) -> CameraView {
+        let turn = Mat4::from_translation(centre)
+            * Mat4::from_rotation_y(degrees.to_radians())
+            * Mat4::from_translation(-centre);
+        CameraView {
+            view: self.view * turn.inverse(),
+            projection: self.projection,
+            eye: turn.transform_point3(self.eye),
+        }
+    }
 }
 
 /// A frame recorded into a command buffer: which passes, and where its timings will be.
@@ -319,17 +332,16 @@ impl Renderer {
         // Against the frame before, which may still run: its reads of what this frame writes.
         memory_barrier(device, cmd, &[Access::Everything], &[Access::Everything]);
         self.buffers.record_uploads(device, cmd);
-        let passes: Vec<Pass> = plan.passes.iter().map(|(p, _)| *p).collect();
         // Taken out for the recording, which borrows `self` immutably.
         let mut timers = std::mem::take(&mut self.timers);
         let mut timer = slot.map(|s| &mut timers[s]);
         if let Some(t) = timer.as_deref_mut() {
             t.reset(cmd);
         }
-        self.record(cmd, plan, &passes, timer, target);
+        self.record(cmd, plan, timer, target);
         self.timers = timers;
         self.pending = None;
-        Ok(RecordedFrame { passes, slot })
+        Ok(RecordedFrame { passes: plan.passes.iter().map(|(p, _)| *p).collect(), slot })
     }
 
     /// GPU milliseconds of each pass of `frame`, from its timestamps: call after the host's
@@ -343,12 +355,11 @@ impl Renderer {
         Ok(FrameTimings { passes })
     }
 
-    /// Record `passes` of `plan` into `cmd`, each between the timer's marks when given.
+    /// Record the passes of `plan` into `cmd`, each between the timer's marks when given.
     fn record(
         &self,
         cmd: vk::CommandBuffer,
         plan: &Plan,
-        passes: &[Pass],
         mut timer: Option<&mut GpuTimer>,
         target: Option<&HostTarget>,
     ) {
@@ -364,7 +375,7 @@ impl Renderer {
             exposure: self.scene.scene.file.render.exposure,
             target,
         };
-        for &pass in passes {
+        for &(pass, _) in &plan.passes {
             let Some(recorder) = self.pass(pass) else { continue };
             if let Some(t) = timer.as_deref_mut() {
                 t.begin(cmd, pass.name());
