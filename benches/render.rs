@@ -9,9 +9,11 @@
 //! asynchronously and their timestamps do not wait for them, so there the isolated wall time
 //! is the figure that bounds a compute pass; frames per second come from whole-frame wall time.
 
+use ash::vk;
+use std::sync::Arc;
 use std::time::Instant;
-use translucent::gpu::{Gpu, GpuOptions, median};
-use translucent::render::plan::Change;
+use translucent::gpu::{Binding, Buffer, BufferDesc, ComputePipeline, Gpu, GpuOptions, median};
+use translucent::render::plan::{Change, Pass};
 use translucent::render::renderer::Renderer;
 use translucent::sampling::Method;
 use translucent::scene::GatherMode;
@@ -79,6 +81,53 @@ fn print(title: &str, m: &Measured) {
     println!("  frame wall time {:.1} ms = {:.2} frames/s", m.frame_wall_ms, 1000.0 / m.frame_wall_ms);
 }
 
+/// Median isolated wall time (submission to fence) of the renderer's gather alone, and of
+/// glsl/bench/gather_naive.comp over the same vertex-sample pairs, alternating the two
+/// `FRAMES` times after a warm-up: (gather ms, naive ms, pairs).
+fn gather_against_naive(gpu: &Arc<Gpu>, renderer: &mut Renderer) -> (f64, f64, f64) {
+    let naive = ComputePipeline::new(gpu, "bench/gather_naive.comp").expect("naive gather pipeline");
+    let b = renderer.buffers();
+    let out = Buffer::new(
+        gpu,
+        &BufferDesc::gpu_only(
+            "naive exitance",
+            16 * b.vertex_count.max(1) as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER,
+        ),
+    )
+    .expect("buffer");
+    let set = naive
+        .descriptor_set(&[
+            Binding::Buffer(&b.vertices),
+            Binding::Buffer(&b.samples),
+            Binding::Buffer(&b.splat),
+            Binding::Buffer(&b.objects),
+            Binding::Buffer(&out),
+        ])
+        .expect("descriptor set");
+    let receivers = b.receivers.clone();
+    let pairs: f64 = receivers.iter().map(|r| r.vertex_count as f64 * r.sample_count as f64).sum();
+    let mut plan = renderer.plan(Change::Everything);
+    plan.passes.retain(|(p, _)| *p == Pass::Gather);
+    let (mut ours, mut theirs) = (Vec::new(), Vec::new());
+    for frame in 0..WARM_UP + FRAMES {
+        let alone = renderer.frame_isolated(&plan).expect("gather");
+        let start = Instant::now();
+        gpu.one_shot("naive gather", |cmd| {
+            for r in &receivers {
+                naive.dispatch(cmd, &set, &r.object, [r.vertex_count, 1, 1]);
+            }
+        })
+        .expect("naive gather");
+        let naive_ms = start.elapsed().as_secs_f64() * 1e3;
+        if frame >= WARM_UP {
+            ours.push(alone.passes[0].1);
+            theirs.push(naive_ms);
+        }
+    }
+    (median(&mut ours), median(&mut theirs), pairs)
+}
+
 fn main() {
     let options = GpuOptions { device: std::env::var("TRANSLUCENT_DEVICE").ok(), ..Default::default() };
     let gpu = Gpu::new(&options).expect("a Vulkan device (run `bash scripts/setup`)");
@@ -105,6 +154,15 @@ fn main() {
     );
     print("only the camera moves (shade, tone map):", &measure(&mut renderer, Change::Camera));
     println!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
+    let (ours, naive, pairs) = gather_against_naive(&gpu, &mut renderer);
+    println!(
+        "\nFlat vertex gather against a naive point-kernel shader (glsl/bench/gather_naive.comp), same {:.1}M \
+         pairs, isolated submissions, alternating:",
+        pairs / 1e6
+    );
+    println!("  ours  {ours:>8.1} ms = {:>7.1} Mpairs/s", pairs / ours / 1e3);
+    println!("  naive {naive:>8.1} ms = {:>7.1} Mpairs/s", pairs / naive / 1e3);
+    println!("  throughput ratio ours / naive = {:.2}", naive / ours);
     drop(renderer);
 
     println!("\nWhere the gather runs: time against difference from the vertex gather (key light moving, 512x512):");

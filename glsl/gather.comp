@@ -3,8 +3,8 @@
 // exitance at every receiver vertex of one translucent object, over that object's samples,
 //     M(x) = sum_i E_i far_kernel(r_i, A_i) + sum_i phi_i E_i E_near,i / sum_i phi_i
 // (kernel::far_kernel explains the split). Samples are staged through shared memory in tiles of 64 (one
-// load per tile for the whole workgroup); the far sum is Kahan-compensated per channel so
-// that the f32 sum stays within 1e-3 of the f64 reference at any sample count.
+// load per tile for the whole workgroup); each tile's far sum is added to a Kahan-compensated
+// total per channel so that the f32 sum stays within 1e-3 of the f64 reference at any sample count.
 //
 // Bindings: 0 = vertices (VertexRecord[], read), 1 = samples (SampleRecord[], read), 2 = splat
 // (SplatRecord[], read), 3 = objects (ObjectRecord[], read), 4 = exitance (vec4 per vertex, write).
@@ -54,6 +54,7 @@ void main() {
             for (uint k = 0u; k < n; ++k) {
                 gather_add(g, ch, x, tile_position_area[k], tile_irradiance[k].rgb, tile_near_energy[k].rgb);
             }
+            gather_flush(g);
         }
         barrier();
     }

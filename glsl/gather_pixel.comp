@@ -40,6 +40,7 @@ void main() {
     GatherSum g = gather_begin();
     for (uint i = first; i < first + count; ++i) {
         gather_add(g, ch, s.xyz, samples[i].position_area, splat[i].irradiance_area.rgb, splat[i].near_energy.rgb);
+        if (((i - first) & 63u) == 63u) gather_flush(g);
     }
     imageStore(hdr, p, vec4(radiance.rgb + gather_end(g) * radiance.a, 1.0));
 }

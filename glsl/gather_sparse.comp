@@ -6,7 +6,7 @@
 //   1: at every vertex, M(x) = sum_j phi_j(x) T_j / sum_j phi_j(x) with the near-field Shepard
 //      weights (nearest sample where none reaches).
 // The far part is smooth on the scale of the sample spacing (optics::kernel), so sampling it at
-// the samples loses little, and the per-vertex work drops from four exponentials per channel
+// the samples loses little, and the per-vertex work drops from two exponentials per channel
 // and pair to one weight per pair. Under uniform light every vertex still gets E R_d,total.
 //
 // Bindings: 0 = vertices (VertexRecord[]), 1 = samples (SampleRecord[]), 2 = splat
@@ -42,7 +42,9 @@ void main() {
         GatherSum g = gather_begin();
         for (uint i = first_sample; i < first_sample + sample_count; ++i) {
             gather_add(g, ch, x, samples[i].position_area, splat[i].irradiance_area.rgb, vec3(0.0));
+            if (((i - first_sample) & 63u) == 63u) gather_flush(g);
         }
+        gather_flush(g);
         sample_exitance[j] = vec4(max(g.far, vec3(0.0)) + splat[j].irradiance_area.rgb * splat[j].near_energy.rgb, 0.0);
         return;
     }

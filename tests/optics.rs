@@ -309,12 +309,10 @@ fn bssrdf_normalization_conserves_energy() {
 
 /// Sum of a kernel over a square lattice of spacing `h` (a plane of samples of area h^2 under
 /// uniform irradiance, seen from the sample at the origin), out to radius `rc`. Returns
-/// (point kernel sum, footprint kernel sum). Octant symmetry; beyond 16 b both kernels are the
-/// point kernel, so it is evaluated once there.
+/// (point kernel sum, footprint kernel sum). Octant symmetry.
 fn lattice_sums(d: &Dipole, h: f64, rc: f64) -> (f64, f64) {
     let n = (rc / h).ceil() as i64;
     let area = h * h;
-    let far = kernel::FAR_BLEND_END * kernel::B_PER_SQRT_AREA * h;
     (0..=n)
         .into_par_iter()
         .map(|i| {
@@ -331,9 +329,8 @@ fn lattice_sums(d: &Dipole, h: f64, rc: f64) -> (f64, f64) {
                 } else {
                     8.0
                 };
-                let pk = point_kernel(d, r, area);
-                p += mult * pk;
-                k += mult * if r >= far { pk } else { footprint_kernel(d, r, area) };
+                p += mult * point_kernel(d, r, area);
+                k += mult * footprint_kernel(d, r, area);
             }
             (p, k)
         })
@@ -413,22 +410,19 @@ fn kernel_integrates_to_total_and_has_no_seams() {
             let area = area_per_z_sq * d.z_r * d.z_r;
             let rho = (area / PI).sqrt();
             let b = kernel::B_PER_SQRT_AREA * area.sqrt();
-            let end = kernel::FAR_BLEND_END * b;
-            // Continuous integral: dA R_d,total, up to the far blend's < 1e-3 of the tail.
+            // Beyond 16 b the kernel is the point kernel to 3e-5 relative (checked below), so the
+            // tail is taken in closed form from R_d.
+            let end = 16.0 * b;
+            // Continuous integral: dA R_d,total.
             let inner = radial_integral(|r| footprint_kernel(&d, r, area), 1e-9 * rho, end, 400_000);
             let integral = inner + area * d.r_d_outside(end);
             let e = rel(integral, area * d.r_d_total());
             assert!(e < 2e-4, "{name} dA = {area_per_z_sq} z_r^2: integral off by {e}");
-            // No seam: across the footprint edge and both ends of the far blend, the jump over
+            // No seam: across both ends of the footprint's edge, the jump over
             // [x (1 - eps), x (1 + eps)] shrinks with eps (a seam would not): by 100x at least
             // when eps shrinks 100x for a continuous kernel, 1e4x where the slope is also 0.
             let cbump = (1.0 - kernel::BUMP_DELTA.powi(2) / 5.0).sqrt();
-            for x in [
-                rho * (cbump - kernel::BUMP_DELTA),
-                rho * (cbump + kernel::BUMP_DELTA),
-                kernel::FAR_BLEND_START * b,
-                end,
-            ] {
+            for x in [rho * (cbump - kernel::BUMP_DELTA), rho * (cbump + kernel::BUMP_DELTA)] {
                 let jump = |eps: f64| {
                     (footprint_kernel(&d, x * (1.0 + eps), area) - footprint_kernel(&d, x * (1.0 - eps), area)).abs()
                 };
@@ -438,9 +432,14 @@ fn kernel_integrates_to_total_and_has_no_seams() {
                     "{name}: seam at r = {x}: jump {fine:e} over 2e-8 r vs {coarse:e} over 2e-6 r"
                 );
             }
-            // Far from the footprint it is R_d(r) dA exactly.
-            for f in [1.0, 1.5, 10.0] {
-                assert_eq!(footprint_kernel(&d, f * end, area), point_kernel(&d, f * end, area));
+            // Far from the footprint it is R_d(r) dA to a relative (beta^2 / 2) R_d''/R_d, at most
+            // (15/8)(b/r)^4 (1 + sigma_tr r / 3)^2 (the module doc), and never above it (R_near >= 0).
+            for f in [6.0, 16.0, 100.0] {
+                let (k, p) = (footprint_kernel(&d, f * b, area), point_kernel(&d, f * b, area));
+                assert!(k <= p, "{name}: K {k} above the point kernel {p} at {f} b");
+                let bound = 1.1 * 15.0 / 8.0 / f.powi(4) * (1.0 + d.sigma_tr * f * b / 3.0).powi(2);
+                let e = rel(k, p);
+                assert!(e <= bound || p < 1e-30, "{name} dA = {area_per_z_sq} z_r^2: K off R_d dA by {e} at {f} b");
             }
         }
         // Limits at the centre: a footprint much wider than the diffusion length and z_r keeps
@@ -459,31 +458,34 @@ fn kernel_integrates_to_total_and_has_no_seams() {
 #[test]
 fn near_energy_is_accurate_in_both_branches() {
     // Where the direct f64 formula still has many digits (moderate cancellation), compare it with
-    // second_difference on both sides of the switch between its two branches.
+    // taylor_remainder on both sides of the switch between its two branches:
+    // G(z^2) - G(z^2 + beta) + beta G'(z^2 + beta), G(D) = z e^(-s sqrt(D)) / sqrt(D).
     let direct = |z: f64, s: f64, beta: f64| {
+        let d1 = (z * z + beta).sqrt();
         let g = |dd: f64| z * (-s * dd).exp() / dd;
-        g(z) - 2.0 * g((z * z + beta).sqrt()) + g((z * z + 2.0 * beta).sqrt())
+        let g_prime = -z * (-s * d1).exp() * (s * d1 + 1.0) / (2.0 * d1.powi(3));
+        g(z) - g(d1) + beta * g_prime
     };
     for s_z in [0.0, 0.01, 0.3, 3.0, 30.0] {
         for x in [0.02, 0.05, 0.09, 0.1, 0.11, 0.2, 1.0, 10.0] {
             let z = 2.0;
             let s = s_z / z;
-            // Choose beta so that (d2 - z)/z = x.
-            let d2 = z * (1.0 + x);
-            let beta = 0.5 * (d2 * d2 - z * z);
-            let (a, b) = (kernel::second_difference(z, s, beta), direct(z, s, beta));
+            // Choose beta so that (d1 - z)/z = x.
+            let d1 = z * (1.0 + x);
+            let beta = d1 * d1 - z * z;
+            let (a, b) = (kernel::taylor_remainder(z, s, beta), direct(z, s, beta));
             assert!(rel(a, b) < 1e-7, "s z {s_z}, spread {x}: {a} vs direct {b}");
         }
-        // Far into the quadrature branch the leading Taylor term beta^2 z g''(z^2) takes over;
-        // the next term is smaller by about beta g'''/g'' ~ (beta / z^2)(s z / 2 + 5/2).
+        // Far into the quadrature branch the leading Taylor term (beta^2 / 2) G''(z^2) takes over;
+        // the next is smaller by about (2/3) beta G'''/G'' ~ (beta / z^2)(s z / 3 + 5/3).
         for beta_rel in [1e-4, 1e-6, 1e-8] {
             let (z, s) = (2.0, s_z / 2.0);
             let beta = beta_rel * z * z;
             let q = z;
-            let g2 = (-s * q).exp() * (s * s * q * q + 3.0 * s * q + 3.0) / (4.0 * q.powi(5));
-            let taylor = beta * beta * z * g2;
+            let g2 = z * (-s * q).exp() * (s * s * q * q + 3.0 * s * q + 3.0) / (4.0 * q.powi(5));
+            let taylor = 0.5 * beta * beta * g2;
             let bound = 2.0 * beta_rel * (0.5 * s_z + 2.5);
-            assert!(rel(kernel::second_difference(z, s, beta), taylor) < bound, "s z {s_z}, beta {beta_rel}");
+            assert!(rel(kernel::taylor_remainder(z, s, beta), taylor) < bound, "s z {s_z}, beta {beta_rel}");
         }
     }
 }

@@ -11,45 +11,50 @@
 //!
 //! Split `R_d = R_far + R_near` with `R_far` smooth on the scale of the spacing, so that point
 //! samples of it sum to its integral, and give the rest, `E_near = R_d,total - integral R_far`,
-//! to the sample's own footprint:
+//! to the sample's own footprint. Write each pole of seed Eq. 8 as a function of `D = r^2 + z^2`,
+//! `p_z(D) = z (sigma_tr + 1/d) e^(-sigma_tr d) / d^2` with `d = sqrt(D)`, and
+//! `G_z(D) = z e^(-sigma_tr d) / d`, whose plane integral it is (`integral p_z(r^2 + z^2) r dr`
+//! over `r > R` is `G_z(R^2 + z^2)`, the antiderivative of the exact disk integral,
+//! [`crate::optics::Dipole::r_d_disk`]; docs/optics.md, "Reflectance profile, its integrals, and
+//! the BSSRDF"). Then, with `beta = b^2`:
 //!
 //! ```text
 //! K(r) = dA R_far(r) + E_near w(r / rho),            rho = sqrt(dA / pi),  b = 1.5 sqrt(dA)
-//! R_far(r) = 2 R_b(r) - R_{sqrt2 b}(r)
-//! R_b(r) = R_d(r) of seed Eq. 8 with every d^2 = r^2 + z^2 replaced by r^2 + z^2 + b^2
-//! E_near = (alpha'/2) sum_{z = z_r, z_v} [e^(-sigma_tr z) - 2 z e^(-sigma_tr d1)/d1 + z e^(-sigma_tr d2)/d2]
-//!          with d1 = sqrt(z^2 + b^2), d2 = sqrt(z^2 + 2 b^2)
+//! R_far(r) = (alpha'/4 pi) sum_{z = z_r, z_v} [p_z(D + beta) - beta p_z'(D + beta)]
+//!          = (alpha'/4 pi) sum_z (z/d)(1/d) e^(-sigma_tr d) [sigma_tr + 1/d + (beta/2d^2)(sigma_tr^2 d + 3 sigma_tr + 3/d)],
+//!            d = sqrt(r^2 + z^2 + beta)
+//! E_near = (alpha'/2) sum_z [G_z(z^2) - G_z(z^2 + beta) + beta G_z'(z^2 + beta)]
+//!        = (alpha'/2) sum_z [e^(-sigma_tr z) - (z/d1) e^(-sigma_tr d1) (1 + (beta/2d1^2)(sigma_tr d1 + 1))],
+//!            d1 = sqrt(z^2 + beta)
 //! ```
 //!
 //! Why each piece:
-//! - `R_b` moves the singularities of `R_d` (at `r = +-i z`) out to `+-i sqrt(z^2 + b^2)`, so its
-//!   point samples on a lattice of spacing `h` sum to its integral up to roughly
-//!   `4 e^(-2 pi b / h)` (Poisson summation), 3e-4 for `b = 1.5 h`, whatever `z_r` and the
-//!   diffusion length are (the plane test measures at most 2.1e-4). The combination `2 R_b - R_{sqrt2 b}` (Richardson in `b^2`) cancels the
-//!   `O(b^2)` change, so `R_far = R_d (1 + O(b^4/r^4))` away from the footprint.
-//! - `integral R_b 2 pi r dr = (alpha'/2) sum_z z e^(-sigma_tr d1)/d1` by the same antiderivative
-//!   as the exact disk integral ([`crate::optics::Dipole::r_d_disk`]; docs/optics.md,
-//!   "Reflectance profile, its integrals, and the BSSRDF"), so `E_near` is exact and closed-form.
-//!   It is a second difference of `z e^(-sigma_tr sqrt(D))/sqrt(D)` in `D`, which is completely
-//!   monotone, so `R_near >= 0` and `E_near >= 0`. When `b << z` it cancels catastrophically;
-//!   there it is evaluated as the integral of the second derivative ([`second_difference`]).
+//! - `p_z(D + beta)` is the profile regularised by `b` (Eq. 8 with `d^2 = r^2 + z^2 + b^2`): its
+//!   singularities move from `r = +-i z` out to `+-i sqrt(z^2 + b^2)`, so its point samples on a
+//!   lattice of spacing `h` sum to its integral up to roughly `e^(-2 pi b / h)` (Poisson
+//!   summation), whatever `z_r` and the diffusion length are; the plane test measures at most
+//!   3e-4 for `b = 1.5 h`. Subtracting `beta p_z'` extrapolates it back to `beta = 0` along its
+//!   tangent, so `R_far = R_d - O(b^4 / r^4) R_d` away from the footprint. The tangent costs one
+//!   exponential per pole, the same as the point kernel `R_d(r) dA`: the gather pays nothing for
+//!   the regularisation. (The same `O(b^4)` follows from Richardson's `2 R_b - R_{sqrt2 b}`, at
+//!   twice the exponentials; this kernel has half its `b^4` term.)
+//! - `p_z` is completely monotone in `D`, hence convex, so `p(D) >= p(D + beta) - beta p'(D + beta)`:
+//!   `R_near >= 0` pointwise, and `R_far >= R_b > 0`.
+//! - `E_near` follows from integrating `R_far` with the antiderivative `G_z` (`p_z = -2 G_z'`), so
+//!   it is exact and closed-form. It is the Taylor remainder `integral_0^beta y G_z''(z^2 + y) dy`
+//!   of the convex `G_z`, hence `>= 0`; when `b << z` the closed form cancels, and the remainder
+//!   is integrated instead ([`taylor_remainder`]).
 //! - `w` is the footprint: 1 inside, 0 outside, with a smoothstep edge of half-width
 //!   `BUMP_DELTA rho` centred so that `integral w 2 pi r dr = dA` exactly. It ends at
 //!   `1.244 rho`, short of any neighbour at the sample spacing (`>= 1.77 rho`), so each sample's
 //!   near energy stays on its own footprint.
 //!
-//! Together: `integral K 2 pi r dr = dA R_d,total` exactly for every `dA` (the far blend below
-//! changes that by under 2e-4, tested); at its own centre a
+//! Together: `integral K 2 pi r dr = dA R_d,total` exactly for every `dA`; at its own centre a
 //! sample returns `K(0) = E_near + dA R_far(0)`, which tends to the disk integral
 //! `P(rho) -> R_d,total` when the spacing is much larger than the diffusion length and to
-//! `dA R_d(0)` when it is much smaller than `z_r`.
-//!
-//! # The far blend
-//!
-//! From `FAR_BLEND_START b` to `FAR_BLEND_END b` the kernel blends (smoothstep in `r`) into the
-//! point kernel `R_d(r) dA`, which it is alone beyond; there `R_far` and `R_d` differ by under
-//! 1e-3 of `R_d`, so nothing visible or measurable changes, and the GPU evaluates two
-//! exponentials per channel instead of four for the bulk of the pairs.
+//! `dA R_d(0)` when it is much smaller than `z_r`. Far from the sample `K` is the point kernel
+//! `R_d(r) dA` to a relative `(15/8)(b/r)^4` (under 1e-3 beyond `6 b`), so the hierarchical
+//! gather may stand a far cluster of samples in for its members with the same kernel.
 //!
 //! Every formula has an f32 twin in `glsl/common/dipole.glsl`; both stay finite for all inputs
 //! a validated [`crate::optics::Material`] produces.
@@ -70,21 +75,20 @@ pub fn point_kernel(dipole: &Dipole, r: f64, area: f64) -> f64 {
     dipole.r_d(r) * area
 }
 
-/// `R_b(r)`: seed Eq. 8 with every `d^2 = r^2 + z^2` replaced by `r^2 + z^2 + b^2`. Each pole is
-/// evaluated as `(z/d)(1/d)(sigma_tr + 1/d) e^(-sigma_tr d)` so nothing overflows.
-pub fn r_d_regularized(dipole: &Dipole, r: f64, b: f64) -> f64 {
-    let rb_sq = r * r + b * b;
+/// The far part `R_far(r) = R_b(r) - b^2 dR_b/d(b^2)`: the regularised profile extrapolated to
+/// `b = 0` along its tangent (see the module doc); `R_b(r) <= R_far(r) <= R_d(r)`. One
+/// exponential per pole; every factor is a ratio `<= 1` or a bounded polynomial so nothing
+/// overflows.
+pub fn r_d_far(dipole: &Dipole, r: f64, b: f64) -> f64 {
+    let beta = b * b;
+    let s = dipole.sigma_tr;
     let pole = |z: f64| {
-        let d = (rb_sq + z * z).sqrt();
+        let d = (r * r + z * z + beta).sqrt();
         let inv_d = 1.0 / d;
-        (z * inv_d) * inv_d * (dipole.sigma_tr + inv_d) * (-dipole.sigma_tr * d).exp()
+        let q = beta * inv_d * inv_d; // <= 1
+        (z * inv_d) * inv_d * (-s * d).exp() * (s + inv_d + 0.5 * q * (s * s * d + 3.0 * s + 3.0 * inv_d))
     };
     dipole.alpha_prime / (4.0 * PI) * (pole(dipole.z_r) + pole(dipole.z_v))
-}
-
-/// The far part `R_far(r) = 2 R_b(r) - R_{sqrt2 b}(r) >= R_b(r) > 0` (see the module doc).
-pub fn r_d_far(dipole: &Dipole, r: f64, b: f64) -> f64 {
-    2.0 * r_d_regularized(dipole, r, b) - r_d_regularized(dipole, r, std::f64::consts::SQRT_2 * b)
 }
 
 /// The near energy `E_near(b) = R_d,total - integral R_far 2 pi r dr >= 0`, in closed form (see
@@ -92,49 +96,46 @@ pub fn r_d_far(dipole: &Dipole, r: f64, b: f64) -> f64 {
 pub fn near_energy(dipole: &Dipole, b: f64) -> f64 {
     let beta = b * b;
     0.5 * dipole.alpha_prime
-        * (second_difference(dipole.z_r, dipole.sigma_tr, beta) + second_difference(dipole.z_v, dipole.sigma_tr, beta))
+        * (taylor_remainder(dipole.z_r, dipole.sigma_tr, beta) + taylor_remainder(dipole.z_v, dipole.sigma_tr, beta))
 }
 
-/// `z [g(z^2) - 2 g(z^2 + beta) + g(z^2 + 2 beta)]` with `g(D) = e^(-s sqrt(D)) / sqrt(D)`.
+/// `G(z^2) - G(z^2 + beta) + beta G'(z^2 + beta)` with `G(D) = z e^(-s sqrt(D)) / sqrt(D)`: the
+/// remainder of the tangent of `G` at `z^2 + beta`, extrapolated to `z^2`, which is
+/// `integral_0^beta y G''(z^2 + y) dy >= 0`.
 ///
-/// When the three points are close (`(d2 - z)/z <= 0.1` and `s (d2 - z) <= 0.5`) the terms agree
-/// to many digits, so instead we integrate: the second difference equals
-/// `integral_0^(2 beta) min(y, 2 beta - y) g''(z^2 + y) dy`, with
-/// `g''(D) = e^(-s q) (s^2 q^2 + 3 s q + 3) / (4 q^5)`, `q = sqrt(D)`, by 3-point Gauss-Legendre
-/// on each half (the integrand is smooth there; error below 1e-8). Each factor is formed as a
-/// ratio `<= 1` so nothing overflows in f32. Otherwise it is the difference of two first
-/// differences, each free of cancellation (see [`crate::optics::dipole::ring_term`]).
-pub fn second_difference(z: f64, s: f64, beta: f64) -> f64 {
+/// When the two points are close (`(d1 - z)/z <= 0.1` and `s (d1 - z) <= 0.5`, `d1 = sqrt(z^2 + beta)`)
+/// the closed form cancels, so the integral is taken instead, by 5-point Gauss-Legendre (the
+/// integrand is smooth there; error below 1e-9), with
+/// `G''(D) = z e^(-s q) (s^2 q^2 + 3 s q + 3) / (4 q^5)`, `q = sqrt(D)`, each factor formed as a
+/// ratio `<= 1` so nothing overflows in f32. Otherwise the closed form
+/// `e^(-s z) [1 - (z/d1) e^(-s (d1 - z)) (1 + (beta/2 d1^2)(s d1 + 1))]` loses at most a digit.
+pub fn taylor_remainder(z: f64, s: f64, beta: f64) -> f64 {
     let d1 = (z * z + beta).sqrt();
-    let d2 = (z * z + 2.0 * beta).sqrt();
-    let spread = 2.0 * beta / (z + d2); // d2 - z without cancellation
-    if spread <= SECOND_DIFF_MAX_SPREAD * z && s * spread <= SECOND_DIFF_MAX_DECAY {
-        const X: [f64; 3] = [-0.774_596_669_241_483_4, 0.0, 0.774_596_669_241_483_4]; // sqrt(3/5)
-        const W: [f64; 3] = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
-        // z beta y g''(z^2 + y) = (y/q^2)(beta/q^2)(z/q) e^(-s q)(s^2 q^2 + 3 s q + 3)/4
-        let term = |y: f64, weight: f64| {
+    let gap = beta / (z + d1); // d1 - z without cancellation
+    if gap <= REMAINDER_MAX_SPREAD * z && s * gap <= REMAINDER_MAX_DECAY {
+        const X: [f64; 5] =
+            [-0.906_179_845_938_664, -0.538_469_310_105_683, 0.0, 0.538_469_310_105_683, 0.906_179_845_938_664];
+        const W: [f64; 5] = [
+            0.236_926_885_056_189,
+            0.478_628_670_499_366,
+            0.568_888_888_888_889,
+            0.478_628_670_499_366,
+            0.236_926_885_056_189,
+        ];
+        // (beta/2) y G''(z^2 + y) = (y/q^2)(beta/q^2)(z/q) e^(-s q)(s^2 q^2 + 3 s q + 3)/8
+        let mut sum = 0.0;
+        for k in 0..5 {
+            let y = 0.5 * beta * (1.0 + X[k]);
             let q_sq = z * z + y;
             let q = q_sq.sqrt();
             let sq = s * q;
-            (weight / q_sq) * (beta / q_sq) * (z / q) * (-sq).exp() * (sq * sq + 3.0 * sq + 3.0) * 0.25
-        };
-        let mut sum = 0.0;
-        for k in 0..3 {
-            let y = 0.5 * beta * (1.0 + X[k]);
-            sum += W[k] * (term(y, y) + term(beta + y, beta - y));
+            sum += W[k] * (y / q_sq) * (beta / q_sq) * (z / q) * (-sq).exp() * (sq * sq + 3.0 * sq + 3.0);
         }
-        0.5 * sum
+        0.125 * sum
     } else {
-        // Gaps between the square roots as beta / (sum), not by subtraction.
-        first_difference(z, s, z, d1, beta / (z + d1)) - first_difference(z, s, d1, d2, beta / (d1 + d2))
+        let q = beta / (d1 * d1);
+        (-s * z).exp() * (1.0 - (z / d1) * (-s * gap).exp() * (1.0 + 0.5 * q * (s * d1 + 1.0)))
     }
-}
-
-/// `z [e^(-s da)/da - e^(-s db)/db]` for `da <= db = da + gap`, free of cancellation: the form
-/// of [`crate::optics::dipole::ring_term`],
-/// `(z/da) e^(-s da) [gap/db + (da/db)(1 - e^(-s gap))]`.
-fn first_difference(z: f64, s: f64, da: f64, db: f64, gap: f64) -> f64 {
-    (z / da) * (-s * da).exp() * (gap / db + (da / db) * -(-s * gap).exp_m1())
 }
 
 /// The footprint weight `w(x)`, `x = r / rho`: 1 inside, a smoothstep edge of half-width
@@ -157,15 +158,13 @@ pub fn footprint_kernel(dipole: &Dipole, r: f64, area: f64) -> f64 {
     if area <= 0.0 {
         return 0.0;
     }
-    // The footprint ends at 1.244 rho, far inside the start of the far blend (8 b = 13.5 rho),
-    // so the near energy adds to the far kernel without touching its blend.
     let b = B_PER_SQRT_AREA * area.sqrt();
     let rho = (area / PI).sqrt();
     far_kernel(dipole, r, area) + near_energy(dipole, b) * footprint_weight(r / rho)
 }
 
-/// The far part of [`footprint_kernel`] alone: `dA R_far(r)` blended into the point kernel
-/// beyond `FAR_BLEND_START b`, without the footprint's near energy.
+/// The far part of [`footprint_kernel`] alone, `dA R_far(r)` with `b = 1.5 sqrt(dA)`, without
+/// the footprint's near energy.
 ///
 /// # Why the renderer gathers with this plus a blended near field
 ///
@@ -188,16 +187,7 @@ pub fn far_kernel(dipole: &Dipole, r: f64, area: f64) -> f64 {
     if area <= 0.0 {
         return 0.0;
     }
-    let b = B_PER_SQRT_AREA * area.sqrt();
-    let (start, end) = (FAR_BLEND_START * b, FAR_BLEND_END * b);
-    if r >= end {
-        return point_kernel(dipole, r, area);
-    }
-    let far = area * r_d_far(dipole, r, b);
-    if r <= start {
-        return far;
-    }
-    far + smoothstep((r - start) / (end - start)) * (point_kernel(dipole, r, area) - far)
+    area * r_d_far(dipole, r, B_PER_SQRT_AREA * area.sqrt())
 }
 
 /// Shepard weight of a sample in the near-field blend at distance `r`: `(1 - (r/R)^2)^3` inside

@@ -3,18 +3,14 @@
 // generated header `kernel_constants.glsl`, which glsl/common/dipole.glsl includes.
 kernel_constants! {
     /// Regularization length `b` in units of `sqrt(dA)`: the lattice-sum error of the far part
-    /// falls as `e^(-2 pi b / h)` (3e-4 here), while larger `b` puts more light into the footprint.
+    /// falls as `e^(-2 pi b / h)` (3e-4 here, measured by tests/optics.rs), while larger `b` puts more light into the footprint.
     B_PER_SQRT_AREA = 1.5;
     /// Half-width of the footprint's smooth edge, in units of `rho`.
     BUMP_DELTA = 0.25;
-    /// Where the blend into the point kernel starts, in units of `b`.
-    FAR_BLEND_START = 8.0;
-    /// Where the kernel is the point kernel alone, in units of `b`.
-    FAR_BLEND_END = 16.0;
-    /// [`second_difference`] integrates the second derivative when `(d2 - z) / z` is at most this...
-    SECOND_DIFF_MAX_SPREAD = 0.1;
-    /// ... and `sigma_tr (d2 - z)` is at most this; otherwise the difference cancels little.
-    SECOND_DIFF_MAX_DECAY = 0.5;
+    /// [`taylor_remainder`] integrates the second derivative when `(d1 - z) / z` is at most this...
+    REMAINDER_MAX_SPREAD = 0.1;
+    /// ... and `sigma_tr (d1 - z)` is at most this; otherwise the closed form cancels little.
+    REMAINDER_MAX_DECAY = 0.5;
     /// Radius of a sample's near-field blend weight, in units of `sqrt(dA)`: wide enough that
     /// neighbours overlap (spacing is about `sqrt(dA)`), narrow enough to keep light local. Across a
     /// shadow edge on marble (tests/render.rs) 2.0 bleeds 7.7% of the lit level too far, 1.5 2.3%,
