@@ -7,7 +7,10 @@ use translucent::gpu::ShaderInterface;
 use translucent::render::gather::GatherPush;
 use translucent::render::gather_pixel::GatherPixelPush;
 use translucent::render::gather_sparse::GatherSparsePush;
-use translucent::render::records::{LightGpu, ObjectRecord, SampleRecord, SplatRecord, Vertex};
+use translucent::render::gather_tree::GatherTreePush;
+use translucent::render::records::{
+    LightGpu, NodePowerRecord, ObjectRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
+};
 use translucent::render::shade::ShadePush;
 use translucent::render::shadow::ShadowPush;
 use translucent::render::splat::SplatPush;
@@ -107,6 +110,18 @@ fn splat_and_vertex_records_match_glsl() {
         ("near_energy", offset_of!(SplatRecord, near_energy)),
     ];
     assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
+    let (fields, size) = glsl_layout(scene, "TreeNodeRecord");
+    assert_eq!(size, size_of::<TreeNodeRecord>());
+    let rust = [
+        ("center_radius", offset_of!(TreeNodeRecord, center_radius)),
+        ("area_reach", offset_of!(TreeNodeRecord, area_reach)),
+        ("range_skip", offset_of!(TreeNodeRecord, range_skip)),
+    ];
+    assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
+    let (fields, size) = glsl_layout(scene, "NodePowerRecord");
+    assert_eq!(size, size_of::<NodePowerRecord>());
+    let rust = [("power", offset_of!(NodePowerRecord, power)), ("mean_weight", offset_of!(NodePowerRecord, mean_weight))];
+    assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
     let (fields, size) = glsl_layout(scene, "VertexRecord");
     assert_eq!(size, size_of::<Vertex>());
     let rust = [("position", offset_of!(Vertex, position)), ("normal", offset_of!(Vertex, normal))];
@@ -117,7 +132,7 @@ fn splat_and_vertex_records_match_glsl() {
 /// offsets, and the compiled shader's reflected push block has its size.
 #[test]
 fn push_blocks_match_glsl_and_spirv() {
-    let cases: [(&str, &str, &str, usize, &[&str]); 8] = [
+    let cases: [(&str, &str, &str, usize, &[&str]); 9] = [
         (
             "splat.comp",
             include_str!("../glsl/splat.comp"),
@@ -139,6 +154,13 @@ fn push_blocks_match_glsl_and_spirv() {
             "GatherSparsePush",
             size_of::<GatherSparsePush>(),
             &["object", "stage"],
+        ),
+        (
+            "gather_tree.comp",
+            include_str!("../glsl/gather_tree.comp"),
+            "GatherTreePush",
+            size_of::<GatherTreePush>(),
+            &["object", "stage", "first_node", "node_count", "epsilon"],
         ),
         (
             "gather_pixel.comp",

@@ -27,6 +27,20 @@ struct SplatRecord {
     vec4 near_energy;       // rgb: near-field energy per channel (dipole_near_energy); w: 0
 };
 
+// One node of an object's sample hierarchy (sampling::SampleTree, packed by TreeNodeRecord):
+// static, built on the CPU when the samples are placed.
+struct TreeNodeRecord {
+    vec4 center_radius;     // xyz: centre of the bounding sphere of its samples; w: radius
+    vec4 area_reach;        // x: total area; y: largest near-blend radius; z: mean area; w: 0
+    uvec4 range_skip;       // x: first order entry; y: sample count; z: node after the subtree; w: leaf
+};
+
+// Per node, after each splat (gather_tree.comp stage 0).
+struct NodePowerRecord {
+    vec4 power;             // rgb: sum E_i A_i per channel; w: 0
+    vec4 mean_weight;       // xyz: power-weighted centroid; w: total weight
+};
+
 // One mesh vertex as compute passes read it (the raster passes read the same buffer as vertex
 // attributes): tightly packed, 24 bytes.
 struct VertexRecord {

@@ -28,10 +28,16 @@ pub struct Args {
     /// Sampler (overrides the scene)
     #[arg(long, value_parser = super::one_of::<Method>(&Method::ALL.map(Method::name)))]
     pub sampler: Option<Method>,
-    /// Where exitance is gathered: at every vertex, at every visible pixel, or at the samples
-    /// blended to the vertices (overrides the scene)
+    /// Where exitance is gathered: at every vertex, at every visible pixel, at the samples
+    /// blended to the vertices, or at every vertex with far clusters of samples standing in for
+    /// their members (overrides the scene)
     #[arg(long, value_parser = super::one_of::<GatherMode>(&GatherMode::ALL.map(GatherMode::name)))]
     pub gather: Option<GatherMode>,
+    /// The hierarchical gather's accuracy knob, 0 to 10: a cluster of samples of area A whose
+    /// nearest member is r away stands in for them when A < EPSILON r^2; 0 is the exact flat
+    /// sum, larger is faster and coarser (overrides render.gather_epsilon)
+    #[arg(long, value_name = "EPSILON", allow_negative_numbers = true)]
+    pub gather_epsilon: Option<f32>,
     /// Image size WIDTHxHEIGHT (overrides the scene)
     #[arg(long, value_parser = parse_resolution)]
     pub resolution: Option<[u32; 2]>,
@@ -77,6 +83,7 @@ impl Default for Args {
             samples: None,
             sampler: None,
             gather: None,
+            gather_epsilon: None,
             resolution: None,
             frames: 1,
             moving: Moving::Light,
@@ -130,8 +137,13 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         Some(path) => Scene::load(path)?,
         None => Scene::builtin(),
     };
-    let overrides =
-        Overrides { samples: args.samples, sampler: args.sampler, gather: args.gather, resolution: args.resolution };
+    let overrides = Overrides {
+        samples: args.samples,
+        sampler: args.sampler,
+        gather: args.gather,
+        gather_epsilon: args.gather_epsilon,
+        resolution: args.resolution,
+    };
     let spinner = ProgressBar::new_spinner().with_message(format!("preparing {} (meshes, sample points)", scene.name));
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
     let prepared = PreparedScene::new(&scene, &overrides);

@@ -3,6 +3,7 @@
 //! the accuracy study.
 
 pub mod bvh;
+pub mod tree;
 
 use crate::optics::Dipole;
 use crate::optics::{fresnel, kernel};
@@ -118,7 +119,7 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3
 /// Blend per-sample values to `x` with the near-field Shepard weights
 /// (`kernel::near_blend_weight`), or take the nearest sample's where no weight reaches: the twin
 /// of the blend in glsl/common/gather.glsl and glsl/gather_sparse.comp.
-fn near_blend(x: DVec3, values: &[(DVec3, f64, [f64; 3])]) -> [f64; 3] {
+pub(crate) fn near_blend(x: DVec3, values: &[(DVec3, f64, [f64; 3])]) -> [f64; 3] {
     let (mut sum, mut weight_sum) = ([0.0; 3], 0.0);
     let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; 3]);
     for (p, area, v) in values {
@@ -166,7 +167,7 @@ pub fn gather_sparse(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<
 
 /// Run `f` on every translucent object with its dipoles and the index of its first sample in
 /// scene order; opaque objects get zero exitance at every vertex.
-fn per_translucent_object(
+pub(crate) fn per_translucent_object(
     scene: &PreparedScene,
     f: impl Fn(&PreparedObject, &[Dipole; 3], usize) -> Vec<[f64; 3]>,
 ) -> Vec<Vec<[f64; 3]>> {

@@ -3,7 +3,7 @@
 //! write and read between frames (splat output, exitance, cached environment irradiance). The
 //! passes get their inputs from here; only lights change after creation.
 
-use super::records::{LightGpu, ObjectRecord, SampleRecord, SplatRecord, Vertex};
+use super::records::{LightGpu, NodePowerRecord, ObjectRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex};
 use crate::gpu::{Access, Buffer, BufferDesc, Gpu, GpuResult, memory_barrier};
 use crate::scene::build::PreparedScene;
 use ash::vk;
@@ -29,6 +29,10 @@ pub struct Receiver {
     pub vertex_count: u32,
     /// Its sample count: the threads of the sparse gather's stage 0.
     pub sample_count: u32,
+    /// Its root node in `GpuScene::tree_nodes`.
+    pub first_node: u32,
+    /// Its node count: the threads of the hierarchical gather's stage 0.
+    pub node_count: u32,
 }
 
 /// A prepared scene's data on the GPU: device-local buffers the passes bind, and the ranges and
@@ -53,6 +57,14 @@ pub struct GpuScene {
     pub samples: Buffer,
     /// `SplatRecord` per sample, from the splat pass.
     pub splat: Buffer,
+    /// `TreeNodeRecord` per node of every translucent object's sample hierarchy
+    /// (`sampling::SampleTree`), objects one after another (`Receiver::first_node`).
+    pub tree_nodes: Buffer,
+    /// Sample indices (u32, absolute) in the hierarchies' leaf order: node `n`'s samples are
+    /// `tree_order[n.first .. n.first + n.count]`.
+    pub tree_order: Buffer,
+    /// `NodePowerRecord` per node, written by the hierarchical gather's stage 0.
+    pub node_power: Buffer,
     /// `LightGpu` per prepared light, key lights first; rewritten inside a frame's command buffer
     /// when lights change (`record_uploads`).
     pub lights: Buffer,
@@ -101,6 +113,7 @@ impl GpuScene {
             (Vec::new(), Vec::<u32>::new(), Vec::new(), Vec::new());
         let (mut draws, mut casters, mut receivers, mut vertex_offsets) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut tree_nodes, mut tree_order) = (Vec::new(), Vec::<u32>::new());
         for (i, o) in scene.objects.iter().enumerate() {
             let first_vertex = vertices.len() as u32;
             let first_sample = samples.len() as u32;
@@ -128,7 +141,12 @@ impl GpuScene {
             let sample_count = o.samples.len() as u32;
             objects.push(ObjectRecord::new(o, [first_vertex, vertex_count, first_sample, sample_count]));
             if matches!(o.material, crate::scene::build::ResolvedMaterial::Translucent { .. }) {
-                receivers.push(Receiver { object: i as u32, vertex_count, sample_count });
+                let tree = o.sample_tree();
+                let (first_node, first_entry) = (tree_nodes.len() as u32, tree_order.len() as u32);
+                tree_nodes.extend(tree.nodes.iter().map(|n| TreeNodeRecord::new(n, first_node, first_entry)));
+                tree_order.extend(tree.order.iter().map(|k| first_sample + k));
+                let node_count = tree.nodes.len() as u32;
+                receivers.push(Receiver { object: i as u32, vertex_count, sample_count, first_node, node_count });
             }
         }
         let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER;
@@ -145,6 +163,14 @@ impl GpuScene {
                 gpu,
                 "splat",
                 (std::mem::size_of::<SplatRecord>() * samples.len()) as u64,
+                vk::BufferUsageFlags::empty(),
+            )?,
+            tree_nodes: upload(gpu, "tree nodes", &tree_nodes, vk::BufferUsageFlags::empty())?,
+            tree_order: upload(gpu, "tree order", &tree_order, vk::BufferUsageFlags::empty())?,
+            node_power: storage(
+                gpu,
+                "node power",
+                (std::mem::size_of::<NodePowerRecord>() * tree_nodes.len()) as u64,
                 vk::BufferUsageFlags::empty(),
             )?,
             lights: storage(

@@ -3,6 +3,7 @@
 pub mod gather;
 pub mod gather_pixel;
 pub mod gather_sparse;
+pub mod gather_tree;
 pub mod gpu_scene;
 pub mod pass;
 pub mod plan;

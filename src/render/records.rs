@@ -110,6 +110,45 @@ impl SplatRecord {
     }
 }
 
+/// `TreeNodeRecord` in glsl/common/scene.glsl: one node of an object's sample hierarchy
+/// (`sampling::SampleTree`), indices made absolute in the shared node and order buffers.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct TreeNodeRecord {
+    /// xyz: centre of the bounding sphere of the node's samples; w: its radius.
+    pub center_radius: [f32; 4],
+    /// x: total area of the samples; y: their largest near-blend radius; z: mean area; w: 0.
+    pub area_reach: [f32; 4],
+    /// x: first entry in the order buffer; y: sample count; z: the node after the subtree; w: 1
+    /// for a leaf.
+    pub range_skip: [u32; 4],
+}
+
+impl TreeNodeRecord {
+    /// Pack `node`, offsetting its node and order indices by the object's first node and
+    /// first order entry in the shared buffers.
+    pub fn new(node: &crate::sampling::TreeNode, first_node: u32, first_entry: u32) -> TreeNodeRecord {
+        let [x, y, z] = node.center;
+        TreeNodeRecord {
+            center_radius: [x, y, z, node.radius],
+            area_reach: [node.area, node.reach, node.area / node.count.max(1) as f32, 0.0],
+            range_skip: [first_entry + node.first, node.count, first_node + node.skip, node.leaf as u32],
+        }
+    }
+}
+
+/// `NodePowerRecord` in glsl/common/scene.glsl: what stage 0 of the hierarchical gather
+/// aggregates per node after each splat.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct NodePowerRecord {
+    /// rgb: transmitted power `sum E_i A_i` per channel; w: 0.
+    pub power: [f32; 4],
+    /// xyz: centroid of the samples weighted by their power summed over channels (the bounding
+    /// centre when unlit); w: that total weight.
+    pub mean_weight: [f32; 4],
+}
+
 /// `struct Light` in glsl/common/lights.glsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]

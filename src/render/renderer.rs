@@ -5,6 +5,7 @@
 use super::gather::GatherPass;
 use super::gather_pixel::GatherPixelPass;
 use super::gather_sparse::GatherSparsePass;
+use super::gather_tree::GatherTreePass;
 use super::gpu_scene::GpuScene;
 use super::pass::{FrameInputs, RenderPass};
 use super::plan::{self, Change, Pass, Plan};
@@ -190,6 +191,9 @@ impl Renderer {
         let gather: Box<dyn RenderPass> = match (shade.surface(), shade.hdr()) {
             (Some(surface), Some(hdr)) => Box::new(GatherPixelPass::new(gpu, &buffers, surface, hdr)?),
             _ if settings.gather == GatherMode::Sparse => Box::new(GatherSparsePass::new(gpu, &buffers)?),
+            _ if settings.gather == GatherMode::Hierarchical => {
+                Box::new(GatherTreePass::new(gpu, &buffers, settings.gather_epsilon)?)
+            }
             _ => Box::new(GatherPass::new(gpu, &buffers)?),
         };
         // Timing is optional: a queue without timestamps still renders.

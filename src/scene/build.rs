@@ -59,6 +59,16 @@ pub struct PreparedObject {
     pub samples: Vec<SamplePoint>,
 }
 
+impl PreparedObject {
+    /// The hierarchy over its samples for the hierarchical gather (built on each call; the
+    /// renderer and the f64 reference each build it once, identically).
+    pub fn sample_tree(&self) -> sampling::SampleTree {
+        let positions: Vec<glam::DVec3> = self.samples.iter().map(|s| s.position.as_dvec3()).collect();
+        let areas: Vec<f64> = self.samples.iter().map(|s| s.area).collect();
+        sampling::SampleTree::new(&positions, &areas)
+    }
+}
+
 /// A scene with all its CPU work done: objects loaded, placed and sampled, lights prepared.
 /// The renderer uploads it as it is.
 #[derive(Clone, Debug)]
@@ -90,6 +100,9 @@ pub struct Overrides {
     pub sampler: Option<Method>,
     /// `--gather`: replaces `render.gather`.
     pub gather: Option<GatherMode>,
+    /// `--gather-epsilon`: replaces `render.gather_epsilon` (0 to
+    /// [`crate::scene::MAX_GATHER_EPSILON`]).
+    pub gather_epsilon: Option<f32>,
     /// `--resolution`: replaces `camera.resolution` (width, height in pixels).
     pub resolution: Option<[u32; 2]>,
 }
@@ -115,6 +128,12 @@ impl PreparedScene {
         }
         if let Some(g) = overrides.gather {
             scene.file.render.gather = g;
+        }
+        if let Some(e) = overrides.gather_epsilon {
+            if !(0.0..=crate::scene::MAX_GATHER_EPSILON).contains(&e) {
+                return Err(SceneError::GatherEpsilon(e));
+            }
+            scene.file.render.gather_epsilon = e;
         }
         if let Some(r) = overrides.resolution {
             scene.file.camera.resolution = r;

@@ -282,6 +282,12 @@ pub struct RenderSettings {
     /// Where exitance is gathered (default `"vertex"`).
     #[serde(default)]
     pub gather: GatherMode,
+    /// The hierarchical gather's accuracy knob (default [`DEFAULT_GATHER_EPSILON`]; 0 to
+    /// [`MAX_GATHER_EPSILON`]): a cluster of samples of area `A` whose nearest member is `r`
+    /// away stands in for its members when `A < epsilon r^2`. 0 is the flat sum; other gather
+    /// modes ignore it.
+    #[serde(default = "gather_epsilon")]
+    pub gather_epsilon: f32,
     /// Exposure multiplier applied before the tone map (default 1; positive).
     #[serde(default = "one")]
     pub exposure: f32,
@@ -305,11 +311,15 @@ pub enum GatherMode {
     /// At the sample points, blended to the vertices: fastest, smooths detail finer than the
     /// sample spacing
     Sparse,
+    /// At every mesh vertex, far clusters of samples standing in for their members
+    /// (`render.gather_epsilon`)
+    Hierarchical,
 }
 
 impl GatherMode {
     /// Every gather mode: what `--gather` accepts and what parsing a name tries.
-    pub const ALL: [GatherMode; 3] = [GatherMode::Vertex, GatherMode::Pixel, GatherMode::Sparse];
+    pub const ALL: [GatherMode; 4] =
+        [GatherMode::Vertex, GatherMode::Pixel, GatherMode::Sparse, GatherMode::Hierarchical];
 
     /// The lowercase name used in scene files and on the command line.
     pub fn name(self) -> &'static str {
@@ -317,6 +327,7 @@ impl GatherMode {
             GatherMode::Vertex => "vertex",
             GatherMode::Pixel => "pixel",
             GatherMode::Sparse => "sparse",
+            GatherMode::Hierarchical => "hierarchical",
         }
     }
 }
@@ -327,7 +338,7 @@ impl std::str::FromStr for GatherMode {
         GatherMode::ALL
             .into_iter()
             .find(|m| m.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| format!("unknown gather mode `{s}` (expected vertex, pixel or sparse)"))
+            .ok_or_else(|| format!("unknown gather mode `{s}` (expected vertex, pixel, sparse or hierarchical)"))
     }
 }
 
@@ -339,8 +350,25 @@ impl std::fmt::Display for GatherMode {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        Self { gather: GatherMode::default(), exposure: 1.0, shadow_map_size: shadow_size(), background: None }
+        Self {
+            gather: GatherMode::default(),
+            gather_epsilon: gather_epsilon(),
+            exposure: 1.0,
+            shadow_map_size: shadow_size(),
+            background: None,
+        }
     }
+}
+
+/// `render.gather_epsilon` when a scene names none: chosen from the benchmark's sweep (README,
+/// "Performance").
+pub const DEFAULT_GATHER_EPSILON: f32 = 0.1;
+/// The largest `render.gather_epsilon`: a node seen under more than this solid angle is never
+/// a good stand-in.
+pub const MAX_GATHER_EPSILON: f32 = 10.0;
+
+fn gather_epsilon() -> f32 {
+    DEFAULT_GATHER_EPSILON
 }
 
 fn shadow_size() -> u32 {

@@ -45,6 +45,9 @@ pub enum SceneError {
     /// `--samples` above [`MAX_SAMPLE_COUNT`].
     #[error("--samples {0} is above the limit of {MAX_SAMPLE_COUNT} (as for sampling.count)")]
     TooManySamples(usize),
+    /// `--gather-epsilon` outside its range.
+    #[error("--gather-epsilon {0} must be 0 to {MAX_GATHER_EPSILON} (as for render.gather_epsilon)")]
+    GatherEpsilon(f32),
     /// `transform.fit` on a mesh whose bounding box has no extent.
     #[error("cannot fit a mesh with an empty bounding box")]
     EmptyBounds,
@@ -375,6 +378,12 @@ fn check(scene: &SceneFile) -> Check {
     let r = &scene.render;
     if !(r.exposure.is_finite() && r.exposure > 0.0) {
         return Err(("render.exposure".into(), format!("{} must be positive", r.exposure)));
+    }
+    if !(r.gather_epsilon >= 0.0 && r.gather_epsilon <= format::MAX_GATHER_EPSILON) {
+        return Err((
+            "render.gather_epsilon".into(),
+            format!("{} must be 0 to {}", r.gather_epsilon, format::MAX_GATHER_EPSILON),
+        ));
     }
     if !(16..=8192).contains(&r.shadow_map_size) {
         return Err(("render.shadow_map_size".into(), format!("{} must be 16 to 8192", r.shadow_map_size)));

@@ -1,0 +1,82 @@
+//! Hierarchical-gather pass (`glsl/gather_tree.comp`), for `render.gather = "hierarchical"`:
+//! the vertex gather's dipole sum with far clusters of samples standing in for their members
+//! (after Jensen and Buhler 2002). Per translucent object, stage 0 aggregates each node of its
+//! sample hierarchy (`sampling::SampleTree`) from this frame's splat, a compute-to-compute
+//! barrier, then stage 1 walks the hierarchy from every vertex. `render.gather_epsilon` is the
+//! accuracy knob: the solid-angle bound below which a node is used whole; 0 is the flat sum.
+//! `reference::tree::gather` is its f64 twin.
+//!
+//! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = tree nodes, 5 = tree order,
+//! 6 = node power, 7 = exitance. Push: `GatherTreePush`.
+
+use super::gather::exitance_written;
+use super::gpu_scene::GpuScene;
+use super::pass::{FrameInputs, RenderPass};
+use crate::gpu::{Access, Binding, ComputePipeline, DescriptorSet, Gpu, GpuResult, memory_barrier};
+use ash::vk;
+use std::sync::Arc;
+
+/// `GatherTreePush` in glsl/gather_tree.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GatherTreePush {
+    /// Index of the receiving translucent object (its `ObjectRecord`).
+    pub object: u32,
+    /// 0: aggregate the nodes; 1: gather at the vertices.
+    pub stage: u32,
+    /// The object's root in `GpuScene::tree_nodes`.
+    pub first_node: u32,
+    /// Its node count.
+    pub node_count: u32,
+    /// The solid-angle bound: a node of area `A` whose samples are all at least `r` away is used
+    /// whole when `A < epsilon r^2`.
+    pub epsilon: f32,
+}
+
+/// The hierarchical gather: two dispatches of glsl/gather_tree.comp per translucent object,
+/// writing exitance at its vertices into `GpuScene::exitance`, then the vertex gather's barrier.
+pub struct GatherTreePass {
+    pipeline: ComputePipeline,
+    set: DescriptorSet,
+    epsilon: f32,
+}
+
+impl GatherTreePass {
+    /// The pipeline and one descriptor set over the scene's buffers; `epsilon` is the
+    /// solid-angle bound (`render.gather_epsilon`).
+    pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene, epsilon: f32) -> GpuResult<GatherTreePass> {
+        let pipeline = ComputePipeline::new(gpu, "gather_tree.comp")?;
+        let set = pipeline.descriptor_set(&[
+            Binding::Buffer(&scene.vertices),
+            Binding::Buffer(&scene.samples),
+            Binding::Buffer(&scene.splat),
+            Binding::Buffer(&scene.objects),
+            Binding::Buffer(&scene.tree_nodes),
+            Binding::Buffer(&scene.tree_order),
+            Binding::Buffer(&scene.node_power),
+            Binding::Buffer(&scene.exitance),
+        ])?;
+        Ok(GatherTreePass { pipeline, set, epsilon })
+    }
+}
+
+impl RenderPass for GatherTreePass {
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        let push = |r: &super::gpu_scene::Receiver, stage| GatherTreePush {
+            object: r.object,
+            stage,
+            first_node: r.first_node,
+            node_count: r.node_count,
+            epsilon: self.epsilon,
+        };
+        for r in &frame.scene.receivers {
+            self.pipeline.dispatch(cmd, &self.set, &push(r, 0), [r.node_count, 1, 1]);
+        }
+        // Stage 1 reads the node power stage 0 wrote.
+        memory_barrier(frame.gpu.device(), cmd, &[Access::ComputeWrite], &[Access::ComputeRead]);
+        for r in &frame.scene.receivers {
+            self.pipeline.dispatch(cmd, &self.set, &push(r, 1), [r.vertex_count, 1, 1]);
+        }
+        exitance_written(frame, cmd);
+    }
+}

@@ -1,0 +1,166 @@
+//! A bounding-sphere hierarchy over one object's sample points, for the hierarchical gather
+//! (after Jensen and Buhler 2002, "A Rapid Hierarchical Rendering Technique for Translucent
+//! Materials", who cluster the irradiance samples in an octree and let a far cluster stand in
+//! for its members).
+//!
+//! Built once on the CPU when the samples are placed (they move only with the geometry): a binary
+//! tree split at the median of the longest axis of each node's bounding box, down to leaves of at
+//! most [`LEAF_SIZE`] samples. Nodes are stored depth first, so a node's first child is the next
+//! node and `skip` is where the walk continues once the node's subtree is done (used whole,
+//! pruned or fully visited): a stackless traversal, one index per receiver, which suits
+//! lavapipe's SIMD lanes better than a stack. The irradiance each node carries changes every
+//! splat and is aggregated on the GPU (`glsl/gather_tree.comp`, stage 0) and in the f64 twin
+//! (`reference::gather_tree`); this module knows only geometry.
+
+use crate::optics::kernel::NEAR_BLEND_RADIUS;
+use glam::DVec3;
+
+/// Most samples in a leaf: a leaf's samples are summed exactly, pair by pair.
+pub const LEAF_SIZE: usize = 8;
+
+/// One node of a [`SampleTree`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TreeNode {
+    /// Centre of a sphere holding every sample position of the subtree.
+    pub center: [f32; 3],
+    /// Its radius, rounded up so that the f32 sphere still holds every sample.
+    pub radius: f32,
+    /// Sum of the samples' areas.
+    pub area: f32,
+    /// Largest near-field blend radius of its samples (`NEAR_BLEND_RADIUS sqrt(dA)`): a receiver
+    /// nearer than `radius + reach` to the centre may get a Shepard weight from one of them.
+    pub reach: f32,
+    /// First entry of the subtree's samples in [`SampleTree::order`].
+    pub first: u32,
+    /// How many samples the subtree holds.
+    pub count: u32,
+    /// Index of the node after this subtree (depth-first order; the node count for the last).
+    pub skip: u32,
+    /// Whether it is a leaf (its samples are summed one by one).
+    pub leaf: bool,
+}
+
+/// The hierarchy over one object's samples: nodes in depth-first order (root first) and the
+/// sample indices in leaf order, each node's samples contiguous.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SampleTree {
+    /// Nodes, depth first; node 0 is the root (none without samples).
+    pub nodes: Vec<TreeNode>,
+    /// Sample indices (into the object's samples), grouped so that node `n` holds
+    /// `order[n.first .. n.first + n.count]`.
+    pub order: Vec<u32>,
+}
+
+impl SampleTree {
+    /// The hierarchy over samples at `positions` with areas `areas` (same length).
+    pub fn new(positions: &[DVec3], areas: &[f64]) -> SampleTree {
+        assert_eq!(positions.len(), areas.len(), "one area per sample");
+        let mut tree = SampleTree { nodes: Vec::new(), order: (0..positions.len() as u32).collect() };
+        if !positions.is_empty() {
+            let mut order = std::mem::take(&mut tree.order);
+            tree.build(positions, areas, &mut order, 0);
+            tree.order = order;
+        }
+        tree
+    }
+
+    fn build(&mut self, positions: &[DVec3], areas: &[f64], order: &mut [u32], first: usize) {
+        let (lo, hi) = order.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), &i| {
+            (lo.min(positions[i as usize]), hi.max(positions[i as usize]))
+        });
+        let center = 0.5 * (lo + hi);
+        let radius = order.iter().map(|&i| positions[i as usize].distance(center)).fold(0.0, f64::max);
+        let center_f32 = center.as_vec3();
+        // The f32 centre is off the f64 one by up to half an ulp of each coordinate: add that
+        // and a relative margin so the rounded sphere stays conservative.
+        let slack = center.distance(center_f32.as_dvec3()) + 1e-6 * radius;
+        let area: f64 = order.iter().map(|&i| areas[i as usize]).sum();
+        let largest = order.iter().map(|&i| areas[i as usize]).fold(0.0, f64::max);
+        let index = self.nodes.len();
+        let leaf = order.len() <= LEAF_SIZE;
+        self.nodes.push(TreeNode {
+            center: center_f32.to_array(),
+            radius: ((radius + slack) as f32).next_up(),
+            area: area as f32,
+            reach: ((NEAR_BLEND_RADIUS * largest.sqrt()) as f32).next_up(),
+            first: first as u32,
+            count: order.len() as u32,
+            skip: 0,
+            leaf,
+        });
+        if !leaf {
+            let extent = hi - lo;
+            let axis = if extent.x >= extent.y && extent.x >= extent.z {
+                0
+            } else if extent.y >= extent.z {
+                1
+            } else {
+                2
+            };
+            let mid = order.len() / 2;
+            order.select_nth_unstable_by(mid, |&a, &b| {
+                positions[a as usize][axis].total_cmp(&positions[b as usize][axis]).then(a.cmp(&b))
+            });
+            let (left, right) = order.split_at_mut(mid);
+            self.build(positions, areas, left, first);
+            self.build(positions, areas, right, first + mid);
+        }
+        self.nodes[index].skip = self.nodes.len() as u32;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn points(n: usize) -> (Vec<DVec3>, Vec<f64>) {
+        // A deterministic scatter on a curved patch, with uneven areas.
+        let p = (0..n)
+            .map(|i| {
+                let (u, v) = ((i as f64 * 0.618_034).fract(), (i as f64 * 0.414_213_5).fract());
+                DVec3::new(u, v, 0.3 * (u * v).sin())
+            })
+            .collect();
+        let a = (0..n).map(|i| 1e-3 * (1.0 + (i % 7) as f64)).collect();
+        (p, a)
+    }
+
+    #[test]
+    fn every_node_bounds_its_samples_and_skips_past_its_subtree() {
+        for n in [1, 2, 7, 8, 9, 100, 1000] {
+            let (p, a) = points(n);
+            let t = SampleTree::new(&p, &a);
+            let mut sorted = t.order.clone();
+            sorted.sort_unstable();
+            assert_eq!(sorted, (0..n as u32).collect::<Vec<_>>(), "every sample exactly once");
+            assert_eq!(t.nodes[0].count as usize, n);
+            assert_eq!(t.nodes[0].skip as usize, t.nodes.len());
+            for (i, node) in t.nodes.iter().enumerate() {
+                let samples = &t.order[node.first as usize..(node.first + node.count) as usize];
+                let c = glam::Vec3::from(node.center);
+                for &s in samples {
+                    let q = p[s as usize].as_vec3();
+                    assert!(q.distance(c) <= node.radius, "node {i} does not hold sample {s}");
+                }
+                let area: f64 = samples.iter().map(|&s| a[s as usize]).sum();
+                assert!((node.area as f64 - area).abs() <= 1e-6 * area);
+                assert_eq!(node.leaf, node.count as usize <= LEAF_SIZE);
+                if node.leaf {
+                    assert_eq!(node.skip as usize, i + 1);
+                } else {
+                    // Children: the next node, and the node its subtree skips to; they split
+                    // the parent's samples.
+                    let (l, r) = (&t.nodes[i + 1], &t.nodes[t.nodes[i + 1].skip as usize]);
+                    assert_eq!(l.first, node.first);
+                    assert_eq!(l.count + r.count, node.count);
+                    assert_eq!(r.skip, node.skip);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn an_empty_object_has_no_nodes() {
+        assert!(SampleTree::new(&[], &[]).nodes.is_empty());
+    }
+}
