@@ -16,8 +16,8 @@ use translucent::gpu::{Binding, Buffer, BufferDesc, ComputePipeline, Gpu, GpuOpt
 use translucent::render::plan::{Change, Pass};
 use translucent::render::renderer::Renderer;
 use translucent::sampling::Method;
-use translucent::scene::GatherMode;
 use translucent::scene::build::{Overrides, PreparedScene};
+use translucent::scene::{DEFAULT_GATHER_EPSILON, GatherMode};
 use translucent::scene::{Scene, lights};
 
 const WARM_UP: usize = 1;
@@ -128,6 +128,118 @@ fn gather_against_naive(gpu: &Arc<Gpu>, renderer: &mut Renderer) -> (f64, f64, f
     (median(&mut ours), median(&mut theirs), pairs)
 }
 
+/// Median isolated wall time of the gather alone on the current splat (`FRAMES` after a
+/// warm-up; stage 0 of the hierarchical gather included).
+fn gather_alone_ms(renderer: &mut Renderer) -> f64 {
+    let mut plan = renderer.plan(Change::Everything);
+    plan.passes.retain(|(p, _)| *p == Pass::Gather);
+    let mut times: Vec<f64> = (0..WARM_UP + FRAMES)
+        .map(|_| renderer.frame_isolated(&plan).expect("gather").passes[0].1)
+        .skip(WARM_UP)
+        .collect();
+    median(&mut times)
+}
+
+/// Exitance of the first translucent object after a full first frame with `overrides`, and the
+/// renderer, on the default scene at 512x512.
+fn prepared_renderer(gpu: &Arc<Gpu>, overrides: Overrides) -> Renderer {
+    let overrides = Overrides { resolution: Some([512, 512]), ..overrides };
+    let prepared = PreparedScene::new(&Scene::builtin(), &overrides).expect("scene");
+    let mut renderer = Renderer::new(gpu, prepared).expect("renderer");
+    renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
+    renderer
+}
+
+fn first_exitance(renderer: &Renderer) -> Vec<[f32; 3]> {
+    let object = renderer.buffers().receivers[0].object as usize;
+    renderer.exitance(object).expect("exitance")
+}
+
+/// Relative RMS of `a` against `b` per vertex and channel, over the vertices brighter than 1%
+/// of `b`'s peak (the measure of tests/hierarchy.rs).
+fn rms_relative(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
+    let peak = b.iter().flat_map(|m| m.iter()).fold(0.0f32, |x, y| x.max(*y)) as f64;
+    let (mut sum_sq, mut n) = (0.0, 0);
+    for (x, y) in a.iter().zip(b) {
+        for c in 0..3 {
+            if y[c] as f64 > 1e-2 * peak {
+                let e = (x[c] as f64 - y[c] as f64) / y[c] as f64;
+                sum_sq += e * e;
+                n += 1;
+            }
+        }
+    }
+    (sum_sq / n.max(1) as f64).sqrt()
+}
+
+/// The hierarchical gather against the flat vertex gather: an epsilon sweep at 400 and 6,400
+/// samples (time and RMS from the flat exitance), then its growth with the sample count.
+fn hierarchy(gpu: &Arc<Gpu>) {
+    let epsilons = [0.02f32, 0.05, 0.1, 0.2, 0.5, 1.0];
+    println!(
+        "\nHierarchical gather against the flat vertex gather (default scene, 512x512, gather alone in \
+         isolated submissions, median of {FRAMES}):"
+    );
+    println!("  {:>8} {:>8} {:>11} {:>9} {:>14}", "samples", "epsilon", "gather ms", "speed-up", "RMS from flat");
+    for count in [400, 6400] {
+        let flat_overrides = Overrides { samples: Some(count), ..Default::default() };
+        let mut flat = prepared_renderer(gpu, flat_overrides.clone());
+        let flat_ms = gather_alone_ms(&mut flat);
+        let reference = first_exitance(&flat);
+        drop(flat);
+        println!("  {count:>8} {:>8} {flat_ms:>11.1} {:>9} {:>14}", "flat", "1.00", "0");
+        for &epsilon in &epsilons {
+            let overrides = Overrides {
+                gather: Some(GatherMode::Hierarchical),
+                gather_epsilon: Some(epsilon),
+                ..flat_overrides.clone()
+            };
+            let mut tree = prepared_renderer(gpu, overrides);
+            let ms = gather_alone_ms(&mut tree);
+            let rms = rms_relative(&first_exitance(&tree), &reference);
+            println!("  {count:>8} {epsilon:>8} {ms:>11.1} {:>9.1} {:>13.3}%", flat_ms / ms, 100.0 * rms);
+        }
+    }
+    println!("\nGather time against sample count (default epsilon {DEFAULT_GATHER_EPSILON}; flat up to 1,600):");
+    println!("  {:>8} {:>16} {:>12}", "samples", "hierarchical ms", "flat ms");
+    let (mut xs, mut ys, mut flat_xs, mut flat_ys) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for count in [400, 800, 1600, 3200, 6400, 12800, 25600] {
+        let overrides =
+            Overrides { samples: Some(count), gather: Some(GatherMode::Hierarchical), ..Default::default() };
+        let ms = gather_alone_ms(&mut prepared_renderer(gpu, overrides));
+        let flat = (count <= 1600).then(|| {
+            gather_alone_ms(&mut prepared_renderer(gpu, Overrides { samples: Some(count), ..Default::default() }))
+        });
+        println!("  {count:>8} {ms:>16.1} {:>12}", flat.map(|f| format!("{f:.1}")).unwrap_or_default());
+        xs.push((count as f64).ln());
+        ys.push(ms.ln());
+        if let Some(f) = flat {
+            flat_xs.push((count as f64).ln());
+            flat_ys.push(f.ln());
+        }
+    }
+    println!(
+        "  growth exponent (least-squares slope of log time on log samples): hierarchical {:.2}, flat {:.2}",
+        slope(&xs, &ys),
+        slope(&flat_xs, &flat_ys)
+    );
+}
+
+fn slope(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let cov: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let var: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
+    cov / var
+}
+
+/// Sections to run: those named on the command line (`cargo bench --bench render -- hierarchy`),
+/// or all.
+fn wanted(section: &str) -> bool {
+    let named: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with("--")).collect();
+    named.is_empty() || named.iter().any(|n| n == section)
+}
+
 fn main() {
     let options = GpuOptions { device: std::env::var("TRANSLUCENT_DEVICE").ok(), ..Default::default() };
     let gpu = Gpu::new(&options).expect("a Vulkan device (run `bash scripts/setup`)");
@@ -146,32 +258,39 @@ fn main() {
         prepared.shadow_layers,
         prepared.scene.file.render.shadow_map_size
     );
-    let mut renderer = Renderer::new(&gpu, prepared).expect("renderer");
-    renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
-    print(
-        "key light moves every frame (its shadow map, splat, gather, shade, tone map):",
-        &measure(&mut renderer, Change::Light(0)),
-    );
-    print("only the camera moves (shade, tone map):", &measure(&mut renderer, Change::Camera));
-    println!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
-    let (ours, naive, pairs) = gather_against_naive(&gpu, &mut renderer);
-    println!(
-        "\nFlat vertex gather against a naive point-kernel shader (glsl/bench/gather_naive.comp), same {:.1}M \
-         pairs, isolated submissions, alternating:",
-        pairs / 1e6
-    );
-    println!("  ours  {ours:>8.1} ms = {:>7.1} Mpairs/s", pairs / ours / 1e3);
-    println!("  naive {naive:>8.1} ms = {:>7.1} Mpairs/s", pairs / naive / 1e3);
-    println!("  throughput ratio ours / naive = {:.2}", naive / ours);
-    drop(renderer);
+    if wanted("frames") {
+        let mut renderer = Renderer::new(&gpu, prepared).expect("renderer");
+        renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
+        print(
+            "key light moves every frame (its shadow map, splat, gather, shade, tone map):",
+            &measure(&mut renderer, Change::Light(0)),
+        );
+        print("only the camera moves (shade, tone map):", &measure(&mut renderer, Change::Camera));
+        println!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
+        let (ours, naive, pairs) = gather_against_naive(&gpu, &mut renderer);
+        println!(
+            "\nFlat vertex gather against a naive point-kernel shader (glsl/bench/gather_naive.comp), same {:.1}M \
+             pairs, isolated submissions, alternating:",
+            pairs / 1e6
+        );
+        println!("  ours  {ours:>8.1} ms = {:>7.1} Mpairs/s", pairs / ours / 1e3);
+        println!("  naive {naive:>8.1} ms = {:>7.1} Mpairs/s", pairs / naive / 1e3);
+        println!("  throughput ratio ours / naive = {:.2}", naive / ours);
+    }
+    if wanted("hierarchy") {
+        hierarchy(&gpu);
+    }
+    if !wanted("gathers") {
+        return;
+    }
 
     println!("\nWhere the gather runs: time against difference from the vertex gather (key light moving, 512x512):");
     println!(
-        "  {:<8} {:>12} {:>12} {:>10} {:>22}",
+        "  {:<12} {:>12} {:>12} {:>10} {:>22}",
         "gather", "gather ms", "frame ms", "frames/s", "image diff (of 255)"
     );
     let mut reference_image: Option<Vec<u8>> = None;
-    for gather in [GatherMode::Vertex, GatherMode::Sparse, GatherMode::Pixel] {
+    for gather in [GatherMode::Vertex, GatherMode::Hierarchical, GatherMode::Sparse, GatherMode::Pixel] {
         let overrides = Overrides { gather: Some(gather), resolution: Some([512, 512]), ..Default::default() };
         let prepared = PreparedScene::new(&scene, &overrides).expect("scene");
         let mut renderer = Renderer::new(&gpu, prepared).expect("renderer");
@@ -189,7 +308,7 @@ fn main() {
             }
         };
         println!(
-            "  {gather:<8} {gather_ms:>12.1} {:>12.1} {:>10.2} {diff:>22.3}",
+            "  {gather:<12} {gather_ms:>12.1} {:>12.1} {:>10.2} {diff:>22.3}",
             m.frame_wall_ms,
             1000.0 / m.frame_wall_ms
         );

@@ -5,12 +5,15 @@
 //   0: per node of the object's sample hierarchy, its transmitted power sum E_i A_i per channel
 //      and its power-weighted centroid, from this frame's splat;
 //   1: per vertex, tree_gather (glsl/common/tree.glsl) with the solid-angle bound
-//      push.epsilon; epsilon = 0 is the flat sum of gather.comp.
+//      push.epsilon; epsilon = 0 is the flat sum of gather.comp. Invocations take the object's
+//      vertices in group order (receiver_order), one workgroup per group of 64, and walk the
+//      hierarchy with the group's bounding sphere, so the walk is uniform across the workgroup.
 //
 // Bindings: 0 = vertices (VertexRecord[]), 1 = samples (SampleRecord[]), 2 = splat
 // (SplatRecord[]), 3 = objects (ObjectRecord[]), 4 = tree nodes (TreeNodeRecord[]), 5 = tree
 // order (uint[]), 6 = node power (NodePowerRecord[], written by stage 0, read by stage 1),
-// 7 = exitance (vec4 per vertex, written by stage 1). Push: GatherTreePush.
+// 7 = receiver order (uint[]), 8 = receiver groups (vec4[]: centre, radius), 9 = exitance (vec4
+// per vertex, written by stage 1). Push: GatherTreePush.
 #include "dipole.glsl"
 #include "scene.glsl"
 #include "gather.glsl"
@@ -23,12 +26,16 @@ layout(std430, set = 0, binding = 3) readonly buffer Objects { ObjectRecord obje
 layout(std430, set = 0, binding = 4) readonly buffer TreeNodes { TreeNodeRecord tree_nodes[]; };
 layout(std430, set = 0, binding = 5) readonly buffer TreeOrder { uint tree_order[]; };
 layout(std430, set = 0, binding = 6) buffer NodePower { NodePowerRecord node_power[]; };
-layout(std430, set = 0, binding = 7) writeonly buffer Exitance { vec4 exitance[]; };
+layout(std430, set = 0, binding = 7) readonly buffer ReceiverOrder { uint receiver_order[]; };
+layout(std430, set = 0, binding = 8) readonly buffer ReceiverGroups { vec4 receiver_groups[]; };
+layout(std430, set = 0, binding = 9) writeonly buffer Exitance { vec4 exitance[]; };
 struct GatherTreePush {
     uint object;            // the receiving object's index
     uint stage;             // 0: aggregate the nodes; 1: gather at the vertices
     uint first_node;        // the object's root in tree_nodes
     uint node_count;        // its node count
+    uint first_receiver;    // its first entry in receiver_order
+    uint first_group;       // its first group in receiver_groups
     float epsilon;          // solid-angle bound: a node of area A at distance r is used whole when A < epsilon r^2
 };
 layout(push_constant) uniform GatherTreePushBlock { GatherTreePush push; };
@@ -60,9 +67,12 @@ void main() {
         return;
     }
     ObjectRecord o = objects[push.object];
-    if (k >= o.ranges.y) return;
-    uint v = o.ranges.x + k;
+    uint count = o.ranges.y;
+    // Invocations past the end walk with their group (keeping the walk uniform) but write nothing.
+    uint v = receiver_order[push.first_receiver + min(k, max(count, 1u) - 1u)];
+    vec4 group = receiver_groups[push.first_group + gl_WorkGroupID.x];
     DipoleChannel ch[3] = gather_channels(o);
-    GatherSum g = tree_gather(vertex_position(vertices[v]), ch, push.first_node, push.node_count, push.epsilon);
-    exitance[v] = vec4(gather_end(g), 1.0);
+    GatherSum g = tree_gather(vertex_position(vertices[v]), group.xyz, group.w, ch, push.first_node, push.node_count,
+                              push.epsilon);
+    if (k < count) exitance[v] = vec4(gather_end(g), 1.0);
 }

@@ -158,7 +158,10 @@ fn uniformly_lit_planes_keep_total_reflectance_at_the_default_epsilon() {
 fn a_bad_gather_epsilon_is_an_error_naming_it() {
     let dir = temp_dir("epsilon");
     let png = dir.join("out.png");
-    let out = translucent(&["render", "--gather", "hierarchical", "--gather-epsilon", "-1", "-o", png.to_str().unwrap()], &[]);
+    let out = translucent(
+        &["render", "--gather", "hierarchical", "--gather-epsilon", "-1", "-o", png.to_str().unwrap()],
+        &[],
+    );
     assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
     assert!(text(&out.stderr).contains("--gather-epsilon -1 must be 0 to 10"), "{}", text(&out.stderr));
     let scene = dir.join("bad.toml");

@@ -120,7 +120,8 @@ fn splat_and_vertex_records_match_glsl() {
     assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
     let (fields, size) = glsl_layout(scene, "NodePowerRecord");
     assert_eq!(size, size_of::<NodePowerRecord>());
-    let rust = [("power", offset_of!(NodePowerRecord, power)), ("mean_weight", offset_of!(NodePowerRecord, mean_weight))];
+    let rust =
+        [("power", offset_of!(NodePowerRecord, power)), ("mean_weight", offset_of!(NodePowerRecord, mean_weight))];
     assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
     let (fields, size) = glsl_layout(scene, "VertexRecord");
     assert_eq!(size, size_of::<Vertex>());
@@ -160,7 +161,7 @@ fn push_blocks_match_glsl_and_spirv() {
             include_str!("../glsl/gather_tree.comp"),
             "GatherTreePush",
             size_of::<GatherTreePush>(),
-            &["object", "stage", "first_node", "node_count", "epsilon"],
+            &["object", "stage", "first_node", "node_count", "first_receiver", "first_group", "epsilon"],
         ),
         (
             "gather_pixel.comp",

@@ -14,17 +14,6 @@ float tree_node_distance(TreeNodeRecord n, vec3 x) {
     return distance(x, n.center_radius.xyz) - n.center_radius.w;
 }
 
-// Whether every channel of a node of transmitted power `power` whose samples are all at least
-// `dist` away adds at most DIPOLE_TREE_PRUNE_FRACTION of the receiver's far sum so far.
-bool tree_negligible(vec3 power, DipoleChannel ch[3], float dist, GatherSum g) {
-    vec3 so_far = g.far + g.partial;
-    bool small = true;
-    for (int c = 0; c < 3; ++c) {
-        small = small && power[c] * dipole_r_d(ch[c], dist) <= DIPOLE_TREE_PRUNE_FRACTION * so_far[c];
-    }
-    return small;
-}
-
 // The sample of the tree nearest to x (the near blend's fallback where no Shepard weight reaches).
 uint tree_nearest_sample(vec3 x, uint first_node, uint node_count) {
     uint best = 0u;
@@ -54,19 +43,33 @@ uint tree_nearest_sample(vec3 x, uint first_node, uint node_count) {
 }
 
 #ifdef TREE_GATHER
-// The hierarchical dipole sum at x (after Jensen and Buhler 2002): a node whose samples are all
-// beyond every near-blend radius and whose area A seen from x is below the solid-angle bound,
-// A < epsilon dist^2 (dist: the nearest its samples can be), acts as one sample: its power at its
+// The hierarchical dipole sum at x (after Jensen and Buhler 2002), walked once for a group of
+// receivers inside the sphere (group_center, group_radius): dist, the nearest any sample of a
+// node can be to any receiver of the group, decides for all of them (sampling::ReceiverGroups
+// says why). A node whose samples are all beyond every near-blend radius and whose area A is
+// below the solid-angle bound, A < epsilon dist^2, acts as one sample: its power at its
 // power-weighted centroid with the far kernel of its mean area. Leaves are summed sample by
-// sample with the flat gather's gather_add, so the near field and its blend are exact. Nodes
-// that can add no more than DIPOLE_TREE_PRUNE_FRACTION of the sum so far are skipped.
-// epsilon = 0 uses no node whole: the flat sum.
-GatherSum tree_gather(vec3 x, DipoleChannel ch[3], uint first_node, uint node_count, float epsilon) {
+// sample with the flat gather's gather_add, so the near field and its blend are exact. A node
+// that could add at most DIPOLE_TREE_PRUNE_FRACTION of the object's mean exitance in every
+// channel (R_d,total times its power per area; R_d at dist bounds R_far beyond) is skipped.
+// epsilon = 0 uses no node whole and prunes none: the flat sum.
+GatherSum tree_gather(vec3 x, vec3 group_center, float group_radius, DipoleChannel ch[3], uint first_node,
+                      uint node_count, float epsilon) {
     GatherSum g = gather_begin();
+    if (node_count == 0u) return g;
+    // The prune threshold per channel, from the root's aggregate.
+    NodePowerRecord root = node_power[first_node];
+    float root_area = max(tree_nodes[first_node].area_reach.x, 1e-30);
+    vec3 negligible;
+    for (int c = 0; c < 3; ++c) {
+        // epsilon = 0 prunes nothing either: the exact flat sum.
+        negligible[c] = epsilon > 0.0 ? DIPOLE_TREE_PRUNE_FRACTION * dipole_r_d_total(ch[c]) * root.power[c] / root_area
+                                      : -1.0;
+    }
     uint i = first_node, end = first_node + node_count;
     while (i < end) {
         TreeNodeRecord n = tree_nodes[i];
-        float dist = tree_node_distance(n, x);
+        float dist = distance(group_center, n.center_radius.xyz) - n.center_radius.w - group_radius;
         bool beyond_blend = dist > n.area_reach.y;
         if (beyond_blend && n.area_reach.x < epsilon * dist * dist) {
             NodePowerRecord p = node_power[i];
@@ -83,10 +86,15 @@ GatherSum tree_gather(vec3 x, DipoleChannel ch[3], uint first_node, uint node_co
             }
             gather_flush(g);
             i = n.range_skip.z;
-        } else if (beyond_blend && tree_negligible(node_power[i].power.rgb, ch, dist, g)) {
-            i = n.range_skip.z;
         } else {
-            i += 1u;
+            bool negligible_node = beyond_blend;
+            if (beyond_blend) {
+                vec3 power = node_power[i].power.rgb;
+                for (int c = 0; c < 3; ++c) {
+                    negligible_node = negligible_node && power[c] * dipole_r_d(ch[c], dist) <= negligible[c];
+                }
+            }
+            i = negligible_node ? n.range_skip.z : i + 1u;
         }
     }
     gather_flush(g);

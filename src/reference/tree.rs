@@ -4,8 +4,8 @@
 //! same criteria, so the GPU can be tested against it node decision for node decision.
 
 use super::{near_blend, per_translucent_object};
-use crate::optics::kernel::{self, B_PER_SQRT_AREA, TREE_PRUNE_FRACTION};
 use crate::optics::Dipole;
+use crate::optics::kernel::{self, B_PER_SQRT_AREA, TREE_PRUNE_FRACTION};
 use crate::sampling::{SampleTree, TreeNode};
 use crate::scene::build::PreparedScene;
 use glam::DVec3;
@@ -48,13 +48,15 @@ fn center_of(n: &TreeNode) -> DVec3 {
     glam::Vec3::from(n.center).as_dvec3()
 }
 
-/// Stage 1 at one receiver `x`: the far sum over the hierarchy with nodes used whole when
-/// `A < epsilon dist^2` beyond every near-blend radius, leaves summed sample by sample, nodes
-/// pruned when they can add at most `TREE_PRUNE_FRACTION` of the far sum so far; plus the near
-/// field blended over the visited leaves (the nearest sample's where no weight reaches).
+/// Stage 1 at one receiver `x` of the group bounded by `group` (centre, radius): the far sum
+/// over the hierarchy with nodes used whole when `A < epsilon dist^2` beyond every near-blend
+/// radius (`dist` from the group's sphere), leaves summed sample by sample, nodes pruned when
+/// they can add at most `TREE_PRUNE_FRACTION` of the object's mean exitance; plus the near field
+/// blended over the visited leaves (the nearest sample's where no weight reaches).
 #[allow(clippy::too_many_arguments)]
 pub fn gather_at(
     x: DVec3,
+    group: ([f32; 3], f32),
     tree: &SampleTree,
     power: &[NodePower],
     dipoles: &[Dipole; 3],
@@ -65,10 +67,16 @@ pub fn gather_at(
 ) -> [f64; 3] {
     let mut far = [0.0f64; 3];
     let mut near = Vec::new();
+    let root_area = (tree.nodes[0].area as f64).max(1e-30);
+    // epsilon = 0 prunes nothing either: the exact flat sum.
+    let negligible: [f64; 3] = [0, 1, 2].map(|c| {
+        if epsilon > 0.0 { TREE_PRUNE_FRACTION * dipoles[c].r_d_total() * power[0].power[c] / root_area } else { -1.0 }
+    });
+    let (group_center, group_radius) = (glam::Vec3::from(group.0).as_dvec3(), group.1 as f64);
     let mut i = 0;
     while i < tree.nodes.len() {
         let n = &tree.nodes[i];
-        let dist = x.distance(center_of(n)) - n.radius as f64;
+        let dist = group_center.distance(center_of(n)) - n.radius as f64 - group_radius;
         let beyond_blend = dist > n.reach as f64;
         if beyond_blend && (n.area as f64) < epsilon * dist * dist {
             let p = &power[i];
@@ -90,9 +98,7 @@ pub fn gather_at(
                 near.push((positions[s], areas[s], [0, 1, 2].map(|c| e[s][c] * kernel::near_energy(&dipoles[c], b))));
             }
             i = n.skip as usize;
-        } else if beyond_blend
-            && (0..3).all(|c| power[i].power[c] * dipoles[c].r_d(dist) <= TREE_PRUNE_FRACTION * far[c])
-        {
+        } else if beyond_blend && (0..3).all(|c| power[i].power[c] * dipoles[c].r_d(dist) <= negligible[c]) {
             i = n.skip as usize;
         } else {
             i += 1;
@@ -121,10 +127,25 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]], epsilon: f64) -> V
         let areas: Vec<f64> = o.samples.iter().map(|s| s.area).collect();
         let e = &irradiance[first..first + o.samples.len()];
         let power = node_power(&tree, &positions, &areas, e);
-        o.mesh
-            .positions()
+        if tree.nodes.is_empty() {
+            return vec![[0.0; 3]; o.mesh.positions().len()];
+        }
+        let groups = o.receiver_groups();
+        let mesh = o.mesh.positions();
+        let mut exitance = vec![[0.0; 3]; mesh.len()];
+        let computed: Vec<(usize, [f64; 3])> = groups
+            .order
             .par_iter()
-            .map(|x| gather_at(x.as_dvec3(), &tree, &power, dipoles, &positions, &areas, e, epsilon))
-            .collect()
+            .enumerate()
+            .map(|(k, &v)| {
+                let x = mesh[v as usize].as_dvec3();
+                let m = gather_at(x, groups.group_of(k), &tree, &power, dipoles, &positions, &areas, e, epsilon);
+                (v as usize, m)
+            })
+            .collect();
+        for (v, m) in computed {
+            exitance[v] = m;
+        }
+        exitance
     })
 }

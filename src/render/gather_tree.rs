@@ -7,7 +7,8 @@
 //! `reference::tree::gather` is its f64 twin.
 //!
 //! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = tree nodes, 5 = tree order,
-//! 6 = node power, 7 = exitance. Push: `GatherTreePush`.
+//! 6 = node power, 7 = receiver order, 8 = receiver groups, 9 = exitance. Push:
+//! `GatherTreePush`.
 
 use super::gather::exitance_written;
 use super::gpu_scene::GpuScene;
@@ -28,6 +29,10 @@ pub struct GatherTreePush {
     pub first_node: u32,
     /// Its node count.
     pub node_count: u32,
+    /// Its first entry in `GpuScene::receiver_order`.
+    pub first_receiver: u32,
+    /// Its first group in `GpuScene::receiver_groups`.
+    pub first_group: u32,
     /// The solid-angle bound: a node of area `A` whose samples are all at least `r` away is used
     /// whole when `A < epsilon r^2`.
     pub epsilon: f32,
@@ -46,6 +51,12 @@ impl GatherTreePass {
     /// solid-angle bound (`render.gather_epsilon`).
     pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene, epsilon: f32) -> GpuResult<GatherTreePass> {
         let pipeline = ComputePipeline::new(gpu, "gather_tree.comp")?;
+        // Stage 1's workgroups are the receiver groups: its local size must be their size.
+        let n = crate::sampling::RECEIVER_GROUP_SIZE as u32;
+        assert!(
+            pipeline.groups([n, 1, 1]) == [1, 1, 1] && pipeline.groups([n + 1, 1, 1]) == [2, 1, 1],
+            "gather_tree.comp's local size is RECEIVER_GROUP_SIZE"
+        );
         let set = pipeline.descriptor_set(&[
             Binding::Buffer(&scene.vertices),
             Binding::Buffer(&scene.samples),
@@ -54,6 +65,8 @@ impl GatherTreePass {
             Binding::Buffer(&scene.tree_nodes),
             Binding::Buffer(&scene.tree_order),
             Binding::Buffer(&scene.node_power),
+            Binding::Buffer(&scene.receiver_order),
+            Binding::Buffer(&scene.receiver_groups),
             Binding::Buffer(&scene.exitance),
         ])?;
         Ok(GatherTreePass { pipeline, set, epsilon })
@@ -67,6 +80,8 @@ impl RenderPass for GatherTreePass {
             stage,
             first_node: r.first_node,
             node_count: r.node_count,
+            first_receiver: r.first_receiver,
+            first_group: r.first_group,
             epsilon: self.epsilon,
         };
         for r in &frame.scene.receivers {

@@ -33,6 +33,10 @@ pub struct Receiver {
     pub first_node: u32,
     /// Its node count: the threads of the hierarchical gather's stage 0.
     pub node_count: u32,
+    /// Its first entry in `GpuScene::receiver_order` (its vertices in group order).
+    pub first_receiver: u32,
+    /// Its first group in `GpuScene::receiver_groups`.
+    pub first_group: u32,
 }
 
 /// A prepared scene's data on the GPU: device-local buffers the passes bind, and the ranges and
@@ -65,6 +69,13 @@ pub struct GpuScene {
     pub tree_order: Buffer,
     /// `NodePowerRecord` per node, written by the hierarchical gather's stage 0.
     pub node_power: Buffer,
+    /// Vertex indices (u32, absolute) of every translucent object in group order
+    /// (`sampling::ReceiverGroups`): the hierarchical gather's invocation `k` of an object
+    /// gathers at `receiver_order[first_receiver + k]`.
+    pub receiver_order: Buffer,
+    /// Per group of `RECEIVER_GROUP_SIZE` receivers: centre (xyz) and radius (w) of a sphere
+    /// holding them.
+    pub receiver_groups: Buffer,
     /// `LightGpu` per prepared light, key lights first; rewritten inside a frame's command buffer
     /// when lights change (`record_uploads`).
     pub lights: Buffer,
@@ -114,6 +125,7 @@ impl GpuScene {
         let (mut draws, mut casters, mut receivers, mut vertex_offsets) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let (mut tree_nodes, mut tree_order) = (Vec::new(), Vec::<u32>::new());
+        let (mut receiver_order, mut receiver_groups) = (Vec::<u32>::new(), Vec::<[f32; 4]>::new());
         for (i, o) in scene.objects.iter().enumerate() {
             let first_vertex = vertices.len() as u32;
             let first_sample = samples.len() as u32;
@@ -146,7 +158,19 @@ impl GpuScene {
                 tree_nodes.extend(tree.nodes.iter().map(|n| TreeNodeRecord::new(n, first_node, first_entry)));
                 tree_order.extend(tree.order.iter().map(|k| first_sample + k));
                 let node_count = tree.nodes.len() as u32;
-                receivers.push(Receiver { object: i as u32, vertex_count, sample_count, first_node, node_count });
+                let groups = o.receiver_groups();
+                let (first_receiver, first_group) = (receiver_order.len() as u32, receiver_groups.len() as u32);
+                receiver_order.extend(groups.order.iter().map(|v| first_vertex + v));
+                receiver_groups.extend(groups.bounds.iter().map(|([x, y, z], r)| [*x, *y, *z, *r]));
+                receivers.push(Receiver {
+                    object: i as u32,
+                    vertex_count,
+                    sample_count,
+                    first_node,
+                    node_count,
+                    first_receiver,
+                    first_group,
+                });
             }
         }
         let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER;
@@ -167,6 +191,8 @@ impl GpuScene {
             )?,
             tree_nodes: upload(gpu, "tree nodes", &tree_nodes, vk::BufferUsageFlags::empty())?,
             tree_order: upload(gpu, "tree order", &tree_order, vk::BufferUsageFlags::empty())?,
+            receiver_order: upload(gpu, "receiver order", &receiver_order, vk::BufferUsageFlags::empty())?,
+            receiver_groups: upload(gpu, "receiver groups", &receiver_groups, vk::BufferUsageFlags::empty())?,
             node_power: storage(
                 gpu,
                 "node power",

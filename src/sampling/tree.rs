@@ -18,6 +18,9 @@ use glam::DVec3;
 /// Most samples in a leaf: a leaf's samples are summed exactly, pair by pair.
 pub const LEAF_SIZE: usize = 8;
 
+/// Receivers per group in [`ReceiverGroups`]: the hierarchical gather's workgroup size.
+pub const RECEIVER_GROUP_SIZE: usize = 64;
+
 /// One node of a [`SampleTree`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TreeNode {
@@ -65,22 +68,19 @@ impl SampleTree {
     }
 
     fn build(&mut self, positions: &[DVec3], areas: &[f64], order: &mut [u32], first: usize) {
-        let (lo, hi) = order.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), &i| {
-            (lo.min(positions[i as usize]), hi.max(positions[i as usize]))
-        });
-        let center = 0.5 * (lo + hi);
-        let radius = order.iter().map(|&i| positions[i as usize].distance(center)).fold(0.0, f64::max);
-        let center_f32 = center.as_vec3();
-        // The f32 centre is off the f64 one by up to half an ulp of each coordinate: add that
-        // and a relative margin so the rounded sphere stays conservative.
-        let slack = center.distance(center_f32.as_dvec3()) + 1e-6 * radius;
+        let (lo, hi) =
+            order.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), &i| {
+                (lo.min(positions[i as usize]), hi.max(positions[i as usize]))
+            });
+        let points: Vec<DVec3> = order.iter().map(|&i| positions[i as usize]).collect();
+        let (center, radius) = sphere(&points);
         let area: f64 = order.iter().map(|&i| areas[i as usize]).sum();
         let largest = order.iter().map(|&i| areas[i as usize]).fold(0.0, f64::max);
         let index = self.nodes.len();
         let leaf = order.len() <= LEAF_SIZE;
         self.nodes.push(TreeNode {
-            center: center_f32.to_array(),
-            radius: ((radius + slack) as f32).next_up(),
+            center,
+            radius,
             area: area as f32,
             reach: ((NEAR_BLEND_RADIUS * largest.sqrt()) as f32).next_up(),
             first: first as u32,
@@ -107,6 +107,58 @@ impl SampleTree {
         }
         self.nodes[index].skip = self.nodes.len() as u32;
     }
+}
+
+/// Receivers (mesh vertices) in a spatially coherent order, cut into groups of
+/// [`RECEIVER_GROUP_SIZE`] consecutive ones, each with a bounding sphere.
+///
+/// The hierarchical gather decides per group, not per receiver: a node is used whole, opened or
+/// pruned by its distance to the group's sphere, a lower bound on its distance to every receiver
+/// of the group. Every invocation of a workgroup then takes the same branch and reads the same
+/// node and samples, so on a SIMD device (lavapipe runs 8 invocations per instruction) the walk is
+/// scalar control flow with the kernel evaluations vectorised across receivers, instead of
+/// divergent lanes each paying for every branch; the decisions are conservative, never coarser
+/// than a per-receiver walk's.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ReceiverGroups {
+    /// Receiver indices in group order (a median-split order, so groups are compact).
+    pub order: Vec<u32>,
+    /// Per group: centre and radius of a sphere holding its receivers (f32, rounded out).
+    pub bounds: Vec<([f32; 3], f32)>,
+}
+
+impl ReceiverGroups {
+    /// The groups over receivers at `positions`.
+    pub fn new(positions: &[DVec3]) -> ReceiverGroups {
+        let order = SampleTree::new(positions, &vec![0.0; positions.len()]).order;
+        let bounds = order
+            .chunks(RECEIVER_GROUP_SIZE)
+            .map(|chunk| {
+                let points: Vec<DVec3> = chunk.iter().map(|&i| positions[i as usize]).collect();
+                sphere(&points)
+            })
+            .collect();
+        ReceiverGroups { order, bounds }
+    }
+
+    /// The bounds of the group of the receiver at `position` in [`Self::order`].
+    pub fn group_of(&self, position: usize) -> ([f32; 3], f32) {
+        self.bounds[position / RECEIVER_GROUP_SIZE]
+    }
+}
+
+/// A sphere holding `points` (the centre of their bounding box), rounded out for f32.
+fn sphere(points: &[DVec3]) -> ([f32; 3], f32) {
+    let (lo, hi) = points.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
+        (lo.min(*p), hi.max(*p))
+    });
+    let center = 0.5 * (lo + hi);
+    let radius = points.iter().map(|p| p.distance(center)).fold(0.0, f64::max);
+    let center_f32 = center.as_vec3();
+    // The f32 centre is off the f64 one by up to half an ulp of each coordinate: add that and a
+    // relative margin so the rounded sphere stays conservative.
+    let slack = center.distance(center_f32.as_dvec3()) + 1e-6 * radius;
+    (center_f32.to_array(), ((radius + slack) as f32).next_up())
 }
 
 #[cfg(test)]
@@ -156,6 +208,20 @@ mod tests {
                     assert_eq!(r.skip, node.skip);
                 }
             }
+        }
+    }
+
+    #[test]
+    fn receiver_groups_hold_their_receivers() {
+        let (p, _) = points(1000);
+        let g = ReceiverGroups::new(&p);
+        assert_eq!(g.bounds.len(), 1000usize.div_ceil(RECEIVER_GROUP_SIZE));
+        let mut sorted = g.order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..1000).collect::<Vec<u32>>());
+        for (k, &v) in g.order.iter().enumerate() {
+            let (c, r) = g.group_of(k);
+            assert!(p[v as usize].as_vec3().distance(glam::Vec3::from(c)) <= r);
         }
     }
 

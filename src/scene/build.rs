@@ -67,6 +67,12 @@ impl PreparedObject {
         let areas: Vec<f64> = self.samples.iter().map(|s| s.area).collect();
         sampling::SampleTree::new(&positions, &areas)
     }
+
+    /// Its vertices as the hierarchical gather groups them (`sampling::ReceiverGroups`).
+    pub fn receiver_groups(&self) -> sampling::ReceiverGroups {
+        let positions: Vec<glam::DVec3> = self.mesh.positions().iter().map(|p| p.as_dvec3()).collect();
+        sampling::ReceiverGroups::new(&positions)
+    }
 }
 
 /// A scene with all its CPU work done: objects loaded, placed and sampled, lights prepared.
