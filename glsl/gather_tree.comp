@@ -1,24 +1,31 @@
 #version 450
 // Hierarchical dipole gather, for `render.gather = "hierarchical"` (after Jensen and Buhler
 // 2002): the vertex gather's sum with far clusters of samples standing in for their members.
-// Two stages, one dispatch each (push `stage`):
-//   0: per node of the object's sample hierarchy, its transmitted power sum E_i A_i per channel
-//      and its power-weighted centroid, from this frame's splat;
-//   1: per vertex, tree_gather (glsl/common/tree.glsl) with the solid-angle bound
-//      push.epsilon; epsilon = 0 is the flat sum of gather.comp. Invocations take the object's
-//      vertices in group order (receiver_order), one workgroup per group of 64, and walk the
-//      hierarchy with the group's bounding sphere, so the walk is uniform across the workgroup.
+// Which clusters stand in for which receivers is decided once on the CPU, per group of 64
+// nearby vertices (sampling::SampleTree::cut, with the solid-angle bound render.gather_epsilon):
+// each group has a list of items, samples and nodes. Two stages, one dispatch each (push
+// `stage`):
+//   0: per node of the object's hierarchy, its transmitted power sum E_i A_i per channel and its
+//      power-weighted centroid, from this frame's splat;
+//   1: one workgroup per receiver group, one invocation per vertex (in group order,
+//      receiver_order), summing the group's items with gather.comp's tiled loop: a sample as
+//      there, a node as one sample of its mean area A_n at its centroid carrying its power
+//      (E = P / A_n), so its term is P R_far(r, b(A_n)); nodes lie beyond every near-blend
+//      radius, so they add no Shepard weight. Where no weight reaches a vertex, the nearest
+//      sample's near exitance is found by walking the hierarchy (glsl/common/tree.glsl).
+// With epsilon = 0 every list holds every sample: the flat sum.
 //
 // Bindings: 0 = vertices (VertexRecord[]), 1 = samples (SampleRecord[]), 2 = splat
 // (SplatRecord[]), 3 = objects (ObjectRecord[]), 4 = tree nodes (TreeNodeRecord[]), 5 = tree
 // order (uint[]), 6 = node power (NodePowerRecord[], written by stage 0, read by stage 1),
-// 7 = receiver order (uint[]), 8 = receiver groups (vec4[]: centre, radius), 9 = exitance (vec4
-// per vertex, written by stage 1). Push: GatherTreePush.
+// 7 = receiver order (uint[]), 8 = receiver groups (ReceiverGroupRecord[]), 9 = group items
+// (uint[]), 10 = exitance (vec4 per vertex, written by stage 1). Push: GatherTreePush.
 #include "dipole.glsl"
 #include "scene.glsl"
 #include "gather.glsl"
 
-layout(local_size_x = 64) in;
+#define TILE 32u
+layout(local_size_x = 32) in;
 layout(std430, set = 0, binding = 0) readonly buffer Vertices { VertexRecord vertices[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Samples { SampleRecord samples[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Splat { SplatRecord splat[]; };
@@ -27,8 +34,9 @@ layout(std430, set = 0, binding = 4) readonly buffer TreeNodes { TreeNodeRecord 
 layout(std430, set = 0, binding = 5) readonly buffer TreeOrder { uint tree_order[]; };
 layout(std430, set = 0, binding = 6) buffer NodePower { NodePowerRecord node_power[]; };
 layout(std430, set = 0, binding = 7) readonly buffer ReceiverOrder { uint receiver_order[]; };
-layout(std430, set = 0, binding = 8) readonly buffer ReceiverGroups { vec4 receiver_groups[]; };
-layout(std430, set = 0, binding = 9) writeonly buffer Exitance { vec4 exitance[]; };
+layout(std430, set = 0, binding = 8) readonly buffer ReceiverGroups { ReceiverGroupRecord receiver_groups[]; };
+layout(std430, set = 0, binding = 9) readonly buffer GroupItems { uint group_items[]; };
+layout(std430, set = 0, binding = 10) writeonly buffer Exitance { vec4 exitance[]; };
 struct GatherTreePush {
     uint object;            // the receiving object's index
     uint stage;             // 0: aggregate the nodes; 1: gather at the vertices
@@ -36,43 +44,82 @@ struct GatherTreePush {
     uint node_count;        // its node count
     uint first_receiver;    // its first entry in receiver_order
     uint first_group;       // its first group in receiver_groups
-    float epsilon;          // solid-angle bound: a node of area A at distance r is used whole when A < epsilon r^2
 };
 layout(push_constant) uniform GatherTreePushBlock { GatherTreePush push; };
 
-#define TREE_GATHER
 #include "tree.glsl"
+
+shared vec4 tile_position_area[TILE];
+shared vec4 tile_irradiance[TILE];
+shared vec4 tile_near_energy[TILE];
+
+void aggregate(uint i) {
+    TreeNodeRecord n = tree_nodes[i];
+    vec3 center = n.center_radius.xyz;
+    vec3 power = vec3(0.0), offset = vec3(0.0);
+    float weight = 0.0;
+    for (uint e = n.range_skip.x; e < n.range_skip.x + n.range_skip.y; ++e) {
+        uint s = tree_order[e];
+        vec4 ea = splat[s].irradiance_area;
+        vec3 p = ea.rgb * ea.w;
+        float w = p.r + p.g + p.b;
+        power += p;
+        // Relative to the node's centre, so that far-off objects keep their digits.
+        offset += w * (samples[s].position_area.xyz - center);
+        weight += w;
+    }
+    vec3 mean = weight > 0.0 ? center + offset / weight : center;
+    node_power[i] = NodePowerRecord(vec4(power, 0.0), vec4(mean, weight));
+}
 
 void main() {
     uint k = gl_GlobalInvocationID.x;
     if (push.stage == 0u) {
-        if (k >= push.node_count) return;
-        uint i = push.first_node + k;
-        TreeNodeRecord n = tree_nodes[i];
-        vec3 center = n.center_radius.xyz;
-        vec3 power = vec3(0.0), offset = vec3(0.0);
-        float weight = 0.0;
-        for (uint e = n.range_skip.x; e < n.range_skip.x + n.range_skip.y; ++e) {
-            uint s = tree_order[e];
-            vec4 ea = splat[s].irradiance_area;
-            vec3 p = ea.rgb * ea.w;
-            float w = p.r + p.g + p.b;
-            power += p;
-            // Relative to the node's centre, so that far-off objects keep their digits.
-            offset += w * (samples[s].position_area.xyz - center);
-            weight += w;
-        }
-        vec3 mean = weight > 0.0 ? center + offset / weight : center;
-        node_power[i] = NodePowerRecord(vec4(power, 0.0), vec4(mean, weight));
+        if (k < push.node_count) aggregate(push.first_node + k);
         return;
     }
     ObjectRecord o = objects[push.object];
     uint count = o.ranges.y;
-    // Invocations past the end walk with their group (keeping the walk uniform) but write nothing.
+    bool is_receiver = k < count;
     uint v = receiver_order[push.first_receiver + min(k, max(count, 1u) - 1u)];
-    vec4 group = receiver_groups[push.first_group + gl_WorkGroupID.x];
+    vec3 x = vertex_position(vertices[v]);
+    uvec4 list = receiver_groups[push.first_group + gl_WorkGroupID.x].items;
+    uint local = gl_LocalInvocationID.x;
     DipoleChannel ch[3] = gather_channels(o);
-    GatherSum g = tree_gather(vertex_position(vertices[v]), group.xyz, group.w, ch, push.first_node, push.node_count,
-                              push.epsilon);
-    if (k < count) exitance[v] = vec4(gather_end(g), 1.0);
+    GatherSum g = gather_begin();
+    for (uint base = 0u; base < list.y; base += TILE) {
+        uint j = base + local;
+        if (j < list.y) {
+            uint item = group_items[list.x + j];
+            if ((item & NODE_ITEM) != 0u) {
+                uint node = item & ~NODE_ITEM;
+                NodePowerRecord p = node_power[node];
+                float mean_area = tree_nodes[node].area_reach.z;
+                tile_position_area[local] = vec4(p.mean_weight.xyz, mean_area);
+                tile_irradiance[local] = vec4(mean_area > 0.0 ? p.power.rgb / mean_area : vec3(0.0), 0.0);
+                tile_near_energy[local] = vec4(0.0);
+            } else {
+                tile_position_area[local] = samples[item].position_area;
+                tile_irradiance[local] = splat[item].irradiance_area;
+                tile_near_energy[local] = splat[item].near_energy;
+            }
+        }
+        barrier();
+        uint n = min(TILE, list.y - base);
+        if (is_receiver) {
+            for (uint t = 0u; t < n; ++t) {
+                gather_add(g, ch, x, tile_position_area[t], tile_irradiance[t].rgb, tile_near_energy[t].rgb);
+            }
+            gather_flush(g);
+        }
+        barrier();
+    }
+    if (!is_receiver) return;
+    if (g.weight_sum == 0.0) {
+        // No Shepard weight reached x: the nearest sample's near exitance, found anywhere in the
+        // hierarchy (a node item may hold it), as the flat gather takes it.
+        uint s = tree_nearest_sample(x, push.first_node, push.node_count);
+        g.nearest_near = splat[s].irradiance_area.rgb * splat[s].near_energy.rgb;
+    }
+    exitance[v] = vec4(gather_end(g), 1.0);
 }

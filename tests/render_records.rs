@@ -161,7 +161,7 @@ fn push_blocks_match_glsl_and_spirv() {
             include_str!("../glsl/gather_tree.comp"),
             "GatherTreePush",
             size_of::<GatherTreePush>(),
-            &["object", "stage", "first_node", "node_count", "first_receiver", "first_group", "epsilon"],
+            &["object", "stage", "first_node", "node_count", "first_receiver", "first_group"],
         ),
         (
             "gather_pixel.comp",

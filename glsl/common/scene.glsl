@@ -41,6 +41,15 @@ struct NodePowerRecord {
     vec4 mean_weight;       // xyz: power-weighted centroid; w: total weight
 };
 
+// One group of the hierarchical gather's receivers (ReceiverGroupRecord; sampling::ReceiverGroups).
+struct ReceiverGroupRecord {
+    vec4 center_radius;     // xyz: centre of a sphere holding its receivers; w: radius
+    uvec4 items;            // x: first entry in the group items; y: item count; z, w: 0
+};
+
+// An item of a group's list is a sample index, or NODE_ITEM | a node index (sampling::NODE_ITEM).
+const uint NODE_ITEM = 0x80000000u;
+
 // One mesh vertex as compute passes read it (the raster passes read the same buffer as vertex
 // attributes): tightly packed, 24 bytes.
 struct VertexRecord {

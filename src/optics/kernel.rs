@@ -201,6 +201,15 @@ pub fn near_blend_weight(r: f64, area: f64) -> f64 {
     t * t * t
 }
 
+/// Whether a cluster of samples of total area `area`, all at least `dist` away from a receiver,
+/// adds at most [`TREE_PRUNE_FRACTION`] of `R_d,total` to its exitance under uniform light in
+/// every channel: `area R_d(dist) <= TREE_PRUNE_FRACTION R_d,total`, which bounds the cluster's far
+/// sum because `R_far <= R_d` and `R_d` falls with distance (callers ensure no sample's near
+/// blend reaches the receiver).
+pub fn negligible_cluster(dipoles: &[Dipole; 3], area: f64, dist: f64) -> bool {
+    dipoles.iter().all(|d| area * d.r_d(dist) <= TREE_PRUNE_FRACTION * d.r_d_total())
+}
+
 /// `3t^2 - 2t^3` on `[0, 1]`, clamped: a blend weight with zero slope at both ends.
 pub fn smoothstep(t: f64) -> f64 {
     let t = t.clamp(0.0, 1.0);

@@ -16,9 +16,8 @@ kernel_constants! {
     /// shadow edge on marble (tests/render.rs) 2.0 bleeds 7.7% of the lit level too far, 1.5 2.3%,
     /// 1.25 1.75%; 1.5 keeps more overlap for irregular sample sets.
     NEAR_BLEND_RADIUS = 1.5;
-    /// The hierarchical gather skips a node that is neither used whole nor within any sample's
-    /// blend reach when, in every channel, its power times `R_d` at its nearest possible point is
-    /// at most this fraction of the receiver's far sum so far (`R_far <= R_d` and `R_d` falls
-    /// with distance, so that bounds all it could add).
-    TREE_PRUNE_FRACTION = 1e-5;
+    /// The hierarchical gather drops a cluster of samples (with its subtree) when, under uniform
+    /// light, it could add at most this fraction of `R_d,total` in every channel
+    /// ([`negligible_cluster`]).
+    TREE_PRUNE_FRACTION = 1e-6;
 }

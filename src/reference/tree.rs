@@ -1,12 +1,12 @@
 //! The hierarchical gather in f64 (`render.gather = "hierarchical"`), twin of
-//! glsl/gather_tree.comp and glsl/common/tree.glsl: the same hierarchy
-//! (`PreparedObject::sample_tree`), the same node aggregates, the same traversal order and the
-//! same criteria, so the GPU can be tested against it node decision for node decision.
+//! glsl/gather_tree.comp: the same hierarchy (`PreparedObject::sample_tree`), the same receiver
+//! groups and cuts (`PreparedObject::gather_cuts`), the same node aggregates, so the GPU can be
+//! tested against it item for item.
 
 use super::{near_blend, per_translucent_object};
 use crate::optics::Dipole;
-use crate::optics::kernel::{self, B_PER_SQRT_AREA, TREE_PRUNE_FRACTION};
-use crate::sampling::{SampleTree, TreeNode};
+use crate::optics::kernel::{self, B_PER_SQRT_AREA};
+use crate::sampling::{NODE_ITEM, RECEIVER_GROUP_SIZE, SampleTree, TreeNode};
 use crate::scene::build::PreparedScene;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -48,60 +48,42 @@ fn center_of(n: &TreeNode) -> DVec3 {
     glam::Vec3::from(n.center).as_dvec3()
 }
 
-/// Stage 1 at one receiver `x` of the group bounded by `group` (centre, radius): the far sum
-/// over the hierarchy with nodes used whole when `A < epsilon dist^2` beyond every near-blend
-/// radius (`dist` from the group's sphere), leaves summed sample by sample, nodes pruned when
-/// they can add at most `TREE_PRUNE_FRACTION` of the object's mean exitance; plus the near field
-/// blended over the visited leaves (the nearest sample's where no weight reaches).
+/// Stage 1 at one receiver `x` whose group's cut is `items` (`sampling::SampleTree::cut`): a
+/// sample's far kernel and near exitance as in the flat sum, a node's power at its centroid with
+/// the far kernel of its mean area; the near field blended over the listed samples (the nearest
+/// sample of the object where no weight reaches).
 #[allow(clippy::too_many_arguments)]
-pub fn gather_at(
+pub fn gather_items(
     x: DVec3,
-    group: ([f32; 3], f32),
+    items: &[u32],
     tree: &SampleTree,
     power: &[NodePower],
     dipoles: &[Dipole; 3],
     positions: &[DVec3],
     areas: &[f64],
     e: &[[f64; 3]],
-    epsilon: f64,
 ) -> [f64; 3] {
     let mut far = [0.0f64; 3];
     let mut near = Vec::new();
-    let root_area = (tree.nodes[0].area as f64).max(1e-30);
-    // epsilon = 0 prunes nothing either: the exact flat sum.
-    let negligible: [f64; 3] = [0, 1, 2].map(|c| {
-        if epsilon > 0.0 { TREE_PRUNE_FRACTION * dipoles[c].r_d_total() * power[0].power[c] / root_area } else { -1.0 }
-    });
-    let (group_center, group_radius) = (glam::Vec3::from(group.0).as_dvec3(), group.1 as f64);
-    let mut i = 0;
-    while i < tree.nodes.len() {
-        let n = &tree.nodes[i];
-        let dist = group_center.distance(center_of(n)) - n.radius as f64 - group_radius;
-        let beyond_blend = dist > n.reach as f64;
-        if beyond_blend && (n.area as f64) < epsilon * dist * dist {
-            let p = &power[i];
-            let r = x.distance(p.centroid);
-            let mean_area = n.area as f64 / n.count as f64;
+    for &item in items {
+        if item & NODE_ITEM != 0 {
+            let i = (item & !NODE_ITEM) as usize;
+            let n = &tree.nodes[i];
+            // As the GPU packs it: the f32 area over the count.
+            let mean_area = (n.area / n.count as f32) as f64;
             let b = B_PER_SQRT_AREA * mean_area.sqrt();
+            let r = x.distance(power[i].centroid);
             for c in 0..3 {
-                far[c] += p.power[c] * kernel::r_d_far(&dipoles[c], r, b);
+                far[c] += power[i].power[c] * kernel::r_d_far(&dipoles[c], r, b);
             }
-            i = n.skip as usize;
-        } else if n.leaf {
-            for &s in &tree.order[n.first as usize..(n.first + n.count) as usize] {
-                let s = s as usize;
-                let r = x.distance(positions[s]);
-                for c in 0..3 {
-                    far[c] += e[s][c] * kernel::far_kernel(&dipoles[c], r, areas[s]);
-                }
-                let b = B_PER_SQRT_AREA * areas[s].sqrt();
-                near.push((positions[s], areas[s], [0, 1, 2].map(|c| e[s][c] * kernel::near_energy(&dipoles[c], b))));
-            }
-            i = n.skip as usize;
-        } else if beyond_blend && (0..3).all(|c| power[i].power[c] * dipoles[c].r_d(dist) <= negligible[c]) {
-            i = n.skip as usize;
         } else {
-            i += 1;
+            let s = item as usize;
+            let r = x.distance(positions[s]);
+            for c in 0..3 {
+                far[c] += e[s][c] * kernel::far_kernel(&dipoles[c], r, areas[s]);
+            }
+            let b = B_PER_SQRT_AREA * areas[s].sqrt();
+            near.push((positions[s], areas[s], [0, 1, 2].map(|c| e[s][c] * kernel::near_energy(&dipoles[c], b))));
         }
     }
     let mut blended = near_blend(x, &near);
@@ -127,22 +109,20 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]], epsilon: f64) -> V
         let areas: Vec<f64> = o.samples.iter().map(|s| s.area).collect();
         let e = &irradiance[first..first + o.samples.len()];
         let power = node_power(&tree, &positions, &areas, e);
-        if tree.nodes.is_empty() {
-            return vec![[0.0; 3]; o.mesh.positions().len()];
-        }
         let groups = o.receiver_groups();
+        let cuts = o.gather_cuts(&tree, &groups, epsilon);
         let mesh = o.mesh.positions();
-        let mut exitance = vec![[0.0; 3]; mesh.len()];
         let computed: Vec<(usize, [f64; 3])> = groups
             .order
             .par_iter()
             .enumerate()
             .map(|(k, &v)| {
                 let x = mesh[v as usize].as_dvec3();
-                let m = gather_at(x, groups.group_of(k), &tree, &power, dipoles, &positions, &areas, e, epsilon);
-                (v as usize, m)
+                let items = &cuts[k / RECEIVER_GROUP_SIZE];
+                (v as usize, gather_items(x, items, &tree, &power, dipoles, &positions, &areas, e))
             })
             .collect();
+        let mut exitance = vec![[0.0; 3]; mesh.len()];
         for (v, m) in computed {
             exitance[v] = m;
         }

@@ -2,13 +2,14 @@
 //! the vertex gather's dipole sum with far clusters of samples standing in for their members
 //! (after Jensen and Buhler 2002). Per translucent object, stage 0 aggregates each node of its
 //! sample hierarchy (`sampling::SampleTree`) from this frame's splat, a compute-to-compute
-//! barrier, then stage 1 walks the hierarchy from every vertex. `render.gather_epsilon` is the
-//! accuracy knob: the solid-angle bound below which a node is used whole; 0 is the flat sum.
-//! `reference::tree::gather` is its f64 twin.
+//! barrier, then stage 1 sums, for every vertex, the list of samples and nodes that
+//! `sampling::SampleTree::cut` chose for its group of 64 (built once in `GpuScene::new`).
+//! `render.gather_epsilon` is the accuracy knob: the solid-angle bound below which a node is used
+//! whole; 0 is the flat sum. `reference::tree::gather` is its f64 twin.
 //!
 //! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = tree nodes, 5 = tree order,
-//! 6 = node power, 7 = receiver order, 8 = receiver groups, 9 = exitance. Push:
-//! `GatherTreePush`.
+//! 6 = node power, 7 = receiver order, 8 = receiver groups, 9 = group items, 10 = exitance.
+//! Push: `GatherTreePush`.
 
 use super::gather::exitance_written;
 use super::gpu_scene::GpuScene;
@@ -33,9 +34,6 @@ pub struct GatherTreePush {
     pub first_receiver: u32,
     /// Its first group in `GpuScene::receiver_groups`.
     pub first_group: u32,
-    /// The solid-angle bound: a node of area `A` whose samples are all at least `r` away is used
-    /// whole when `A < epsilon r^2`.
-    pub epsilon: f32,
 }
 
 /// The hierarchical gather: two dispatches of glsl/gather_tree.comp per translucent object,
@@ -43,13 +41,12 @@ pub struct GatherTreePush {
 pub struct GatherTreePass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
-    epsilon: f32,
 }
 
 impl GatherTreePass {
-    /// The pipeline and one descriptor set over the scene's buffers; `epsilon` is the
-    /// solid-angle bound (`render.gather_epsilon`).
-    pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene, epsilon: f32) -> GpuResult<GatherTreePass> {
+    /// The pipeline and one descriptor set over the scene's buffers (whose group items
+    /// `GpuScene::new` built for the scene's `render.gather_epsilon`).
+    pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene) -> GpuResult<GatherTreePass> {
         let pipeline = ComputePipeline::new(gpu, "gather_tree.comp")?;
         // Stage 1's workgroups are the receiver groups: its local size must be their size.
         let n = crate::sampling::RECEIVER_GROUP_SIZE as u32;
@@ -67,9 +64,10 @@ impl GatherTreePass {
             Binding::Buffer(&scene.node_power),
             Binding::Buffer(&scene.receiver_order),
             Binding::Buffer(&scene.receiver_groups),
+            Binding::Buffer(&scene.group_items),
             Binding::Buffer(&scene.exitance),
         ])?;
-        Ok(GatherTreePass { pipeline, set, epsilon })
+        Ok(GatherTreePass { pipeline, set })
     }
 }
 
@@ -82,7 +80,6 @@ impl RenderPass for GatherTreePass {
             node_count: r.node_count,
             first_receiver: r.first_receiver,
             first_group: r.first_group,
-            epsilon: self.epsilon,
         };
         for r in &frame.scene.receivers {
             self.pipeline.dispatch(cmd, &self.set, &push(r, 0), [r.node_count, 1, 1]);

@@ -3,7 +3,10 @@
 //! write and read between frames (splat output, exitance, cached environment irradiance). The
 //! passes get their inputs from here; only lights change after creation.
 
-use super::records::{LightGpu, NodePowerRecord, ObjectRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex};
+use super::records::{
+    LightGpu, NodePowerRecord, ObjectRecord, ReceiverGroupRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
+};
+use crate::sampling::NODE_ITEM;
 use crate::gpu::{Access, Buffer, BufferDesc, Gpu, GpuResult, memory_barrier};
 use crate::scene::build::PreparedScene;
 use ash::vk;
@@ -73,9 +76,13 @@ pub struct GpuScene {
     /// (`sampling::ReceiverGroups`): the hierarchical gather's invocation `k` of an object
     /// gathers at `receiver_order[first_receiver + k]`.
     pub receiver_order: Buffer,
-    /// Per group of `RECEIVER_GROUP_SIZE` receivers: centre (xyz) and radius (w) of a sphere
-    /// holding them.
+    /// `ReceiverGroupRecord` per group of `RECEIVER_GROUP_SIZE` receivers: its bounding sphere
+    /// and its range in `group_items`.
     pub receiver_groups: Buffer,
+    /// The hierarchical gather's items (`sampling::SampleTree::cut`) of every group, groups one
+    /// after another, made absolute: a sample index, or `NODE_ITEM |` a node index. Built only
+    /// when the scene gathers hierarchically (otherwise empty).
+    pub group_items: Buffer,
     /// `LightGpu` per prepared light, key lights first; rewritten inside a frame's command buffer
     /// when lights change (`record_uploads`).
     pub lights: Buffer,
@@ -125,7 +132,10 @@ impl GpuScene {
         let (mut draws, mut casters, mut receivers, mut vertex_offsets) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let (mut tree_nodes, mut tree_order) = (Vec::new(), Vec::<u32>::new());
-        let (mut receiver_order, mut receiver_groups) = (Vec::<u32>::new(), Vec::<[f32; 4]>::new());
+        let (mut receiver_order, mut receiver_groups) = (Vec::<u32>::new(), Vec::<ReceiverGroupRecord>::new());
+        let mut group_items = Vec::<u32>::new();
+        let render = &scene.scene.file.render;
+        let hierarchical = render.gather == crate::scene::GatherMode::Hierarchical;
         for (i, o) in scene.objects.iter().enumerate() {
             let first_vertex = vertices.len() as u32;
             let first_sample = samples.len() as u32;
@@ -161,7 +171,21 @@ impl GpuScene {
                 let groups = o.receiver_groups();
                 let (first_receiver, first_group) = (receiver_order.len() as u32, receiver_groups.len() as u32);
                 receiver_order.extend(groups.order.iter().map(|v| first_vertex + v));
-                receiver_groups.extend(groups.bounds.iter().map(|([x, y, z], r)| [*x, *y, *z, *r]));
+                let cuts = if hierarchical {
+                    o.gather_cuts(&tree, &groups, render.gather_epsilon as f64)
+                } else {
+                    vec![Vec::new(); groups.bounds.len()]
+                };
+                for (&([x, y, z], r), items) in groups.bounds.iter().zip(&cuts) {
+                    let first = group_items.len() as u32;
+                    group_items.extend(items.iter().map(|&it| {
+                        if it & NODE_ITEM != 0 { it + first_node } else { it + first_sample }
+                    }));
+                    receiver_groups.push(ReceiverGroupRecord {
+                        center_radius: [x, y, z, r],
+                        items: [first, items.len() as u32, 0, 0],
+                    });
+                }
                 receivers.push(Receiver {
                     object: i as u32,
                     vertex_count,
@@ -193,6 +217,7 @@ impl GpuScene {
             tree_order: upload(gpu, "tree order", &tree_order, vk::BufferUsageFlags::empty())?,
             receiver_order: upload(gpu, "receiver order", &receiver_order, vk::BufferUsageFlags::empty())?,
             receiver_groups: upload(gpu, "receiver groups", &receiver_groups, vk::BufferUsageFlags::empty())?,
+            group_items: upload(gpu, "group items", &group_items, vk::BufferUsageFlags::empty())?,
             node_power: storage(
                 gpu,
                 "node power",

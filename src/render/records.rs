@@ -149,6 +149,17 @@ pub struct NodePowerRecord {
     pub mean_weight: [f32; 4],
 }
 
+/// `ReceiverGroupRecord` in glsl/common/scene.glsl: one group of receivers of the hierarchical
+/// gather (`sampling::ReceiverGroups`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ReceiverGroupRecord {
+    /// xyz: centre of a sphere holding the group's receivers; w: its radius.
+    pub center_radius: [f32; 4],
+    /// x: first entry in the group items; y: item count; z, w: 0.
+    pub items: [u32; 4],
+}
+
 /// `struct Light` in glsl/common/lights.glsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]

@@ -192,7 +192,7 @@ impl Renderer {
             (Some(surface), Some(hdr)) => Box::new(GatherPixelPass::new(gpu, &buffers, surface, hdr)?),
             _ if settings.gather == GatherMode::Sparse => Box::new(GatherSparsePass::new(gpu, &buffers)?),
             _ if settings.gather == GatherMode::Hierarchical => {
-                Box::new(GatherTreePass::new(gpu, &buffers, settings.gather_epsilon)?)
+                Box::new(GatherTreePass::new(gpu, &buffers)?)
             }
             _ => Box::new(GatherPass::new(gpu, &buffers)?),
         };

@@ -68,6 +68,24 @@ impl PreparedObject {
         sampling::SampleTree::new(&positions, &areas)
     }
 
+    /// The hierarchical gather's items for each receiver group at accuracy `epsilon`
+    /// (`sampling::SampleTree::cut`, nodes dropped by `optics::kernel::negligible_cluster`);
+    /// empty lists for an opaque object.
+    pub fn gather_cuts(
+        &self,
+        tree: &sampling::SampleTree,
+        groups: &sampling::ReceiverGroups,
+        epsilon: f64,
+    ) -> Vec<Vec<u32>> {
+        use rayon::prelude::*;
+        let ResolvedMaterial::Translucent { dipoles, .. } = &self.material else {
+            return vec![Vec::new(); groups.bounds.len()];
+        };
+        let negligible =
+            |n: &sampling::TreeNode, dist: f64| crate::optics::kernel::negligible_cluster(dipoles, n.area as f64, dist);
+        groups.bounds.par_iter().map(|&g| tree.cut(g, epsilon, negligible)).collect()
+    }
+
     /// Its vertices as the hierarchical gather groups them (`sampling::ReceiverGroups`).
     pub fn receiver_groups(&self) -> sampling::ReceiverGroups {
         let positions: Vec<glam::DVec3> = self.mesh.positions().iter().map(|p| p.as_dvec3()).collect();
