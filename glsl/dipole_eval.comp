@@ -37,6 +37,7 @@ struct EvalOutput {
     float kernel;         // dipole_kernel(r, area)
     float near_energy;    // E_near(1.5 sqrt(area))
     float r_d_far;        // R_far(r, 1.5 sqrt(area))
+    float r_d_far_cluster; // the cluster kernel at r with tr C = 0.3 r^2, axial variance 0.1 r^2
     float fresnel_r;      // F_r(cos_theta_i, eta)
     float fresnel_t;      // F_t(cos_theta_o, eta)
     float s_d;
@@ -69,6 +70,7 @@ void main() {
     o.kernel = dipole_kernel(ch, p.r, p.area);
     o.near_energy = dipole_near_energy(ch, b);
     o.r_d_far = dipole_r_d_far(ch, p.r, b);
+    o.r_d_far_cluster = dipole_r_d_far_cluster_sq(ch, p.r * p.r, b * b, 0.3 * p.r * p.r, 0.1 * p.r * p.r);
     o.fresnel_r = dipole_fresnel_reflectance(p.cos_theta_i, p.eta);
     o.fresnel_t = dipole_fresnel_transmittance(p.cos_theta_o, p.eta);
     o.s_d = dipole_s_d(ch, p.eta, p.r, p.cos_theta_i, p.cos_theta_o, p.t_eta);

@@ -4,31 +4,51 @@
 //   0: at every sample j, T_j = sum_i E_i far_kernel(|x_j - x_i|, A_i) + E_j E_near,j, the
 //      exitance there (glsl/common/gather.glsl's far sum plus the sample's own near exitance);
 //   1: at every vertex, M(x) = sum_j phi_j(x) T_j / sum_j phi_j(x) with the near-field Shepard
-//      weights (nearest sample where none reaches).
+//      weights (nearest sample where none reaches). Vertices come in receiver groups
+//      (sampling::ReceiverGroups, one workgroup each), and each group visits only the samples
+//      whose blend radius reaches its bounding sphere (blend items, found on the CPU by
+//      SampleTree::within_reach), staged through shared memory; the nearest-sample fallback
+//      walks the sample hierarchy (glsl/common/tree.glsl).
 // The far part is smooth on the scale of the sample spacing (optics::kernel), so sampling it at
 // the samples loses little, and the per-vertex work drops from two exponentials per channel
 // and pair to one weight per pair. Under uniform light every vertex still gets E R_d,total.
 //
 // Bindings: 0 = vertices (VertexRecord[]), 1 = samples (SampleRecord[]), 2 = splat
 // (SplatRecord[]), 3 = objects (ObjectRecord[]), 4 = sample exitance (vec4 per sample,
-// written by stage 0, read by stage 1), 5 = exitance (vec4 per vertex, written by stage 1).
-// Push: GatherSparsePush.
+// written by stage 0, read by stage 1), 5 = exitance (vec4 per vertex, written by stage 1),
+// 6 = tree nodes (TreeNodeRecord[]), 7 = tree order (uint[]), 8 = receiver order (uint[]),
+// 9 = receiver groups (ReceiverGroupRecord[]), 10 = blend items (uint[]). Push: GatherSparsePush.
 #include "dipole.glsl"
 #include "scene.glsl"
 #include "gather.glsl"
 
-layout(local_size_x = 64) in;
+#define TILE 32u
+layout(local_size_x = 32) in;
 layout(std430, set = 0, binding = 0) readonly buffer Vertices { VertexRecord vertices[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Samples { SampleRecord samples[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Splat { SplatRecord splat[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Objects { ObjectRecord objects[]; };
 layout(std430, set = 0, binding = 4) buffer SampleExitance { vec4 sample_exitance[]; };
 layout(std430, set = 0, binding = 5) writeonly buffer Exitance { vec4 exitance[]; };
+layout(std430, set = 0, binding = 6) readonly buffer TreeNodes { TreeNodeRecord tree_nodes[]; };
+layout(std430, set = 0, binding = 7) readonly buffer TreeOrder { uint tree_order[]; };
+layout(std430, set = 0, binding = 8) readonly buffer ReceiverOrder { uint receiver_order[]; };
+layout(std430, set = 0, binding = 9) readonly buffer ReceiverGroups { ReceiverGroupRecord receiver_groups[]; };
+layout(std430, set = 0, binding = 10) readonly buffer BlendItems { uint blend_items[]; };
 struct GatherSparsePush {
     uint object;            // the receiving object's index
     uint stage;             // 0: exitance at the samples; 1: blended to the vertices
+    uint first_node;        // the object's root in tree_nodes
+    uint node_count;        // its node count
+    uint first_receiver;    // its first entry in receiver_order
+    uint first_group;       // its first group in receiver_groups
 };
 layout(push_constant) uniform GatherSparsePushBlock { GatherSparsePush push; };
+
+#include "tree.glsl"
+
+shared vec4 tile_position_area[TILE];
+shared vec4 tile_exitance[TILE];
 
 void main() {
     ObjectRecord o = objects[push.object];
@@ -48,24 +68,32 @@ void main() {
         sample_exitance[j] = vec4(max(g.far, vec3(0.0)) + splat[j].irradiance_area.rgb * splat[j].near_energy.rgb, 0.0);
         return;
     }
-    if (k >= o.ranges.y) return;
-    uint v = o.ranges.x + k;
+    uint count = o.ranges.y;
+    bool is_receiver = k < count;
+    uint v = receiver_order[push.first_receiver + min(k, max(count, 1u) - 1u)];
     vec3 x = vertex_position(vertices[v]);
+    uvec4 list = receiver_groups[push.first_group + gl_WorkGroupID.x].blend;
+    uint local = gl_LocalInvocationID.x;
     vec3 sum = vec3(0.0);
     float weight_sum = 0.0;
-    float nearest_r = 3.4e38;
-    vec3 nearest = vec3(0.0);
-    for (uint i = first_sample; i < first_sample + sample_count; ++i) {
-        vec4 pa = samples[i].position_area;
-        float r = distance(x, pa.xyz);
-        float w = dipole_near_blend_weight(r, pa.w);
-        vec3 t = sample_exitance[i].rgb;
-        sum += w * t;
-        weight_sum += w;
-        if (r < nearest_r) {
-            nearest_r = r;
-            nearest = t;
+    for (uint base = 0u; base < list.y; base += TILE) {
+        uint j = base + local;
+        if (j < list.y) {
+            uint s = blend_items[list.x + j];
+            tile_position_area[local] = samples[s].position_area;
+            tile_exitance[local] = sample_exitance[s];
         }
+        barrier();
+        uint n = min(TILE, list.y - base);
+        for (uint t = 0u; t < n; ++t) {
+            vec4 pa = tile_position_area[t];
+            float w = dipole_near_blend_weight(distance(x, pa.xyz), pa.w);
+            sum += w * tile_exitance[t].rgb;
+            weight_sum += w;
+        }
+        barrier();
     }
-    exitance[v] = vec4(weight_sum > 0.0 ? sum / weight_sum : nearest, 1.0);
+    if (!is_receiver) return;
+    vec3 blended = weight_sum > 0.0 ? sum / weight_sum : sample_exitance[tree_nearest_sample(x, push.first_node, push.node_count)].rgb;
+    exitance[v] = vec4(blended, 1.0);
 }

@@ -5,14 +5,16 @@
 // nearby vertices (sampling::SampleTree::cut, with the solid-angle bound render.gather_epsilon):
 // each group has a list of items, samples and nodes. Two stages, one dispatch each (push
 // `stage`):
-//   0: per node of the object's hierarchy, its transmitted power sum E_i A_i per channel and its
-//      power-weighted centroid, from this frame's splat;
+//   0: per node of the object's hierarchy, its transmitted power sum E_i A_i per channel, its
+//      power-weighted centroid and the power-weighted covariance of its members about it, from
+//      this frame's splat;
 //   1: one workgroup per receiver group, one invocation per vertex (in group order,
-//      receiver_order), summing the group's items with gather.comp's tiled loop: a sample as
-//      there, a node as one sample of its mean area A_n at its centroid carrying its power
-//      (E = P / A_n), so its term is P R_far(r, b(A_n)); nodes lie beyond every near-blend
-//      radius, so they add no Shepard weight. Where no weight reaches a vertex, the nearest
-//      sample's near exitance is found by walking the hierarchy (glsl/common/tree.glsl).
+//      receiver_order), summing the group's items with gather.comp's tiled loop: first its
+//      nodes, each its power times the cluster kernel (dipole_r_d_far_cluster_sq: R_far at the
+//      centroid with b of the members' mean area, plus the second-order term of their spread),
+//      then its samples as gather.comp sums them. Nodes lie beyond every near-blend radius, so
+//      they add no Shepard weight. Where no weight reaches a vertex, the nearest sample's near
+//      exitance is found by walking the hierarchy (glsl/common/tree.glsl).
 // With epsilon = 0 every list holds every sample: the flat sum.
 //
 // Bindings: 0 = vertices (VertexRecord[]), 1 = samples (SampleRecord[]), 2 = splat
@@ -49,14 +51,17 @@ layout(push_constant) uniform GatherTreePushBlock { GatherTreePush push; };
 
 #include "tree.glsl"
 
+// Per tile entry: a sample's position and area, irradiance and near energy; or a node's
+// centroid and mean area, power, covariance diagonal (in the near-energy slot) and off-diagonal.
 shared vec4 tile_position_area[TILE];
 shared vec4 tile_irradiance[TILE];
 shared vec4 tile_near_energy[TILE];
+shared vec4 tile_cov_off[TILE];
 
 void aggregate(uint i) {
     TreeNodeRecord n = tree_nodes[i];
     vec3 center = n.center_radius.xyz;
-    vec3 power = vec3(0.0), offset = vec3(0.0);
+    vec3 power = vec3(0.0), offset = vec3(0.0), diag = vec3(0.0), off = vec3(0.0);
     float weight = 0.0;
     for (uint e = n.range_skip.x; e < n.range_skip.x + n.range_skip.y; ++e) {
         uint s = tree_order[e];
@@ -65,11 +70,17 @@ void aggregate(uint i) {
         float w = p.r + p.g + p.b;
         power += p;
         // Relative to the node's centre, so that far-off objects keep their digits.
-        offset += w * (samples[s].position_area.xyz - center);
+        vec3 y = samples[s].position_area.xyz - center;
+        offset += w * y;
+        diag += w * y * y;
+        off += w * vec3(y.x * y.y, y.x * y.z, y.y * y.z);
         weight += w;
     }
-    vec3 mean = weight > 0.0 ? center + offset / weight : center;
-    node_power[i] = NodePowerRecord(vec4(power, 0.0), vec4(mean, weight));
+    vec3 m = weight > 0.0 ? offset / weight : vec3(0.0);
+    // Covariance about the centroid: E[y y^T] - m m^T, never negative on the diagonal.
+    vec3 cov_diag = weight > 0.0 ? max(diag / weight - m * m, vec3(0.0)) : vec3(0.0);
+    vec3 cov_off = weight > 0.0 ? off / weight - vec3(m.x * m.y, m.x * m.z, m.y * m.z) : vec3(0.0);
+    node_power[i] = NodePowerRecord(vec4(power, 0.0), vec4(center + m, weight), vec4(cov_diag, 0.0), vec4(cov_off, 0.0));
 }
 
 void main() {
@@ -87,25 +98,49 @@ void main() {
     uint local = gl_LocalInvocationID.x;
     DipoleChannel ch[3] = gather_channels(o);
     GatherSum g = gather_begin();
+    // The group's nodes: power P per channel times the cluster kernel.
     for (uint base = 0u; base < list.y; base += TILE) {
         uint j = base + local;
         if (j < list.y) {
-            uint item = group_items[list.x + j];
-            if ((item & NODE_ITEM) != 0u) {
-                uint node = item & ~NODE_ITEM;
-                NodePowerRecord p = node_power[node];
-                float mean_area = tree_nodes[node].area_reach.z;
-                tile_position_area[local] = vec4(p.mean_weight.xyz, mean_area);
-                tile_irradiance[local] = vec4(mean_area > 0.0 ? p.power.rgb / mean_area : vec3(0.0), 0.0);
-                tile_near_energy[local] = vec4(0.0);
-            } else {
-                tile_position_area[local] = samples[item].position_area;
-                tile_irradiance[local] = splat[item].irradiance_area;
-                tile_near_energy[local] = splat[item].near_energy;
-            }
+            uint node = group_items[list.x + j] & ~NODE_ITEM;
+            NodePowerRecord p = node_power[node];
+            tile_position_area[local] = vec4(p.mean_weight.xyz, tree_nodes[node].area_reach.z);
+            tile_irradiance[local] = p.power;
+            tile_near_energy[local] = p.cov_diag;
+            tile_cov_off[local] = p.cov_off;
         }
         barrier();
         uint n = min(TILE, list.y - base);
+        if (is_receiver) {
+            for (uint t = 0u; t < n; ++t) {
+                vec3 u = x - tile_position_area[t].xyz;
+                float r_sq = dot(u, u);
+                vec3 w = u * inversesqrt(max(r_sq, 1e-30)); // unit, so nothing of order r^4 forms
+                vec3 cd = tile_near_energy[t].xyz, co = tile_cov_off[t].xyz;
+                float tr_cov = cd.x + cd.y + cd.z;
+                float axial_cov = dot(w * w, cd) + 2.0 * (w.x * w.y * co.x + w.x * w.z * co.y + w.y * w.z * co.z);
+                float beta = DIPOLE_B_PER_SQRT_AREA * DIPOLE_B_PER_SQRT_AREA * tile_position_area[t].w;
+                vec3 power = tile_irradiance[t].rgb;
+                for (int c = 0; c < 3; ++c) {
+                    g.partial[c] += power[c] * dipole_r_d_far_cluster_sq(ch[c], r_sq, beta, tr_cov, axial_cov);
+                }
+            }
+            gather_flush(g);
+        }
+        barrier();
+    }
+    // Its samples, as gather.comp sums them.
+    uint first_sample = list.x + list.y;
+    for (uint base = 0u; base < list.z; base += TILE) {
+        uint j = base + local;
+        if (j < list.z) {
+            uint s = group_items[first_sample + j];
+            tile_position_area[local] = samples[s].position_area;
+            tile_irradiance[local] = splat[s].irradiance_area;
+            tile_near_energy[local] = splat[s].near_energy;
+        }
+        barrier();
+        uint n = min(TILE, list.z - base);
         if (is_receiver) {
             for (uint t = 0u; t < n; ++t) {
                 gather_add(g, ch, x, tile_position_area[t], tile_irradiance[t].rgb, tile_near_energy[t].rgb);

@@ -120,8 +120,12 @@ fn splat_and_vertex_records_match_glsl() {
     assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
     let (fields, size) = glsl_layout(scene, "NodePowerRecord");
     assert_eq!(size, size_of::<NodePowerRecord>());
-    let rust =
-        [("power", offset_of!(NodePowerRecord, power)), ("mean_weight", offset_of!(NodePowerRecord, mean_weight))];
+    let rust = [
+        ("power", offset_of!(NodePowerRecord, power)),
+        ("mean_weight", offset_of!(NodePowerRecord, mean_weight)),
+        ("cov_diag", offset_of!(NodePowerRecord, cov_diag)),
+        ("cov_off", offset_of!(NodePowerRecord, cov_off)),
+    ];
     assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
     let (fields, size) = glsl_layout(scene, "VertexRecord");
     assert_eq!(size, size_of::<Vertex>());
@@ -154,7 +158,7 @@ fn push_blocks_match_glsl_and_spirv() {
             include_str!("../glsl/gather_sparse.comp"),
             "GatherSparsePush",
             size_of::<GatherSparsePush>(),
-            &["object", "stage"],
+            &["object", "stage", "first_node", "node_count", "first_receiver", "first_group"],
         ),
         (
             "gather_tree.comp",

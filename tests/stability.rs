@@ -115,7 +115,7 @@ fn every_preset_scale_count_and_gather_stays_finite_and_bounded() {
         worst.ratio,
         worst.at
     );
-    assert_eq!(worst.configurations, scales.len() * 3 * 3);
+    assert_eq!(worst.configurations, scales.len() * 3 * GatherMode::ALL.len());
 }
 
 /// The long sweep: every measured material (Jensen 2001 and Narasimhan 2006), more scales and

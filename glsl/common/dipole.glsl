@@ -155,6 +155,27 @@ float dipole_r_d_far_sq(DipoleChannel ch, float r_sq, float beta) {
          + dipole_far_pole(ch.z_v, ch.sigma_tr, r_sq + beta + ch.z_v * ch.z_v, beta));
 }
 
+// The far kernel of a cluster, to second order in its spread (kernel::r_d_far_cluster): tr_cov
+// is the trace of the power-weighted covariance C of its members about the centroid, axial_cov
+// the variance along the direction to the receiver; r_sq the squared distance to the centroid.
+float dipole_far_cluster_pole(float z, float s, float r_sq, float dd_sq, float beta, float tr_cov, float axial_cov) {
+    float inv_d = inversesqrt(dd_sq);
+    float d = dd_sq * inv_d;
+    float q = beta * inv_d * inv_d;
+    float sd = s * d;
+    float far = s + inv_d + 0.5 * q * (s * s * d + 3.0 * s + 3.0 * inv_d);
+    float u = tr_cov * inv_d * inv_d;
+    float v = axial_cov * (inv_d * inv_d) * (r_sq * inv_d * inv_d);
+    float spread = 0.5 * (-(sd * sd + 3.0 * sd + 3.0) * u + (((sd + 6.0) * sd + 15.0) * sd + 15.0) * v);
+    return (z * inv_d) * inv_d * exp(-sd) * (far + spread * inv_d);
+}
+
+float dipole_r_d_far_cluster_sq(DipoleChannel ch, float r_sq, float beta, float tr_cov, float axial_cov) {
+    return ch.alpha_prime / (4.0 * DIPOLE_PI)
+        * (dipole_far_cluster_pole(ch.z_r, ch.sigma_tr, r_sq, r_sq + beta + ch.z_r * ch.z_r, beta, tr_cov, axial_cov)
+         + dipole_far_cluster_pole(ch.z_v, ch.sigma_tr, r_sq, r_sq + beta + ch.z_v * ch.z_v, beta, tr_cov, axial_cov));
+}
+
 float dipole_r_d_far(DipoleChannel ch, float r, float b) {
     return dipole_r_d_far_sq(ch, r * r, b * b);
 }

@@ -39,12 +39,16 @@ struct TreeNodeRecord {
 struct NodePowerRecord {
     vec4 power;             // rgb: sum E_i A_i per channel; w: 0
     vec4 mean_weight;       // xyz: power-weighted centroid; w: total weight
+    vec4 cov_diag;          // xyz: power-weighted covariance of the members about it: xx, yy, zz
+    vec4 cov_off;           // xyz: xy, xz, yz
 };
 
 // One group of the hierarchical gather's receivers (ReceiverGroupRecord; sampling::ReceiverGroups).
 struct ReceiverGroupRecord {
     vec4 center_radius;     // xyz: centre of a sphere holding its receivers; w: radius
-    uvec4 items;            // x: first entry in the group items; y: item count; z, w: 0
+    uvec4 items;            // hierarchical gather: x: first entry in the group items; y: its node
+                            // items, which come first; z: its sample items, which follow; w: 0
+    uvec4 blend;            // sparse gather: x: first entry in the blend items; y: count; z, w: 0
 };
 
 // An item of a group's list is a sample index, or NODE_ITEM | a node index (sampling::NODE_ITEM).

@@ -90,6 +90,8 @@ pub struct DipoleEvalOutput {
     pub near_energy: f32,
     /// [`crate::optics::kernel::r_d_far`]`(r, b)`.
     pub r_d_far: f32,
+    /// [`crate::optics::kernel::r_d_far_cluster`]`(r, b, 0.3 r^2, 0.1 r^2)`.
+    pub r_d_far_cluster: f32,
     /// `F_r(cos_theta_i, eta)`.
     pub fresnel_r: f32,
     /// `F_t(cos_theta_o, eta)`.

@@ -91,6 +91,42 @@ pub fn r_d_far(dipole: &Dipole, r: f64, b: f64) -> f64 {
     dipole.alpha_prime / (4.0 * PI) * (pole(dipole.z_r) + pole(dipole.z_v))
 }
 
+/// The far kernel of a cluster of samples seen from `r` away from its centroid, per unit of its
+/// power, to second order in its spread: `R_far(r) + (1/2) tr(H C)` with `C` the power-weighted
+/// covariance of the members' positions about the centroid and `H` the Hessian of the profile
+/// in the receiver's position (the first-order term vanishes about the centroid). Taking the
+/// profile as a function of `D = r^2`, `H = 2 R' I + 4 R'' u u^T` (`u` the offset from the
+/// centroid), so `(1/2) tr(H C) = R' tr C + 2 R'' r^2 (û^T C û)`; `tr_cov = tr C` and
+/// `axial_cov = û^T C û`, the variance along the direction to the receiver, are passed in (both
+/// in scene units squared, so nothing of order `r^4` is formed).
+///
+/// The derivatives are those of the regularised profile `R_b` (each pole
+/// `z e^(-s d)(s d + 1)/d^3`, `d^2 = r^2 + z^2 + b^2`), so the correction shares the far kernel's
+/// exponential; next to `R_d`'s they differ by `O(b^2/r^2)` of a term that is itself second order:
+/// ```text
+/// dp/dD   = -z e^(-s d) (s^2 d^2 + 3 s d + 3) / (2 d^5)
+/// d2p/dD2 =  z e^(-s d) (s^3 d^3 + 6 s^2 d^2 + 15 s d + 15) / (4 d^7)
+/// ```
+/// With no spread it is [`r_d_far`]. The hierarchical gather evaluates it for every cluster it
+/// uses whole (glsl/common/dipole.glsl's twin).
+pub fn r_d_far_cluster(dipole: &Dipole, r: f64, b: f64, tr_cov: f64, axial_cov: f64) -> f64 {
+    let beta = b * b;
+    let s = dipole.sigma_tr;
+    let pole = |z: f64| {
+        let d = (r * r + z * z + beta).sqrt();
+        let inv_d = 1.0 / d;
+        let q = beta * inv_d * inv_d;
+        let e = (-s * d).exp();
+        let sd = s * d;
+        let far = s + inv_d + 0.5 * q * (s * s * d + 3.0 * s + 3.0 * inv_d);
+        // (1/2) tr(H C) over (z/d)(1/d^2) e^(-s d): u = tr C / d^2, v = r^2 (û^T C û) / d^4.
+        let (u, v) = (tr_cov * inv_d * inv_d, axial_cov * inv_d * inv_d * (r * inv_d) * (r * inv_d));
+        let spread = 0.5 * (-(sd * sd + 3.0 * sd + 3.0) * u + (sd * sd * sd + 6.0 * sd * sd + 15.0 * sd + 15.0) * v);
+        (z * inv_d) * inv_d * e * (far + spread * inv_d)
+    };
+    dipole.alpha_prime / (4.0 * PI) * (pole(dipole.z_r) + pole(dipole.z_v))
+}
+
 /// The near energy `E_near(b) = R_d,total - integral R_far 2 pi r dr >= 0`, in closed form (see
 /// the module doc), evaluated without cancellation.
 pub fn near_energy(dipole: &Dipole, b: f64) -> f64 {

@@ -8,17 +8,20 @@ use crate::optics::Dipole;
 use crate::optics::kernel::{self, B_PER_SQRT_AREA};
 use crate::sampling::{NODE_ITEM, RECEIVER_GROUP_SIZE, SampleTree, TreeNode};
 use crate::scene::build::PreparedScene;
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
 /// What stage 0 of glsl/gather_tree.comp computes per node: transmitted power `sum E_i A_i`
-/// per channel and the power-weighted centroid (the bounding centre when unlit).
+/// per channel, the power-weighted centroid (the bounding centre when unlit) and the
+/// power-weighted covariance of the members about it.
 #[derive(Clone, Copy, Debug)]
 pub struct NodePower {
     /// `sum E_i A_i` per channel.
     pub power: [f64; 3],
     /// Centroid weighted by each sample's power summed over channels.
     pub centroid: DVec3,
+    /// Covariance of the members' positions about the centroid, with the same weights.
+    pub covariance: DMat3,
 }
 
 /// Stage 0: every node's power and centroid, from per-sample transmitted irradiance `e` and
@@ -28,8 +31,9 @@ pub fn node_power(tree: &SampleTree, positions: &[DVec3], areas: &[f64], e: &[[f
         .iter()
         .map(|n| {
             let center = center_of(n);
+            let members = &tree.order[n.first as usize..(n.first + n.count) as usize];
             let (mut power, mut offset, mut weight) = ([0.0; 3], DVec3::ZERO, 0.0);
-            for &s in &tree.order[n.first as usize..(n.first + n.count) as usize] {
+            for &s in members {
                 let s = s as usize;
                 let p = e[s].map(|v| v * areas[s]);
                 let w = p[0] + p[1] + p[2];
@@ -39,7 +43,18 @@ pub fn node_power(tree: &SampleTree, positions: &[DVec3], areas: &[f64], e: &[[f
                 offset += w * (positions[s] - center);
                 weight += w;
             }
-            NodePower { power, centroid: if weight > 0.0 { center + offset / weight } else { center } }
+            if weight <= 0.0 {
+                return NodePower { power, centroid: center, covariance: DMat3::ZERO };
+            }
+            let centroid = center + offset / weight;
+            let mut covariance = DMat3::ZERO;
+            for &s in members {
+                let s = s as usize;
+                let w = e[s].iter().sum::<f64>() * areas[s];
+                let y = positions[s] - centroid;
+                covariance += DMat3::from_cols(y * y.x, y * y.y, y * y.z) * (w / weight);
+            }
+            NodePower { power, centroid, covariance }
         })
         .collect()
 }
@@ -49,9 +64,10 @@ fn center_of(n: &TreeNode) -> DVec3 {
 }
 
 /// Stage 1 at one receiver `x` whose group's cut is `items` (`sampling::SampleTree::cut`): a
-/// sample's far kernel and near exitance as in the flat sum, a node's power at its centroid with
-/// the far kernel of its mean area; the near field blended over the listed samples (the nearest
-/// sample of the object where no weight reaches).
+/// sample's far kernel and near exitance as in the flat sum, a node's power times the cluster
+/// kernel (`kernel::r_d_far_cluster`: its centroid, the `b` of its mean area, its spread); the
+/// near field blended over the listed samples (the nearest sample of the object where no weight
+/// reaches).
 #[allow(clippy::too_many_arguments)]
 pub fn gather_items(
     x: DVec3,
@@ -72,9 +88,12 @@ pub fn gather_items(
             // As the GPU packs it: the f32 area over the count.
             let mean_area = (n.area / n.count as f32) as f64;
             let b = B_PER_SQRT_AREA * mean_area.sqrt();
-            let r = x.distance(power[i].centroid);
+            let u = x - power[i].centroid;
+            let cov = &power[i].covariance;
+            let w = u.normalize_or_zero();
+            let (tr_cov, axial_cov) = (cov.x_axis.x + cov.y_axis.y + cov.z_axis.z, w.dot(*cov * w));
             for c in 0..3 {
-                far[c] += power[i].power[c] * kernel::r_d_far(&dipoles[c], r, b);
+                far[c] += power[i].power[c] * kernel::r_d_far_cluster(&dipoles[c], u.length(), b, tr_cov, axial_cov);
             }
         } else {
             let s = item as usize;

@@ -4,8 +4,12 @@
 //! exponentials); the cost is detail finer than the sample spacing in the far field, which the
 //! far kernel smooths at that scale anyway. `tests/render.rs` measures the difference.
 //!
+//! Stage 1 visits, per group of 32 vertices (`sampling::ReceiverGroups`), only the samples whose
+//! blend radius reaches the group (`GpuScene::blend_items`), not every sample.
+//!
 //! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = sample exitance,
-//! 5 = exitance. Push: `GatherSparsePush`.
+//! 5 = exitance, 6 = tree nodes, 7 = tree order, 8 = receiver order, 9 = receiver groups,
+//! 10 = blend items. Push: `GatherSparsePush`.
 
 use super::gather::exitance_written;
 use super::gpu_scene::GpuScene;
@@ -22,6 +26,14 @@ pub struct GatherSparsePush {
     pub object: u32,
     /// 0: exitance at the samples; 1: blended to the vertices.
     pub stage: u32,
+    /// The object's root in `GpuScene::tree_nodes` (the nearest-sample fallback walks it).
+    pub first_node: u32,
+    /// Its node count.
+    pub node_count: u32,
+    /// Its first entry in `GpuScene::receiver_order`.
+    pub first_receiver: u32,
+    /// Its first group in `GpuScene::receiver_groups`.
+    pub first_group: u32,
 }
 
 /// The sparse gather: per translucent object, stage 0 of glsl/gather_sparse.comp over its samples
@@ -38,6 +50,7 @@ impl GatherSparsePass {
     /// descriptor set over it and the scene's buffers.
     pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene) -> GpuResult<GatherSparsePass> {
         let pipeline = ComputePipeline::new(gpu, "gather_sparse.comp")?;
+        super::gather_tree::assert_group_size(&pipeline);
         let bytes = 16 * scene.sample_count.max(1) as u64;
         let sample_exitance =
             Buffer::new(gpu, &BufferDesc::gpu_only("sample exitance", bytes, vk::BufferUsageFlags::STORAGE_BUFFER))?;
@@ -48,6 +61,11 @@ impl GatherSparsePass {
             Binding::Buffer(&scene.objects),
             Binding::Buffer(&sample_exitance),
             Binding::Buffer(&scene.exitance),
+            Binding::Buffer(&scene.tree_nodes),
+            Binding::Buffer(&scene.tree_order),
+            Binding::Buffer(&scene.receiver_order),
+            Binding::Buffer(&scene.receiver_groups),
+            Binding::Buffer(&scene.blend_items),
         ])?;
         Ok(GatherSparsePass { pipeline, set, _sample_exitance: sample_exitance })
     }
@@ -55,15 +73,21 @@ impl GatherSparsePass {
 
 impl RenderPass for GatherSparsePass {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        let push = |r: &super::gpu_scene::Receiver, stage| GatherSparsePush {
+            object: r.object,
+            stage,
+            first_node: r.first_node,
+            node_count: r.node_count,
+            first_receiver: r.first_receiver,
+            first_group: r.first_group,
+        };
         for r in &frame.scene.receivers {
-            let push = GatherSparsePush { object: r.object, stage: 0 };
-            self.pipeline.dispatch(cmd, &self.set, &push, [r.sample_count, 1, 1]);
+            self.pipeline.dispatch(cmd, &self.set, &push(r, 0), [r.sample_count, 1, 1]);
         }
         // Stage 1 reads what stage 0 wrote.
         memory_barrier(frame.gpu.device(), cmd, &[Access::ComputeWrite], &[Access::ComputeRead]);
         for r in &frame.scene.receivers {
-            let push = GatherSparsePush { object: r.object, stage: 1 };
-            self.pipeline.dispatch(cmd, &self.set, &push, [r.vertex_count, 1, 1]);
+            self.pipeline.dispatch(cmd, &self.set, &push(r, 1), [r.vertex_count, 1, 1]);
         }
         exitance_written(frame, cmd);
     }

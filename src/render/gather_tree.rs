@@ -48,12 +48,7 @@ impl GatherTreePass {
     /// `GpuScene::new` built for the scene's `render.gather_epsilon`).
     pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene) -> GpuResult<GatherTreePass> {
         let pipeline = ComputePipeline::new(gpu, "gather_tree.comp")?;
-        // Stage 1's workgroups are the receiver groups: its local size must be their size.
-        let n = crate::sampling::RECEIVER_GROUP_SIZE as u32;
-        assert!(
-            pipeline.groups([n, 1, 1]) == [1, 1, 1] && pipeline.groups([n + 1, 1, 1]) == [2, 1, 1],
-            "gather_tree.comp's local size is RECEIVER_GROUP_SIZE"
-        );
+        assert_group_size(&pipeline);
         let set = pipeline.descriptor_set(&[
             Binding::Buffer(&scene.vertices),
             Binding::Buffer(&scene.samples),
@@ -91,4 +86,15 @@ impl RenderPass for GatherTreePass {
         }
         exitance_written(frame, cmd);
     }
+}
+
+/// A gather whose workgroups are receiver groups (`sampling::ReceiverGroups`) must have their
+/// size as its local size.
+pub(super) fn assert_group_size(pipeline: &ComputePipeline) {
+    let n = crate::sampling::RECEIVER_GROUP_SIZE as u32;
+    assert!(
+        pipeline.groups([n, 1, 1]) == [1, 1, 1] && pipeline.groups([n + 1, 1, 1]) == [2, 1, 1],
+        "{}: local size is not RECEIVER_GROUP_SIZE",
+        pipeline.name()
+    );
 }

@@ -6,8 +6,8 @@
 use super::records::{
     LightGpu, NodePowerRecord, ObjectRecord, ReceiverGroupRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
 };
-use crate::sampling::NODE_ITEM;
 use crate::gpu::{Access, Buffer, BufferDesc, Gpu, GpuResult, memory_barrier};
+use crate::sampling::NODE_ITEM;
 use crate::scene::build::PreparedScene;
 use ash::vk;
 use std::sync::Arc;
@@ -83,6 +83,10 @@ pub struct GpuScene {
     /// after another, made absolute: a sample index, or `NODE_ITEM |` a node index. Built only
     /// when the scene gathers hierarchically (otherwise empty).
     pub group_items: Buffer,
+    /// The samples (absolute indices) whose near-blend radius reaches each group
+    /// (`sampling::SampleTree::within_reach`), groups one after another: what the sparse
+    /// gather's blend visits. Built only when the scene gathers sparsely (otherwise empty).
+    pub blend_items: Buffer,
     /// `LightGpu` per prepared light, key lights first; rewritten inside a frame's command buffer
     /// when lights change (`record_uploads`).
     pub lights: Buffer,
@@ -133,9 +137,10 @@ impl GpuScene {
             (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let (mut tree_nodes, mut tree_order) = (Vec::new(), Vec::<u32>::new());
         let (mut receiver_order, mut receiver_groups) = (Vec::<u32>::new(), Vec::<ReceiverGroupRecord>::new());
-        let mut group_items = Vec::<u32>::new();
+        let (mut group_items, mut blend_items) = (Vec::<u32>::new(), Vec::<u32>::new());
         let render = &scene.scene.file.render;
         let hierarchical = render.gather == crate::scene::GatherMode::Hierarchical;
+        let sparse = render.gather == crate::scene::GatherMode::Sparse;
         for (i, o) in scene.objects.iter().enumerate() {
             let first_vertex = vertices.len() as u32;
             let first_sample = samples.len() as u32;
@@ -176,14 +181,26 @@ impl GpuScene {
                 } else {
                     vec![Vec::new(); groups.bounds.len()]
                 };
-                for (&([x, y, z], r), items) in groups.bounds.iter().zip(&cuts) {
+                let positions: Vec<glam::DVec3> = o.samples.iter().map(|s| s.position.as_dvec3()).collect();
+                let areas: Vec<f64> = o.samples.iter().map(|s| s.area).collect();
+                for (&group, items) in groups.bounds.iter().zip(&cuts) {
+                    // Nodes first, then samples: the shader sums each kind in its own loop.
                     let first = group_items.len() as u32;
-                    group_items.extend(items.iter().map(|&it| {
-                        if it & NODE_ITEM != 0 { it + first_node } else { it + first_sample }
-                    }));
+                    let nodes = items.iter().filter(|&&it| it & NODE_ITEM != 0);
+                    group_items.extend(nodes.clone().map(|&it| it + first_node));
+                    let node_count = group_items.len() as u32 - first;
+                    group_items.extend(items.iter().filter(|&&it| it & NODE_ITEM == 0).map(|&it| it + first_sample));
+                    let sample_count = group_items.len() as u32 - first - node_count;
+                    let first_blend = blend_items.len() as u32;
+                    if sparse {
+                        blend_items
+                            .extend(tree.within_reach(group, &positions, &areas).iter().map(|s| s + first_sample));
+                    }
+                    let ([x, y, z], r) = group;
                     receiver_groups.push(ReceiverGroupRecord {
                         center_radius: [x, y, z, r],
-                        items: [first, items.len() as u32, 0, 0],
+                        items: [first, node_count, sample_count, 0],
+                        blend: [first_blend, blend_items.len() as u32 - first_blend, 0, 0],
                     });
                 }
                 receivers.push(Receiver {
@@ -218,6 +235,7 @@ impl GpuScene {
             receiver_order: upload(gpu, "receiver order", &receiver_order, vk::BufferUsageFlags::empty())?,
             receiver_groups: upload(gpu, "receiver groups", &receiver_groups, vk::BufferUsageFlags::empty())?,
             group_items: upload(gpu, "group items", &group_items, vk::BufferUsageFlags::empty())?,
+            blend_items: upload(gpu, "blend items", &blend_items, vk::BufferUsageFlags::empty())?,
             node_power: storage(
                 gpu,
                 "node power",

@@ -147,6 +147,10 @@ pub struct NodePowerRecord {
     /// xyz: centroid of the samples weighted by their power summed over channels (the bounding
     /// centre when unlit); w: that total weight.
     pub mean_weight: [f32; 4],
+    /// xyz: the members' power-weighted covariance about the centroid: xx, yy, zz; w: 0.
+    pub cov_diag: [f32; 4],
+    /// xyz: xy, xz, yz; w: 0.
+    pub cov_off: [f32; 4],
 }
 
 /// `ReceiverGroupRecord` in glsl/common/scene.glsl: one group of receivers of the hierarchical
@@ -156,8 +160,11 @@ pub struct NodePowerRecord {
 pub struct ReceiverGroupRecord {
     /// xyz: centre of a sphere holding the group's receivers; w: its radius.
     pub center_radius: [f32; 4],
-    /// x: first entry in the group items; y: item count; z, w: 0.
+    /// Hierarchical gather: x: first entry in the group items; y: how many of them are nodes
+    /// (first); z: how many samples follow; w: 0.
     pub items: [u32; 4],
+    /// Sparse gather: x: first entry in the blend items; y: their count; z, w: 0.
+    pub blend: [u32; 4],
 }
 
 /// `struct Light` in glsl/common/lights.glsl.

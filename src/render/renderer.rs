@@ -191,9 +191,7 @@ impl Renderer {
         let gather: Box<dyn RenderPass> = match (shade.surface(), shade.hdr()) {
             (Some(surface), Some(hdr)) => Box::new(GatherPixelPass::new(gpu, &buffers, surface, hdr)?),
             _ if settings.gather == GatherMode::Sparse => Box::new(GatherSparsePass::new(gpu, &buffers)?),
-            _ if settings.gather == GatherMode::Hierarchical => {
-                Box::new(GatherTreePass::new(gpu, &buffers)?)
-            }
+            _ if settings.gather == GatherMode::Hierarchical => Box::new(GatherTreePass::new(gpu, &buffers)?),
             _ => Box::new(GatherPass::new(gpu, &buffers)?),
         };
         // Timing is optional: a queue without timestamps still renders.

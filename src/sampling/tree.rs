@@ -154,6 +154,38 @@ impl SampleTree {
     }
 }
 
+impl SampleTree {
+    /// The samples whose near-field blend radius (`NEAR_BLEND_RADIUS sqrt(dA)`; positions and
+    /// areas in the object's sample order) reaches into the sphere `group`: every sample that can
+    /// give a receiver of the group a Shepard weight, found by walking only the nodes within reach.
+    pub fn within_reach(&self, group: ([f32; 3], f32), positions: &[DVec3], areas: &[f64]) -> Vec<u32> {
+        let (center, radius) = (glam::Vec3::from(group.0).as_dvec3(), group.1 as f64);
+        let mut found = Vec::new();
+        let mut i = 0;
+        while i < self.nodes.len() {
+            let n = &self.nodes[i];
+            let dist = center.distance(glam::Vec3::from(n.center).as_dvec3()) - n.radius as f64 - radius;
+            if dist >= n.reach as f64 {
+                i = n.skip as usize;
+            } else if n.leaf {
+                for &s in &self.order[n.first as usize..(n.first + n.count) as usize] {
+                    // A sample of the leaf is within reach when its own radius reaches the sphere
+                    // (f32 rounding is covered by the node's rounded-out reach and radius).
+                    if positions[s as usize].distance(center) - radius
+                        < NEAR_BLEND_RADIUS * areas[s as usize].sqrt() * (1.0 + 1e-6)
+                    {
+                        found.push(s);
+                    }
+                }
+                i = n.skip as usize;
+            } else {
+                i += 1;
+            }
+        }
+        found
+    }
+}
+
 /// Receivers (mesh vertices) in a spatially coherent order, cut into groups of
 /// [`RECEIVER_GROUP_SIZE`] consecutive ones, each with a bounding sphere.
 ///
@@ -192,9 +224,9 @@ impl ReceiverGroups {
 
 /// A sphere holding `points` (the centre of their bounding box), rounded out for f32.
 fn sphere(points: &[DVec3]) -> ([f32; 3], f32) {
-    let (lo, hi) = points.iter().fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), p| {
-        (lo.min(*p), hi.max(*p))
-    });
+    let (lo, hi) = points
+        .iter()
+        .fold((DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
     let center = 0.5 * (lo + hi);
     let radius = points.iter().map(|p| p.distance(center)).fold(0.0, f64::max);
     let center_f32 = center.as_vec3();
@@ -297,6 +329,22 @@ mod tests {
         // A larger epsilon uses bigger nodes: fewer items.
         let size = |e| groups.bounds.iter().map(|&g| t.cut(g, e, |_, _| false).len()).sum::<usize>();
         assert!(size(1.0) < size(0.1) && size(0.1) < size(0.0));
+    }
+
+    #[test]
+    fn within_reach_finds_exactly_the_samples_whose_blend_radius_reaches_the_group() {
+        let (p, a) = points(1000);
+        let t = SampleTree::new(&p, &a);
+        let groups = ReceiverGroups::new(&p);
+        for &group in &groups.bounds {
+            let mut got = t.within_reach(group, &p, &a);
+            got.sort_unstable();
+            let c = glam::Vec3::from(group.0).as_dvec3();
+            let want: Vec<u32> = (0..1000u32)
+                .filter(|&s| p[s as usize].distance(c) - (group.1 as f64) < NEAR_BLEND_RADIUS * a[s as usize].sqrt())
+                .collect();
+            assert_eq!(got, want);
+        }
     }
 
     #[test]
