@@ -175,7 +175,7 @@ fn rms_relative(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
 /// The hierarchical gather against the flat vertex gather: an epsilon sweep at 400 and 6,400
 /// samples (time and RMS from the flat exitance), then its growth with the sample count.
 fn hierarchy(gpu: &Arc<Gpu>) {
-    let epsilons = [0.02f32, 0.05, 0.1, 0.2, 0.5, 1.0];
+    let epsilons = [0.1f32, 0.25, 0.5, 1.0, 2.0, 4.0];
     println!(
         "\nHierarchical gather against the flat vertex gather (default scene, 512x512, gather alone in \
          isolated submissions, median of {FRAMES}):"

@@ -158,44 +158,53 @@ shadow_map_size = 2048
 "#;
     let toml = plane_scene("marble", 400.0, 4000, "").replace("[sampling]", &format!("{extra}\n[sampling]"));
     with_gpu(|gpu| {
-        let prepared = prepare(&toml, &Overrides::default());
-        let material = Material::preset("marble").unwrap();
-        let dipole = &material.dipoles(1.0).unwrap()[0];
-        let f_t = fresnel::fresnel_transmittance(1.0, material.eta);
-        let mesh = prepared.objects[0].mesh.clone();
-        let renderer = run_all(gpu, prepared);
-        let exitance = renderer.exitance(0).unwrap();
-        let line = |u: f64| {
-            let n = 2000;
-            let y_max = 200.0;
-            (0..n).map(|k| dipole.r_d((u * u + ((k as f64 + 0.5) * y_max / n as f64).powi(2)).sqrt())).sum::<f64>()
-                * 2.0
-                * y_max
-                / n as f64
-        };
-        let predicted = |x: f64| {
-            let n = 400;
-            let integral =
-                (0..n).map(|k| line((k as f64 + 0.5) * x.abs() / n as f64)).sum::<f64>() * x.abs() / n as f64;
-            f_t * (0.5 * dipole.r_d_total() + x.signum() * integral)
-        };
-        let lit_far = f_t * dipole.r_d_total();
-        let mut checked = 0;
-        let mut worst = 0.0f64;
-        for (v, p) in mesh.positions().iter().enumerate() {
-            let (x, z) = (p.x as f64, p.z as f64);
-            // Away from the plane's rim, and from the edge by more than a few shadow texels.
-            if z.abs() > 60.0 || x.abs() > 60.0 || x.abs() < 3.0 {
-                continue;
+        // The vertex gather, and the hierarchical one at its default epsilon (same tolerance).
+        for gather in [GatherMode::Vertex, GatherMode::Hierarchical] {
+            let prepared = prepare(&toml, &Overrides { gather: Some(gather), ..Default::default() });
+            let material = Material::preset("marble").unwrap();
+            let dipole = &material.dipoles(1.0).unwrap()[0];
+            let f_t = fresnel::fresnel_transmittance(1.0, material.eta);
+            let mesh = prepared.objects[0].mesh.clone();
+            let renderer = run_all(gpu, prepared);
+            let exitance = renderer.exitance(0).unwrap();
+            let line = |u: f64| {
+                let n = 2000;
+                let y_max = 200.0;
+                (0..n).map(|k| dipole.r_d((u * u + ((k as f64 + 0.5) * y_max / n as f64).powi(2)).sqrt())).sum::<f64>()
+                    * 2.0
+                    * y_max
+                    / n as f64
+            };
+            let predicted = |x: f64| {
+                let n = 400;
+                let integral =
+                    (0..n).map(|k| line((k as f64 + 0.5) * x.abs() / n as f64)).sum::<f64>() * x.abs() / n as f64;
+                f_t * (0.5 * dipole.r_d_total() + x.signum() * integral)
+            };
+            let lit_far = f_t * dipole.r_d_total();
+            let mut checked = 0;
+            let mut worst = 0.0f64;
+            for (v, p) in mesh.positions().iter().enumerate() {
+                let (x, z) = (p.x as f64, p.z as f64);
+                // Away from the plane's rim, and from the edge by more than a few shadow texels.
+                if z.abs() > 60.0 || x.abs() > 60.0 || x.abs() < 3.0 {
+                    continue;
+                }
+                let want = predicted(x);
+                let got = exitance[v][0] as f64;
+                worst = worst.max((got - want).abs() / lit_far);
+                assert!(
+                    (got - want).abs() < 0.05 * lit_far,
+                    "{gather}, x = {x:.1}: exitance {got:.5}, predicted {want:.5}"
+                );
+                checked += 1;
             }
-            let want = predicted(x);
-            let got = exitance[v][0] as f64;
-            worst = worst.max((got - want).abs() / lit_far);
-            assert!((got - want).abs() < 0.05 * lit_far, "x = {x:.1}: exitance {got:.5}, predicted {want:.5}");
-            checked += 1;
+            eprintln!(
+                "shadow edge ({gather} gather): {checked} vertices, worst deviation {:.2}% of the lit level",
+                100.0 * worst
+            );
+            assert!(checked > 20);
         }
-        eprintln!("shadow edge: {checked} vertices, worst deviation {:.2}% of the lit level", 100.0 * worst);
-        assert!(checked > 20);
     });
 }
 

@@ -362,7 +362,7 @@ impl Default for RenderSettings {
 
 /// `render.gather_epsilon` when a scene names none: chosen from the benchmark's sweep (README,
 /// "Performance").
-pub const DEFAULT_GATHER_EPSILON: f32 = 0.1;
+pub const DEFAULT_GATHER_EPSILON: f32 = 4.0;
 /// The largest `render.gather_epsilon`: a node seen under more than this solid angle is never
 /// a good stand-in.
 pub const MAX_GATHER_EPSILON: f32 = 10.0;
