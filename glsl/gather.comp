@@ -6,9 +6,12 @@
 // load per tile for the whole workgroup); each tile's far sum is added to a Kahan-compensated
 // total per channel so that the f32 sum stays within 1e-3 of the f64 reference at any sample count.
 //
+// Where no Shepard weight reaches a vertex, the nearest sample's near exitance is found by
+// walking the object's sample hierarchy (glsl/common/tree.glsl) rather than tracked per pair.
+//
 // Bindings: 0 = vertices (VertexRecord[], read), 1 = samples (SampleRecord[], read), 2 = splat
-// (SplatRecord[], read), 3 = objects (ObjectRecord[], read), 4 = exitance (vec4 per vertex, write).
-// Push: GatherPush.
+// (SplatRecord[], read), 3 = objects (ObjectRecord[], read), 4 = exitance (vec4 per vertex, write),
+// 5 = tree nodes (TreeNodeRecord[]), 6 = tree order (uint[]). Push: GatherPush.
 #include "dipole.glsl"
 #include "scene.glsl"
 #include "gather.glsl"
@@ -20,10 +23,16 @@ layout(std430, set = 0, binding = 1) readonly buffer Samples { SampleRecord samp
 layout(std430, set = 0, binding = 2) readonly buffer Splat { SplatRecord splat[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Objects { ObjectRecord objects[]; };
 layout(std430, set = 0, binding = 4) writeonly buffer Exitance { vec4 exitance[]; };
+layout(std430, set = 0, binding = 5) readonly buffer TreeNodes { TreeNodeRecord tree_nodes[]; };
+layout(std430, set = 0, binding = 6) readonly buffer TreeOrder { uint tree_order[]; };
 struct GatherPush {
     uint object;            // the receiving object's index
+    uint first_node;        // its root in tree_nodes
+    uint node_count;        // its node count
 };
 layout(push_constant) uniform GatherPushBlock { GatherPush push; };
+
+#include "tree.glsl"
 
 shared vec4 tile_position_area[TILE];
 shared vec4 tile_irradiance[TILE];
@@ -58,5 +67,10 @@ void main() {
         }
         barrier();
     }
-    if (is_receiver) exitance[first_vertex + v] = vec4(gather_end(g), 1.0);
+    if (!is_receiver) return;
+    if (g.weight_sum == 0.0) {
+        uint s = tree_nearest_sample(x, push.first_node, push.node_count);
+        g.nearest_near = splat[s].irradiance_area.rgb * splat[s].near_energy.rgb;
+    }
+    exitance[first_vertex + v] = vec4(gather_end(g), 1.0);
 }

@@ -10,6 +10,7 @@
 // Push: GatherPixelPush.
 #include "dipole.glsl"
 #include "scene.glsl"
+#define GATHER_TRACK_NEAREST
 #include "gather.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

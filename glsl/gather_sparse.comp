@@ -20,6 +20,7 @@
 // 9 = receiver groups (ReceiverGroupRecord[]), 10 = blend items (uint[]). Push: GatherSparsePush.
 #include "dipole.glsl"
 #include "scene.glsl"
+#define GATHER_TRACK_NEAREST
 #include "gather.glsl"
 
 #define TILE 32u

@@ -152,7 +152,13 @@ fn push_blocks_match_glsl_and_spirv() {
             size_of::<VertexLightPush>(),
             &["vertex_count", "light_count"],
         ),
-        ("gather.comp", include_str!("../glsl/gather.comp"), "GatherPush", size_of::<GatherPush>(), &["object"]),
+        (
+            "gather.comp",
+            include_str!("../glsl/gather.comp"),
+            "GatherPush",
+            size_of::<GatherPush>(),
+            &["object", "first_node", "node_count"],
+        ),
         (
             "gather_sparse.comp",
             include_str!("../glsl/gather_sparse.comp"),

@@ -44,10 +44,15 @@ void gather_add(inout GatherSum g, DipoleChannel ch[3], vec3 x, vec4 position_ar
     vec3 near_exitance = e * near_energy;
     g.near_sum += w * near_exitance;
     g.weight_sum += w;
+#ifdef GATHER_TRACK_NEAREST
+    // Gathers without the sample hierarchy track the nearest sample for the fallback where no
+    // Shepard weight reaches; the others find it afterwards by walking the hierarchy, which
+    // costs nothing per pair (glsl/common/tree.glsl).
     if (r_sq < g.nearest_r_sq) {
         g.nearest_r_sq = r_sq;
         g.nearest_near = near_exitance;
     }
+#endif
 }
 
 // Move the partial sum into the compensated one (Kahan): callers flush every 64 terms or so, so

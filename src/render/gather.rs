@@ -2,7 +2,8 @@
 //! object, the discrete dipole sum of seed Eq. 11 with the energy-conserving near-field kernel
 //! (`optics::kernel`), samples staged through shared memory, Kahan-compensated f32 sums.
 //!
-//! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = exitance. Push: `GatherPush`.
+//! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = exitance, 5 = tree nodes,
+//! 6 = tree order. Push: `GatherPush`.
 //! One dispatch per translucent object, over its vertex range.
 
 use super::gpu_scene::GpuScene;
@@ -18,6 +19,10 @@ pub struct GatherPush {
     /// Index of the receiving translucent object (its `ObjectRecord`); the dispatch covers its
     /// vertex range.
     pub object: u32,
+    /// Its root in `GpuScene::tree_nodes` (the nearest-sample fallback walks the hierarchy).
+    pub first_node: u32,
+    /// Its node count.
+    pub node_count: u32,
 }
 
 /// The vertex gather: one dispatch of glsl/gather.comp per translucent object
@@ -39,6 +44,8 @@ impl GatherPass {
             Binding::Buffer(&scene.splat),
             Binding::Buffer(&scene.objects),
             Binding::Buffer(&scene.exitance),
+            Binding::Buffer(&scene.tree_nodes),
+            Binding::Buffer(&scene.tree_order),
         ])?;
         Ok(GatherPass { pipeline, set })
     }
@@ -47,7 +54,8 @@ impl GatherPass {
 impl RenderPass for GatherPass {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         for r in &frame.scene.receivers {
-            self.pipeline.dispatch(cmd, &self.set, &GatherPush { object: r.object }, [r.vertex_count, 1, 1]);
+            let push = GatherPush { object: r.object, first_node: r.first_node, node_count: r.node_count };
+            self.pipeline.dispatch(cmd, &self.set, &push, [r.vertex_count, 1, 1]);
         }
         exitance_written(frame, cmd);
     }
