@@ -175,4 +175,18 @@ fn a_bad_gather_epsilon_is_an_error_naming_it() {
         "{stderr}"
     );
     assert!(!png.exists());
+
+    // Epsilon 0 lists every sample for every group of vertices: a scene where that exceeds the
+    // device's storage-buffer range is refused before any GPU work, naming the setting.
+    let big = plane_toml("marble")
+        .replace("divisions = 48", "divisions = 400")
+        .replace("method = \"poisson\"", "method = \"random\"")
+        .replace("count = 3000", "count = 8000")
+        .replace("[sampling]", "[render]\ngather = \"hierarchical\"\ngather_epsilon = 0.0\n\n[sampling]");
+    std::fs::write(&scene, big).unwrap();
+    let out = translucent(&["render", scene.to_str().unwrap(), "-o", png.to_str().unwrap()], &[]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("render.gather_epsilon 0") && stderr.contains("maxStorageBufferRange"), "{stderr}");
+    assert!(!png.exists());
 }

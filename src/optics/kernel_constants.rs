@@ -3,7 +3,8 @@
 // generated header `kernel_constants.glsl`, which glsl/common/dipole.glsl includes.
 kernel_constants! {
     /// Regularization length `b` in units of `sqrt(dA)`: the lattice-sum error of the far part
-    /// falls as `e^(-2 pi b / h)` (3e-4 here, measured by tests/optics.rs), while larger `b` puts more light into the footprint.
+    /// falls as `e^(-2 pi b / h)` (at most 6.7e-4 here, measured by tests/optics.rs), while larger `b` puts
+    /// more light into the footprint.
     B_PER_SQRT_AREA = 1.5;
     /// Half-width of the footprint's smooth edge, in units of `rho`.
     BUMP_DELTA = 0.25;

@@ -214,6 +214,19 @@ impl GpuScene {
                 });
             }
         }
+        let range = gpu.properties().limits.max_storage_buffer_range as u64;
+        let list_bytes = 4 * group_items.len() as u64;
+        if list_bytes > range {
+            return Err(crate::gpu::GpuError::Limit {
+                what: format!(
+                    "bytes of the hierarchical gather's item lists at render.gather_epsilon {} (raise it)",
+                    render.gather_epsilon
+                ),
+                value: list_bytes,
+                limit: range,
+                name: "maxStorageBufferRange",
+            });
+        }
         let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER;
         let zeros = vec![[0f32; 4]; vertices.len()];
         let mut gpu_scene = GpuScene {

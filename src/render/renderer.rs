@@ -519,7 +519,26 @@ fn check_fits(gpu: &Gpu, scene: &PreparedScene) -> Result<(), RenderError> {
     let surface = if file.render.gather == GatherMode::Pixel { hdr_bytes } else { 0 };
     // HDR, surface, depth (4), tone-mapped output (4) and the EXR readback (16) per pixel.
     let total = hdr_bytes + surface + 24 * pixels + shadow_bytes + vertex_bytes;
+    // With epsilon 0 the hierarchical gather lists every sample for every group of receivers.
+    let flat_lists: u64 = if file.render.gather == GatherMode::Hierarchical && file.render.gather_epsilon == 0.0 {
+        let group = crate::sampling::RECEIVER_GROUP_SIZE as u64;
+        scene
+            .objects
+            .iter()
+            .map(|o| (o.mesh.positions().len() as u64).div_ceil(group) * o.samples.len() as u64 * 4)
+            .sum()
+    } else {
+        0
+    };
     let checks = [
+        (
+            "bytes of the hierarchical gather's item lists at render.gather_epsilon 0 (every sample for every \
+             group of 32 vertices)"
+                .to_string(),
+            flat_lists,
+            "maxStorageBufferRange",
+            limits.max_storage_buffer_range as u64,
+        ),
         (
             "the meshes' vertex count".to_string(),
             scene.vertex_count() as u64,
