@@ -14,8 +14,9 @@ kernel_constants! {
     REMAINDER_MAX_DECAY = 0.5;
     /// Radius of a sample's near-field blend weight, in units of `sqrt(dA)`: wide enough that
     /// neighbours overlap (spacing is about `sqrt(dA)`), narrow enough to keep light local. Across a
-    /// shadow edge on marble (tests/render.rs) 2.0 bleeds 7.7% of the lit level too far, 1.5 2.3%,
-    /// 1.25 1.75%; 1.5 keeps more overlap for irregular sample sets.
+    /// shadow edge on marble (tests/render.rs, measured with the earlier Richardson far part) 2.0
+    /// bleeds 7.7% of the lit level too far, 1.5 2.3%, 1.25 1.75%; 1.5 keeps more overlap for
+    /// irregular sample sets.
     NEAR_BLEND_RADIUS = 1.5;
     /// The hierarchical gather drops a cluster of samples (with its subtree) when, under uniform
     /// light, it could add at most this fraction of `R_d,total` in every channel
