@@ -537,12 +537,13 @@ fn std430_records_have_pinned_layouts() {
     assert_eq!(offset_of!(DipoleEvalInput, area), 20);
     assert_eq!(offset_of!(DipoleEvalInput, cos_theta_o), 28);
     assert_eq!(offset_of!(DipoleEvalInput, t_eta), 32);
-    assert_eq!(size_of::<DipoleEvalOutput>(), 64);
+    assert_eq!(size_of::<DipoleEvalOutput>(), 68);
     assert_eq!(offset_of!(DipoleEvalOutput, F_dr), 12);
     assert_eq!(offset_of!(DipoleEvalOutput, r_d), 28);
     assert_eq!(offset_of!(DipoleEvalOutput, kernel), 40);
     assert_eq!(offset_of!(DipoleEvalOutput, near_energy), 44);
-    assert_eq!(offset_of!(DipoleEvalOutput, s_d), 60);
+    assert_eq!(offset_of!(DipoleEvalOutput, r_d_far_cluster), 52);
+    assert_eq!(offset_of!(DipoleEvalOutput, s_d), 64);
     // And the GLSL declares the same fields in the same order.
     let glsl = include_str!("../glsl/dipole_eval.comp");
     let fields = |block: &str| -> Vec<String> {
