@@ -22,7 +22,7 @@ use crate::optics::kernel::NEAR_BLEND_RADIUS;
 use glam::DVec3;
 
 /// Most samples in a leaf: a leaf's samples are summed exactly, pair by pair.
-pub const LEAF_SIZE: usize = 8;
+pub const LEAF_SIZE: usize = 4;
 
 /// Receivers per group in [`ReceiverGroups`]: the hierarchical gather's workgroup size.
 pub const RECEIVER_GROUP_SIZE: usize = 32;
