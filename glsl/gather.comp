@@ -68,7 +68,7 @@ void main() {
         barrier();
     }
     if (!is_receiver) return;
-    if (g.weight_sum == 0.0) {
+    if (g.weight_sum == 0.0 && push.node_count > 0u) {
         uint s = tree_nearest_sample(x, push.first_node, push.node_count);
         g.nearest_near = splat[s].irradiance_area.rgb * splat[s].near_energy.rgb;
     }

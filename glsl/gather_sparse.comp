@@ -95,6 +95,9 @@ void main() {
         barrier();
     }
     if (!is_receiver) return;
-    vec3 blended = weight_sum > 0.0 ? sum / weight_sum : sample_exitance[tree_nearest_sample(x, push.first_node, push.node_count)].rgb;
+    vec3 blended = weight_sum > 0.0 ? sum / weight_sum : vec3(0.0);
+    if (weight_sum == 0.0 && push.node_count > 0u) {
+        blended = sample_exitance[tree_nearest_sample(x, push.first_node, push.node_count)].rgb;
+    }
     exitance[v] = vec4(blended, 1.0);
 }

@@ -150,7 +150,7 @@ void main() {
         barrier();
     }
     if (!is_receiver) return;
-    if (g.weight_sum == 0.0) {
+    if (g.weight_sum == 0.0 && push.node_count > 0u) {
         // No Shepard weight reached x: the nearest sample's near exitance, found anywhere in the
         // hierarchy (a node item may hold it), as the flat gather takes it.
         uint s = tree_nearest_sample(x, push.first_node, push.node_count);
