@@ -18,7 +18,6 @@
 //! each node carries changes every splat and is aggregated on the GPU (`glsl/gather_tree.comp`,
 //! stage 0) and in the f64 twin (`reference::tree`); this module knows only geometry.
 
-use crate::optics::kernel::NEAR_BLEND_RADIUS;
 use glam::DVec3;
 
 /// Most samples in a leaf: a leaf's samples are summed exactly, pair by pair.
@@ -36,8 +35,9 @@ pub struct TreeNode {
     pub radius: f32,
     /// Sum of the samples' areas.
     pub area: f32,
-    /// Largest near-field blend radius of its samples (`NEAR_BLEND_RADIUS sqrt(dA)`): a receiver
-    /// nearer than `radius + reach` to the centre may get a Shepard weight from one of them.
+    /// Largest near-field blend radius of its samples (`blend_radius sqrt(dA)`, see
+    /// [`SampleTree::new`]): a receiver nearer than `radius + reach` to the centre may get a
+    /// Shepard weight from one of them.
     pub reach: f32,
     /// First entry of the subtree's samples in [`SampleTree::order`].
     pub first: u32,
@@ -58,13 +58,17 @@ pub struct SampleTree {
     /// Sample indices (into the object's samples), grouped so that node `n` holds
     /// `order[n.first .. n.first + n.count]`.
     pub order: Vec<u32>,
+    /// A sample's near-field blend radius per square root of its area (the gathers pass
+    /// `optics::kernel::NEAR_BLEND_RADIUS`; geometry knows no optics).
+    pub blend_radius: f64,
 }
 
 impl SampleTree {
-    /// The hierarchy over samples at `positions` with areas `areas` (same length).
-    pub fn new(positions: &[DVec3], areas: &[f64]) -> SampleTree {
+    /// The hierarchy over samples at `positions` with areas `areas` (same length), each sample
+    /// blending its near field out to `blend_radius sqrt(area)`.
+    pub fn new(positions: &[DVec3], areas: &[f64], blend_radius: f64) -> SampleTree {
         assert_eq!(positions.len(), areas.len(), "one area per sample");
-        let mut tree = SampleTree { nodes: Vec::new(), order: (0..positions.len() as u32).collect() };
+        let mut tree = SampleTree { nodes: Vec::new(), order: (0..positions.len() as u32).collect(), blend_radius };
         if !positions.is_empty() {
             let mut order = std::mem::take(&mut tree.order);
             tree.build(positions, areas, &mut order, 0);
@@ -88,7 +92,7 @@ impl SampleTree {
             center,
             radius,
             area: area as f32,
-            reach: ((NEAR_BLEND_RADIUS * largest.sqrt()) as f32).next_up(),
+            reach: ((self.blend_radius * largest.sqrt()) as f32).next_up(),
             first: first as u32,
             count: order.len() as u32,
             skip: 0,
@@ -155,7 +159,7 @@ impl SampleTree {
 }
 
 impl SampleTree {
-    /// The samples whose near-field blend radius (`NEAR_BLEND_RADIUS sqrt(dA)`; positions and
+    /// The samples whose near-field blend radius (`blend_radius sqrt(dA)`; positions and
     /// areas in the object's sample order) reaches into the sphere `group`: every sample that can
     /// give a receiver of the group a Shepard weight, found by walking only the nodes within reach.
     pub fn within_reach(&self, group: ([f32; 3], f32), positions: &[DVec3], areas: &[f64]) -> Vec<u32> {
@@ -172,7 +176,7 @@ impl SampleTree {
                     // A sample of the leaf is within reach when its own radius reaches the sphere
                     // (f32 rounding is covered by the node's rounded-out reach and radius).
                     if positions[s as usize].distance(center) - radius
-                        < NEAR_BLEND_RADIUS * areas[s as usize].sqrt() * (1.0 + 1e-6)
+                        < self.blend_radius * areas[s as usize].sqrt() * (1.0 + 1e-6)
                     {
                         found.push(s);
                     }
@@ -205,7 +209,7 @@ pub struct ReceiverGroups {
 impl ReceiverGroups {
     /// The groups over receivers at `positions`.
     pub fn new(positions: &[DVec3]) -> ReceiverGroups {
-        let order = SampleTree::new(positions, &vec![0.0; positions.len()]).order;
+        let order = SampleTree::new(positions, &vec![0.0; positions.len()], 0.0).order;
         let bounds = order
             .chunks(RECEIVER_GROUP_SIZE)
             .map(|chunk| {
@@ -240,6 +244,8 @@ fn sphere(points: &[DVec3]) -> ([f32; 3], f32) {
 mod tests {
     use super::*;
 
+    const BLEND: f64 = 1.5;
+
     fn points(n: usize) -> (Vec<DVec3>, Vec<f64>) {
         // A deterministic scatter on a curved patch, with uneven areas.
         let p = (0..n)
@@ -256,7 +262,7 @@ mod tests {
     fn every_node_bounds_its_samples_and_skips_past_its_subtree() {
         for n in [1, 2, 7, 8, 9, 100, 1000] {
             let (p, a) = points(n);
-            let t = SampleTree::new(&p, &a);
+            let t = SampleTree::new(&p, &a, BLEND);
             let mut sorted = t.order.clone();
             sorted.sort_unstable();
             assert_eq!(sorted, (0..n as u32).collect::<Vec<_>>(), "every sample exactly once");
@@ -303,7 +309,7 @@ mod tests {
     #[test]
     fn a_cut_covers_every_sample_once_and_epsilon_zero_takes_them_all() {
         let (p, a) = points(1000);
-        let t = SampleTree::new(&p, &a);
+        let t = SampleTree::new(&p, &a, BLEND);
         let groups = ReceiverGroups::new(&p);
         for epsilon in [0.0, 0.1, 1.0] {
             for &group in &groups.bounds {
@@ -334,14 +340,14 @@ mod tests {
     #[test]
     fn within_reach_finds_exactly_the_samples_whose_blend_radius_reaches_the_group() {
         let (p, a) = points(1000);
-        let t = SampleTree::new(&p, &a);
+        let t = SampleTree::new(&p, &a, BLEND);
         let groups = ReceiverGroups::new(&p);
         for &group in &groups.bounds {
             let mut got = t.within_reach(group, &p, &a);
             got.sort_unstable();
             let c = glam::Vec3::from(group.0).as_dvec3();
             let want: Vec<u32> = (0..1000u32)
-                .filter(|&s| p[s as usize].distance(c) - (group.1 as f64) < NEAR_BLEND_RADIUS * a[s as usize].sqrt())
+                .filter(|&s| p[s as usize].distance(c) - (group.1 as f64) < BLEND * a[s as usize].sqrt())
                 .collect();
             assert_eq!(got, want);
         }
@@ -349,6 +355,6 @@ mod tests {
 
     #[test]
     fn an_empty_object_has_no_nodes() {
-        assert!(SampleTree::new(&[], &[]).nodes.is_empty());
+        assert!(SampleTree::new(&[], &[], BLEND).nodes.is_empty());
     }
 }

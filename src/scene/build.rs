@@ -65,7 +65,7 @@ impl PreparedObject {
     pub fn sample_tree(&self) -> sampling::SampleTree {
         let positions: Vec<glam::DVec3> = self.samples.iter().map(|s| s.position.as_dvec3()).collect();
         let areas: Vec<f64> = self.samples.iter().map(|s| s.area).collect();
-        sampling::SampleTree::new(&positions, &areas)
+        sampling::SampleTree::new(&positions, &areas, crate::optics::kernel::NEAR_BLEND_RADIUS)
     }
 
     /// The hierarchical gather's items for each receiver group at accuracy `epsilon`
