@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{builtin, gather_from, temp_dir, text, translucent, with_gpu};
+use common::{builtin, gather_from, plane_scene, temp_dir, text, translucent, with_gpu};
 use translucent::optics::{Material, fresnel};
 use translucent::reference;
 use translucent::scene::build::{Overrides, PreparedScene};
@@ -96,33 +96,8 @@ fn default_epsilon_is_within_half_a_percent_rms_of_the_flat_gather() {
 
 /// A 1 m translucent plane (1 unit = 1 mm) lit from straight above, 3,000 Poisson samples.
 fn plane(preset: &str, gather: GatherMode) -> PreparedScene {
-    let scene = Scene::parse(&plane_toml(preset), "plane", None).unwrap();
+    let scene = Scene::parse(&plane_scene(preset, 1000.0, 3000, ""), "plane", None).unwrap();
     PreparedScene::new(&scene, &Overrides { gather: Some(gather), ..Default::default() }).unwrap()
-}
-
-fn plane_toml(preset: &str) -> String {
-    format!(
-        r#"
-[camera]
-eye = [0.0, 1000.0, 500.0]
-target = [0.0, 0.0, 0.0]
-resolution = [64, 64]
-
-[[object]]
-shape = {{ type = "plane", size = 1000.0, divisions = 48 }}
-material = {{ type = "translucent", preset = "{preset}", mm_per_unit = 1.0 }}
-casts_shadow = false
-
-[[light]]
-type = "directional"
-direction = [0.0, 1.0, 0.0]
-irradiance = [1.0, 1.0, 1.0]
-
-[sampling]
-method = "poisson"
-count = 3000
-"#
-    )
 }
 
 #[test]
@@ -165,7 +140,8 @@ fn a_bad_gather_epsilon_is_an_error_naming_it() {
     assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
     assert!(text(&out.stderr).contains("--gather-epsilon -1 must be 0 to 10"), "{}", text(&out.stderr));
     let scene = dir.join("bad.toml");
-    let toml = plane_toml("marble").replace("[sampling]", "[render]\ngather_epsilon = 11.0\n\n[sampling]");
+    let toml =
+        plane_scene("marble", 1000.0, 3000, "").replace("[sampling]", "[render]\ngather_epsilon = 11.0\n\n[sampling]");
     std::fs::write(&scene, toml).unwrap();
     let out = translucent(&["render", scene.to_str().unwrap(), "-o", png.to_str().unwrap()], &[]);
     assert_eq!(out.status.code(), Some(1));
@@ -178,7 +154,7 @@ fn a_bad_gather_epsilon_is_an_error_naming_it() {
 
     // Epsilon 0 lists every sample for every group of vertices: a scene where that exceeds the
     // device's storage-buffer range is refused before any GPU work, naming the setting.
-    let big = plane_toml("marble")
+    let big = plane_scene("marble", 1000.0, 3000, "")
         .replace("divisions = 48", "divisions = 400")
         .replace("method = \"poisson\"", "method = \"random\"")
         .replace("count = 3000", "count = 8000")

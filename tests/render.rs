@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{builtin, gather_from, run_all, with_gpu};
+use common::{builtin, gather_from, plane_scene, run_all, with_gpu};
 use translucent::optics::{Material, fresnel};
 use translucent::reference;
 use translucent::render::plan::{Change, Pass};
@@ -13,35 +13,6 @@ use translucent::scene::{GatherMode, Scene, lights};
 fn prepare(toml: &str, overrides: &Overrides) -> PreparedScene {
     let scene = Scene::parse(toml, "test scene", None).expect("test scene parses");
     PreparedScene::new(&scene, overrides).expect("test scene prepares")
-}
-
-/// A large translucent plane (size in mm, with 1 unit = 1 mm) under light from straight above.
-fn plane_scene(preset: &str, size: f32, samples: usize, extra: &str) -> String {
-    format!(
-        r#"
-[camera]
-eye = [0.0, {h}, {z}]
-target = [0.0, 0.0, 0.0]
-resolution = [64, 64]
-
-[[object]]
-shape = {{ type = "plane", size = {size}, divisions = 48 }}
-material = {{ type = "translucent", preset = "{preset}", mm_per_unit = 1.0 }}
-casts_shadow = false
-
-[[light]]
-type = "directional"
-direction = [0.0, 1.0, 0.0]
-irradiance = [1.0, 1.0, 1.0]
-
-[sampling]
-method = "poisson"
-count = {samples}
-{extra}
-"#,
-        h = size,
-        z = 0.5 * size
-    )
 }
 
 #[test]

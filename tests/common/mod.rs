@@ -135,6 +135,35 @@ pub fn with_gpu<R>(f: impl FnOnce(&Arc<Gpu>) -> R) -> R {
 // ---------------------------------------------------------------------------------------------
 // Scenes and frames
 
+/// A large translucent plane (size in mm, with 1 unit = 1 mm) under light from straight above.
+pub fn plane_scene(preset: &str, size: f32, samples: usize, extra: &str) -> String {
+    format!(
+        r#"
+[camera]
+eye = [0.0, {h}, {z}]
+target = [0.0, 0.0, 0.0]
+resolution = [64, 64]
+
+[[object]]
+shape = {{ type = "plane", size = {size}, divisions = 48 }}
+material = {{ type = "translucent", preset = "{preset}", mm_per_unit = 1.0 }}
+casts_shadow = false
+
+[[light]]
+type = "directional"
+direction = [0.0, 1.0, 0.0]
+irradiance = [1.0, 1.0, 1.0]
+
+[sampling]
+method = "poisson"
+count = {samples}
+{extra}
+"#,
+        h = size,
+        z = 0.5 * size
+    )
+}
+
 /// The built-in scene, prepared with `overrides`.
 pub fn builtin(overrides: &Overrides) -> PreparedScene {
     PreparedScene::new(&Scene::builtin(), overrides).unwrap()
