@@ -18,23 +18,10 @@ use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, Descripto
 use ash::vk;
 use std::sync::Arc;
 
-/// `GatherSparsePush` in glsl/gather_sparse.comp.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct GatherSparsePush {
-    /// Index of the receiving translucent object (its `ObjectRecord`).
-    pub object: u32,
-    /// 0: exitance at the samples; 1: blended to the vertices.
-    pub stage: u32,
-    /// The object's root in `GpuScene::tree_nodes` (the nearest-sample fallback walks it).
-    pub first_node: u32,
-    /// Its node count.
-    pub node_count: u32,
-    /// Its first entry in `GpuScene::receiver_order`.
-    pub first_receiver: u32,
-    /// Its first group in `GpuScene::receiver_groups`.
-    pub first_group: u32,
-}
+// `GatherSparsePush` in glsl/gather_sparse.comp has the hierarchical gather's fields (stage 0:
+// exitance at the samples, 1: blended to the vertices; the nearest-sample fallback walks the
+// hierarchy), so one Rust type serves both.
+pub use super::gather_tree::GatherTreePush as GatherSparsePush;
 
 /// The sparse gather: per translucent object, stage 0 of glsl/gather_sparse.comp over its samples
 /// (exitance into a per-sample buffer this pass owns), a compute-to-compute barrier, then stage 1
@@ -73,14 +60,7 @@ impl GatherSparsePass {
 
 impl RenderPass for GatherSparsePass {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        let push = |r: &super::gpu_scene::Receiver, stage| GatherSparsePush {
-            object: r.object,
-            stage,
-            first_node: r.first_node,
-            node_count: r.node_count,
-            first_receiver: r.first_receiver,
-            first_group: r.first_group,
-        };
+        let push = GatherSparsePush::new;
         for r in &frame.scene.receivers {
             self.pipeline.dispatch(cmd, &self.set, &push(r, 0), [r.sample_count, 1, 1]);
         }

@@ -12,7 +12,7 @@
 //! Push: `GatherTreePush`.
 
 use super::gather::exitance_written;
-use super::gpu_scene::GpuScene;
+use super::gpu_scene::{GpuScene, Receiver};
 use super::pass::{FrameInputs, RenderPass};
 use crate::gpu::{Access, Binding, ComputePipeline, DescriptorSet, Gpu, GpuResult, memory_barrier};
 use ash::vk;
@@ -34,6 +34,20 @@ pub struct GatherTreePush {
     pub first_receiver: u32,
     /// Its first group in `GpuScene::receiver_groups`.
     pub first_group: u32,
+}
+
+impl GatherTreePush {
+    /// The push block for `stage` of a dispatch over `receiver`.
+    pub fn new(receiver: &Receiver, stage: u32) -> GatherTreePush {
+        GatherTreePush {
+            object: receiver.object,
+            stage,
+            first_node: receiver.first_node,
+            node_count: receiver.node_count,
+            first_receiver: receiver.first_receiver,
+            first_group: receiver.first_group,
+        }
+    }
 }
 
 /// The hierarchical gather: two dispatches of glsl/gather_tree.comp per translucent object,
@@ -68,14 +82,7 @@ impl GatherTreePass {
 
 impl RenderPass for GatherTreePass {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        let push = |r: &super::gpu_scene::Receiver, stage| GatherTreePush {
-            object: r.object,
-            stage,
-            first_node: r.first_node,
-            node_count: r.node_count,
-            first_receiver: r.first_receiver,
-            first_group: r.first_group,
-        };
+        let push = GatherTreePush::new;
         for r in &frame.scene.receivers {
             self.pipeline.dispatch(cmd, &self.set, &push(r, 0), [r.node_count, 1, 1]);
         }
