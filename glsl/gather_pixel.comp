@@ -36,6 +36,12 @@ void main() {
         return;
     }
     ObjectRecord o = objects[uint(s.w - 0.5)];
+    // Local channels were shaded whole by shade_pixel.frag.
+    vec3 gathered = object_gathered_channels(o);
+    if (gathered == vec3(0.0)) {
+        imageStore(hdr, p, vec4(radiance.rgb, 1.0));
+        return;
+    }
     uint first = o.ranges.z, count = o.ranges.w;
     DipoleChannel ch[3] = gather_channels(o);
     GatherSum g = gather_begin();
@@ -43,5 +49,5 @@ void main() {
         gather_add(g, ch, s.xyz, samples[i].position_area, splat[i].irradiance_area.rgb, splat[i].near_energy.rgb);
         if (((i - first) & 63u) == 63u) gather_flush(g);
     }
-    imageStore(hdr, p, vec4(radiance.rgb + gather_end(g) * radiance.a, 1.0));
+    imageStore(hdr, p, vec4(radiance.rgb + gather_end(g) * gathered * radiance.a, 1.0));
 }

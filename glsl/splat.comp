@@ -20,14 +20,15 @@ layout(std430, set = 0, binding = 2) readonly buffer Lights { Light lights[]; };
 layout(set = 0, binding = 3) uniform sampler2DArrayShadow shadow_maps;
 layout(std430, set = 0, binding = 4) writeonly buffer Splat { SplatRecord splat[]; };
 struct SplatPush {
+    uint first_sample;      // one dispatch per object: its samples
     uint sample_count;
     uint light_count;
 };
 layout(push_constant) uniform SplatPushBlock { SplatPush push; };
 
 void main() {
-    uint i = gl_GlobalInvocationID.x;
-    if (i >= push.sample_count) return;
+    if (gl_GlobalInvocationID.x >= push.sample_count) return;
+    uint i = push.first_sample + gl_GlobalInvocationID.x;
     SampleRecord s = samples[i];
     ObjectRecord o = objects[uint(s.normal_object.w)];
     vec3 p = s.position_area.xyz;

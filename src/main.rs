@@ -25,6 +25,8 @@ enum Command {
     Material(cli::material::Args),
     /// Place sample points on a mesh and print their statistics
     Sample(cli::sample::Args),
+    /// Show what each kind of frame change would run, per pass, object and channel, and why
+    Plan(cli::plan::Args),
 }
 
 fn main() -> ExitCode {
@@ -36,6 +38,7 @@ fn main() -> ExitCode {
         Some(Command::Devices(args)) => cli::devices::run(&cli.gpu, &args),
         Some(Command::Material(args)) => cli::material::run(&args),
         Some(Command::Sample(args)) => cli::sample::run(&args),
+        Some(Command::Plan(args)) => cli::plan::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

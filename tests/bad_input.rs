@@ -431,3 +431,20 @@ fn an_interrupted_write_leaves_no_temporary_file() {
     assert!(partials(&dir).is_empty(), "temporaries left: {:?}", partials(&dir));
     assert_eq!(std::fs::read_to_string(&png).unwrap(), "old");
 }
+
+#[test]
+fn an_environment_map_whose_header_claims_millions_of_texels_is_refused_naming_the_limit() {
+    use translucent::scene::lights::{Environment, EnvironmentError, MAX_ENVIRONMENT_SIDE, MAX_ENVIRONMENT_TEXELS};
+    // 881 bytes of tiled EXR whose header says 7733242x4: decoding it took 10 s (found by the
+    // environment fuzzer, now in its corpus).
+    let bytes = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/fuzz/corpus/environment/regression-exr-7733242x4"))
+        .unwrap();
+    match Environment::from_bytes(&bytes, "huge.exr") {
+        Err(e @ EnvironmentError::TooLarge { width: 7733242, height: 4, limit: MAX_ENVIRONMENT_TEXELS, .. }) => {
+            let message = e.to_string();
+            assert!(message.contains("huge.exr") && message.contains("7733242x4"), "{message}");
+            assert!(message.contains(&MAX_ENVIRONMENT_SIDE.to_string()), "{message}");
+        }
+        other => panic!("expected TooLarge, got {:?}", other.map(|e| (e.width, e.height))),
+    }
+}

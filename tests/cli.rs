@@ -148,14 +148,14 @@ fn a_moving_camera_really_moves_and_only_reshades() {
     let (still, moved) = (dir.join("still.png"), dir.join("moved.png"));
     let render = |frames: &str, out: &std::path::Path| {
         let args = ["render", "--resolution", "64x64", "--samples", "50", "--frames", frames, "--moving", "camera"];
-        translucent(&[&args[..], &["--plan", "-o", out.to_str().unwrap()]].concat(), &[])
+        translucent(&[&args[..], &["--explain", "-o", out.to_str().unwrap()]].concat(), &[])
     };
     let out = render("1", &still);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let out = render("4", &moved);
     let stderr = text(&out.stderr);
     assert!(out.status.success(), "{stderr}");
-    let frame1 = stderr.split("frame 1 (Camera):").nth(1).expect("frame 1's plan");
+    let frame1 = stderr.split("frame 1 (change: camera):").nth(1).expect("frame 1's plan");
     assert!(
         frame1.contains("run  shade") && frame1.contains("skip splat") && frame1.contains("skip gather"),
         "{frame1}"

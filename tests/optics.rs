@@ -53,6 +53,25 @@ fn rel(a: f64, b: f64) -> f64 {
 // ---------------------------------------------------------------- the dipole profile
 
 #[test]
+fn the_profile_radius_is_the_rms_radius_of_r_d_by_quadrature() {
+    let mut checked = 0;
+    for (name, d) in preset_dipoles() {
+        if d.sigma_a == 0.0 || d.alpha_prime == 0.0 {
+            assert!(d.sigma_a > 0.0 || d.profile_radius().is_infinite(), "{name}");
+            continue;
+        }
+        let hi = d.z_v + 80.0 * d.diffusion_length();
+        let moment = radial_integral(|r| r * r * d.r_d(r), 1e-9 * d.z_r, hi, 40_000);
+        let numeric = (moment / d.r_d_total()).sqrt();
+        assert!(rel(numeric, d.profile_radius()) < 1e-6, "{name}: numeric {numeric} vs {}", d.profile_radius());
+        // Wider than the real source's depth, and finite.
+        assert!(d.profile_radius() > d.z_r * 0.5 && d.profile_radius().is_finite(), "{name}");
+        checked += 1;
+    }
+    assert!(checked > 100);
+}
+
+#[test]
 fn total_reflectance_equals_numerical_integral_of_r_d() {
     let mut worst = 0.0f64;
     let mut checked = 0;

@@ -143,14 +143,14 @@ fn push_blocks_match_glsl_and_spirv() {
             include_str!("../glsl/splat.comp"),
             "SplatPush",
             size_of::<SplatPush>(),
-            &["sample_count", "light_count"],
+            &["first_sample", "sample_count", "light_count"],
         ),
         (
             "vertex_light.comp",
             include_str!("../glsl/vertex_light.comp"),
             "VertexLightPush",
             size_of::<VertexLightPush>(),
-            &["vertex_count", "light_count"],
+            &["first_vertex", "vertex_count", "light_count", "eta"],
         ),
         (
             "gather.comp",
@@ -211,7 +211,8 @@ fn push_blocks_match_glsl_and_spirv() {
         assert_eq!(reflected.push_bytes as usize, rust_size, "{shader}: reflected push block");
     }
     // Offsets of the multi-field structs, against repr(C).
-    assert_eq!(offset_of!(SplatPush, light_count), 4);
+    assert_eq!(offset_of!(SplatPush, light_count), 8);
+    assert_eq!(offset_of!(VertexLightPush, eta), 12);
     assert_eq!(offset_of!(TonemapPush, exposure), 8);
     assert_eq!(offset_of!(ShadowPush, layer), 64);
 }

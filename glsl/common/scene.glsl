@@ -11,10 +11,18 @@ struct ObjectRecord {
     vec4 albedo_roughness;  // opaque: rgb albedo; w: GGX roughness (both kinds)
     vec4 eta_norm_kind;     // x: relative index of refraction eta; y: BSSRDF normalization
                             // 1 / (pi T(eta)), T(eta) = 1 - 2 FM1(eta) (optics::Dipole::s_d);
-                            // z: kind (MATERIAL_*); w: unused
+                            // z: kind (MATERIAL_*); w: channels computed locally, a bit
+                            // mask as float (bit c: channel c; render::plan)
     DipoleChannel dipole[3]; // per channel: alpha', sigma_tr, z_r, z_v in scene units
     uvec4 ranges;           // x: first vertex, y: vertex count, z: first sample, w: sample count
 };
+
+// 1 in each channel whose exitance is gathered, 0 in each the planner computes locally
+// (M = R_d,total E_t at the receiver itself; ObjectRecord::local_channels).
+vec3 object_gathered_channels(ObjectRecord o) {
+    uint local = uint(o.eta_norm_kind.w);
+    return vec3((local & 1u) == 0u ? 1.0 : 0.0, (local & 2u) == 0u ? 1.0 : 0.0, (local & 4u) == 0u ? 1.0 : 0.0);
+}
 
 struct SampleRecord {
     vec4 position_area;     // xyz: world position; w: area weight (scene units^2)

@@ -56,8 +56,10 @@ void main() {
     float alpha = max(roughness * roughness, 1e-3);
     vec3 radiance = vec3(0.0);
     float exitance_to_radiance = translucent ? dipole_fresnel_transmittance(cos_o, eta) * o.eta_norm_kind.y : 0.0;
-    // Zero under the pixel gather (no vertex gather runs), which adds its exitance afterwards.
-    radiance += v_exitance * exitance_to_radiance;
+    // Irradiance transmitted into a translucent surface here, for the channels the planner
+    // computes locally: the environment's part arrives per vertex (vertex_light.comp weighs it
+    // by F_t for translucent objects), the key lights' is added below.
+    vec3 transmitted = translucent ? v_environment : vec3(0.0);
     if (!translucent) radiance += v_environment * (o.albedo_roughness.rgb / DIPOLE_PI);
     // The key lights come first in the buffer (scene::lights::prepare); counts.y of them.
     for (uint l = 0u; l < push.counts.y; ++l) {
@@ -71,6 +73,15 @@ void main() {
         vec3 lit = irradiance * v;
         radiance += lit * (fresnel * ggx_specular(n, wi, wo, alpha));
         if (!translucent) radiance += lit * (o.albedo_roughness.rgb / DIPOLE_PI * cos_i);
+        else transmitted += lit * (cos_i * dipole_fresnel_transmittance(cos_i, eta));
+    }
+    if (translucent) {
+        // Gathered channels: the exitance interpolated from the vertices (zero under the pixel
+        // gather, which adds its own afterwards). Local ones: M = R_d,total E_t, the dipole
+        // integral when E_t is uniform over the profile's width (render::plan).
+        vec3 gathered = object_gathered_channels(o);
+        vec3 r_d_total = vec3(dipole_r_d_total(o.dipole[0]), dipole_r_d_total(o.dipole[1]), dipole_r_d_total(o.dipole[2]));
+        radiance += mix(r_d_total * transmitted, v_exitance, gathered) * exitance_to_radiance;
     }
     // Nothing non-finite leaves this pass (the tone map counts any that would).
 #ifdef PIXEL_GATHER

@@ -11,6 +11,7 @@ macro_rules! out {
 
 pub mod devices;
 pub mod material;
+pub mod plan;
 pub mod render;
 pub mod sample;
 

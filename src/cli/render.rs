@@ -10,7 +10,7 @@ use translucent::render::plan::Change;
 use translucent::render::renderer::Renderer;
 use translucent::sampling::Method;
 use translucent::scene::build::{Overrides, PreparedScene};
-use translucent::scene::{GatherMode, Light, Scene, lights};
+use translucent::scene::{GatherMode, Light, Scene, TransportMode, lights};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -54,9 +54,14 @@ pub struct Args {
     /// Print per-pass GPU milliseconds (median over the frames after the first)
     #[arg(long)]
     pub timings: bool,
-    /// Print which passes run and why
-    #[arg(long)]
-    pub plan: bool,
+    /// Print, for every frame rendered, which passes run and why, and each translucent
+    /// object's choices per channel with the numbers behind them (as `translucent plan`)
+    #[arg(long, alias = "plan")]
+    pub explain: bool,
+    /// Local or gathered exitance per channel: the planner's choice (auto), or forced
+    /// (overrides render.transport)
+    #[arg(long, value_parser = super::one_of::<TransportMode>(&TransportMode::ALL.map(TransportMode::name)))]
+    pub transport: Option<TransportMode>,
     /// Write each translucent vertex's world position and RGB radiant exitance to a PLY
     #[arg(long)]
     pub export_exitance: Option<PathBuf>,
@@ -89,7 +94,8 @@ impl Default for Args {
             moving: Moving::Light,
             isolate: false,
             timings: false,
-            plan: false,
+            explain: false,
+            transport: None,
             export_exitance: None,
         }
     }
@@ -143,6 +149,13 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         gather: args.gather,
         gather_epsilon: args.gather_epsilon,
         resolution: args.resolution,
+        transport: args.transport.or_else(|| {
+            // Local channels have no exitance at the vertices to export.
+            args.export_exitance.is_some().then(|| {
+                eprintln!("--export-exitance: every channel gathered (--transport gather) so each has vertex exitance");
+                TransportMode::Gather
+            })
+        }),
     };
     let spinner = ProgressBar::new_spinner().with_message(format!("preparing {} (meshes, sample points)", scene.name));
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
@@ -196,8 +209,8 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
             _ => {}
         }
         let plan = renderer.plan(change);
-        if args.plan && frame < 2 {
-            eprintln!("frame {frame} ({change:?}):\n{plan}");
+        if args.explain {
+            eprintln!("frame {frame} (change: {change}):\n{}", plan.to_string().trim_end());
         }
         let timings = if args.isolate { renderer.frame_isolated(&plan)? } else { renderer.frame(&plan)? };
         // The first frame builds everything and warms caches: it is not counted.

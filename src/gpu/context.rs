@@ -37,6 +37,7 @@ pub struct Gpu {
     properties: vk::PhysicalDeviceProperties,
     allocator: ManuallyDrop<Mutex<Allocator>>,
     counters: Arc<ValidationCounters>,
+    recorded: super::RecordCounter,
     timeout: Duration,
 }
 
@@ -253,6 +254,7 @@ impl Gpu {
             properties,
             allocator: ManuallyDrop::new(Mutex::new(allocator)),
             counters,
+            recorded: Default::default(),
             timeout: options.timeout,
         }))
     }
@@ -297,6 +299,14 @@ impl Gpu {
     /// outlive the `Gpu`, so messages sent while the device is destroyed (leaks) are counted.
     pub fn validation(&self) -> Arc<ValidationCounters> {
         self.counters.clone()
+    }
+    /// Dispatches and draws recorded through this device's pipelines, per shader.
+    pub fn recorded(&self) -> super::RecordCounts {
+        self.recorded.snapshot()
+    }
+    /// Count one command recorded by `shader`'s pipeline (the pipelines call it).
+    pub(super) fn count_recorded(&self, shader: &str) {
+        self.recorded.add(shader)
     }
     /// Whether this `Gpu` created its instance with the validation layer and messenger
     /// (`GpuOptions::validation`). Always false over a host's instance, whatever layers the host

@@ -167,6 +167,7 @@ impl ComputePipeline {
         unsafe { device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline) };
         self.layout.bind(cmd, vk::PipelineBindPoint::COMPUTE, Some(set), push);
         unsafe { device.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
+        self.layout.gpu.count_recorded(&self.name);
     }
 
     /// The shader path it was built from, e.g. "splat.comp".
@@ -228,6 +229,8 @@ impl GraphicsDesc {
 pub struct GraphicsPipeline {
     pipeline: vk::Pipeline,
     layout: Layout,
+    /// The vertex shader's path, which names its draws in `Gpu::recorded`.
+    name: String,
 }
 
 impl GraphicsPipeline {
@@ -302,7 +305,7 @@ impl GraphicsPipeline {
         // SAFETY: every pointer refers to locals alive for the call; dynamic rendering is enabled.
         let pipeline = unsafe { gpu.device().create_graphics_pipelines(vk::PipelineCache::null(), &info, None) }
             .map_err(|(_, result)| GpuError::Vk { what: "vkCreateGraphicsPipelines", result })?[0];
-        Ok(GraphicsPipeline { pipeline, layout })
+        Ok(GraphicsPipeline { pipeline, layout, name: desc.vertex.clone() })
     }
 
     /// A descriptor set for this pipeline's set 0, binding i being `bindings[i]`.
@@ -336,6 +339,14 @@ impl GraphicsPipeline {
             device.cmd_set_scissor(cmd, 0, &[vk::Rect2D { offset: vk::Offset2D::default(), extent }]);
         }
         self.layout.bind(cmd, vk::PipelineBindPoint::GRAPHICS, set, push);
+    }
+
+    /// Record an indexed draw with this pipeline bound (`bind`), counted in `Gpu::recorded`.
+    pub fn draw_indexed(&self, cmd: vk::CommandBuffer, index_count: u32, first_index: u32, vertex_offset: i32) {
+        // SAFETY: `cmd` is recording inside dynamic rendering with this pipeline and its vertex
+        // and index buffers bound.
+        unsafe { self.layout.gpu.device().cmd_draw_indexed(cmd, index_count, 1, first_index, vertex_offset, 0) };
+        self.layout.gpu.count_recorded(&self.name);
     }
 }
 

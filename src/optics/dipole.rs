@@ -111,6 +111,23 @@ impl Dipole {
         0.5 * self.alpha_prime * (1.0 + (-4.0 / 3.0 * self.A * s).exp()) * (-s).exp()
     }
 
+    /// RMS radius of the profile: `sqrt(integral r^2 R_d(r) 2 pi r dr / R_d,total)`, the width
+    /// of the blur subsurface transport gives an image, in closed form. Each pole's share of
+    /// `R_d 2 pi r` is `(alpha'/2) (-d/dr) [z e^(-sigma_tr d) / d]`; integrating `r^2` against it
+    /// by parts gives `alpha' z e^(-sigma_tr z) / sigma_tr`, so
+    /// `<r^2> = alpha' sum_z z e^(-sigma_tr z) / (sigma_tr R_d,total)`.
+    /// Why it matters: the local answer `M = R_d,total E(x)` is off from the dipole integral by
+    /// `R_d,total <r^2> laplacian(E) / 4` to second order (planner, `render::plan`). Infinite
+    /// without absorption.
+    pub fn profile_radius(&self) -> f64 {
+        if self.sigma_tr == 0.0 {
+            return f64::INFINITY;
+        }
+        let pole = |z: f64| z * (-self.sigma_tr * z).exp();
+        let moment = self.alpha_prime * (pole(self.z_r) + pole(self.z_v)) / self.sigma_tr;
+        (moment / self.r_d_total()).sqrt()
+    }
+
     /// Exact disk integral `P(R) = integral_0^R R_d(r) 2 pi r dr` (docs/optics.md,
     /// "Reflectance profile, its integrals, and the BSSRDF"):
     /// `(alpha'/2) sum_{z in z_r, z_v} [e^(-sigma_tr z) - z e^(-sigma_tr d(R)) / d(R)]`.

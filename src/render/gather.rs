@@ -53,7 +53,7 @@ impl GatherPass {
 
 impl RenderPass for GatherPass {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        for r in &frame.scene.receivers {
+        for r in frame.scene.receivers.iter().filter(|r| frame.plan.gathers(r.object as usize)) {
             let push = GatherPush { object: r.object, first_node: r.first_node, node_count: r.node_count };
             self.pipeline.dispatch(cmd, &self.set, &push, [r.vertex_count, 1, 1]);
         }

@@ -61,7 +61,7 @@ impl GatherSparsePass {
 impl RenderPass for GatherSparsePass {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         let push = GatherSparsePush::new;
-        for r in &frame.scene.receivers {
+        for r in frame.scene.receivers.iter().filter(|r| frame.plan.gathers(r.object as usize)) {
             self.pipeline.dispatch(cmd, &self.set, &push(r, 0), [r.sample_count, 1, 1]);
         }
         // Stage 1 reads what stage 0 wrote.

@@ -83,7 +83,7 @@ impl GatherTreePass {
 impl RenderPass for GatherTreePass {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         let push = GatherTreePush::new;
-        for r in &frame.scene.receivers {
+        for r in frame.scene.receivers.iter().filter(|r| frame.plan.gathers(r.object as usize)) {
             self.pipeline.dispatch(cmd, &self.set, &push(r, 0), [r.node_count, 1, 1]);
         }
         // Stage 1 reads the node power stage 0 wrote.

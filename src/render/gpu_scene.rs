@@ -1,7 +1,7 @@
 //! `GpuScene`: a prepared scene's data on the GPU, packed once (`records`) and uploaded: the
 //! shared vertex and index buffers, object, sample and light records, and the buffers the passes
 //! write and read between frames (splat output, exitance, cached environment irradiance). The
-//! passes get their inputs from here; only lights change after creation.
+//! passes get their inputs from here; only lights and object records change after creation.
 
 use super::records::{
     LightGpu, NodePowerRecord, ObjectRecord, ReceiverGroupRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
@@ -40,6 +40,22 @@ pub struct Receiver {
     pub first_receiver: u32,
     /// Its first group in `GpuScene::receiver_groups`.
     pub first_group: u32,
+}
+
+/// Where one object's vertices and samples lie in the shared buffers (every object, opaque ones
+/// included): what per-object dispatches cover.
+#[derive(Clone, Copy, Debug)]
+pub struct ObjectRange {
+    /// First vertex in the shared vertex buffer.
+    pub first_vertex: u32,
+    /// Its vertex count.
+    pub vertex_count: u32,
+    /// First sample in the shared sample buffer.
+    pub first_sample: u32,
+    /// Its sample count (0 for an opaque object).
+    pub sample_count: u32,
+    /// Index of refraction of a translucent object; 0 for an opaque one.
+    pub eta: f32,
 }
 
 /// A prepared scene's data on the GPU: device-local buffers the passes bind, and the ranges and
@@ -98,6 +114,8 @@ pub struct GpuScene {
     pub light_matrices: Vec<[[f32; 4]; 4]>,
     /// The translucent objects, in scene order: what the gathers dispatch over.
     pub receivers: Vec<Receiver>,
+    /// Every object's vertex and sample range, in scene order.
+    pub ranges: Vec<ObjectRange>,
     /// First vertex of each object in the shared buffers.
     pub vertex_offsets: Vec<u32>,
     /// Vertices of all objects together.
@@ -110,6 +128,10 @@ pub struct GpuScene {
     pub key_light_count: u32,
     /// Light records waiting to be copied into `lights` by the next recorded frame.
     pending_lights: Option<Vec<LightGpu>>,
+    /// The object records as last packed; copied into `objects` by the next recorded frame when
+    /// `pending_objects` (a material or the planner's local channels changed).
+    object_records: Vec<ObjectRecord>,
+    pending_objects: bool,
 }
 
 fn storage(gpu: &Arc<Gpu>, name: &str, bytes: u64, extra: vk::BufferUsageFlags) -> GpuResult<Buffer> {
@@ -133,8 +155,8 @@ impl GpuScene {
     pub fn new(gpu: &Arc<Gpu>, scene: &PreparedScene) -> GpuResult<GpuScene> {
         let (mut vertices, mut indices, mut objects, mut samples) =
             (Vec::new(), Vec::<u32>::new(), Vec::new(), Vec::new());
-        let (mut draws, mut casters, mut receivers, mut vertex_offsets) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut draws, mut casters, mut receivers, mut vertex_offsets, mut ranges) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let (mut tree_nodes, mut tree_order) = (Vec::new(), Vec::<u32>::new());
         let (mut receiver_order, mut receiver_groups) = (Vec::<u32>::new(), Vec::<ReceiverGroupRecord>::new());
         let (mut group_items, mut blend_items) = (Vec::<u32>::new(), Vec::<u32>::new());
@@ -167,6 +189,11 @@ impl GpuScene {
             let vertex_count = o.mesh.positions().len() as u32;
             let sample_count = o.samples.len() as u32;
             objects.push(ObjectRecord::new(o, [first_vertex, vertex_count, first_sample, sample_count]));
+            let eta = match &o.material {
+                crate::scene::build::ResolvedMaterial::Translucent { material, .. } => material.eta as f32,
+                crate::scene::build::ResolvedMaterial::Opaque { .. } => 0.0,
+            };
+            ranges.push(ObjectRange { first_vertex, vertex_count, first_sample, sample_count, eta });
             if matches!(o.material, crate::scene::build::ResolvedMaterial::Translucent { .. }) {
                 let tree = o.sample_tree();
                 let (first_node, first_entry) = (tree_nodes.len() as u32, tree_order.len() as u32);
@@ -265,12 +292,15 @@ impl GpuScene {
             casters,
             light_matrices: Vec::new(),
             receivers,
+            ranges,
             vertex_offsets,
             vertex_count: vertices.len() as u32,
             sample_count: samples.len() as u32,
             light_count: scene.lights.len() as u32,
             key_light_count: crate::scene::lights::key_light_count(&scene.lights) as u32,
             pending_lights: None,
+            object_records: objects,
+            pending_objects: false,
         };
         gpu_scene.set_lights(scene);
         // Before any frame the buffer is idle: written from the host directly.
@@ -293,19 +323,50 @@ impl GpuScene {
         self.pending_lights = Some(scene.lights.iter().map(LightGpu::new).collect());
     }
 
-    /// Record the copy of pending light records into the light buffer (vkCmdUpdateBuffer, in
-    /// the command buffer rather than through mapped memory), and the barrier to its readers.
-    pub fn record_uploads(&mut self, device: &ash::Device, cmd: vk::CommandBuffer) {
-        let Some(records) = self.pending_lights.take().filter(|r| !r.is_empty()) else {
-            return;
-        };
-        let bytes: &[u8] = bytemuck::cast_slice(&records);
-        // vkCmdUpdateBuffer takes at most 65536 bytes a call.
-        for (i, chunk) in bytes.chunks(65536).enumerate() {
-            // SAFETY: `cmd` is recording outside rendering; the range lies inside the buffer,
-            // which has TRANSFER_DST usage; sizes are multiples of 4 (records are 128 bytes).
-            unsafe { device.cmd_update_buffer(cmd, self.lights.raw(), (i * 65536) as u64, chunk) };
+    /// Which channels of object `object` the planner computes locally (bit c: channel c), in
+    /// its record's `eta_norm_kind.w`; uploaded by the next recorded frame when it changed.
+    pub fn set_local_channels(&mut self, object: usize, mask: u32) {
+        let record = &mut self.object_records[object];
+        if record.eta_norm_kind[3] != mask as f32 {
+            record.eta_norm_kind[3] = mask as f32;
+            self.pending_objects = true;
         }
-        memory_barrier(device, cmd, &[Access::TransferWrite], &[Access::ComputeRead, Access::FragmentRead]);
+    }
+
+    /// Re-pack object `object`'s record from the scene (its material changed; its ranges and
+    /// local channels stay), uploaded by the next recorded frame.
+    pub fn set_material(&mut self, scene: &PreparedScene, object: usize) {
+        let old = self.object_records[object];
+        let mut record = ObjectRecord::new(&scene.objects[object], old.ranges);
+        record.eta_norm_kind[3] = old.eta_norm_kind[3];
+        self.object_records[object] = record;
+        self.ranges[object].eta = record.eta_norm_kind[0];
+        self.pending_objects = true;
+    }
+
+    /// Record the copy of pending light and object records into their buffers
+    /// (vkCmdUpdateBuffer, in the command buffer rather than through mapped memory, so frames in
+    /// flight keep what they had), and the barrier to their readers.
+    pub fn record_uploads(&mut self, device: &ash::Device, cmd: vk::CommandBuffer) {
+        let lights = self.pending_lights.take().filter(|r| !r.is_empty());
+        let objects = std::mem::take(&mut self.pending_objects);
+        if let Some(records) = &lights {
+            update(device, cmd, &self.lights, bytemuck::cast_slice(records));
+        }
+        if objects {
+            update(device, cmd, &self.objects, bytemuck::cast_slice(&self.object_records));
+        }
+        if lights.is_some() || objects {
+            memory_barrier(device, cmd, &[Access::TransferWrite], &[Access::ComputeRead, Access::FragmentRead]);
+        }
+    }
+}
+
+/// vkCmdUpdateBuffer of `bytes` at the start of `buffer`, in the 65536-byte pieces it takes.
+fn update(device: &ash::Device, cmd: vk::CommandBuffer, buffer: &Buffer, bytes: &[u8]) {
+    for (i, chunk) in bytes.chunks(65536).enumerate() {
+        // SAFETY: `cmd` is recording outside rendering; the range lies inside the buffer, which
+        // has TRANSFER_DST usage; sizes are multiples of 4 (records are multiples of 16 bytes).
+        unsafe { device.cmd_update_buffer(cmd, buffer.raw(), (i * 65536) as u64, chunk) };
     }
 }

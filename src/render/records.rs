@@ -33,7 +33,8 @@ pub struct ObjectRecord {
     /// rgb: albedo of an opaque object (zero for a translucent one); w: GGX roughness (both kinds).
     pub albedo_roughness: [f32; 4],
     /// x: relative index of refraction eta; y: the BSSRDF normalization 1 / (pi T(eta)) (0 for
-    /// opaque); z: kind (`MATERIAL_*`); w: unused.
+    /// opaque); z: kind (`MATERIAL_*`); w: the channels computed locally, a bit mask as a
+    /// float (bit c: channel c; set per frame from the plan, `GpuScene::set_local_channels`).
     pub eta_norm_kind: [f32; 4],
     /// Per channel: alpha', sigma_tr, z_r, z_v, with lengths in scene units.
     pub dipole: [DipoleChannelGpu; 3],

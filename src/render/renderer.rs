@@ -47,9 +47,13 @@ pub enum RenderError {
         /// The format given.
         format: vk::Format,
     },
-    /// A call that does not fit the renderer's target (own images or the host's).
+    /// A call that does not fit the renderer's target (own images or the host's), or names an
+    /// object that cannot take it.
     #[error("{0}")]
     Target(&'static str),
+    /// A scene change could not be prepared (the message names the object and step).
+    #[error("{0}")]
+    Scene(String),
     /// `set_light` was given a light of another kind than scene light `index`, or an index past the
     /// scene's lights.
     #[error("light {0} cannot be replaced by a light of another kind")]
@@ -158,6 +162,9 @@ pub struct Renderer {
     camera: CameraView,
     /// What changed since the last recorded frame; `None` when nothing did.
     pending: Option<Change>,
+    /// Per object: its gathered exitance is out of date (lights or its material changed while
+    /// it was out of view or local), so the next frame that gathers it must splat it first.
+    stale: Vec<bool>,
 }
 
 impl Renderer {
@@ -176,8 +183,7 @@ impl Renderer {
         if let TargetDesc::Host { color_format, depth_format } = target {
             check_host_formats(gpu, color_format, depth_format)?;
         }
-        let mut needs = scene.needs();
-        needs.host_target = target != TargetDesc::Own;
+        let needs = Self::needs_of(&scene, target);
         if needs.host_target && needs.pixel_gather {
             return Err(RenderError::Target(
                 "the pixel gather needs the renderer's own HDR image: use vertex or sparse",
@@ -216,6 +222,7 @@ impl Renderer {
             target,
             camera: CameraView::of_scene(&scene),
             pending: Some(Change::Everything),
+            stale: vec![true; scene.objects.len()],
             scene,
         })
     }
@@ -235,9 +242,20 @@ impl Renderer {
         &mut self.buffers
     }
 
-    /// The passes a frame with this change would run.
+    /// The passes a frame with this change would run, seen from the current camera, and what
+    /// each object gets.
     pub fn plan(&self, change: Change) -> Plan {
-        plan::plan(&self.needs, change)
+        plan::plan(&self.needs, &self.view(), &self.stale, change)
+    }
+
+    /// The current camera as the planner sees it.
+    pub fn view(&self) -> plan::View {
+        plan::View::of_camera(&self.camera, self.scene.scene.file.camera.resolution[1])
+    }
+
+    /// What the planner knows of the scene (per-object facts included).
+    pub fn needs(&self) -> &SceneNeeds {
+        &self.needs
     }
 
     /// What changed since the last recorded frame (`record_frame` plans from it).
@@ -330,6 +348,9 @@ impl Renderer {
             self.next_slot += 1;
             slot
         });
+        for o in &plan.objects {
+            self.buffers.set_local_channels(o.object, o.local_mask());
+        }
         let device = self.gpu.device();
         // Against the frame before, which may still run: its reads of what this frame writes.
         memory_barrier(device, cmd, &[Access::Everything], &[Access::Everything]);
@@ -343,6 +364,9 @@ impl Renderer {
         self.record(cmd, plan, timer, target);
         self.timers = timers;
         self.pending = None;
+        for o in &plan.objects {
+            self.stale[o.object] = o.stale_after;
+        }
         Ok(RecordedFrame { passes: plan.passes.iter().map(|(p, _)| *p).collect(), slot })
     }
 
@@ -406,8 +430,7 @@ impl Renderer {
         let gpu = self.gpu.clone();
         let mut passes = Vec::new();
         for (pass, why) in &plan.passes {
-            let alone =
-                Plan { passes: vec![(*pass, why.clone())], skipped: Vec::new(), shadow_light: plan.shadow_light };
+            let alone = Plan { passes: vec![(*pass, why.clone())], skipped: Vec::new(), ..plan.clone() };
             let start = std::time::Instant::now();
             gpu.one_shot(pass.name(), |cmd| self.record_plan(cmd, &alone, None))??;
             passes.push((pass.name().to_string(), start.elapsed().as_secs_f64() * 1e3));
@@ -460,6 +483,61 @@ impl Renderer {
         self.buffers.set_lights(&self.scene);
         self.mark(Change::Light(index));
         Ok(())
+    }
+
+    /// Replace object `object`'s translucent material (new coefficients, same samples): its
+    /// record is re-packed and uploaded by the next frame, which reruns its splat and gather
+    /// (`Change::Material`). Errors when the object is opaque or the index is out of range.
+    pub fn set_material(&mut self, object: usize, material: crate::optics::Material) -> Result<(), RenderError> {
+        let Some(o) = self.scene.objects.get_mut(object) else {
+            return Err(RenderError::Target("set_material: no such object"));
+        };
+        let crate::scene::build::ResolvedMaterial::Translucent { material: m, dipoles, mm_per_unit, .. } =
+            &mut o.material
+        else {
+            return Err(RenderError::Target("set_material: the object is opaque"));
+        };
+        *dipoles = material.dipoles(*mm_per_unit).map_err(|_| RenderError::Target("set_material: invalid material"))?;
+        // The scene file says so too, so that a later resampling (`set_transform`) keeps it.
+        if let crate::scene::MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, eta, .. } =
+            &mut self.scene.scene.file.objects[object].material
+        {
+            (*preset, *sigma_a, *sigma_s_prime, *eta) =
+                (None, Some(material.sigma_a), Some(material.sigma_s_prime), Some(material.eta));
+        }
+        *m = material;
+        self.buffers.set_material(&self.scene, object);
+        self.needs = Self::needs_of(&self.scene, self.target);
+        self.stale[object] = true;
+        self.mark(Change::Material(object));
+        Ok(())
+    }
+
+    /// Move object `object`: `transform` replaces its transform in the scene. Its mesh is placed
+    /// again and resampled (same method, count and seed), and the scene's GPU data and passes
+    /// are rebuilt around it (the hierarchy and its lists depend on the geometry); the next
+    /// frame redraws every shadow and gathers every object (`Change::Geometry`). Call with no
+    /// frame of this renderer in flight: its GPU objects are replaced.
+    pub fn set_transform(&mut self, object: usize, transform: crate::scene::Transform) -> Result<(), RenderError> {
+        let mut file_scene = self.scene.scene.clone();
+        let Some(o) = file_scene.file.objects.get_mut(object) else {
+            return Err(RenderError::Target("set_transform: no such object"));
+        };
+        o.transform = transform;
+        let prepared = PreparedScene::new(&file_scene, &crate::scene::build::Overrides::default())
+            .map_err(|e| RenderError::Scene(e.to_string()))?;
+        let camera = self.camera;
+        let pending = self.pending.map_or(Change::Geometry(object), |p| p.and(Change::Geometry(object)));
+        *self = Renderer::with_target(&self.gpu.clone(), prepared, self.target)?;
+        self.camera = camera;
+        self.pending = Some(pending);
+        Ok(())
+    }
+
+    fn needs_of(scene: &PreparedScene, target: TargetDesc) -> SceneNeeds {
+        let mut needs = scene.needs();
+        needs.host_target = target != TargetDesc::Own;
+        needs
     }
 
     /// Where the last frame's non-finite values are, pass by pass and object by object (the

@@ -244,7 +244,7 @@ impl RenderPass for ShadePass {
                 counts: [scene.light_count, scene.key_light_count, 0, 0],
             };
             self.pipeline.bind(cmd, Some(&self.set), &push, extent);
-            unsafe { device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
+            self.pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
         }
         unsafe { device.cmd_end_rendering(cmd) };
         for image in self.colors() {

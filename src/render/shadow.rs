@@ -154,9 +154,9 @@ impl RenderPass for ShadowPass {
             unsafe {
                 device.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.raw()], &[0]);
                 device.cmd_bind_index_buffer(cmd, scene.indices.raw(), 0, vk::IndexType::UINT32);
-                for d in &scene.casters {
-                    device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0);
-                }
+            }
+            for d in &scene.casters {
+                self.pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
             }
         }
         unsafe { device.cmd_end_rendering(cmd) };

@@ -17,18 +17,20 @@ use std::sync::Arc;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SplatPush {
-    /// Sample points of all objects; invocations beyond it return.
+    /// The object's first sample in the shared buffers.
+    pub first_sample: u32,
+    /// Its sample count; invocations beyond it return.
     pub sample_count: u32,
     /// Lights in the light buffer; each adds its transmitted irradiance at every sample.
     pub light_count: u32,
 }
 
-/// The irradiance splat: one dispatch of glsl/splat.comp over every sample point, writing
+/// The irradiance splat: one dispatch of glsl/splat.comp per object the plan splats, writing
 /// `SplatRecord`s into `GpuScene::splat`, then a barrier to compute reads (the gathers).
 pub struct SplatPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
-    push: SplatPush,
+    light_count: u32,
 }
 
 impl SplatPass {
@@ -43,14 +45,21 @@ impl SplatPass {
             shadow.binding(),
             Binding::Buffer(&scene.splat),
         ])?;
-        let push = SplatPush { sample_count: scene.sample_count, light_count: scene.light_count };
-        Ok(SplatPass { pipeline, set, push })
+        Ok(SplatPass { pipeline, set, light_count: scene.light_count })
     }
 }
 
 impl RenderPass for SplatPass {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        self.pipeline.dispatch(cmd, &self.set, &self.push, [self.push.sample_count, 1, 1]);
+        // One dispatch per object the plan splats: the others keep their last irradiance.
+        for (i, r) in frame.scene.ranges.iter().enumerate() {
+            if r.sample_count == 0 || !frame.plan.splats(i) {
+                continue;
+            }
+            let push =
+                SplatPush { first_sample: r.first_sample, sample_count: r.sample_count, light_count: self.light_count };
+            self.pipeline.dispatch(cmd, &self.set, &push, [r.sample_count, 1, 1]);
+        }
         memory_barrier(frame.gpu.device(), cmd, &[Access::ComputeWrite], &[Access::ComputeRead]);
     }
 }

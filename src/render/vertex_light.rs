@@ -17,18 +17,23 @@ use std::sync::Arc;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct VertexLightPush {
-    /// Vertices of all objects; invocations beyond it return.
+    /// The object's first vertex in the shared buffers.
+    pub first_vertex: u32,
+    /// Its vertex count; invocations beyond it return.
     pub vertex_count: u32,
     /// Lights in the light buffer; the shader adds only the environment's directions.
     pub light_count: u32,
+    /// A translucent object's index of refraction (its irradiance is weighed by `F_t`, what the
+    /// local exitance needs); 0 for an opaque one.
+    pub eta: f32,
 }
 
-/// The environment cache: one dispatch of glsl/vertex_light.comp over every vertex, writing
+/// The environment cache: one dispatch of glsl/vertex_light.comp per object, writing
 /// `GpuScene::environment_irradiance`, then a barrier to vertex-attribute reads by shading.
 pub struct VertexLightPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
-    push: VertexLightPush,
+    light_count: u32,
 }
 
 impl VertexLightPass {
@@ -42,14 +47,21 @@ impl VertexLightPass {
             shadow.binding(),
             Binding::Buffer(&scene.environment_irradiance),
         ])?;
-        let push = VertexLightPush { vertex_count: scene.vertex_count, light_count: scene.light_count };
-        Ok(VertexLightPass { pipeline, set, push })
+        Ok(VertexLightPass { pipeline, set, light_count: scene.light_count })
     }
 }
 
 impl RenderPass for VertexLightPass {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        self.pipeline.dispatch(cmd, &self.set, &self.push, [self.push.vertex_count, 1, 1]);
+        for r in &frame.scene.ranges {
+            let push = VertexLightPush {
+                first_vertex: r.first_vertex,
+                vertex_count: r.vertex_count,
+                light_count: self.light_count,
+                eta: r.eta,
+            };
+            self.pipeline.dispatch(cmd, &self.set, &push, [r.vertex_count, 1, 1]);
+        }
         memory_barrier(frame.gpu.device(), cmd, &[Access::ComputeWrite], &[Access::VertexAttributeRead]);
     }
 }

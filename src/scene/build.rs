@@ -129,6 +129,8 @@ pub struct Overrides {
     pub gather_epsilon: Option<f32>,
     /// `--resolution`: replaces `camera.resolution` (width, height in pixels).
     pub resolution: Option<[u32; 2]>,
+    /// `--transport`: replaces `render.transport`.
+    pub transport: Option<crate::scene::TransportMode>,
 }
 
 impl PreparedScene {
@@ -158,6 +160,9 @@ impl PreparedScene {
                 return Err(SceneError::GatherEpsilon(e));
             }
             scene.file.render.gather_epsilon = e;
+        }
+        if let Some(t) = overrides.transport {
+            scene.file.render.transport = t;
         }
         if let Some(r) = overrides.resolution {
             scene.file.camera.resolution = r;

@@ -288,6 +288,10 @@ pub struct RenderSettings {
     /// modes ignore it.
     #[serde(default = "gather_epsilon")]
     pub gather_epsilon: f32,
+    /// How each translucent object's channels get their exitance (default `"auto"`: the
+    /// planner chooses per object and channel, `render::plan`).
+    #[serde(default)]
+    pub transport: TransportMode,
     /// Exposure multiplier applied before the tone map (default 1; positive).
     #[serde(default = "one")]
     pub exposure: f32,
@@ -348,11 +352,56 @@ impl std::fmt::Display for GatherMode {
     }
 }
 
+/// How translucent channels get their exitance: `render.transport`, `--transport`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TransportMode {
+    /// The planner chooses per object and channel, from the profile's width against what the
+    /// samples, the mesh and the pixels can show (`render::plan`)
+    #[default]
+    Auto,
+    /// Every channel gathered from the samples (the dipole sum)
+    Gather,
+    /// Every channel local: `M = R_d,total E_t` at the receiver, no splat or gather
+    Local,
+}
+
+impl TransportMode {
+    /// Every mode, in the order `--transport` lists them.
+    pub const ALL: [TransportMode; 3] = [TransportMode::Auto, TransportMode::Gather, TransportMode::Local];
+
+    /// The lowercase name used in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            TransportMode::Auto => "auto",
+            TransportMode::Gather => "gather",
+            TransportMode::Local => "local",
+        }
+    }
+}
+
+impl std::str::FromStr for TransportMode {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        TransportMode::ALL
+            .into_iter()
+            .find(|m| m.name().eq_ignore_ascii_case(s))
+            .ok_or_else(|| format!("unknown transport `{s}` (expected auto, gather or local)"))
+    }
+}
+
+impl std::fmt::Display for TransportMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.name())
+    }
+}
+
 impl Default for RenderSettings {
     fn default() -> Self {
         Self {
             gather: GatherMode::default(),
             gather_epsilon: gather_epsilon(),
+            transport: TransportMode::default(),
             exposure: 1.0,
             shadow_map_size: shadow_size(),
             background: None,

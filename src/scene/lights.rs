@@ -44,6 +44,24 @@ pub enum EnvironmentError {
         /// Its height in texels.
         height: usize,
     },
+    /// The map is wider or higher than `MAX_ENVIRONMENT_SIDE` or has more than the allowed
+    /// number of texels (`MAX_ENVIRONMENT_TEXELS` when loaded from a file): found from the
+    /// header, before any texel is decoded.
+    #[error(
+        "environment map {} is {width}x{height}, above the limit of {limit} texels and \
+         {side} texels a side (an 8192x4096 map fits; downscale it)",
+        path.display(), side = MAX_ENVIRONMENT_SIDE
+    )]
+    TooLarge {
+        /// The map's file.
+        path: std::path::PathBuf,
+        /// Its width in texels, from the header.
+        width: usize,
+        /// Its height in texels, from the header.
+        height: usize,
+        /// The limit it exceeds.
+        limit: usize,
+    },
     /// A texel is negative, infinite or NaN.
     #[error("environment map {}: texel ({x}, {y}) is {value:?}, negative or not finite", path.display())]
     BadTexel {
@@ -79,6 +97,15 @@ pub enum EnvironmentError {
 /// 255 gives 1.7e38) would overflow to infinite lights.
 pub const MAX_RADIANCE: f32 = 1e30;
 
+/// The most texels an environment map may have: an 8K equirectangular map (8192x4096). The
+/// per-vertex cache and the median cut walk the whole map, and a header can claim any size.
+pub const MAX_ENVIRONMENT_TEXELS: usize = 8192 * 4096;
+
+/// The widest or highest an environment map may be. An equirectangular map is twice as wide as
+/// high; a header claiming millions of texels in one row is refused before decoding (the EXR
+/// decoder took 10 s on 881 bytes claiming 7733242x4).
+pub const MAX_ENVIRONMENT_SIDE: usize = 16384;
+
 impl Environment {
     /// The built-in sky: a blue zenith fading to a bright horizon; nothing from below the
     /// horizon (light bounced off the ground is not simulated, and would reach objects through
@@ -102,27 +129,48 @@ impl Environment {
     pub fn load(path: &std::path::Path) -> Result<Environment, EnvironmentError> {
         let read = |source| EnvironmentError::Read { path: path.to_path_buf(), source };
         let bytes = std::fs::read(path).map_err(|e| read(image::ImageError::IoError(e)))?;
-        Self::decode(&bytes, image::ImageFormat::from_path(path).ok(), path)
+        Self::decode(&bytes, image::ImageFormat::from_path(path).ok(), path, MAX_ENVIRONMENT_TEXELS)
     }
 
     /// Decode an equirectangular .hdr or .exr map already in memory, the format guessed from
     /// its content; `name` names it in errors.
     pub fn from_bytes(bytes: &[u8], name: impl AsRef<std::path::Path>) -> Result<Environment, EnvironmentError> {
-        Self::decode(bytes, None, name.as_ref())
+        Self::decode(bytes, None, name.as_ref(), MAX_ENVIRONMENT_TEXELS)
+    }
+
+    /// `from_bytes` with a lower texel limit than `MAX_ENVIRONMENT_TEXELS`: a caller that
+    /// decodes untrusted maps in bulk (the fuzzer) keeps each one cheap.
+    pub fn from_bytes_within(
+        bytes: &[u8],
+        name: impl AsRef<std::path::Path>,
+        max_texels: usize,
+    ) -> Result<Environment, EnvironmentError> {
+        Self::decode(bytes, None, name.as_ref(), max_texels.min(MAX_ENVIRONMENT_TEXELS))
     }
 
     fn decode(
         bytes: &[u8],
         format: Option<image::ImageFormat>,
         path: &std::path::Path,
+        max_texels: usize,
     ) -> Result<Environment, EnvironmentError> {
         let read = |source| EnvironmentError::Read { path: path.to_path_buf(), source };
-        let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
-        match format {
-            Some(format) => reader.set_format(format),
-            None => reader = reader.with_guessed_format().map_err(|e| read(image::ImageError::IoError(e)))?,
+        let reader = || -> Result<_, EnvironmentError> {
+            let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+            match format {
+                Some(format) => reader.set_format(format),
+                None => reader = reader.with_guessed_format().map_err(|e| read(image::ImageError::IoError(e)))?,
+            }
+            Ok(reader)
+        };
+        // The header's size first: decoding a map that claims millions of texels takes seconds
+        // even when the file holds a few bytes of them.
+        let (width, height) = reader()?.into_dimensions().map_err(read)?;
+        let (width, height) = (width as usize, height as usize);
+        if width.saturating_mul(height) > max_texels || width.max(height) > MAX_ENVIRONMENT_SIDE {
+            return Err(EnvironmentError::TooLarge { path: path.to_path_buf(), width, height, limit: max_texels });
         }
-        let img = reader.decode().map_err(read)?;
+        let img = reader()?.decode().map_err(read)?;
         let rgb = img.to_rgb32f();
         let (width, height) = (rgb.width() as usize, rgb.height() as usize);
         if width < 2 || height < 2 {

@@ -20,6 +20,76 @@ pub struct SceneNeeds {
     pub pixel_gather: bool,
     /// Drawn into a host engine's images, which the host tone-maps (set by the renderer).
     pub host_target: bool,
+    /// `render.transport`: the planner chooses, or every channel is forced one way.
+    pub transport: super::TransportMode,
+    /// Per object, in scene order: what the planner weighs for it.
+    pub objects: Vec<ObjectFacts>,
+}
+
+/// What the planner weighs for one object: where it is, how finely it is sampled and meshed, and
+/// per channel how far light spreads under its surface. Lengths in scene units.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ObjectFacts {
+    /// The mesh path or built-in shape.
+    pub name: String,
+    /// Centre of its bounding sphere.
+    pub center: [f32; 3],
+    /// Radius of its bounding sphere.
+    pub radius: f32,
+    /// Mean distance between sample points, `sqrt(area / samples)` (0 without samples).
+    pub sample_spacing: f64,
+    /// Mean edge length of its mesh.
+    pub vertex_spacing: f64,
+    /// Per channel (R, G, B) of a translucent object; `None` for an opaque one.
+    pub channels: Option<[ChannelFacts; 3]>,
+}
+
+/// One colour channel of a translucent material at the scene's scale (`optics::Dipole`).
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct ChannelFacts {
+    /// `1 / sigma_tr`: how far light travels before it is absorbed (infinite without
+    /// absorption).
+    pub diffusion_length: f64,
+    /// Height of the virtual source `z_v`.
+    pub z_v: f64,
+    /// RMS radius of `R_d` (`Dipole::profile_radius`): the width of the blur transport gives.
+    pub profile_radius: f64,
+    /// `R_d,total`, the local answer's factor.
+    pub r_d_total: f64,
+}
+
+impl ObjectFacts {
+    fn of(object: &super::build::PreparedObject) -> ObjectFacts {
+        let mesh = &object.mesh;
+        let (lo, hi) = mesh.bounds();
+        let center = (lo + hi) * 0.5;
+        let radius = mesh.positions().iter().map(|p| p.distance(center)).fold(0.0f32, f32::max);
+        let triangles = mesh.triangles();
+        let positions = mesh.positions();
+        let edges: f64 = triangles
+            .iter()
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+            .map(|(a, b)| positions[a as usize].distance(positions[b as usize]) as f64)
+            .sum();
+        let samples = object.samples.len();
+        let channels = match &object.material {
+            super::build::ResolvedMaterial::Translucent { dipoles, .. } => Some(dipoles.map(|d| ChannelFacts {
+                diffusion_length: d.diffusion_length(),
+                z_v: d.z_v,
+                profile_radius: d.profile_radius(),
+                r_d_total: d.r_d_total(),
+            })),
+            super::build::ResolvedMaterial::Opaque { .. } => None,
+        };
+        ObjectFacts {
+            name: object.name.clone(),
+            center: center.to_array(),
+            radius,
+            sample_spacing: if samples > 0 { (mesh.total_area() / samples as f64).sqrt() } else { 0.0 },
+            vertex_spacing: edges / (3 * triangles.len()).max(1) as f64,
+            channels,
+        }
+    }
 }
 
 impl PreparedScene {
@@ -35,6 +105,8 @@ impl PreparedScene {
             environment: self.lights.iter().find(|l| l.environment).map(|l| l.source),
             pixel_gather: self.scene.file.render.gather == super::GatherMode::Pixel,
             host_target: false,
+            transport: self.scene.file.render.transport,
+            objects: self.objects.iter().map(ObjectFacts::of).collect(),
         }
     }
 

@@ -1,0 +1,66 @@
+//! `translucent plan [SCENE] [--json]`: what each kind of frame change would run for a scene,
+//! per pass and per object and channel, with the reason and the numbers behind each choice. No
+//! GPU is needed: planning is CPU work over the prepared scene.
+
+use anyhow::Result;
+use std::path::PathBuf;
+use translucent::render::plan::{self, Change};
+use translucent::render::renderer::CameraView;
+use translucent::scene::build::{Overrides, PreparedScene};
+use translucent::scene::{GatherMode, Scene, TransportMode};
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Scene file (TOML); the built-in marble bunny when omitted
+    pub scene: Option<PathBuf>,
+    /// Print JSON (the shape docs/PLAN.md documents) instead of text
+    #[arg(long)]
+    pub json: bool,
+    /// Sample points per translucent object (overrides the scene)
+    #[arg(long)]
+    pub samples: Option<usize>,
+    /// Where exitance is gathered (overrides the scene)
+    #[arg(long, value_parser = super::one_of::<GatherMode>(&GatherMode::ALL.map(GatherMode::name)))]
+    pub gather: Option<GatherMode>,
+    /// Local or gathered exitance per channel: the planner's choice, or forced (overrides
+    /// render.transport)
+    #[arg(long, value_parser = super::one_of::<TransportMode>(&TransportMode::ALL.map(TransportMode::name)))]
+    pub transport: Option<TransportMode>,
+}
+
+pub fn run(args: &Args) -> Result<()> {
+    let scene = match &args.scene {
+        Some(path) => Scene::load(path)?,
+        None => Scene::builtin(),
+    };
+    let overrides =
+        Overrides { samples: args.samples, gather: args.gather, transport: args.transport, ..Overrides::default() };
+    let prepared = PreparedScene::new(&scene, &overrides)?;
+    let needs = prepared.needs();
+    let view = plan::View::of_camera(&CameraView::of_scene(&prepared), prepared.scene.file.camera.resolution[1]);
+    let objects = prepared.objects.len();
+    // The first frame computes everything; every other change follows a frame that did.
+    let frames: Vec<(Change, plan::Plan)> = Change::all(prepared.scene.file.lights.len(), objects)
+        .into_iter()
+        .map(|change| {
+            let stale = vec![change == Change::Everything; objects];
+            (change, plan::plan(&needs, &view, &stale, change))
+        })
+        .collect();
+    if args.json {
+        let json = serde_json::json!({
+            "scene": prepared.scene.name,
+            "version": 1,
+            "objects": needs.objects,
+            "frames": frames.iter().map(|(_, p)| p.to_json()).collect::<Vec<_>>(),
+        });
+        out!("{}", serde_json::to_string_pretty(&json)?);
+        return Ok(());
+    }
+    out!("{}: {} objects, {} lights", prepared.scene.name, objects, prepared.scene.file.lights.len());
+    for (change, p) in &frames {
+        out!("after a change of {change}:");
+        out!("{}", p.to_string().trim_end());
+    }
+    Ok(())
+}

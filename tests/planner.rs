@@ -1,0 +1,268 @@
+//! The planner's claims, checked by counting what frames really record (`Gpu::recorded`: every
+//! dispatch and draw, per shader) rather than by reading the plan: a scene simulates only what
+//! it calls for, and a frame redoes only what its change invalidates.
+
+mod common;
+
+use common::*;
+use glam::Vec3;
+use std::sync::Arc;
+use translucent::gpu::{Gpu, RecordCounts};
+use translucent::optics::Material;
+use translucent::render::plan::{Change, Transport};
+use translucent::render::renderer::Renderer;
+use translucent::scene::build::{Overrides, PreparedScene};
+use translucent::scene::{Scene, Transform, TransportMode, lights};
+
+fn prepare(text: &str, overrides: &Overrides) -> PreparedScene {
+    PreparedScene::new(&Scene::parse(text, "planner.toml", None).unwrap(), overrides).unwrap()
+}
+
+/// Render the frame the renderer's pending change calls for; what it recorded.
+fn frame(gpu: &Arc<Gpu>, renderer: &mut Renderer) -> RecordCounts {
+    let before = gpu.recorded();
+    let change = renderer.pending_change().unwrap_or(Change::Camera);
+    renderer.frame(&renderer.plan(change)).unwrap();
+    gpu.recorded().since(&before)
+}
+
+/// A sphere of `radius` at `center` made of `material`, for a scene's object list.
+fn sphere(radius: f32, center: [f32; 3], material: &str, mm_per_unit: f64, casts: bool) -> String {
+    format!(
+        r#"
+[[object]]
+shape = {{ type = "sphere", radius = {radius}, divisions = 24 }}
+transform = {{ translate = [{}, {}, {}] }}
+material = {{ type = "translucent", preset = "{material}", mm_per_unit = {mm_per_unit} }}
+casts_shadow = {casts}
+"#,
+        center[0], center[1], center[2]
+    )
+}
+
+/// A camera at `eye` looking at the origin, `resolution` pixels square, and one key light from
+/// above-front.
+fn stage(eye: [f32; 3], resolution: u32) -> String {
+    format!(
+        r#"
+[camera]
+eye = [{}, {}, {}]
+target = [0.0, 0.0, 0.0]
+fov_y = 30.0
+resolution = [{resolution}, {resolution}]
+
+[[light]]
+type = "directional"
+direction = [0.3, 0.8, 0.5]
+irradiance = [1.0, 1.0, 1.0]
+
+[sampling]
+method = "turk"
+count = 200
+"#,
+        eye[0], eye[1], eye[2]
+    )
+}
+
+#[test]
+fn an_opaque_only_scene_dispatches_no_compute_but_the_tone_map() {
+    let text = format!(
+        "{}\n[[object]]\nshape = {{ type = \"sphere\", radius = 1.0, divisions = 12 }}\nmaterial = {{ type = \"opaque\", \
+         albedo = [0.5, 0.5, 0.5] }}\n",
+        stage([0.0, 0.0, 6.0], 32)
+    );
+    with_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, prepare(&text, &Overrides::default())).unwrap();
+        let counts = frame(gpu, &mut renderer);
+        // The tone map turns the HDR image into the readable one; nothing else computes.
+        assert_eq!(counts.dispatches(), counts.get("tonemap.comp"), "{counts:?}");
+        assert_eq!(counts.get("tonemap.comp"), 1);
+        assert!(counts.get("shade.vert") == 1 && counts.get("shadow.vert") == 1, "{counts:?}");
+    });
+}
+
+#[test]
+fn a_camera_orbit_splats_and_gathers_once_while_the_view_changes() {
+    let text = format!("{}{}", stage([0.0, 0.02, 0.06], 48), sphere(0.01, [0.0; 3], "marble", 1000.0, true));
+    with_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, prepare(&text, &Overrides::default())).unwrap();
+        let plan = renderer.plan(Change::Everything);
+        assert!(plan.objects[0].channels.iter().all(|c| c.transport == Transport::Gather), "{plan}");
+        let mut total = RecordCounts::default();
+        let mut images = Vec::new();
+        for i in 0..10 {
+            if i > 0 {
+                renderer.set_camera(renderer.camera().orbited(Vec3::ZERO, 12.0));
+            }
+            let counts = frame(gpu, &mut renderer);
+            for (k, v) in counts.0 {
+                *total.0.entry(k).or_default() += v;
+            }
+            images.push(renderer.image().unwrap().0);
+        }
+        assert_eq!(total.get("splat.comp"), 1, "{total:?}");
+        assert_eq!(total.get("gather.comp"), 1, "{total:?}");
+        assert_eq!(total.get("shade.vert"), 10, "{total:?}");
+        assert!(images.windows(2).all(|w| w[0] != w[1]), "the view did not change between frames");
+    });
+}
+
+#[test]
+fn a_moving_key_light_splats_and_gathers_every_frame_and_redraws_one_shadow_map() {
+    let mut text = format!("{}{}", stage([0.0, 0.02, 0.06], 32), sphere(0.01, [0.0; 3], "marble", 1000.0, true));
+    text.push_str("\n[[light]]\ntype = \"directional\"\ndirection = [-0.5, 0.6, 0.2]\nirradiance = [0.5, 0.5, 0.5]\n");
+    with_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, prepare(&text, &Overrides::default())).unwrap();
+        let first = frame(gpu, &mut renderer);
+        assert_eq!(first.get("shadow.vert"), 2, "two lights, one caster: {first:?}");
+        for _ in 0..3 {
+            let light = &renderer.scene().scene.file.lights[0];
+            let moved = lights::orbit(light, Vec3::ZERO, 5.0).unwrap();
+            renderer.set_light(0, moved).unwrap();
+            let counts = frame(gpu, &mut renderer);
+            assert_eq!(counts.get("shadow.vert"), 1, "one map of one caster: {counts:?}");
+            assert_eq!((counts.get("splat.comp"), counts.get("gather.comp")), (1, 1), "{counts:?}");
+        }
+    });
+}
+
+/// Relative RMSE of `a` against `b` over the pixels where `b` is lit (linear HDR, RGB).
+fn relative_rmse(a: &[f32], b: &[f32]) -> f64 {
+    let (mut err, mut norm) = (0.0f64, 0.0f64);
+    for (pa, pb) in a.chunks(4).zip(b.chunks(4)) {
+        for c in 0..3 {
+            err += (pa[c] as f64 - pb[c] as f64).powi(2);
+            norm += (pb[c] as f64).powi(2);
+        }
+    }
+    (err / norm).sqrt()
+}
+
+#[test]
+fn ketchup_at_metre_scale_goes_local_in_green_and_blue_and_matches_a_dense_gather() {
+    // A 1 m ketchup ball: green and blue diffuse about a millimetre, far under a pixel (about
+    // 4 mm here) and far under the sample spacing.
+    let text = format!("{}{}", stage([0.0, 0.6, 2.4], 96), sphere(0.5, [0.0; 3], "ketchup", 1000.0, false));
+    with_gpu(|gpu| {
+        let prepared = prepare(&text, &Overrides::default());
+        let mut auto = Renderer::new(gpu, prepared).unwrap();
+        let plan = auto.plan(Change::Everything);
+        let o = &plan.objects[0];
+        assert_eq!(o.channels[1].transport, Transport::Local, "{plan}");
+        assert_eq!(o.channels[2].transport, Transport::Local, "{plan}");
+        let before = gpu.recorded();
+        auto.frame(&plan).unwrap();
+        let counts = gpu.recorded().since(&before);
+        if o.local_mask() == 0b111 {
+            assert_eq!(counts.get("splat.comp") + counts.get("gather.comp"), 0, "all local: {counts:?}");
+        }
+        let local = auto.hdr_image().unwrap();
+        drop(auto);
+        let dense = Overrides { samples: Some(12_800), transport: Some(TransportMode::Gather), ..Overrides::default() };
+        let mut gathered = Renderer::new(gpu, prepare(&text, &dense)).unwrap();
+        gathered.frame(&gathered.plan(Change::Everything)).unwrap();
+        let reference = gathered.hdr_image().unwrap();
+        let e = relative_rmse(&local, &reference);
+        println!("ketchup at 1 m, local ({:03b}) against a 12,800-sample gather: relative RMSE {e:.4}", o.local_mask());
+        assert!(e < 0.02, "relative RMSE {e}");
+    });
+}
+
+#[test]
+fn marble_at_five_centimetres_is_gathered_in_every_channel() {
+    let text = format!("{}{}", stage([0.0, 0.05, 0.15], 256), sphere(0.025, [0.0; 3], "marble", 1000.0, true));
+    let prepared = prepare(&text, &Overrides { samples: Some(400), ..Overrides::default() });
+    let camera = translucent::render::renderer::CameraView::of_scene(&prepared);
+    let view = translucent::render::plan::View::of_camera(&camera, 256);
+    let plan = translucent::render::plan::plan(&prepared.needs(), &view, &[true], Change::Everything);
+    assert!(plan.objects[0].channels.iter().all(|c| c.transport == Transport::Gather), "{plan}");
+}
+
+#[test]
+fn an_object_behind_the_camera_is_not_gathered_until_the_camera_turns_to_it() {
+    // One ball in front of the eye (at the origin), one behind it.
+    let text = format!(
+        "{}{}{}",
+        stage([0.0, 0.0, 0.1], 32),
+        sphere(0.01, [0.0; 3], "marble", 1000.0, false),
+        sphere(0.01, [0.0, 0.0, 0.2], "skimmilk", 1000.0, false)
+    );
+    with_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, prepare(&text, &Overrides::default())).unwrap();
+        let plan = renderer.plan(Change::Everything);
+        assert!(plan.objects[0].in_view && !plan.objects[1].in_view, "{plan}");
+        let counts = frame(gpu, &mut renderer);
+        assert_eq!((counts.get("splat.comp"), counts.get("gather.comp")), (1, 1), "front ball only: {counts:?}");
+        let behind = renderer.exitance(1).unwrap();
+        assert!(behind.iter().all(|e| *e == [0.0; 3]), "the ball behind was gathered");
+        // Turn round on the spot: the ball behind comes into view, stale, and is gathered.
+        let eye = renderer.camera().eye;
+        renderer.set_camera(renderer.camera().orbited(eye, 180.0));
+        let counts = frame(gpu, &mut renderer);
+        assert_eq!((counts.get("splat.comp"), counts.get("gather.comp")), (1, 1), "back ball only: {counts:?}");
+        assert!(renderer.exitance(1).unwrap().iter().any(|e| e[0] > 0.0), "the ball now in view has no exitance");
+        // And once more: nothing stale, nothing gathered.
+        renderer.set_camera(renderer.camera().orbited(eye, 1.0));
+        let counts = frame(gpu, &mut renderer);
+        assert_eq!(counts.get("splat.comp") + counts.get("gather.comp"), 0, "{counts:?}");
+    });
+}
+
+#[test]
+fn a_material_change_regathers_the_same_samples_and_a_transform_change_resamples() {
+    let text = format!("{}{}", stage([0.0, 0.02, 0.06], 32), sphere(0.01, [0.0; 3], "marble", 1000.0, true));
+    with_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, prepare(&text, &Overrides::default())).unwrap();
+        frame(gpu, &mut renderer);
+        let samples = renderer.scene().objects[0].samples.clone();
+        let marble = renderer.exitance(0).unwrap();
+
+        renderer.set_material(0, Material::preset("skimmilk").unwrap()).unwrap();
+        let counts = frame(gpu, &mut renderer);
+        assert_eq!((counts.get("splat.comp"), counts.get("gather.comp")), (1, 1), "{counts:?}");
+        assert_eq!(counts.get("shadow.vert"), 0, "a material does not move shadows: {counts:?}");
+        assert_eq!(renderer.scene().objects[0].samples, samples, "resampled on a material change");
+        assert_ne!(renderer.exitance(0).unwrap(), marble, "the new material changed nothing");
+
+        let moved = Transform { translate: Some([0.002, 0.0, 0.0]), ..Transform::default() };
+        renderer.set_transform(0, moved).unwrap();
+        let counts = frame(gpu, &mut renderer);
+        assert_eq!((counts.get("splat.comp"), counts.get("gather.comp")), (1, 1), "{counts:?}");
+        assert_eq!(counts.get("shadow.vert"), 1, "geometry moved: shadows redrawn: {counts:?}");
+        let resampled = &renderer.scene().objects[0].samples;
+        assert_eq!(resampled.len(), samples.len());
+        let shift = resampled[0].position - samples[0].position;
+        assert!((shift - Vec3::new(0.002, 0.0, 0.0)).length() < 1e-6, "samples did not move with the object");
+        assert_ne!(renderer.exitance(0).unwrap(), marble, "the move lost the new material");
+    });
+}
+
+#[test]
+fn plan_prints_every_change_and_its_json_has_the_documented_fields() {
+    let out = subcommand("plan", &[]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    for line in
+        ["after a change of everything:", "after a change of camera:", "after a change of material of object 0:"]
+    {
+        assert!(stdout.contains(line), "{line} missing:\n{stdout}");
+    }
+    assert!(stdout.contains("profile radius") && stdout.contains("sample spacing"), "{stdout}");
+    let out = subcommand("plan", &["--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["version"], 1);
+    let frames = json["frames"].as_array().unwrap();
+    assert!(frames.len() >= 6);
+    for f in frames {
+        for key in ["change", "passes", "skipped", "shadow_light", "objects"] {
+            assert!(f.get(key).is_some(), "{key} missing from {f}");
+        }
+    }
+    let bunny = &frames[0]["objects"][0];
+    for key in ["object", "name", "in_view", "pixel_footprint", "channels", "splat", "gather", "why", "stale_after"] {
+        assert!(bunny.get(key).is_some(), "{key} missing from {bunny}");
+    }
+    assert_eq!(bunny["channels"][0]["transport"], "gather");
+    assert!(json["objects"][0]["channels"][0]["profile_radius"].as_f64().unwrap() > 0.0);
+}
