@@ -2,7 +2,7 @@
 //! seed paper's FPS-against-sample-count comparison (its Figure 7), on whatever device the
 //! loader offers (TRANSLUCENT_DEVICE to choose). Prints figures; asserts nothing.
 //!
-//!     cargo bench --bench render
+//!     cargo bench --bench render [-- frames|hierarchy|planner|gathers]
 //!
 //! Two timings per pass: GPU timestamp queries inside one submission, and the wall time of the
 //! pass submitted alone (submission to fence). On lavapipe, compute dispatches run
@@ -238,6 +238,149 @@ fn slope(x: &[f64], y: &[f64]) -> f64 {
 
 /// Sections to run: those named on the command line (`cargo bench --bench render -- hierarchy`),
 /// or all.
+/// Median wall time of frames that follow `change` (the key light or the camera orbiting 3
+/// degrees a frame) in two renderers side by side, alternating: `planned` records what its plan
+/// asks for, `forced` records every pass for every object each frame, every channel gathered.
+fn planned_against_forced(planned: &mut Renderer, forced: &mut Renderer, change: Change) -> (f64, f64) {
+    let step = |r: &mut Renderer| match change {
+        Change::Light(i) => {
+            let scene = r.scene();
+            let moved = lights::orbit(&scene.scene.file.lights[i], scene.bounds.0, 3.0).expect("a key light");
+            r.set_light(i, moved).expect("orbit");
+        }
+        _ => r.set_camera(r.camera().orbited(r.scene().bounds.0, 3.0)),
+    };
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    for frame in 0..WARM_UP + FRAMES {
+        for (renderer, times, force) in [(&mut *planned, &mut a, false), (&mut *forced, &mut b, true)] {
+            step(renderer);
+            let plan = renderer.plan(if force { Change::Everything } else { change });
+            let start = Instant::now();
+            renderer.frame(&plan).expect("frame");
+            if frame >= WARM_UP {
+                times.push(start.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+    }
+    (median(&mut a), median(&mut b))
+}
+
+/// Relative RMSE of channel `c` of `a` against `b` (linear HDR, RGBA).
+fn channel_rmse(a: &[f32], b: &[f32], c: usize) -> f64 {
+    let (mut e, mut n) = (0.0f64, 0.0f64);
+    for (pa, pb) in a.chunks(4).zip(b.chunks(4)) {
+        e += (pa[c] as f64 - pb[c] as f64).powi(2);
+        n += (pb[c] as f64).powi(2);
+    }
+    (e / n.max(1e-300)).sqrt()
+}
+
+/// A ball of radius 0.5 units in `material` at `mm_per_unit`, 256x256, one key light.
+fn ball(material: &str, mm_per_unit: f64) -> String {
+    format!(
+        r#"
+[camera]
+eye = [0.0, 0.6, 2.4]
+target = [0.0, 0.0, 0.0]
+fov_y = 30.0
+resolution = [256, 256]
+
+[[object]]
+shape = {{ type = "sphere", radius = 0.5, divisions = 64 }}
+material = {{ type = "translucent", preset = "{material}", mm_per_unit = {mm_per_unit} }}
+casts_shadow = false
+
+[[light]]
+type = "directional"
+direction = [0.3, 0.8, 0.5]
+irradiance = [1.0, 1.0, 1.0]
+
+[sampling]
+method = "turk"
+count = 400
+seed = 1
+"#
+    )
+}
+
+/// The planner's savings (frames it plans against the same frames with every pass forced), and
+/// the measurement behind its local-or-gather thresholds.
+fn planner(gpu: &Arc<Gpu>) {
+    use translucent::render::plan::Transport;
+    use translucent::scene::TransportMode;
+    let open = |path: &str, transport: TransportMode| {
+        let scene = match path {
+            "" => Scene::builtin(),
+            p => Scene::load(std::path::Path::new(p)).expect("scene"),
+        };
+        let overrides = Overrides { transport: Some(transport), resolution: Some([512, 512]), ..Default::default() };
+        let mut r = Renderer::new(gpu, PreparedScene::new(&scene, &overrides).expect("scene")).expect("renderer");
+        r.frame(&r.plan(Change::Everything)).expect("first frame");
+        r
+    };
+    println!(
+        "
+Planner against every pass forced on (every channel gathered), 512x512, frames side by side:"
+    );
+    println!("  {:<34} {:<16} {:>11} {:>11} {:>8}", "scene", "change", "planned ms", "forced ms", "speed-up");
+    for (name, path) in
+        [("default scene", ""), ("ketchup ball 1 m (ketchup-metre)", "assets/scenes/ketchup-metre.toml")]
+    {
+        let mut planned = open(path, TransportMode::Auto);
+        let mut forced = open(path, TransportMode::Gather);
+        for (what, change) in [("key light moves", Change::Light(0)), ("camera moves", Change::Camera)] {
+            let (p, f) = planned_against_forced(&mut planned, &mut forced, change);
+            println!("  {name:<34} {what:<16} {p:>11.1} {f:>11.1} {:>7.1}x", f / p);
+        }
+    }
+
+    println!(
+        "
+Local against a dense gather, per channel: relative RMSE of the local image against a 12,800-sample \
+         vertex gather (ball of radius 0.5 units, 256x256). r: profile RMS radius, p: pixel footprint, s: sample \
+         spacing at 400 samples; the planner's choice (local when r <= p or 4 r <= s):"
+    );
+    println!(
+        "  {:<9} {:>8} {:>3} {:>9} {:>9} {:>11} {:>8}",
+        "material", "diameter", "ch", "r / p", "s / r", "RMSE local", "planner"
+    );
+    for material in ["ketchup", "marble", "skimmilk"] {
+        for mm_per_unit in [1000.0, 100.0, 20.0] {
+            let text = ball(material, mm_per_unit);
+            let scene = Scene::parse(&text, "ball.toml", None).expect("scene");
+            let render = |overrides: Overrides| {
+                let mut r =
+                    Renderer::new(gpu, PreparedScene::new(&scene, &overrides).expect("scene")).expect("renderer");
+                let plan = r.plan(Change::Everything);
+                r.frame(&plan).expect("frame");
+                (r.hdr_image().expect("image"), plan, r.needs().objects[0].clone())
+            };
+            let (local, _, _) = render(Overrides { transport: Some(TransportMode::Local), ..Default::default() });
+            let (_, auto, facts) = render(Overrides::default());
+            let dense =
+                Overrides { transport: Some(TransportMode::Gather), samples: Some(12_800), ..Default::default() };
+            let (reference, _, _) = render(dense);
+            let p = auto.objects[0].pixel_footprint.unwrap_or(f64::NAN);
+            for c in 0..3 {
+                let r = facts.channels.as_ref().expect("translucent")[c].profile_radius;
+                let choice = match auto.objects[0].channels[c].transport {
+                    Transport::Local => "local",
+                    Transport::Gather => "gather",
+                };
+                println!(
+                    "  {material:<9} {:>6.0}mm {:>3} {:>9.2} {:>9.2} {:>11.4} {:>8}",
+                    mm_per_unit,
+                    ["R", "G", "B"][c],
+                    r / p,
+                    facts.sample_spacing / r,
+                    channel_rmse(&local, &reference, c),
+                    choice
+                );
+            }
+        }
+    }
+}
+
 fn wanted(section: &str) -> bool {
     let named: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with("--")).collect();
     named.is_empty() || named.iter().any(|n| n == section)
@@ -282,6 +425,9 @@ fn main() {
     }
     if wanted("hierarchy") {
         hierarchy(&gpu);
+    }
+    if wanted("planner") {
+        planner(&gpu);
     }
     if !wanted("gathers") {
         return;

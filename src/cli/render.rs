@@ -180,6 +180,18 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     );
     let [width, height] = prepared.scene.file.camera.resolution;
     let mut renderer = Renderer::new(&gpu, prepared).context("creating GPU resources")?;
+    if let Some(ply) = &args.export_exitance
+        && let Some(o) = renderer.plan(Change::Everything).objects.iter().find(|o| o.local_mask() != 0)
+    {
+        bail!(
+            "--export-exitance {}: object[{}] ({}) has channels computed locally (render.transport = \"{}\"), which \
+             have no exitance at the vertices: use --transport gather",
+            ply.display(),
+            o.object,
+            o.name,
+            renderer.scene().scene.file.render.transport
+        );
+    }
     let moving = match args.moving {
         Moving::Light => {
             let key = renderer.scene().scene.file.lights.iter().position(|l| !matches!(l, Light::Environment { .. }));
