@@ -477,9 +477,12 @@ pub fn plan(needs: &SceneNeeds, view: &View, stale: &[bool], change: Change) -> 
         format!("irradiance at the samples is stale for objects {splatted:?}"),
         none("its sample irradiance recomputed"),
     );
+    // The pixel gather also finishes every pixel's HDR alpha (shade_pixel.frag leaves a factor
+    // there), so it runs whenever the scene has a translucent object; its pixels of local or
+    // unseen objects cost a texel fetch each.
     let gather_pass = (
         Pass::Gather,
-        !gathered.is_empty(),
+        if needs.pixel_gather { translucent } else { !gathered.is_empty() },
         if needs.pixel_gather {
             format!("pixel gather: the receivers are the pixels in view of objects {gathered:?}")
         } else {
@@ -575,6 +578,10 @@ mod tests {
         let p = run(&n, Change::Camera);
         let order: Vec<Pass> = p.passes.iter().map(|(p, _)| *p).collect();
         assert_eq!(order, [Pass::Shade, Pass::Gather, Pass::Tonemap]);
+        // Every channel local: the pixel gather still runs, to finish the HDR alpha.
+        n.objects[0] = object(1.0, 0.1, 0.01);
+        let p = run(&n, Change::Camera);
+        assert!(p.runs(Pass::Gather) && !p.objects[0].gather && !p.runs(Pass::Splat), "{p}");
     }
 
     #[test]
