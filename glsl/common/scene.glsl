@@ -18,7 +18,7 @@ struct ObjectRecord {
 };
 
 // 1 in each channel whose exitance is gathered, 0 in each the planner computes locally
-// (M = R_d,total E_t at the receiver itself; ObjectRecord::local_channels).
+// (M = R_d,total E_t at the receiver itself; GpuScene::set_local_channels).
 vec3 object_gathered_channels(ObjectRecord o) {
     uint local = uint(o.eta_norm_kind.w);
     return vec3((local & 1u) == 0u ? 1.0 : 0.0, (local & 2u) == 0u ? 1.0 : 0.0, (local & 4u) == 0u ? 1.0 : 0.0);
