@@ -114,10 +114,6 @@ pub struct GpuScene {
     pub light_matrices: Vec<[[f32; 4]; 4]>,
     /// The translucent objects, in scene order: what the gathers dispatch over.
     pub receivers: Vec<Receiver>,
-    /// Every object's vertex and sample range, in scene order.
-    pub ranges: Vec<ObjectRange>,
-    /// First vertex of each object in the shared buffers.
-    pub vertex_offsets: Vec<u32>,
     /// Vertices of all objects together.
     pub vertex_count: u32,
     /// Sample points of all objects together.
@@ -155,8 +151,7 @@ impl GpuScene {
     pub fn new(gpu: &Arc<Gpu>, scene: &PreparedScene) -> GpuResult<GpuScene> {
         let (mut vertices, mut indices, mut objects, mut samples) =
             (Vec::new(), Vec::<u32>::new(), Vec::new(), Vec::new());
-        let (mut draws, mut casters, mut receivers, mut vertex_offsets, mut ranges) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut draws, mut casters, mut receivers) = (Vec::new(), Vec::new(), Vec::new());
         let (mut tree_nodes, mut tree_order) = (Vec::new(), Vec::<u32>::new());
         let (mut receiver_order, mut receiver_groups) = (Vec::<u32>::new(), Vec::<ReceiverGroupRecord>::new());
         let (mut group_items, mut blend_items) = (Vec::<u32>::new(), Vec::<u32>::new());
@@ -166,7 +161,6 @@ impl GpuScene {
         for (i, o) in scene.objects.iter().enumerate() {
             let first_vertex = vertices.len() as u32;
             let first_sample = samples.len() as u32;
-            vertex_offsets.push(first_vertex);
             let normals = o.mesh.vertex_normals();
             vertices.extend(
                 o.mesh
@@ -189,11 +183,6 @@ impl GpuScene {
             let vertex_count = o.mesh.positions().len() as u32;
             let sample_count = o.samples.len() as u32;
             objects.push(ObjectRecord::new(o, [first_vertex, vertex_count, first_sample, sample_count]));
-            let eta = match &o.material {
-                crate::scene::build::ResolvedMaterial::Translucent { material, .. } => material.eta as f32,
-                crate::scene::build::ResolvedMaterial::Opaque { .. } => 0.0,
-            };
-            ranges.push(ObjectRange { first_vertex, vertex_count, first_sample, sample_count, eta });
             if matches!(o.material, crate::scene::build::ResolvedMaterial::Translucent { .. }) {
                 let tree = o.sample_tree();
                 let (first_node, first_entry) = (tree_nodes.len() as u32, tree_order.len() as u32);
@@ -292,8 +281,6 @@ impl GpuScene {
             casters,
             light_matrices: Vec::new(),
             receivers,
-            ranges,
-            vertex_offsets,
             vertex_count: vertices.len() as u32,
             sample_count: samples.len() as u32,
             light_count: scene.lights.len() as u32,
@@ -323,6 +310,22 @@ impl GpuScene {
         self.pending_lights = Some(scene.lights.iter().map(LightGpu::new).collect());
     }
 
+    /// Every object's vertex and sample range and index of refraction, in scene order, read from
+    /// its record.
+    pub fn object_ranges(&self) -> impl Iterator<Item = ObjectRange> + '_ {
+        self.object_records.iter().map(|r| {
+            let translucent = r.eta_norm_kind[2] == super::records::MATERIAL_TRANSLUCENT;
+            let [first_vertex, vertex_count, first_sample, sample_count] = r.ranges;
+            let eta = if translucent { r.eta_norm_kind[0] } else { 0.0 };
+            ObjectRange { first_vertex, vertex_count, first_sample, sample_count, eta }
+        })
+    }
+
+    /// Object `object`'s range (`object_ranges`).
+    pub fn object_range(&self, object: usize) -> ObjectRange {
+        self.object_ranges().nth(object).expect("an object of the scene")
+    }
+
     /// Which channels of object `object` the planner computes locally (bit c: channel c), in
     /// its record's `eta_norm_kind.w`; uploaded by the next recorded frame when it changed.
     pub fn set_local_channels(&mut self, object: usize, mask: u32) {
@@ -340,7 +343,6 @@ impl GpuScene {
         let mut record = ObjectRecord::new(&scene.objects[object], old.ranges);
         record.eta_norm_kind[3] = old.eta_norm_kind[3];
         self.object_records[object] = record;
-        self.ranges[object].eta = record.eta_norm_kind[0];
         self.pending_objects = true;
     }
 

@@ -456,7 +456,7 @@ impl Renderer {
     /// `object`, from the last vertex gather (zero in pixel-gather mode).
     pub fn exitance(&self, object: usize) -> Result<Vec<[f32; 3]>, RenderError> {
         let all: Vec<[f32; 4]> = self.buffers.exitance.read()?;
-        let first = self.buffers.vertex_offsets[object] as usize;
+        let first = self.buffers.object_range(object).first_vertex as usize;
         let count = self.scene.objects[object].mesh.positions().len();
         Ok(all[first..first + count].iter().map(|e| [e[0], e[1], e[2]]).collect())
     }
@@ -556,7 +556,7 @@ impl Renderer {
             if bad > 0 {
                 found.push(NonFinite { pass: "splat", object, count: bad });
             }
-            let first = self.buffers.vertex_offsets[object] as usize;
+            let first = self.buffers.object_range(object).first_vertex as usize;
             let vertices = &exitance[first..first + o.mesh.positions().len()];
             let bad = vertices.iter().filter(|e| !e.iter().all(|v| v.is_finite())).count();
             if bad > 0 {

@@ -52,7 +52,7 @@ impl SplatPass {
 impl RenderPass for SplatPass {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         // One dispatch per object the plan splats: the others keep their last irradiance.
-        for (i, r) in frame.scene.ranges.iter().enumerate() {
+        for (i, r) in frame.scene.object_ranges().enumerate() {
             if r.sample_count == 0 || !frame.plan.splats(i) {
                 continue;
             }

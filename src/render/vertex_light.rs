@@ -53,7 +53,7 @@ impl VertexLightPass {
 
 impl RenderPass for VertexLightPass {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        for r in &frame.scene.ranges {
+        for r in frame.scene.object_ranges() {
             let push = VertexLightPush {
                 first_vertex: r.first_vertex,
                 vertex_count: r.vertex_count,
