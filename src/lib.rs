@@ -31,6 +31,7 @@ pub mod reference;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod study;
 
 pub use gpu::{EnabledFeatures, Gpu, GpuError, GpuOptions, HostVulkan, RequiredFeatures, required_features};
 pub use optics::Material;

@@ -27,6 +27,9 @@ enum Command {
     Sample(cli::sample::Args),
     /// Show what each kind of frame change would run, per pass, object and channel, and why
     Plan(cli::plan::Args),
+    /// Measure what accuracy costs in time: every sampler, sample count and gather against the
+    /// exact dipole integral (CSV, Markdown, a plot)
+    Study(cli::study::Args),
 }
 
 fn main() -> ExitCode {
@@ -39,6 +42,7 @@ fn main() -> ExitCode {
         Some(Command::Material(args)) => cli::material::run(&args),
         Some(Command::Sample(args)) => cli::sample::run(&args),
         Some(Command::Plan(args)) => cli::plan::run(&args),
+        Some(Command::Study(args)) => cli::study::run(&cli.gpu, &args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -72,6 +72,24 @@ fn the_profile_radius_is_the_rms_radius_of_r_d_by_quadrature() {
 }
 
 #[test]
+fn r_d_derivatives_match_central_differences() {
+    for (name, d) in preset_dipoles() {
+        for r in [0.0, 0.3 * d.z_r, d.z_r, 2.0 * d.z_v, 3.0 / d.sigma_tr] {
+            let (g, g1, g2) = d.r_d_derivatives(r * r);
+            assert!(rel(g, d.r_d(r)) < 1e-12, "{name} r={r}: R_d");
+            let h = 1e-4 * (r + d.z_r);
+            let f = |r: f64| d.r_d(r);
+            let first = (f(r + h) - f((r - h).abs())) / (2.0 * h);
+            let second = (f(r + h) - 2.0 * f(r) + f((r - h).abs())) / (h * h);
+            if r > 0.0 {
+                assert!(rel(g1 * r, first) < 1e-5, "{name} r={r}: R_d' {} vs {first}", g1 * r);
+            }
+            assert!(rel(g2, second) < 1e-4, "{name} r={r}: R_d'' {g2} vs {second}");
+        }
+    }
+}
+
+#[test]
 fn total_reflectance_equals_numerical_integral_of_r_d() {
     let mut worst = 0.0f64;
     let mut checked = 0;

@@ -93,12 +93,40 @@ impl Dipole {
     /// Each pole's term `z (sigma_tr + 1/d) e^(-sigma_tr d) / d^2` is evaluated as
     /// `(z/d) (1/d) (sigma_tr + 1/d) e^(-sigma_tr d)` so no intermediate overflows (`z/d <= 1`).
     pub fn r_d(&self, r: f64) -> f64 {
+        self.r_d_sq(r * r)
+    }
+
+    /// `R_d` at squared distance `r2` (seed Eq. 8), for loops that already have `r^2`: the
+    /// exact integral of `reference::truth` evaluates it billions of times.
+    pub fn r_d_sq(&self, r2: f64) -> f64 {
         let pole = |z: f64| {
-            let d = z.hypot(r);
+            let d = (z * z + r2).sqrt();
             let inv_d = 1.0 / d;
             (z * inv_d) * inv_d * (self.sigma_tr + inv_d) * (-self.sigma_tr * d).exp()
         };
         self.alpha_prime / (4.0 * PI) * (pole(self.z_r) + pole(self.z_v))
+    }
+
+    /// `R_d` with its radial derivatives at squared distance `r2`: `(R_d, R_d'(r)/r, R_d''(r))`,
+    /// for the quadrupole term of a far cluster (`reference::truth`). Per pole, with
+    /// `d^2 = r^2 + z^2` and `k = alpha' z / (4 pi)`, `R_d = k (sigma_tr d + 1) e^(-sigma_tr d) / d^3`,
+    /// `R_d'/r = -k e^(-sigma_tr d) (s^2 + 3 s + 3) / d^5` and
+    /// `R_d'' = R_d'/r + k r^2 e^(-sigma_tr d) (s^3 + 6 s^2 + 15 s + 15) / d^7`, `s = sigma_tr d`.
+    pub fn r_d_derivatives(&self, r2: f64) -> (f64, f64, f64) {
+        let (mut g, mut g1, mut g2) = (0.0, 0.0, 0.0);
+        for z in [self.z_r, self.z_v] {
+            let d = (z * z + r2).sqrt();
+            let inv_d = 1.0 / d;
+            let s = self.sigma_tr * d;
+            // z/d <= 1 first, so nothing overflows before the exponential shrinks it.
+            let k = (z * inv_d) * (-s).exp() * inv_d * inv_d;
+            g += k * (s + 1.0);
+            let first = -k * (s * s + 3.0 * s + 3.0) * inv_d * inv_d;
+            g1 += first;
+            g2 += first + k * (r2 * inv_d * inv_d) * (s * s * s + 6.0 * s * s + 15.0 * s + 15.0) * inv_d * inv_d;
+        }
+        let c = self.alpha_prime / (4.0 * PI);
+        (c * g, c * g1, c * g2)
     }
 
     /// Total diffuse reflectance `R_d,total = integral R_d(r) 2 pi r dr` in closed form

@@ -4,6 +4,7 @@
 
 pub mod bvh;
 pub mod tree;
+pub mod truth;
 
 use crate::optics::Dipole;
 use crate::optics::{fresnel, kernel};
@@ -60,26 +61,49 @@ pub fn splat(scene: &PreparedScene, occluders: &Bvh) -> Vec<[f64; 3]> {
             }
         }
     }
-    let eps = 1e-5 * scene.bounds.1 as f64;
+    let eps = ray_offset(scene);
     jobs.par_iter()
         .map(|(s, eta)| {
-            let p = s.position.as_dvec3();
-            let n = s.normal.as_dvec3().normalize();
-            let mut e = DVec3::ZERO;
-            for l in &scene.lights {
-                let (wi, irradiance, dist) = light_incidence(l, p);
-                let cos_i = n.dot(wi);
-                if cos_i <= 0.0 {
-                    continue;
-                }
-                if l.shadow_layer.is_some() && occluders.occluded(p + n * eps, wi, eps, dist) {
-                    continue;
-                }
-                e += irradiance * (cos_i * fresnel::fresnel_transmittance(cos_i, *eta));
-            }
+            let (e, ..) =
+                transmitted_irradiance(scene, occluders, s.position.as_dvec3(), s.normal.as_dvec3(), *eta, eps);
             e.to_array()
         })
         .collect()
+}
+
+/// How far a visibility ray starts off the surface: the scale of f32 positions in the scene.
+pub(crate) fn ray_offset(scene: &PreparedScene) -> f64 {
+    1e-5 * scene.bounds.1 as f64
+}
+
+/// Fresnel-transmitted irradiance `E_t(p) = sum_l E_l cos_i F_t(cos_i, eta) V_l(p)` at a surface
+/// point with shading normal `n` (seed Eq. 10's integrand without `R_d`), with two bit masks of
+/// the lights (first 64) that face it: those that reach it and those a caster blocks. A light
+/// reaching one point and blocked at a nearby one marks a shadow edge between them.
+pub fn transmitted_irradiance(
+    scene: &PreparedScene,
+    occluders: &Bvh,
+    p: DVec3,
+    n: DVec3,
+    eta: f64,
+    eps: f64,
+) -> (DVec3, u64, u64) {
+    let n = n.normalize();
+    let (mut e, mut reached, mut blocked) = (DVec3::ZERO, 0u64, 0u64);
+    for (i, l) in scene.lights.iter().enumerate() {
+        let (wi, irradiance, dist) = light_incidence(l, p);
+        let cos_i = n.dot(wi);
+        if cos_i <= 0.0 {
+            continue;
+        }
+        if l.shadow_layer.is_some() && occluders.occluded(p + n * eps, wi, eps, dist) {
+            blocked |= 1u64 << (i % 64);
+            continue;
+        }
+        e += irradiance * (cos_i * fresnel::fresnel_transmittance(cos_i, eta));
+        reached |= 1u64 << (i % 64);
+    }
+    (e, reached, blocked)
 }
 
 /// Radiant exitance at every vertex of every object (zero for opaque ones), from per-sample

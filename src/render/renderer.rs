@@ -461,6 +461,21 @@ impl Renderer {
         Ok(all[first..first + count].iter().map(|e| [e[0], e[1], e[2]]).collect())
     }
 
+    /// Replace object `object`'s per-vertex exitance (RGB per vertex, its vertex order) before
+    /// a frame that shades without gathering (`Change::Camera` in vertex mode): how the study
+    /// draws the image of the exact exitance. The next gather overwrites it. Call with no
+    /// frame in flight.
+    pub fn set_exitance(&mut self, object: usize, exitance: &[[f32; 3]]) -> Result<(), RenderError> {
+        let count = self.scene.objects.get(object).map(|o| o.mesh.positions().len());
+        if count != Some(exitance.len()) {
+            return Err(RenderError::Target("set_exitance: not one value per vertex of that object"));
+        }
+        let first = u64::from(self.buffers.object_range(object).first_vertex);
+        let values: Vec<[f32; 4]> = exitance.iter().map(|e| [e[0], e[1], e[2], 1.0]).collect();
+        self.buffers.exitance.write(first * 16, &values)?;
+        Ok(())
+    }
+
     /// Splat output of every sample, in scene order: (irradiance RGB, area).
     pub fn splat_irradiance(&self) -> Result<Vec<([f32; 3], f32)>, RenderError> {
         let all: Vec<super::records::SplatRecord> = self.buffers.splat.read()?;

@@ -1,0 +1,183 @@
+//! `translucent study [SCENE] -o DIR`: what accuracy costs in time, against the exact dipole
+//! integral (`translucent::study`).
+
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
+use std::sync::Arc;
+use translucent::gpu::Gpu;
+use translucent::output::OutputSet;
+use translucent::reference::truth;
+use translucent::sampling::Method;
+use translucent::scene::{GatherMode, Scene};
+use translucent::study::{self, Event, StudyConfig, report};
+
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Scene file (TOML); the built-in marble bunny when omitted
+    pub scene: Option<PathBuf>,
+    /// Folder for study.csv, study.md, study.png and truth.png (made if missing)
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// A few configurations and one seed (seconds on a small scene), instead of the full sweep
+    #[arg(long)]
+    pub quick: bool,
+    /// Seeds per configuration (the full sweep's default is 3)
+    #[arg(long)]
+    pub seeds: Option<u64>,
+    /// Also draw per-vertex relative error on the model for one configuration,
+    /// SAMPLER:COUNT[:GATHER] (gather vertex by default; first seed), to error.png
+    #[arg(long, value_name = "SAMPLER:COUNT[:GATHER]")]
+    pub error_image: Option<String>,
+    /// Where the truth is cached, keyed by the scene's content (default: the user's cache
+    /// folder, translucent/truth)
+    #[arg(long)]
+    pub truth_cache: Option<PathBuf>,
+}
+
+fn parse_error_image(spec: &str) -> Result<(Method, usize, GatherMode)> {
+    let parts: Vec<&str> = spec.split(':').collect();
+    let bad = || format!("--error-image {spec:?}: expected SAMPLER:COUNT[:GATHER], e.g. turk:400:vertex");
+    if !(2..=3).contains(&parts.len()) {
+        bail!(bad());
+    }
+    let method: Method = parts[0].parse().map_err(|e: String| anyhow::anyhow!("{}: {e}", bad()))?;
+    let count: usize = parts[1].parse().with_context(bad)?;
+    let gather: GatherMode = parts
+        .get(2)
+        .map_or(Ok(GatherMode::Vertex), |g| g.parse())
+        .map_err(|e: String| anyhow::anyhow!("{}: {e}", bad()))?;
+    if gather == GatherMode::Pixel {
+        bail!("--error-image {spec:?}: the pixel gather has no per-vertex exitance to draw");
+    }
+    Ok((method, count, gather))
+}
+
+pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
+    let chosen = args.error_image.as_deref().map(parse_error_image).transpose()?;
+    let mut config = if args.quick { StudyConfig::quick() } else { StudyConfig::full() };
+    if let Some(n) = args.seeds {
+        if n == 0 {
+            bail!("--seeds must be at least 1");
+        }
+        config.seeds = (1..=n).collect();
+    }
+    if let Some((m, n, g)) = chosen {
+        let swept =
+            config.samplers.contains(&m) && config.counts.contains(&n) && config.gathers.iter().any(|x| x.0 == g);
+        if !swept {
+            bail!(
+                "--error-image: {m} with {n} samples and the {} gather is not in this sweep (samplers {:?}, counts {:?})",
+                g.name(),
+                config.samplers.iter().map(|m| m.name()).collect::<Vec<_>>(),
+                config.counts
+            );
+        }
+    }
+    if args.output.exists() && !args.output.is_dir() {
+        bail!("{} exists and is not a folder", args.output.display());
+    }
+    let names = ["study.csv", "study.md", "study.png", "truth.png", "error.png"];
+    let outputs: Vec<PathBuf> = names.iter().map(|n| args.output.join(n)).collect();
+    let scene = match &args.scene {
+        Some(path) => Scene::load(path)?,
+        None => Scene::builtin(),
+    };
+    let gpu: Arc<Gpu> = Gpu::new(&gpu_args.options())?;
+    let device = gpu.info().name.clone();
+    let cache = args.truth_cache.clone().unwrap_or_else(truth::default_cache_dir);
+
+    let bar = ProgressBar::new(config.runs() as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} eta {eta} {msg}")
+            .expect("a valid template"),
+    );
+    let study = study::run(&gpu, &scene, &config, &cache, &|e| match e {
+        Event::Truth(level, done, of) => {
+            bar.set_message(format!("exact integral, level {level}: {done}/{of} receivers"))
+        }
+        Event::TruthCached => bar.set_message("exact integral from the cache".to_string()),
+        Event::Run(i, _, label) => {
+            bar.set_position(i as u64);
+            bar.set_message(label);
+        }
+    })?;
+    bar.finish_and_clear();
+
+    let t = &study.truth;
+    let mut levels = String::new();
+    for l in &t.levels {
+        levels += &format!(
+            "| {} | {:.3} | {} | {} | {} | {:.1} |\n",
+            l.level,
+            l.eta,
+            l.irradiance_points,
+            l.change_rms.map_or("-".to_string(), |c| format!("{c:.2e}")),
+            l.change_max.map_or("-".to_string(), |c| format!("{c:.2e}")),
+            l.seconds
+        );
+    }
+    let timing = if device.contains("llvmpipe") {
+        "each pass in a submission of its own, submission to fence (lavapipe's timestamps do not wait for compute)"
+    } else {
+        "each pass in a submission of its own, submission to fence"
+    };
+    let preamble = format!(
+        "Scene `{}`, device {device}, {} configurations x seeds. Times: median of {} frames after one warm-up, \
+         a moving light's frame (splat, gather, shade), {timing}.\n\n\
+         Truth: the exact dipole integral at every vertex (`reference::truth`), {} (last change between levels \
+         {:.2e} RMS relative over lit vertices; tolerance {:.0e}){}. Per-vertex errors are relative, over \
+         vertices at least {:.0}% of the object's brightest in each channel.\n\n\
+         | level | eta | E_t points | change RMS | change max | seconds |\n|---|---|---|---|---|---|\n{levels}",
+        scene.name,
+        config.runs() / config.seeds.len(),
+        config.frames,
+        if t.converged { "converged" } else { "NOT converged" },
+        t.change(),
+        t.tolerance,
+        if study.truth_cached { ", read from the cache" } else { "" },
+        100.0 * truth::LIT_FLOOR,
+    );
+    let summaries = report::summarise(&study.rows);
+    let md = report::markdown(&format!("Accuracy study: {}", scene.name), &preamble, &summaries);
+    let [w, h] = study.truth_image.size;
+    let plot = report_plot(&summaries, &scene.name)?;
+
+    std::fs::create_dir_all(&args.output).with_context(|| format!("cannot make {}", args.output.display()))?;
+    let mut set = OutputSet::new();
+    let text = |set: &mut OutputSet, path: &PathBuf, body: String| {
+        set.stage(path, |tmp| {
+            std::fs::write(tmp, body.as_bytes())
+                .map_err(|source| translucent::output::OutputError::Io { path: path.clone(), source })
+        })
+    };
+    text(&mut set, &outputs[0], report::csv(&study.rows))?;
+    text(&mut set, &outputs[1], md)?;
+    set.png(&outputs[2], 960, 640, &plot)?;
+    set.png(&outputs[3], w, h, &study.truth_image.ldr)?;
+    if let Some((m, n, g)) = chosen {
+        let i = study
+            .rows
+            .iter()
+            .position(|r| r.sampler == m.name() && r.samples == n && r.gather == g.name())
+            .expect("checked to be in the sweep");
+        let estimate = study.exitance[i].as_ref().expect("not the pixel gather");
+        let rgba = study::error_image(&study.prepared, &t.exitance, estimate, 0.1).map_err(anyhow::Error::msg)?;
+        set.png(&outputs[4], w, h, &rgba)?;
+    }
+    for p in set.commit()? {
+        out!("wrote {}", p.display());
+    }
+    for target in report::TARGETS {
+        match report::fastest_meeting(&summaries, target) {
+            Some(s) => out!("error <= {:>4}%: {} at {:.1} ms", target * 100.0, s.label(), s.frame_ms),
+            None => out!("error <= {:>4}%: no configuration in the sweep", target * 100.0),
+        }
+    }
+    Ok(())
+}
+
+fn report_plot(summaries: &[report::Summary], name: &str) -> Result<Vec<u8>> {
+    translucent::study::plot::error_vs_time(summaries, &format!("{name}: error against frame time"), 960, 640)
+        .map_err(anyhow::Error::msg)
+}

@@ -1,0 +1,666 @@
+//! The ground truth of the accuracy study: the dipole model's exact answer, independent of the
+//! renderer's sample points.
+//!
+//! At every vertex `x` of a translucent object, the radiant exitance of seed Eq. 10,
+//!
+//! ```text
+//! M(x) = integral over the object's surface S of R_d(|x - y|) E_t(y) dA(y)
+//! E_t(y) = sum over lights l of E_l cos_i F_t(cos_i, eta) V_l(y)
+//! ```
+//!
+//! with `R_d` seed Eq. 8 (`Dipole::r_d`), the renderer's lights (the environment as its
+//! median-cut directions), its shading normals (interpolated vertex normals) and exact
+//! visibility by ray casting through a BVH of the shadow casters.
+//!
+//! # Quadrature
+//!
+//! Two approximations, both refined level by level until the answer stops changing:
+//! - `E_t` is evaluated on a grid over each mesh triangle (the triangle split in `4^depth`
+//!   cells) and taken as linear inside each cell. Where a light reaches some of a triangle's
+//!   grid points and is blocked at others (a shadow edge crosses it) the grid is
+//!   [`EDGE_EXTRA_DEPTH`] levels finer. This is the only place rays are cast, and it
+//!   does not depend on the receiver.
+//! - The kernel integral over each triangle is adaptive per receiver: a piece of surface of
+//!   radius `R` at distance `d` from `x` is fine enough when `2 R kappa <= eta_l` with
+//!   `kappa = sigma_tr,max + 3 / sqrt(d^2 + z_r,min^2)`, the inverse length over which `R_d`
+//!   changes there (its `1/d^3` flank near, its exponential far, its peak of width `z_r` at
+//!   `d = 0`, so no singularity needs special treatment: `R_d` is finite at `r = 0`). A fine
+//!   piece is integrated with Radon's 7-point degree-5 rule over the linear `E_t`, or, when
+//!   four times finer still, as a point at its `E_t`-weighted centroid with its exact flux (the
+//!   monopole, exact to second order). Coarser pieces are split in four.
+//!
+//! Level `l` uses grid depth `l` more than a triangle's base depth (set by how far its shading
+//! normal turns, [`NORMAL_SPREAD`]) and `eta_l = 0.4 / 2^(l/2)`. The change between two levels,
+//! relative, over lit receivers, estimates the coarser level's error; levels are added until
+//! its RMS is under the tolerance (1e-4), and the finer level is kept. `Truth::levels` reports
+//! every step, so a reader can see it converge.
+
+use super::bvh::Bvh;
+use super::{occluders, ray_offset, transmitted_irradiance};
+use crate::optics::Dipole;
+use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
+use glam::DVec3;
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Relative RMS change between two levels, over lit receivers, under which the truth counts
+/// as converged.
+pub const TOLERANCE: f64 = 1e-4;
+/// The finest level tried: past it the truth reports that it did not converge rather than run
+/// for hours (each level costs about four times the one before).
+pub const MAX_LEVEL: u32 = 5;
+/// A receiver is lit in a channel when its exitance is at least this fraction of the object's
+/// brightest in that channel; relative errors are taken over lit receivers only (a dark
+/// receiver's relative error is noise over nothing).
+pub const LIT_FLOOR: f64 = 0.01;
+/// The most the shading normal may turn across one grid cell at level 0 (radians).
+pub const NORMAL_SPREAD: f64 = 0.05;
+/// Extra grid depth on triangles a shadow edge or the terminator crosses.
+pub const EDGE_EXTRA_DEPTH: u32 = 2;
+/// Bumped whenever the quadrature changes, so an old cache is not read as the truth.
+pub const VERSION: u32 = 1;
+/// Deepest split of one piece of surface (a guard: `kappa` bounds the depth long before).
+const MAX_DEPTH: u32 = 40;
+
+/// One refinement level of the truth.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct Level {
+    /// 0, 1, 2, ...
+    pub level: u32,
+    /// The kernel quadrature's fineness (`2 R kappa <= eta`).
+    pub eta: f64,
+    /// Points at which `E_t` was ray cast, over every object.
+    pub irradiance_points: usize,
+    /// Relative change from the previous level, RMS over lit receivers (none on level 0,
+    /// which has nothing to compare with).
+    pub change_rms: Option<f64>,
+    /// The largest relative change over lit receivers (none on level 0).
+    pub change_max: Option<f64>,
+    /// Wall time of this level, seconds.
+    pub seconds: f64,
+}
+
+/// The exact exitance at every vertex, with the evidence that it converged.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct Truth {
+    /// [`VERSION`] of the quadrature that made it.
+    pub version: u32,
+    /// The scene content it belongs to ([`content_key`]).
+    pub key: String,
+    /// Per object (scene order), per vertex, RGB exitance; all zero for an opaque object.
+    pub exitance: Vec<Vec<[f64; 3]>>,
+    /// Every level computed, in order.
+    pub levels: Vec<Level>,
+    /// The tolerance it was asked for.
+    pub tolerance: f64,
+    /// Whether the last level changed by less than `tolerance`.
+    pub converged: bool,
+}
+
+impl Truth {
+    /// The last level's RMS relative change: the truth's own error estimate (an upper bound of
+    /// the kept level's error when each level at least halves the error).
+    pub fn change(&self) -> f64 {
+        self.levels.last().and_then(|l| l.change_rms).unwrap_or(f64::NAN)
+    }
+}
+
+/// How far and how hard to refine.
+#[derive(Clone, Copy, Debug)]
+pub struct TruthOptions {
+    /// Stop when the RMS relative change between two levels is below this.
+    pub tolerance: f64,
+    /// Give up (reporting `converged: false`) after this level.
+    pub max_level: u32,
+}
+
+impl Default for TruthOptions {
+    fn default() -> Self {
+        TruthOptions { tolerance: TOLERANCE, max_level: MAX_LEVEL }
+    }
+}
+
+/// Progress of a truth computation, for a progress bar: `(level, receivers done, receivers in
+/// the level)`.
+pub type Progress<'a> = &'a (dyn Fn(u32, usize, usize) + Sync);
+
+/// Compute the truth for every translucent object of `scene`, level after level until it
+/// converges (or `options.max_level`).
+pub fn compute(scene: &PreparedScene, options: &TruthOptions, progress: Progress) -> Truth {
+    let occluders = occluders(scene);
+    let eps = ray_offset(scene);
+    let mut levels: Vec<Level> = Vec::new();
+    let mut previous: Option<Vec<Vec<[f64; 3]>>> = None;
+    let mut converged = false;
+    for level in 0..=options.max_level {
+        let start = std::time::Instant::now();
+        let eta = 0.4 * 0.5f64.powf(f64::from(level) / 2.0);
+        let mut points = 0;
+        let receivers = scene.vertex_count();
+        let done = AtomicUsize::new(0);
+        let exitance: Vec<Vec<[f64; 3]>> = scene
+            .objects
+            .iter()
+            .map(|o| match &o.material {
+                ResolvedMaterial::Translucent { material, dipoles, .. } => {
+                    let sources = sources(scene, &occluders, o, material.eta, level, eps);
+                    points += sources.iter().map(|s| s.grid.len()).sum::<usize>();
+                    exitance_at_vertices(o, dipoles, &sources, eta, &|n| {
+                        let d = done.fetch_add(n, Ordering::Relaxed) + n;
+                        progress(level, d, receivers);
+                    })
+                }
+                ResolvedMaterial::Opaque { .. } => {
+                    done.fetch_add(o.mesh.positions().len(), Ordering::Relaxed);
+                    vec![[0.0; 3]; o.mesh.positions().len()]
+                }
+            })
+            .collect();
+        let (change_rms, change_max) = match &previous {
+            Some(p) => {
+                let (rms, max) = relative_change(p, &exitance);
+                (Some(rms), Some(max))
+            }
+            None => (None, None),
+        };
+        levels.push(Level {
+            level,
+            eta,
+            irradiance_points: points,
+            change_rms,
+            change_max,
+            seconds: start.elapsed().as_secs_f64(),
+        });
+        previous = Some(exitance);
+        if change_rms.is_some_and(|c| c < options.tolerance) {
+            converged = true;
+            break;
+        }
+    }
+    Truth {
+        version: VERSION,
+        key: content_key(scene, options),
+        exitance: previous.unwrap_or_default(),
+        levels,
+        tolerance: options.tolerance,
+        converged,
+    }
+}
+
+/// Why the cached truth could not be read or written.
+#[derive(Debug, thiserror::Error)]
+#[allow(missing_docs)] // each variant names the cache file and the underlying error
+pub enum TruthCacheError {
+    #[error("truth cache {}: {source}", path.display())]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("truth cache {}: {source}", path.display())]
+    Json { path: PathBuf, source: serde_json::Error },
+}
+
+/// The truth of `scene` from `dir` if an earlier run left it there (same content key and
+/// quadrature version), else computed and stored there. Returns it and whether it was cached.
+pub fn cached(
+    scene: &PreparedScene,
+    options: &TruthOptions,
+    dir: &Path,
+    progress: Progress,
+) -> Result<(Truth, bool), TruthCacheError> {
+    let key = content_key(scene, options);
+    let path = dir.join(format!("truth-{key}.json"));
+    if let Ok(bytes) = std::fs::read(&path) {
+        // An unreadable or foreign file is recomputed and replaced, never trusted.
+        if let Ok(truth) = serde_json::from_slice::<Truth>(&bytes)
+            && truth.key == key
+            && truth.version == VERSION
+        {
+            return Ok((truth, true));
+        }
+    }
+    let truth = compute(scene, options, progress);
+    let io = |source| TruthCacheError::Io { path: path.clone(), source };
+    std::fs::create_dir_all(dir).map_err(io)?;
+    let json = serde_json::to_vec(&truth).map_err(|source| TruthCacheError::Json { path: path.clone(), source })?;
+    // Write then rename, so a run cut short never leaves half a truth behind.
+    let tmp = dir.join(format!(".truth-{key}.json.tmp"));
+    std::fs::write(&tmp, json).map_err(io)?;
+    std::fs::rename(&tmp, &path).map_err(io)?;
+    Ok((truth, false))
+}
+
+/// Where truths are cached unless told otherwise: `$XDG_CACHE_HOME/translucent/truth`, else
+/// `$HOME/.cache/translucent/truth`, else the system's temporary folder.
+pub fn default_cache_dir() -> PathBuf {
+    let base = std::env::var_os("XDG_CACHE_HOME")
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").filter(|v| !v.is_empty()).map(|h| PathBuf::from(h).join(".cache")))
+        .unwrap_or_else(std::env::temp_dir);
+    base.join("translucent").join("truth")
+}
+
+/// A hash (FNV-1a, 64 bits, hex) of everything the truth depends on: each object's placed mesh
+/// and dipoles, which objects cast shadows, the prepared lights, the options and the quadrature
+/// version. Sample points, the camera and the gather are left out: the truth does not depend
+/// on them.
+pub fn content_key(scene: &PreparedScene, options: &TruthOptions) -> String {
+    let mut h = Fnv(0xcbf2_9ce4_8422_2325);
+    h.u64(u64::from(VERSION));
+    h.f64(options.tolerance);
+    h.u64(u64::from(options.max_level));
+    for o in &scene.objects {
+        h.u64(o.mesh.positions().len() as u64);
+        for p in o.mesh.positions() {
+            p.to_array().iter().for_each(|c| h.u64(u64::from(c.to_bits())));
+        }
+        for t in o.mesh.triangles() {
+            t.iter().for_each(|&i| h.u64(u64::from(i)));
+        }
+        h.u64(u64::from(o.casts_shadow));
+        match &o.material {
+            ResolvedMaterial::Translucent { material, dipoles, .. } => {
+                h.f64(material.eta);
+                for d in dipoles {
+                    [d.sigma_a, d.sigma_s_prime, d.eta].iter().for_each(|&v| h.f64(v));
+                }
+            }
+            ResolvedMaterial::Opaque { .. } => h.u64(0),
+        }
+    }
+    for l in &scene.lights {
+        h.bytes(format!("{:?} {}", l.kind, l.shadow_layer.is_some()).as_bytes());
+    }
+    format!("{:016x}", h.0)
+}
+
+struct Fnv(u64);
+
+impl Fnv {
+    fn bytes(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    fn u64(&mut self, v: u64) {
+        self.bytes(&v.to_le_bytes());
+    }
+    fn f64(&mut self, v: f64) {
+        self.u64(v.to_bits());
+    }
+}
+
+/// Relative change from `a` to `b` over the receivers lit in `b` ([`LIT_FLOOR`]): RMS and
+/// maximum over every lit (object, vertex, channel).
+pub fn relative_change(a: &[Vec<[f64; 3]>], b: &[Vec<[f64; 3]>]) -> (f64, f64) {
+    let (mut sum, mut n, mut max) = (0.0, 0usize, 0.0f64);
+    for (oa, ob) in a.iter().zip(b) {
+        for c in 0..3 {
+            let floor = LIT_FLOOR * ob.iter().map(|m| m[c]).fold(0.0, f64::max);
+            for (ma, mb) in oa.iter().zip(ob) {
+                if mb[c] > 0.0 && mb[c] >= floor {
+                    let rel = (ma[c] - mb[c]).abs() / mb[c];
+                    sum += rel * rel;
+                    n += 1;
+                    max = max.max(rel);
+                }
+            }
+        }
+    }
+    if n == 0 { (0.0, 0.0) } else { ((sum / n as f64).sqrt(), max) }
+}
+
+/// One mesh triangle as a source: its transmitted irradiance on a grid of `4^depth` cells.
+struct Source {
+    corners: [DVec3; 3],
+    depth: u32,
+    /// `E_t` at grid point `(i, j)` (`u = i/n`, `v = j/n`, `n = 2^depth`), at [`grid_index`].
+    grid: Vec<DVec3>,
+    area: f64,
+    /// Flux `integral E_t dA` per channel and its `E_t`-weighted centroid.
+    flux: [f64; 3],
+    centroid: [DVec3; 3],
+    /// Second moment `integral (y - c)(y - c)^T E_t dA` about each channel's centroid `c`:
+    /// xx, yy, zz, xy, xz, yz.
+    quadrupole: [[f64; 6]; 3],
+    /// Bounding sphere of the triangle (centre of its corners).
+    centre: DVec3,
+    radius: f64,
+}
+
+/// Index of grid point `(i, j)`, `i + j <= n`, in a triangle's grid (rows of `i`).
+fn grid_index(i: usize, j: usize, n: usize) -> usize {
+    i * (n + 1) - i * i.saturating_sub(1) / 2 + j
+}
+
+impl Source {
+    fn point(&self, u: f64, v: f64) -> DVec3 {
+        self.corners[0] + (self.corners[1] - self.corners[0]) * u + (self.corners[2] - self.corners[0]) * v
+    }
+
+    /// `E_t` at `(u, v)`, linear in each grid cell.
+    fn irradiance(&self, u: f64, v: f64) -> DVec3 {
+        let n = 1usize << self.depth;
+        let (s, t) = (u * n as f64, v * n as f64);
+        let i = (s.floor().max(0.0) as usize).min(n - 1);
+        let j = (t.floor().max(0.0) as usize).min(n - 1 - i);
+        let (a, b) = (s - i as f64, t - j as f64);
+        let e = |i, j| self.grid[grid_index(i, j, n)];
+        if a + b <= 1.0 || i + j + 2 > n {
+            e(i, j) * (1.0 - a - b) + e(i + 1, j) * a + e(i, j + 1) * b
+        } else {
+            e(i + 1, j + 1) * (a + b - 1.0) + e(i + 1, j) * (1.0 - b) + e(i, j + 1) * (1.0 - a)
+        }
+    }
+}
+
+/// Call `f` with the grid points of every cell of a triangle's grid of side `n`: the `n^2`
+/// triangles of its uniform subdivision, pointing up and down.
+fn for_each_cell(n: usize, mut f: impl FnMut([(usize, usize); 3])) {
+    for i in 0..n {
+        for j in 0..n - i {
+            f([(i, j), (i + 1, j), (i, j + 1)]);
+            if i + j + 2 <= n {
+                f([(i + 1, j), (i + 1, j + 1), (i, j + 1)]);
+            }
+        }
+    }
+}
+
+/// Flux and first moment of a linear `E` over a triangle of `area` with corners `y` and
+/// values `e`: `integral E dA = A mean(E)`, `integral y E dA = (A/12)(sum y_i E_i + sum y_i sum E_i)`.
+fn linear_moments(y: &[DVec3; 3], e: &[DVec3; 3], area: f64) -> ([f64; 3], [DVec3; 3]) {
+    let ys = y[0] + y[1] + y[2];
+    let mut flux = [0.0; 3];
+    let mut moment = [DVec3::ZERO; 3];
+    for c in 0..3 {
+        let es = e[0][c] + e[1][c] + e[2][c];
+        flux[c] = area * es / 3.0;
+        moment[c] = (y[0] * e[0][c] + y[1] * e[1][c] + y[2] * e[2][c] + ys * es) * (area / 12.0);
+    }
+    (flux, moment)
+}
+
+/// The object's triangles as sources at `level`: `E_t` ray cast on each triangle's grid, finer
+/// where the set of lights reaching it changes inside it.
+fn sources(scene: &PreparedScene, occluders: &Bvh, o: &PreparedObject, eta: f64, level: u32, eps: f64) -> Vec<Source> {
+    let mesh = &o.mesh;
+    let normals = mesh.vertex_normals();
+    (0..mesh.triangles().len())
+        .into_par_iter()
+        .map(|t| {
+            let corners = mesh.corners(t);
+            let [a, b, c] = mesh.triangles()[t].map(|i| normals[i as usize].as_dvec3());
+            let grid_at = |depth: u32| -> (Vec<DVec3>, bool) {
+                let n = 1usize << depth;
+                let mut grid = vec![DVec3::ZERO; (n + 1) * (n + 2) / 2];
+                let at = |u: f64, v: f64| {
+                    let p = corners[0] + (corners[1] - corners[0]) * u + (corners[2] - corners[0]) * v;
+                    let normal = a * (1.0 - u - v) + b * u + c * v;
+                    transmitted_irradiance(scene, occluders, p, normal, eta, eps)
+                };
+                let (mut reached, mut blocked) = (0u64, 0u64);
+                for i in 0..=n {
+                    for j in 0..=n - i {
+                        let (e, r, b) = at(i as f64 / n as f64, j as f64 / n as f64);
+                        grid[grid_index(i, j, n)] = e;
+                        (reached, blocked) = (reached | r, blocked | b);
+                    }
+                }
+                let (_, r, b) = at(1.0 / 3.0, 1.0 / 3.0);
+                // A light that reaches some points and is blocked at others: a shadow edge. (The
+                // terminator is no edge: E_t falls to zero there continuously, as cos^2.)
+                let edge = (reached | r) & (blocked | b) != 0;
+                (grid, edge)
+            };
+            // E_t follows the shading normal: linear interpolation over a cell whose normals
+            // turn by `delta` radians misses about `delta^2 / 8` of it, so cells start small
+            // enough that `delta` is at most NORMAL_SPREAD.
+            let spread = [a.angle_between(b), b.angle_between(c), c.angle_between(a)].into_iter().fold(0.0, f64::max);
+            let base = (spread / NORMAL_SPREAD).log2().ceil().clamp(0.0, 8.0) as u32;
+            let (mut grid, edge) = grid_at(base + level);
+            let mut depth = base + level;
+            if edge {
+                depth = base + level + EDGE_EXTRA_DEPTH;
+                grid = grid_at(depth).0;
+            }
+            let area = mesh.triangle_areas()[t];
+            let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
+            let radius = corners.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
+            let mut s = Source {
+                corners,
+                depth,
+                grid,
+                area,
+                flux: [0.0; 3],
+                centroid: [DVec3::ZERO; 3],
+                quadrupole: [[0.0; 6]; 3],
+                centre,
+                radius,
+            };
+            // Moments of the whole triangle, cell by cell (every cell has area A / 4^depth).
+            let n = 1usize << depth;
+            let cell_area = area / (n * n) as f64;
+            let (mut flux, mut moment) = ([0.0; 3], [DVec3::ZERO; 3]);
+            let mut add = |cells: [(usize, usize); 3]| {
+                let y = cells.map(|(i, j)| s.point(i as f64 / n as f64, j as f64 / n as f64));
+                let e = cells.map(|(i, j)| s.grid[grid_index(i, j, n)]);
+                let (f, m) = linear_moments(&y, &e, cell_area);
+                for ch in 0..3 {
+                    flux[ch] += f[ch];
+                    moment[ch] += m[ch];
+                }
+            };
+            for_each_cell(n, &mut add);
+            s.centroid = [0, 1, 2].map(|ch| if flux[ch] > 0.0 { moment[ch] / flux[ch] } else { centre });
+            s.flux = flux;
+            // Second moments cell by cell: Radon's rule is exact for the cubic (y - c)^2 E_t.
+            let mut q = [[0.0; 6]; 3];
+            for_each_cell(n, |cell| {
+                let y = cell.map(|(i, j)| s.point(i as f64 / n as f64, j as f64 / n as f64));
+                let e = cell.map(|(i, j)| s.grid[grid_index(i, j, n)]);
+                for (b, w) in RADON {
+                    let p = y[0] * b[0] + y[1] * b[1] + y[2] * b[2];
+                    let ep = e[0] * b[0] + e[1] * b[1] + e[2] * b[2];
+                    for ch in 0..3 {
+                        let r = p - s.centroid[ch];
+                        let we = w * cell_area * ep[ch];
+                        let terms = [r.x * r.x, r.y * r.y, r.z * r.z, r.x * r.y, r.x * r.z, r.y * r.z];
+                        for (qk, t) in q[ch].iter_mut().zip(terms) {
+                            *qk += we * t;
+                        }
+                    }
+                }
+            });
+            s.quadrupole = q;
+            s
+        })
+        .collect()
+}
+
+/// Radon's 7-point degree-5 rule on a triangle: barycentric coordinates and weights (summing
+/// to one). Published constants: `a = (6 -+ sqrt 15)/21`, `w = (155 -+ sqrt 15)/1200`.
+const RADON: [([f64; 3], f64); 7] = {
+    const A1: f64 = 0.101_286_507_323_456_3;
+    const B1: f64 = 0.797_426_985_353_087_4;
+    const W1: f64 = 0.125_939_180_544_827_1;
+    const A2: f64 = 0.470_142_064_105_115_1;
+    const B2: f64 = 0.059_715_871_789_769_8;
+    const W2: f64 = 0.132_394_152_788_506_2;
+    [
+        ([1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0], 0.225),
+        ([A1, A1, B1], W1),
+        ([A1, B1, A1], W1),
+        ([B1, A1, A1], W1),
+        ([A2, A2, B2], W2),
+        ([A2, B2, A2], W2),
+        ([B2, A2, A2], W2),
+    ]
+};
+
+/// The exact exitance at every vertex of `o`.
+///
+/// A first pass sums every triangle as one monopole: a coarse `M_0(x)`. The refinement then
+/// measures each piece's error against `max(its own bound, TAU M_ref)`, with
+/// `M_ref = max(M_0(x), LIT_FLOOR max M_0)`: a piece whose whole contribution is negligible
+/// next to the receiver's exitance needs no accuracy of its own (far pieces, where `R_d` has
+/// decayed by `e^(-sigma_tr d)`, would otherwise be split to the diffusion length).
+fn exitance_at_vertices(
+    o: &PreparedObject,
+    dipoles: &[Dipole; 3],
+    sources: &[Source],
+    eta: f64,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Vec<[f64; 3]> {
+    let lit: Vec<&Source> = sources.iter().filter(|s| s.flux.iter().any(|&f| f > 0.0)).collect();
+    let positions = o.mesh.positions();
+    let coarse: Vec<[f64; 3]> = positions
+        .par_iter()
+        .map(|x| {
+            let x = x.as_dvec3();
+            let mut m = [0.0; 3];
+            for s in &lit {
+                for c in 0..3 {
+                    if s.flux[c] > 0.0 {
+                        m[c] += s.flux[c] * dipoles[c].r_d_sq(x.distance_squared(s.centroid[c]));
+                    }
+                }
+            }
+            m
+        })
+        .collect();
+    let floor = [0, 1, 2].map(|c| LIT_FLOOR * coarse.iter().map(|m| m[c]).fold(0.0, f64::max));
+    let chunk = 64;
+    positions
+        .par_chunks(chunk)
+        .zip(coarse.par_chunks(chunk))
+        .flat_map_iter(|(xs, m0)| {
+            let out: Vec<[f64; 3]> = xs
+                .iter()
+                .zip(m0)
+                .map(|(x, m0)| {
+                    let m_ref = [0, 1, 2].map(|c| m0[c].max(floor[c]));
+                    let q = Quadrature { x: x.as_dvec3(), dipoles, eta, m_ref };
+                    let mut m = [0.0; 3];
+                    for s in &lit {
+                        q.piece(s, [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], 0, &mut m);
+                    }
+                    m
+                })
+                .collect();
+            progress(xs.len());
+            out
+        })
+        .collect()
+}
+
+/// A piece's error may reach this fraction of the receiver's reference exitance (times the
+/// rule's `(eta)^2`) when that is more than its own relative error would allow.
+const TAU: f64 = 1e-3;
+
+struct Quadrature<'a> {
+    x: DVec3,
+    dipoles: &'a [Dipole; 3],
+    eta: f64,
+    m_ref: [f64; 3],
+}
+
+impl Quadrature<'_> {
+    /// Is a piece of radius `radius` at distance `d` (to its nearest point, at most), carrying
+    /// `flux`, fine enough for a rule of fineness `limit`? Per channel, `t = 2 R kappa` with
+    /// `kappa = sigma_tr + 3 / sqrt(d^2 + z_r^2)` the inverse length over which `R_d` changes
+    /// there; the rule's error is about `t^2` of the piece's contribution, bounded by
+    /// `flux R_d(d)`. Fine when that error is within `limit^2` of the contribution, or of
+    /// `TAU M_ref`.
+    fn fine(&self, d: f64, radius: f64, flux: &[f64; 3], limit: f64) -> bool {
+        (0..3).all(|c| {
+            if flux[c] <= 0.0 {
+                return true;
+            }
+            let dp = &self.dipoles[c];
+            let t = 2.0 * radius * (dp.sigma_tr + 3.0 / (d * d + dp.z_r * dp.z_r).sqrt());
+            if t <= limit {
+                return true;
+            }
+            let bound = flux[c] * dp.r_d_sq(d * d);
+            t * t * bound <= limit * limit * TAU * self.m_ref[c]
+        })
+    }
+
+    fn monopole(&self, flux: &[f64; 3], centroid: &[DVec3; 3], m: &mut [f64; 3]) {
+        for c in 0..3 {
+            if flux[c] > 0.0 {
+                m[c] += flux[c] * self.dipoles[c].r_d_sq(self.x.distance_squared(centroid[c]));
+            }
+        }
+    }
+
+    /// A whole triangle as a point at each channel's centroid plus the quadrupole term
+    /// `(1/2) Q : H`, `H = R_d'' r^ r^T + (R_d'/r)(I - r^ r^T)` the kernel's Hessian: the error
+    /// is third order in the triangle's size over the kernel's length.
+    #[allow(clippy::needless_range_loop)] // c indexes four per-channel arrays at once
+    fn multipole(&self, s: &Source, m: &mut [f64; 3]) {
+        for c in 0..3 {
+            if s.flux[c] <= 0.0 {
+                continue;
+            }
+            let r = self.x - s.centroid[c];
+            let r2 = r.length_squared();
+            let (g, g1, g2) = self.dipoles[c].r_d_derivatives(r2);
+            let q = &s.quadrupole[c];
+            let trace = q[0] + q[1] + q[2];
+            let along = if r2 > 0.0 {
+                (r.x * r.x * q[0]
+                    + r.y * r.y * q[1]
+                    + r.z * r.z * q[2]
+                    + 2.0 * (r.x * r.y * q[3] + r.x * r.z * q[4] + r.y * r.z * q[5]))
+                    / r2
+            } else {
+                0.0
+            };
+            m[c] += s.flux[c] * g + 0.5 * ((g2 - g1) * along + g1 * trace);
+        }
+    }
+
+    /// Integrate over the piece of `s` with corners `uv` (in the triangle's `(u, v)`), at split
+    /// depth `depth` below the triangle.
+    fn piece(&self, s: &Source, uv: [[f64; 2]; 3], depth: u32, m: &mut [f64; 3]) {
+        if depth == 0 {
+            let d = (self.x.distance(s.centre) - s.radius).max(0.0);
+            if self.fine(d, s.radius, &s.flux, self.eta / 2.0) {
+                return self.multipole(s, m);
+            }
+        }
+        let y = uv.map(|[u, v]| s.point(u, v));
+        let centre = (y[0] + y[1] + y[2]) / 3.0;
+        let radius = y.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
+        let d = (self.x.distance(centre) - radius).max(0.0);
+        // Inside one grid cell `E_t` is linear, so the piece's moments are known exactly.
+        if depth >= s.depth {
+            let e = uv.map(|[u, v]| s.irradiance(u, v));
+            let area = s.area * 0.25f64.powi(depth as i32);
+            let (flux, moment) = linear_moments(&y, &e, area);
+            if self.fine(d, radius, &flux, self.eta / 4.0) {
+                let centroid = [0, 1, 2].map(|c| if flux[c] > 0.0 { moment[c] / flux[c] } else { centre });
+                return self.monopole(&flux, &centroid, m);
+            }
+            if self.fine(d, radius, &flux, self.eta) || depth >= MAX_DEPTH {
+                for (b, w) in RADON {
+                    let p = y[0] * b[0] + y[1] * b[1] + y[2] * b[2];
+                    let ep = e[0] * b[0] + e[1] * b[1] + e[2] * b[2];
+                    let r2 = self.x.distance_squared(p);
+                    for c in 0..3 {
+                        if ep[c] > 0.0 {
+                            m[c] += w * area * ep[c] * self.dipoles[c].r_d_sq(r2);
+                        }
+                    }
+                }
+                return;
+            }
+        }
+        let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) * 0.5, (a[1] + b[1]) * 0.5];
+        let (ab, bc, ca) = (mid(uv[0], uv[1]), mid(uv[1], uv[2]), mid(uv[2], uv[0]));
+        for child in [[uv[0], ab, ca], [ab, uv[1], bc], [ca, bc, uv[2]], [ab, bc, ca]] {
+            self.piece(s, child, depth + 1, m);
+        }
+    }
+}

@@ -1,0 +1,369 @@
+//! The accuracy study (`translucent study`): what accuracy costs in time.
+//!
+//! Every configuration (sampler x sample count x gather x seed) is rendered and compared with
+//! the exact dipole integral of `reference::truth`, per vertex and as an image; its passes are
+//! timed. `report` turns the rows into CSV and Markdown, `plot` into error against time, `flip`
+//! measures the tone-mapped images' FLIP error, `raster` draws per-vertex error on the model.
+
+pub mod flip;
+pub mod plot;
+pub mod raster;
+pub mod report;
+
+use crate::gpu::Gpu;
+use crate::reference::truth::{self, LIT_FLOOR, Truth, TruthOptions};
+use crate::render::plan::Change;
+use crate::render::renderer::{RenderError, Renderer};
+use crate::sampling::{self, Method, SampleOptions};
+use crate::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
+use crate::scene::{GatherMode, Scene, SceneError, TransportMode};
+use report::Row;
+use std::path::Path;
+use std::sync::Arc;
+
+/// What a study sweeps.
+#[derive(Clone, Debug)]
+pub struct StudyConfig {
+    /// Samplers, in order.
+    pub samplers: Vec<Method>,
+    /// Sample counts per object.
+    pub counts: Vec<usize>,
+    /// Gathers, with the hierarchical gather's epsilon where it applies.
+    pub gathers: Vec<(GatherMode, Option<f32>)>,
+    /// Seeds (each replaces `sampling.seed`).
+    pub seeds: Vec<u64>,
+    /// Timed frames per configuration (median taken), after one warm-up frame.
+    pub frames: usize,
+}
+
+impl StudyConfig {
+    /// The sweep: every sampler, 100 to 6,400 samples doubling, every gather (the
+    /// hierarchical at three epsilons), three seeds, five timed frames.
+    pub fn full() -> StudyConfig {
+        StudyConfig {
+            samplers: Method::ALL.to_vec(),
+            counts: vec![100, 200, 400, 800, 1600, 3200, 6400],
+            gathers: vec![
+                (GatherMode::Vertex, None),
+                (GatherMode::Sparse, None),
+                (GatherMode::Pixel, None),
+                (GatherMode::Hierarchical, Some(0.3)),
+                (GatherMode::Hierarchical, Some(0.1)),
+                (GatherMode::Hierarchical, Some(0.03)),
+            ],
+            seeds: vec![1, 2, 3],
+            frames: 5,
+        }
+    }
+
+    /// A few seconds' worth, for CI: Turk at three doubling counts and random at one, the
+    /// vertex gather, one seed, three frames.
+    pub fn quick() -> StudyConfig {
+        StudyConfig {
+            samplers: vec![Method::Turk, Method::Random],
+            counts: vec![100, 200, 400],
+            gathers: vec![(GatherMode::Vertex, None)],
+            seeds: vec![1],
+            frames: 3,
+        }
+    }
+
+    /// Configurations times seeds.
+    pub fn runs(&self) -> usize {
+        self.samplers.len() * self.counts.len() * self.gathers.len() * self.seeds.len()
+    }
+}
+
+/// Why a study stopped.
+#[derive(Debug, thiserror::Error)]
+#[allow(missing_docs)] // each variant carries the underlying error, which names what failed
+pub enum StudyError {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    #[error(transparent)]
+    Truth(#[from] truth::TruthCacheError),
+    #[error("sampling {object}: {message}")]
+    Sampling { object: String, message: String },
+    #[error("{0}")]
+    Report(String),
+    #[error("the scene has no translucent object: there is nothing to study")]
+    NothingTranslucent,
+}
+
+/// What a running study reports, for a progress bar.
+#[derive(Clone, Debug)]
+pub enum Event {
+    /// The truth: `(level, receivers done, receivers)`.
+    Truth(u32, usize, usize),
+    /// The truth was read from the cache.
+    TruthCached,
+    /// A configuration starts: `(index, of, label)`.
+    Run(usize, usize, String),
+}
+
+/// Per-vertex error against the truth, per channel, over the receivers lit in the truth
+/// (exitance at least [`LIT_FLOOR`] of the object's brightest in that channel).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct VertexError {
+    /// Relative RMS error.
+    pub rel_rms: [f64; 3],
+    /// 99th percentile of the absolute relative error.
+    pub p99: [f64; 3],
+    /// Largest absolute relative error.
+    pub max: [f64; 3],
+    /// Mean relative error (signed: positive reads too bright).
+    pub bias: [f64; 3],
+    /// Lit receivers per channel.
+    pub lit: [usize; 3],
+}
+
+/// Per-vertex error of `estimate` against `truth`, over every object (scene order; opaque
+/// objects have all-zero truth and count for nothing). The floor is per object and channel.
+pub fn vertex_error(truth: &[Vec<[f64; 3]>], estimate: &[Vec<[f32; 3]>]) -> VertexError {
+    let mut out = VertexError::default();
+    for c in 0..3 {
+        let mut rel = Vec::new();
+        for (t, e) in truth.iter().zip(estimate) {
+            let floor = LIT_FLOOR * t.iter().map(|m| m[c]).fold(0.0, f64::max);
+            for (tv, ev) in t.iter().zip(e) {
+                if tv[c] > 0.0 && tv[c] >= floor {
+                    rel.push((f64::from(ev[c]) - tv[c]) / tv[c]);
+                }
+            }
+        }
+        if rel.is_empty() {
+            continue;
+        }
+        let n = rel.len() as f64;
+        out.lit[c] = rel.len();
+        out.rel_rms[c] = (rel.iter().map(|r| r * r).sum::<f64>() / n).sqrt();
+        out.bias[c] = rel.iter().sum::<f64>() / n;
+        let mut abs: Vec<f64> = rel.iter().map(|r| r.abs()).collect();
+        abs.sort_by(f64::total_cmp);
+        out.max[c] = abs[abs.len() - 1];
+        out.p99[c] = abs[((0.99 * (abs.len() - 1) as f64).round() as usize).min(abs.len() - 1)];
+    }
+    out
+}
+
+/// Relative RMSE of the RGB of two linear RGBA images: `sqrt(sum (a - b)^2 / sum b^2)`.
+pub fn image_rel_rmse(truth: &[f32], image: &[f32]) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for (t, i) in truth.chunks_exact(4).zip(image.chunks_exact(4)) {
+        for c in 0..3 {
+            let (t, i) = (f64::from(t[c]), f64::from(i[c]));
+            num += (i - t) * (i - t);
+            den += t * t;
+        }
+    }
+    if den > 0.0 { (num / den).sqrt() } else { 0.0 }
+}
+
+/// The images of one frame: tone-mapped RGBA8 and linear RGBA f32.
+#[derive(Clone, Debug)]
+pub struct Images {
+    /// Width and height in pixels.
+    pub size: [u32; 2],
+    /// Tone-mapped, 8-bit RGBA, rows top to bottom.
+    pub ldr: Vec<u8>,
+    /// Linear HDR RGBA.
+    pub hdr: Vec<f32>,
+}
+
+/// A finished study.
+#[derive(Clone, Debug)]
+pub struct Study {
+    /// One row per configuration and seed.
+    pub rows: Vec<Row>,
+    /// The truth it was measured against.
+    pub truth: Truth,
+    /// Whether the truth came from the cache.
+    pub truth_cached: bool,
+    /// The scene shaded with the true exitance (vertex interpolation, like the vertex gather).
+    pub truth_image: Images,
+    /// The scene prepared as the truth saw it (the study's first configuration's geometry).
+    pub prepared: PreparedScene,
+    /// Each configuration's per-vertex exitance, for `--error-image` (same order as `rows`).
+    pub exitance: Vec<Option<Vec<Vec<[f32; 3]>>>>,
+}
+
+/// The scene for one configuration: `base` (prepared once, geometry and lights) with new
+/// samples, the gather set, every channel gathered. Returns it and the sampling time (ms).
+fn configure(
+    base: &PreparedScene,
+    method: Method,
+    count: usize,
+    seed: u64,
+    gather: (GatherMode, Option<f32>),
+) -> Result<(PreparedScene, f64), StudyError> {
+    let mut scene = base.clone();
+    let file = &mut scene.scene.file;
+    file.sampling.method = method;
+    file.sampling.count = count;
+    file.sampling.seed = seed;
+    file.render.gather = gather.0;
+    if let Some(e) = gather.1 {
+        file.render.gather_epsilon = e;
+    }
+    file.render.transport = TransportMode::Gather;
+    let start = std::time::Instant::now();
+    for (i, o) in scene.objects.iter_mut().enumerate() {
+        if let ResolvedMaterial::Translucent { .. } = o.material {
+            // The seed of object i is sampling.seed + i, as `PreparedScene::new` places them.
+            let options = SampleOptions::new(method, count).with_seed(seed.wrapping_add(i as u64));
+            o.samples = sampling::sample(&o.mesh, &options)
+                .map_err(|e| StudyError::Sampling { object: o.name.clone(), message: e.to_string() })?
+                .points;
+        }
+    }
+    Ok((scene, start.elapsed().as_secs_f64() * 1e3))
+}
+
+fn images(renderer: &Renderer) -> Result<Images, StudyError> {
+    let scene = renderer.scene();
+    let [w, h] = scene.scene.file.camera.resolution;
+    Ok(Images { size: [w, h], ldr: renderer.image()?.0, hdr: renderer.hdr_image()? })
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    crate::gpu::median(&mut v)
+}
+
+/// Run the study of `scene` on `gpu`: the truth (from `truth_dir` if cached there), its image,
+/// then every configuration of `config`. `progress` hears of each step.
+pub fn run(
+    gpu: &Arc<Gpu>,
+    scene: &Scene,
+    config: &StudyConfig,
+    truth_dir: &Path,
+    progress: &(dyn Fn(Event) + Sync),
+) -> Result<Study, StudyError> {
+    let overrides =
+        Overrides { transport: Some(TransportMode::Gather), gather: Some(GatherMode::Vertex), ..Overrides::default() };
+    let base = PreparedScene::new(scene, &overrides)?;
+    if !base.has_translucent() {
+        return Err(StudyError::NothingTranslucent);
+    }
+    let (truth, truth_cached) =
+        truth::cached(&base, &TruthOptions::default(), truth_dir, &|l, d, n| progress(Event::Truth(l, d, n)))?;
+    if truth_cached {
+        progress(Event::TruthCached);
+    }
+
+    // The truth's image: a full frame for shadows and sky, then the exact exitance shaded.
+    let mut renderer = Renderer::new(gpu, base.clone())?;
+    renderer.frame(&renderer.plan(Change::Everything))?;
+    for (i, m) in truth.exitance.iter().enumerate() {
+        if matches!(base.objects[i].material, ResolvedMaterial::Translucent { .. }) {
+            let values: Vec<[f32; 3]> = m.iter().map(|v| v.map(|x| x as f32)).collect();
+            renderer.set_exitance(i, &values)?;
+        }
+    }
+    renderer.frame(&renderer.plan(Change::Camera))?;
+    let truth_image = images(&renderer)?;
+    drop(renderer);
+
+    let name = scene.name.clone();
+    let (mut rows, mut exitances) = (Vec::new(), Vec::new());
+    let total = config.runs();
+    for &method in &config.samplers {
+        for &count in &config.counts {
+            for &seed in &config.seeds {
+                for &gather in &config.gathers {
+                    let label = format!(
+                        "{method} {count} {}{} seed {seed}",
+                        gather.0.name(),
+                        gather.1.map_or(String::new(), |e| format!(" eps {e}"))
+                    );
+                    progress(Event::Run(rows.len(), total, label));
+                    let (prepared, sampling_ms) = configure(&base, method, count, seed, gather)?;
+                    let mut renderer = Renderer::new(gpu, prepared)?;
+                    renderer.frame(&renderer.plan(Change::Everything))?;
+                    let exitance = if gather.0 == GatherMode::Pixel {
+                        None
+                    } else {
+                        Some((0..base.objects.len()).map(|i| renderer.exitance(i)).collect::<Result<Vec<_>, _>>()?)
+                    };
+                    let image = images(&renderer)?;
+                    // A moving light's frame: splat, gather and shade (the study's subject),
+                    // each pass in a submission of its own (`frame_isolated`).
+                    let plan = renderer.plan(Change::Lights);
+                    renderer.frame_isolated(&plan)?;
+                    let mut timings = Vec::new();
+                    for _ in 0..config.frames.max(1) {
+                        timings.push(renderer.frame_isolated(&plan)?);
+                    }
+                    let pass = |name: &str| median(timings.iter().map(|t| t.get(name).unwrap_or(0.0)).collect());
+                    let error = exitance.as_ref().map(|e| vertex_error(&truth.exitance, e));
+                    let nan = [f64::NAN; 3];
+                    rows.push(Row {
+                        scene: name.clone(),
+                        sampler: method.name().to_string(),
+                        samples: count,
+                        gather: gather.0.name().to_string(),
+                        epsilon: gather.1.map(f64::from),
+                        seed,
+                        sampling_ms,
+                        splat_ms: pass("splat"),
+                        gather_ms: pass("gather"),
+                        shade_ms: pass("shade"),
+                        frame_ms: median(timings.iter().map(|t| t.total()).collect()),
+                        device_mib: renderer.device_memory() as f64 / (1024.0 * 1024.0),
+                        rel_rms: error.map_or(nan, |e| e.rel_rms),
+                        p99: error.map_or(nan, |e| e.p99),
+                        max: error.map_or(nan, |e| e.max),
+                        bias: error.map_or(nan, |e| e.bias),
+                        image_rel_rmse: image_rel_rmse(&truth_image.hdr, &image.hdr),
+                        flip_mean: flip::flip_mean(&truth_image.ldr, &image.ldr, image.size[0], image.size[1])
+                            .map_err(StudyError::Report)?,
+                    });
+                    exitances.push(exitance);
+                }
+            }
+        }
+    }
+    Ok(Study { rows, truth, truth_cached, truth_image, prepared: base, exitance: exitances })
+}
+
+/// A false-colour picture of per-vertex relative error `|M - M_true| / M_true` drawn on the
+/// model from the scene's camera, `0` to `scale` mapped through `raster::colormap`; dark
+/// receivers (under [`LIT_FLOOR`]) are grey. RGBA8 of the camera's resolution, with a legend.
+pub fn error_image(
+    scene: &PreparedScene,
+    truth: &[Vec<[f64; 3]>],
+    estimate: &[Vec<[f32; 3]>],
+    scale: f64,
+) -> Result<Vec<u8>, String> {
+    let [w, h] = scene.scene.file.camera.resolution;
+    let camera = crate::render::renderer::CameraView::of_scene(scene);
+    let view_proj = camera.projection * camera.view;
+    let (mut positions, mut triangles, mut colours) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, o) in scene.objects.iter().enumerate() {
+        let first = positions.len() as u32;
+        positions.extend(o.mesh.positions().iter().map(|p| p.to_array()));
+        triangles.extend(o.mesh.triangles().iter().map(|t| t.map(|v| v + first)));
+        let translucent = matches!(o.material, ResolvedMaterial::Translucent { .. });
+        let floor = [0, 1, 2].map(|c| LIT_FLOOR * truth[i].iter().map(|m| m[c]).fold(0.0, f64::max));
+        for (v, t) in truth[i].iter().enumerate() {
+            let lit: Vec<usize> = (0..3).filter(|&c| t[c] > 0.0 && t[c] >= floor[c]).collect();
+            colours.push(if !translucent {
+                [0.15, 0.15, 0.15]
+            } else if lit.is_empty() {
+                [0.45, 0.45, 0.45]
+            } else {
+                // The worst lit channel: where any colour is wrong shows.
+                let e = lit.iter().map(|&c| ((f64::from(estimate[i][v][c]) - t[c]) / t[c]).abs()).fold(0.0, f64::max);
+                raster::colormap((e / scale) as f32)
+            });
+        }
+    }
+    let mut rgba = raster::rasterise(&positions, &triangles, &colours, view_proj, w, h, [255, 255, 255]);
+    let labels = ["0".to_string(), format!("{:.2}%", 50.0 * scale), format!(">= {:.2}%", 100.0 * scale)];
+    // The legend needs room (220x80); a smaller image goes without.
+    if w >= 220 && h >= 80 {
+        raster::legend_bar(&mut rgba, w, h, [&labels[0], &labels[1], &labels[2]])?;
+    }
+    Ok(rgba)
+}

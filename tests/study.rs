@@ -1,0 +1,115 @@
+//! `translucent study --quick` on a tiny scene, as CI runs it: every column written, the truth
+//! converged, error falling as Turk's sample count doubles, and the study's per-vertex error
+//! equal to one computed by hand from `render --export-exitance` and the cached truth.
+
+mod common;
+
+use common::{repo_path, temp_dir, text, translucent};
+use translucent::reference::truth::{LIT_FLOOR, Truth};
+use translucent::study::report::COLUMNS;
+
+fn csv_rows(csv: &str) -> Vec<std::collections::HashMap<String, String>> {
+    let mut lines = csv.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(str::to_string).collect();
+    lines.map(|l| header.iter().cloned().zip(l.split(',').map(str::to_string)).collect()).collect()
+}
+
+#[test]
+fn quick_study_writes_every_column_converges_and_turk_error_falls_with_samples_and_matches_exported_exitance() {
+    let dir = temp_dir("study-quick");
+    let scene = repo_path("tests/scenes/study-tiny.toml");
+    let scene = scene.to_str().unwrap();
+    let (out, cache) = (dir.join("out"), dir.join("cache"));
+    let run = translucent(
+        &[
+            "study",
+            scene,
+            "-o",
+            out.to_str().unwrap(),
+            "--quick",
+            "--error-image",
+            "turk:400",
+            "--truth-cache",
+            cache.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(run.status.success(), "study failed:\n{}\n{}", text(&run.stdout), text(&run.stderr));
+    for f in ["study.csv", "study.md", "study.png", "truth.png", "error.png"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+
+    let csv = std::fs::read_to_string(out.join("study.csv")).unwrap();
+    assert_eq!(csv.lines().next().unwrap().split(',').collect::<Vec<_>>(), COLUMNS);
+    let rows = csv_rows(&csv);
+    assert_eq!(rows.len(), 6, "{csv}");
+    for r in &rows {
+        for c in COLUMNS.iter().filter(|c| **c != "epsilon") {
+            assert!(!r[*c].is_empty(), "empty {c} in {r:?}");
+        }
+    }
+
+    // The truth converged, and says so.
+    let entry = std::fs::read_dir(&cache).unwrap().next().unwrap().unwrap();
+    let truth: Truth = serde_json::from_slice(&std::fs::read(entry.path()).unwrap()).unwrap();
+    assert!(truth.converged && truth.change() < 1e-4, "levels {:?}", truth.levels);
+    assert!(std::fs::read_to_string(out.join("study.md")).unwrap().contains("converged"));
+
+    // Turk's error falls at every doubling.
+    let error = |r: &std::collections::HashMap<String, String>| {
+        ["rel_rms_r", "rel_rms_g", "rel_rms_b"].iter().map(|c| r[*c].parse::<f64>().unwrap()).sum::<f64>() / 3.0
+    };
+    let turk: Vec<(usize, f64)> =
+        rows.iter().filter(|r| r["sampler"] == "turk").map(|r| (r["samples"].parse().unwrap(), error(r))).collect();
+    assert_eq!(turk.iter().map(|t| t.0).collect::<Vec<_>>(), [100, 200, 400]);
+    assert!(turk.windows(2).all(|w| w[1].1 < w[0].1), "turk error does not fall: {turk:?}");
+
+    // The same configuration rendered on its own, its exitance exported, its error by hand.
+    let ply = dir.join("exitance.ply");
+    let render = translucent(
+        &[
+            "render",
+            scene,
+            "-o",
+            dir.join("r.png").to_str().unwrap(),
+            "--sampler",
+            "turk",
+            "--samples",
+            "400",
+            "--gather",
+            "vertex",
+            "--transport",
+            "gather",
+            "--export-exitance",
+            ply.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(render.status.success(), "{}", text(&render.stderr));
+    let ply = std::fs::read_to_string(ply).unwrap();
+    let body = ply.split("end_header\n").nth(1).unwrap();
+    let exported: Vec<[f64; 3]> = body
+        .lines()
+        .map(|l| {
+            // The PLY holds f32s, printed shortest: parse them as f32, as written.
+            let v: Vec<f64> = l.split_whitespace().map(|x| f64::from(x.parse::<f32>().unwrap())).collect();
+            [v[3], v[4], v[5]]
+        })
+        .collect();
+    let t = &truth.exitance[0];
+    assert_eq!(exported.len(), t.len());
+    let row = rows.iter().find(|r| r["sampler"] == "turk" && r["samples"] == "400").unwrap();
+    for (c, name) in ["rel_rms_r", "rel_rms_g", "rel_rms_b"].iter().enumerate() {
+        let floor = LIT_FLOOR * t.iter().map(|m| m[c]).fold(0.0, f64::max);
+        let rel: Vec<f64> = t
+            .iter()
+            .zip(&exported)
+            .filter(|(m, _)| m[c] >= floor && m[c] > 0.0)
+            .map(|(m, e)| (e[c] - m[c]) / m[c])
+            .collect();
+        let by_hand = (rel.iter().map(|r| r * r).sum::<f64>() / rel.len() as f64).sqrt();
+        let study: f64 = row[*name].parse().unwrap();
+        assert!((by_hand - study).abs() <= 1e-9 * study.max(1e-12) + 1e-12, "{name}: study {study}, by hand {by_hand}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
