@@ -74,7 +74,8 @@ fn the_profile_radius_is_the_rms_radius_of_r_d_by_quadrature() {
 #[test]
 fn r_d_derivatives_match_central_differences() {
     for (name, d) in preset_dipoles() {
-        for r in [0.0, 0.3 * d.z_r, d.z_r, 2.0 * d.z_v, 3.0 / d.sigma_tr] {
+        // (No absorption makes the diffusion length infinite: that distance is skipped.)
+        for r in [0.0, 0.3 * d.z_r, d.z_r, 2.0 * d.z_v, 3.0 / d.sigma_tr].into_iter().filter(|r| r.is_finite()) {
             let (g, g1, g2) = d.r_d_derivatives(r * r);
             assert!(rel(g, d.r_d(r)) < 1e-12, "{name} r={r}: R_d");
             let h = 1e-4 * (r + d.z_r);
