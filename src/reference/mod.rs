@@ -72,7 +72,7 @@ pub fn splat(scene: &PreparedScene, occluders: &Bvh) -> Vec<[f64; 3]> {
 }
 
 /// How far a visibility ray starts off the surface: the scale of f32 positions in the scene.
-pub(crate) fn ray_offset(scene: &PreparedScene) -> f64 {
+pub fn ray_offset(scene: &PreparedScene) -> f64 {
     1e-5 * scene.bounds.1 as f64
 }
 
@@ -88,6 +88,35 @@ pub fn transmitted_irradiance(
     eta: f64,
     eps: f64,
 ) -> (DVec3, u64, u64) {
+    transmitted_irradiance_known(scene, occluders, p, n, eta, eps, Visibility::TRACE_ALL)
+}
+
+/// Which lights' visibility is already known at a point (the first 64 lights, by bit), so that
+/// only the others are ray cast.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Visibility {
+    /// Lights to ray cast.
+    pub trace: u64,
+    /// Of the lights not traced, those known to be blocked (the rest are known to reach).
+    pub blocked: u64,
+}
+
+impl Visibility {
+    /// Nothing known: every light with shadows is ray cast.
+    pub const TRACE_ALL: Visibility = Visibility { trace: !0, blocked: 0 };
+}
+
+/// [`transmitted_irradiance`] taking the visibility of the lights outside `known.trace` from
+/// `known` instead of casting their rays. Lights past the 64th are always traced.
+pub fn transmitted_irradiance_known(
+    scene: &PreparedScene,
+    occluders: &Bvh,
+    p: DVec3,
+    n: DVec3,
+    eta: f64,
+    eps: f64,
+    known: Visibility,
+) -> (DVec3, u64, u64) {
     let n = n.normalize();
     let (mut e, mut reached, mut blocked) = (DVec3::ZERO, 0u64, 0u64);
     for (i, l) in scene.lights.iter().enumerate() {
@@ -96,12 +125,20 @@ pub fn transmitted_irradiance(
         if cos_i <= 0.0 {
             continue;
         }
-        if l.shadow_layer.is_some() && occluders.occluded(p + n * eps, wi, eps, dist) {
-            blocked |= 1u64 << (i % 64);
+        let bit = 1u64 << (i % 64);
+        let occluded = if l.shadow_layer.is_none() {
+            false
+        } else if i < 64 && known.trace & bit == 0 {
+            known.blocked & bit != 0
+        } else {
+            occluders.occluded(p + n * eps, wi, eps, dist)
+        };
+        if occluded {
+            blocked |= bit;
             continue;
         }
         e += irradiance * (cos_i * fresnel::fresnel_transmittance(cos_i, eta));
-        reached |= 1u64 << (i % 64);
+        reached |= bit;
     }
     (e, reached, blocked)
 }

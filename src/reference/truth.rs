@@ -16,18 +16,23 @@
 //!
 //! Two approximations, both refined level by level until the answer stops changing:
 //! - `E_t` is evaluated on a grid over each mesh triangle (the triangle split in `4^depth`
-//!   cells) and taken as linear inside each cell. Where a light reaches some of a triangle's
-//!   grid points and is blocked at others (a shadow edge crosses it) the grid is
-//!   [`EDGE_EXTRA_DEPTH`] levels finer. This is the only place rays are cast, and it
-//!   does not depend on the receiver.
-//! - The kernel integral over each triangle is adaptive per receiver: a piece of surface of
-//!   radius `R` at distance `d` from `x` is fine enough when `2 R kappa <= eta_l` with
+//!   cells) and taken as linear inside each cell. Every light is ray cast on the triangle's
+//!   base grid; on finer grids only the lights whose shadow edge crosses it (reaching some base
+//!   points, blocked at others). Where a strong light's edge crosses ([`STRONG_LIGHT`]) the grid
+//!   is [`EDGE_EXTRA_DEPTH`] levels finer. This is the only place rays are cast, and it does not
+//!   depend on the receiver. Each triangle keeps the exact flux and centroid of
+//!   every coarser piece of its grid (a pyramid of moments).
+//! - The kernel integral is adaptive per receiver: a piece of surface of radius `R` at distance
+//!   `d` from `x` is fine enough when `2 R kappa <= eta_l` with
 //!   `kappa = sigma_tr,max + 3 / sqrt(d^2 + z_r,min^2)`, the inverse length over which `R_d`
 //!   changes there (its `1/d^3` flank near, its exponential far, its peak of width `z_r` at
-//!   `d = 0`, so no singularity needs special treatment: `R_d` is finite at `r = 0`). A fine
-//!   piece is integrated with Radon's 7-point degree-5 rule over the linear `E_t`, or, when
-//!   four times finer still, as a point at its `E_t`-weighted centroid with its exact flux (the
-//!   monopole, exact to second order). Coarser pieces are split in four.
+//!   `d = 0`, so no singularity needs special treatment: `R_d` is finite at `r = 0`). The lit
+//!   triangles sit in a binary tree of clusters: a cluster fine at `eta_l / 2` is one point at
+//!   its `E_t`-weighted centroid plus its quadrupole (exact to third order), so far surface
+//!   costs a receiver the log of the triangle count. A triangle that is not fine is split in
+//!   four, recursively; a piece four times finer than `eta_l` is a monopole with its exact
+//!   moments (from the pyramid while it spans several cells), one inside a grid cell that is
+//!   merely fine takes Radon's 7-point degree-5 rule over the linear `E_t`.
 //!
 //! Level `l` uses grid depth `l` more than a triangle's base depth (set by how far its shading
 //! normal turns, [`NORMAL_SPREAD`]) and `eta_l = 0.4 / 2^(l/2)`. The change between two levels,
@@ -36,7 +41,7 @@
 //! every step, so a reader can see it converge.
 
 use super::bvh::Bvh;
-use super::{occluders, ray_offset, transmitted_irradiance};
+use super::{Visibility, occluders, ray_offset, transmitted_irradiance_known};
 use crate::optics::Dipole;
 use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
 use glam::DVec3;
@@ -56,10 +61,15 @@ pub const MAX_LEVEL: u32 = 5;
 pub const LIT_FLOOR: f64 = 0.01;
 /// The most the shading normal may turn across one grid cell at level 0 (radians).
 pub const NORMAL_SPREAD: f64 = 0.05;
-/// Extra grid depth on triangles a shadow edge or the terminator crosses.
+/// Extra grid depth on triangles the shadow edge of a strong light crosses.
 pub const EDGE_EXTRA_DEPTH: u32 = 2;
+/// A light is strong, and its shadow edges refined [`EDGE_EXTRA_DEPTH`] levels more, when it
+/// brings at least this fraction of all the lights' irradiance to the object. The weak ones (an
+/// environment's many directions) are left to the levels' uniform refinement: refining every
+/// triangle that any of 16 sky directions half-shadows would refine nearly all of them.
+pub const STRONG_LIGHT: f64 = 0.1;
 /// Bumped whenever the quadrature changes, so an old cache is not read as the truth.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 4;
 /// Deepest split of one piece of surface (a guard: `kappa` bounds the depth long before).
 const MAX_DEPTH: u32 = 40;
 
@@ -325,16 +335,74 @@ struct Source {
     /// Bounding sphere of the triangle (centre of its corners).
     centre: DVec3,
     radius: f64,
+    /// Exact moments of every piece coarser than a grid cell, in the order [`Quadrature::piece`]
+    /// splits (node `k`'s children are `4k + 1 ..= 4k + 4`, the root is the whole triangle), so
+    /// a piece spanning many cells can stand as one monopole once the kernel is smooth over it.
+    pyramid: Vec<Moments>,
 }
+
+/// Flux `integral E_t dA` and first moment `integral y E_t dA` of a piece of surface, per channel.
+#[derive(Clone, Copy, Debug, Default)]
+struct Moments {
+    flux: [f64; 3],
+    moment: [DVec3; 3],
+}
+
+impl Moments {
+    fn add(&mut self, o: &Moments) {
+        for c in 0..3 {
+            self.flux[c] += o.flux[c];
+            self.moment[c] += o.moment[c];
+        }
+    }
+
+    /// Each channel's `E_t`-weighted centroid (`fallback` where the piece is dark).
+    fn centroid(&self, fallback: DVec3) -> [DVec3; 3] {
+        [0, 1, 2].map(|c| if self.flux[c] > 0.0 { self.moment[c] / self.flux[c] } else { fallback })
+    }
+}
+
+/// The four children of the piece with corners `uv`, in the order of [`Source::pyramid`].
+fn split(uv: [[f64; 2]; 3]) -> [[[f64; 2]; 3]; 4] {
+    let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) * 0.5, (a[1] + b[1]) * 0.5];
+    let (ab, bc, ca) = (mid(uv[0], uv[1]), mid(uv[1], uv[2]), mid(uv[2], uv[0]));
+    [[uv[0], ab, ca], [ab, uv[1], bc], [ca, bc, uv[2]], [ab, bc, ca]]
+}
+
+/// The whole triangle in `(u, v)`.
+const WHOLE: [[f64; 2]; 3] = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
 
 /// Index of grid point `(i, j)`, `i + j <= n`, in a triangle's grid (rows of `i`).
 fn grid_index(i: usize, j: usize, n: usize) -> usize {
     i * (n + 1) - i * i.saturating_sub(1) / 2 + j
 }
 
+/// The point at `(u, v)` of the triangle with `corners`.
+fn triangle_point(corners: &[DVec3; 3], u: f64, v: f64) -> DVec3 {
+    corners[0] + (corners[1] - corners[0]) * u + (corners[2] - corners[0]) * v
+}
+
 impl Source {
     fn point(&self, u: f64, v: f64) -> DVec3 {
-        self.corners[0] + (self.corners[1] - self.corners[0]) * u + (self.corners[2] - self.corners[0]) * v
+        triangle_point(&self.corners, u, v)
+    }
+
+    /// Exact moments of the piece `uv` at split depth `depth <= self.depth`: a grid cell's from
+    /// its linear `E_t`, a coarser piece's as the sum of its children's (stored in `pyramid`
+    /// at `node`). Returns the piece's moments.
+    fn build_pyramid(&mut self, uv: [[f64; 2]; 3], depth: u32, node: usize) -> Moments {
+        if depth == self.depth {
+            let y = uv.map(|[u, v]| self.point(u, v));
+            let e = uv.map(|[u, v]| self.irradiance(u, v));
+            let (flux, moment) = linear_moments(&y, &e, self.area * 0.25f64.powi(depth as i32));
+            return Moments { flux, moment };
+        }
+        let mut sum = Moments::default();
+        for (k, child) in split(uv).into_iter().enumerate() {
+            sum.add(&self.build_pyramid(child, depth + 1, 4 * node + 1 + k));
+        }
+        self.pyramid[node] = sum;
+        sum
     }
 
     /// `E_t` at `(u, v)`, linear in each grid cell.
@@ -385,18 +453,26 @@ fn linear_moments(y: &[DVec3; 3], e: &[DVec3; 3], area: f64) -> ([f64; 3], [DVec
 fn sources(scene: &PreparedScene, occluders: &Bvh, o: &PreparedObject, eta: f64, level: u32, eps: f64) -> Vec<Source> {
     let mesh = &o.mesh;
     let normals = mesh.vertex_normals();
+    let centre = mesh.positions().iter().map(|p| p.as_dvec3()).sum::<DVec3>() / mesh.positions().len().max(1) as f64;
+    let peak: Vec<f64> = scene.lights.iter().map(|l| super::light_incidence(l, centre).1.max_element()).collect();
+    let total: f64 = peak.iter().sum();
+    let strong = peak
+        .iter()
+        .enumerate()
+        .filter(|&(_, &p)| p >= STRONG_LIGHT * total)
+        .fold(0u64, |m, (i, _)| m | 1u64 << (i % 64));
     (0..mesh.triangles().len())
         .into_par_iter()
         .map(|t| {
             let corners = mesh.corners(t);
             let [a, b, c] = mesh.triangles()[t].map(|i| normals[i as usize].as_dvec3());
-            let grid_at = |depth: u32| -> (Vec<DVec3>, bool) {
+            let grid_at = |depth: u32, known: Visibility| -> (Vec<DVec3>, u64, u64) {
                 let n = 1usize << depth;
                 let mut grid = vec![DVec3::ZERO; (n + 1) * (n + 2) / 2];
                 let at = |u: f64, v: f64| {
-                    let p = corners[0] + (corners[1] - corners[0]) * u + (corners[2] - corners[0]) * v;
+                    let p = triangle_point(&corners, u, v);
                     let normal = a * (1.0 - u - v) + b * u + c * v;
-                    transmitted_irradiance(scene, occluders, p, normal, eta, eps)
+                    transmitted_irradiance_known(scene, occluders, p, normal, eta, eps, known)
                 };
                 let (mut reached, mut blocked) = (0u64, 0u64);
                 for i in 0..=n {
@@ -407,22 +483,27 @@ fn sources(scene: &PreparedScene, occluders: &Bvh, o: &PreparedObject, eta: f64,
                     }
                 }
                 let (_, r, b) = at(1.0 / 3.0, 1.0 / 3.0);
-                // A light that reaches some points and is blocked at others: a shadow edge. (The
-                // terminator is no edge: E_t falls to zero there continuously, as cos^2.)
-                let edge = (reached | r) & (blocked | b) != 0;
-                (grid, edge)
+                (grid, reached | r, blocked | b)
             };
             // E_t follows the shading normal: linear interpolation over a cell whose normals
             // turn by `delta` radians misses about `delta^2 / 8` of it, so cells start small
             // enough that `delta` is at most NORMAL_SPREAD.
             let spread = [a.angle_between(b), b.angle_between(c), c.angle_between(a)].into_iter().fold(0.0, f64::max);
             let base = (spread / NORMAL_SPREAD).log2().ceil().clamp(0.0, 8.0) as u32;
-            let (mut grid, edge) = grid_at(base + level);
-            let mut depth = base + level;
-            if edge {
-                depth = base + level + EDGE_EXTRA_DEPTH;
-                grid = grid_at(depth).0;
-            }
+            // Every light is ray cast on the base grid. A light that reaches some of its points
+            // and is blocked at others casts a shadow edge across the triangle (the terminator
+            // is no edge: E_t falls to zero there continuously, as cos^2); only such lights are
+            // ray cast on the finer grids, the others keep the base grid's verdict. A shadow
+            // narrower than the base grid that touches none of its points is therefore missed
+            // at every level.
+            let (base_grid, reached, blocked) = grid_at(base, Visibility::TRACE_ALL);
+            let edges = reached & blocked;
+            let depth = base + level + if edges & strong != 0 { EDGE_EXTRA_DEPTH } else { 0 };
+            let grid = if depth == base {
+                base_grid
+            } else {
+                grid_at(depth, Visibility { trace: edges, blocked: blocked & !reached }).0
+            };
             let area = mesh.triangle_areas()[t];
             let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
             let radius = corners.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
@@ -436,23 +517,13 @@ fn sources(scene: &PreparedScene, occluders: &Bvh, o: &PreparedObject, eta: f64,
                 quadrupole: [[0.0; 6]; 3],
                 centre,
                 radius,
+                pyramid: vec![Moments::default(); ((1usize << (2 * depth)) - 1) / 3],
             };
-            // Moments of the whole triangle, cell by cell (every cell has area A / 4^depth).
+            let whole = s.build_pyramid(WHOLE, 0, 0);
+            s.centroid = whole.centroid(centre);
+            s.flux = whole.flux;
             let n = 1usize << depth;
             let cell_area = area / (n * n) as f64;
-            let (mut flux, mut moment) = ([0.0; 3], [DVec3::ZERO; 3]);
-            let mut add = |cells: [(usize, usize); 3]| {
-                let y = cells.map(|(i, j)| s.point(i as f64 / n as f64, j as f64 / n as f64));
-                let e = cells.map(|(i, j)| s.grid[grid_index(i, j, n)]);
-                let (f, m) = linear_moments(&y, &e, cell_area);
-                for ch in 0..3 {
-                    flux[ch] += f[ch];
-                    moment[ch] += m[ch];
-                }
-            };
-            for_each_cell(n, &mut add);
-            s.centroid = [0, 1, 2].map(|ch| if flux[ch] > 0.0 { moment[ch] / flux[ch] } else { centre });
-            s.flux = flux;
             // Second moments cell by cell: Radon's rule is exact for the cubic (y - c)^2 E_t.
             let mut q = [[0.0; 6]; 3];
             for_each_cell(n, |cell| {
@@ -499,11 +570,13 @@ const RADON: [([f64; 3], f64); 7] = {
 
 /// The exact exitance at every vertex of `o`.
 ///
-/// A first pass sums every triangle as one monopole: a coarse `M_0(x)`. The refinement then
-/// measures each piece's error against `max(its own bound, TAU M_ref)`, with
-/// `M_ref = max(M_0(x), LIT_FLOOR max M_0)`: a piece whose whole contribution is negligible
-/// next to the receiver's exitance needs no accuracy of its own (far pieces, where `R_d` has
-/// decayed by `e^(-sigma_tr d)`, would otherwise be split to the diffusion length).
+/// The lit triangles are gathered in a [`Clusters`] tree. A first pass sums it Barnes-Hut
+/// style (a cluster as one point once it is small seen from `x`): a coarse `M_0(x)`, which
+/// only sets what "negligible" means. The refinement then measures each piece's error against
+/// `max(its own bound, TAU M_ref)`, with `M_ref = max(M_0(x), LIT_FLOOR max M_0)`: a piece
+/// whose whole contribution is negligible next to the receiver's exitance needs no accuracy of
+/// its own (far pieces, where `R_d` has decayed by `e^(-sigma_tr d)`, would otherwise be split
+/// to the diffusion length).
 fn exitance_at_vertices(
     o: &PreparedObject,
     dipoles: &[Dipole; 3],
@@ -512,19 +585,20 @@ fn exitance_at_vertices(
     progress: &(dyn Fn(usize) + Sync),
 ) -> Vec<[f64; 3]> {
     let lit: Vec<&Source> = sources.iter().filter(|s| s.flux.iter().any(|&f| f > 0.0)).collect();
+    if lit.is_empty() {
+        return vec![[0.0; 3]; o.mesh.positions().len()];
+    }
+    let tree = Clusters::new(&lit);
     let positions = o.mesh.positions();
     let coarse: Vec<[f64; 3]> = positions
         .par_iter()
         .map(|x| {
-            let x = x.as_dvec3();
+            let q = Quadrature { x: x.as_dvec3(), dipoles, eta, m_ref: [0.0; 3] };
             let mut m = [0.0; 3];
-            for s in &lit {
-                for c in 0..3 {
-                    if s.flux[c] > 0.0 {
-                        m[c] += s.flux[c] * dipoles[c].r_d_sq(x.distance_squared(s.centroid[c]));
-                    }
-                }
-            }
+            tree.walk(
+                |c| c.radius <= COARSE_OPENING * (x.as_dvec3().distance(c.centre) - c.radius),
+                |c| q.monopole(&c.moments.flux, &c.centroid, &mut m),
+            );
             m
         })
         .collect();
@@ -538,12 +612,20 @@ fn exitance_at_vertices(
                 .iter()
                 .zip(m0)
                 .map(|(x, m0)| {
+                    let x = x.as_dvec3();
                     let m_ref = [0, 1, 2].map(|c| m0[c].max(floor[c]));
-                    let q = Quadrature { x: x.as_dvec3(), dipoles, eta, m_ref };
+                    let q = Quadrature { x, dipoles, eta, m_ref };
                     let mut m = [0.0; 3];
-                    for s in &lit {
-                        q.piece(s, [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]], 0, &mut m);
-                    }
+                    // A cluster that is fine as a whole is one multipole; a triangle that is not
+                    // is integrated piece by piece.
+                    let fine = |c: &Cluster| {
+                        let d = (x.distance(c.centre) - c.radius).max(0.0);
+                        c.source.is_none() && q.fine(d, c.radius, &c.moments.flux, eta / 2.0)
+                    };
+                    tree.walk(fine, |c| match c.source {
+                        Some(s) => q.piece(lit[s], WHOLE, 0, 0, &mut m),
+                        None => q.multipole(&c.moments.flux, &c.centroid, &c.quadrupole, &mut m),
+                    });
                     m
                 })
                 .collect();
@@ -551,6 +633,99 @@ fn exitance_at_vertices(
             out
         })
         .collect()
+}
+
+/// The coarse pass takes a cluster whole once its radius is at most this fraction of its
+/// distance (an error of a few percent in `M_0`, which only scales what "negligible" means).
+const COARSE_OPENING: f64 = 0.3;
+
+/// A node of the tree of lit triangles: their moments about each channel's centroid and a
+/// bounding sphere.
+struct Cluster {
+    moments: Moments,
+    centroid: [DVec3; 3],
+    /// Second moments about `centroid`, as [`Source::quadrupole`].
+    quadrupole: [[f64; 6]; 3],
+    centre: DVec3,
+    radius: f64,
+    /// The triangle (index into the lit sources) of a leaf.
+    source: Option<usize>,
+    /// Children of an inner node.
+    children: [usize; 2],
+}
+
+/// A binary tree over the lit triangles (median split on the longest axis of their centres),
+/// so a receiver takes a far group of triangles as one multipole instead of visiting each: the
+/// cost per receiver grows with the log of the triangle count, not with it.
+struct Clusters {
+    nodes: Vec<Cluster>,
+}
+
+impl Clusters {
+    fn new(lit: &[&Source]) -> Clusters {
+        let mut nodes = Vec::with_capacity(2 * lit.len());
+        let mut members: Vec<usize> = (0..lit.len()).collect();
+        Self::build(lit, &mut members, &mut nodes);
+        Clusters { nodes }
+    }
+
+    /// Append the subtree over `members` (post-order) and return its root's index.
+    fn build(lit: &[&Source], members: &mut [usize], nodes: &mut Vec<Cluster>) -> usize {
+        if let [only] = members {
+            let s = lit[*only];
+            nodes.push(Cluster {
+                moments: Moments { flux: s.flux, moment: [0, 1, 2].map(|c| s.centroid[c] * s.flux[c]) },
+                centroid: s.centroid,
+                quadrupole: s.quadrupole,
+                centre: s.centre,
+                radius: s.radius,
+                source: Some(*only),
+                children: [0; 2],
+            });
+            return nodes.len() - 1;
+        }
+        let (lo, hi) = members.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &i| {
+            (lo.min(lit[i].centre), hi.max(lit[i].centre))
+        });
+        let axis = (hi - lo).max_position();
+        let half = members.len() / 2;
+        members.select_nth_unstable_by(half, |&a, &b| lit[a].centre[axis].total_cmp(&lit[b].centre[axis]));
+        let (left, right) = members.split_at_mut(half);
+        let children = [Self::build(lit, left, nodes), Self::build(lit, right, nodes)];
+        let [a, b] = children.map(|k| &nodes[k]);
+        let mut moments = a.moments;
+        moments.add(&b.moments);
+        let centre = (a.centre + b.centre) * 0.5;
+        let centroid = moments.centroid(centre);
+        // Parallel axes: each child's second moment moved from its centroid to the parent's.
+        let mut quadrupole = [[0.0; 6]; 3];
+        for child in [a, b] {
+            for c in 0..3 {
+                let (f, r) = (child.moments.flux[c], child.centroid[c] - centroid[c]);
+                let shift = [r.x * r.x, r.y * r.y, r.z * r.z, r.x * r.y, r.x * r.z, r.y * r.z];
+                for k in 0..6 {
+                    quadrupole[c][k] += child.quadrupole[c][k] + f * shift[k];
+                }
+            }
+        }
+        let radius = [a, b].iter().map(|n| n.centre.distance(centre) + n.radius).fold(0.0, f64::max);
+        nodes.push(Cluster { moments, centroid, quadrupole, centre, radius, source: None, children });
+        nodes.len() - 1
+    }
+
+    /// Visit the tree from the root: `take` a node that is a leaf or `whole(node)`, else go
+    /// down to its children.
+    fn walk(&self, whole: impl Fn(&Cluster) -> bool, mut take: impl FnMut(&Cluster)) {
+        let mut stack = vec![self.nodes.len() - 1];
+        while let Some(k) = stack.pop() {
+            let node = &self.nodes[k];
+            if node.source.is_some() || whole(node) {
+                take(node);
+            } else {
+                stack.extend(node.children);
+            }
+        }
+    }
 }
 
 /// A piece's error may reach this fraction of the receiver's reference exitance (times the
@@ -594,19 +769,18 @@ impl Quadrature<'_> {
         }
     }
 
-    /// A whole triangle as a point at each channel's centroid plus the quadrupole term
+    /// A piece of surface as a point at each channel's centroid plus the quadrupole term
     /// `(1/2) Q : H`, `H = R_d'' r^ r^T + (R_d'/r)(I - r^ r^T)` the kernel's Hessian: the error
-    /// is third order in the triangle's size over the kernel's length.
-    #[allow(clippy::needless_range_loop)] // c indexes four per-channel arrays at once
-    fn multipole(&self, s: &Source, m: &mut [f64; 3]) {
+    /// is third order in the piece's size over the kernel's length.
+    fn multipole(&self, flux: &[f64; 3], centroid: &[DVec3; 3], quadrupole: &[[f64; 6]; 3], m: &mut [f64; 3]) {
         for c in 0..3 {
-            if s.flux[c] <= 0.0 {
+            if flux[c] <= 0.0 {
                 continue;
             }
-            let r = self.x - s.centroid[c];
+            let r = self.x - centroid[c];
             let r2 = r.length_squared();
             let (g, g1, g2) = self.dipoles[c].r_d_derivatives(r2);
-            let q = &s.quadrupole[c];
+            let q = &quadrupole[c];
             let trace = q[0] + q[1] + q[2];
             let along = if r2 > 0.0 {
                 (r.x * r.x * q[0]
@@ -617,31 +791,37 @@ impl Quadrature<'_> {
             } else {
                 0.0
             };
-            m[c] += s.flux[c] * g + 0.5 * ((g2 - g1) * along + g1 * trace);
+            m[c] += flux[c] * g + 0.5 * ((g2 - g1) * along + g1 * trace);
         }
     }
 
     /// Integrate over the piece of `s` with corners `uv` (in the triangle's `(u, v)`), at split
-    /// depth `depth` below the triangle.
-    fn piece(&self, s: &Source, uv: [[f64; 2]; 3], depth: u32, m: &mut [f64; 3]) {
+    /// depth `depth` below the triangle and, while coarser than a grid cell, `node` of its
+    /// pyramid.
+    fn piece(&self, s: &Source, uv: [[f64; 2]; 3], depth: u32, node: usize, m: &mut [f64; 3]) {
         if depth == 0 {
             let d = (self.x.distance(s.centre) - s.radius).max(0.0);
             if self.fine(d, s.radius, &s.flux, self.eta / 2.0) {
-                return self.multipole(s, m);
+                return self.multipole(&s.flux, &s.centroid, &s.quadrupole, m);
             }
         }
         let y = uv.map(|[u, v]| s.point(u, v));
         let centre = (y[0] + y[1] + y[2]) / 3.0;
         let radius = y.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
         let d = (self.x.distance(centre) - radius).max(0.0);
-        // Inside one grid cell `E_t` is linear, so the piece's moments are known exactly.
-        if depth >= s.depth {
+        if depth < s.depth {
+            // Coarser than a grid cell: its exact moments are in the pyramid.
+            let moments = &s.pyramid[node];
+            if self.fine(d, radius, &moments.flux, self.eta / 4.0) {
+                return self.monopole(&moments.flux, &moments.centroid(centre), m);
+            }
+        } else {
+            // Inside one grid cell `E_t` is linear, so the piece's moments are known exactly.
             let e = uv.map(|[u, v]| s.irradiance(u, v));
             let area = s.area * 0.25f64.powi(depth as i32);
             let (flux, moment) = linear_moments(&y, &e, area);
             if self.fine(d, radius, &flux, self.eta / 4.0) {
-                let centroid = [0, 1, 2].map(|c| if flux[c] > 0.0 { moment[c] / flux[c] } else { centre });
-                return self.monopole(&flux, &centroid, m);
+                return self.monopole(&flux, &Moments { flux, moment }.centroid(centre), m);
             }
             if self.fine(d, radius, &flux, self.eta) || depth >= MAX_DEPTH {
                 for (b, w) in RADON {
@@ -657,10 +837,10 @@ impl Quadrature<'_> {
                 return;
             }
         }
-        let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) * 0.5, (a[1] + b[1]) * 0.5];
-        let (ab, bc, ca) = (mid(uv[0], uv[1]), mid(uv[1], uv[2]), mid(uv[2], uv[0]));
-        for child in [[uv[0], ab, ca], [ab, uv[1], bc], [ca, bc, uv[2]], [ab, bc, ca]] {
-            self.piece(s, child, depth + 1, m);
+        for (k, child) in split(uv).into_iter().enumerate() {
+            // Pieces finer than a grid cell have no pyramid node.
+            let child_node = if depth + 1 < s.depth { 4 * node + 1 + k } else { 0 };
+            self.piece(s, child, depth + 1, child_node, m);
         }
     }
 }
