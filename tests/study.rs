@@ -113,3 +113,26 @@ fn quick_study_writes_every_column_converges_and_turk_error_falls_with_samples_a
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A sweep narrowed on the command line: a bad entry stops the study before any work, naming
+/// the flag and the entry, with a non-zero exit and no output folder made.
+#[test]
+fn study_rejects_a_bad_sweep_selection_naming_the_flag_and_writes_nothing() {
+    let dir = temp_dir("study-bad-sweep");
+    let out = dir.join("out");
+    for (flag, value, says) in [
+        ("--gathers", "hierarchical", "epsilon"),
+        ("--gathers", "vertex:0.1", "only the hierarchical"),
+        ("--gathers", "hierarchical:99", "epsilon must be"),
+        ("--gathers", "splat", "splat"),
+        ("--counts", "0", "1 to"),
+        ("--samplers", "sobol", "sobol"),
+        ("--truth-levels", "0", "1 to"),
+    ] {
+        let run = translucent(&["study", "-o", out.to_str().unwrap(), flag, value], &[]);
+        let err = text(&run.stderr);
+        assert!(!run.status.success(), "{flag} {value} was accepted");
+        assert!(err.contains(flag) && err.contains(says), "{flag} {value}: {err}");
+        assert!(!out.exists(), "{flag} {value} made the output folder");
+    }
+}

@@ -9,7 +9,7 @@ use translucent::gpu::Gpu;
 use translucent::output::OutputSet;
 use translucent::reference::truth;
 use translucent::sampling::Method;
-use translucent::scene::{GatherMode, Scene};
+use translucent::scene::{GatherMode, MAX_GATHER_EPSILON, MAX_SAMPLE_COUNT, Scene};
 use translucent::study::{self, Event, StudyConfig, report};
 
 #[derive(clap::Args, Debug)]
@@ -25,10 +25,24 @@ pub struct Args {
     /// Seeds per configuration (the full sweep's default is 3)
     #[arg(long)]
     pub seeds: Option<u64>,
+    /// Only these samplers, comma-separated (default: all four; random, turk, feature, poisson)
+    #[arg(long, value_delimiter = ',', value_name = "SAMPLER,...")]
+    pub samplers: Vec<String>,
+    /// Only these sample counts, comma-separated (default: 100 to 6400, doubling)
+    #[arg(long, value_delimiter = ',', value_name = "N,...")]
+    pub counts: Vec<usize>,
+    /// Only these gathers, comma-separated: vertex, sparse, pixel, hierarchical:EPSILON
+    /// (default: the first three and hierarchical at 0.3, 0.1 and 0.03)
+    #[arg(long, value_delimiter = ',', value_name = "GATHER,...")]
+    pub gathers: Vec<String>,
     /// Also draw per-vertex relative error on the model for one configuration,
     /// SAMPLER:COUNT[:GATHER] (gather vertex by default; first seed), to error.png
     #[arg(long, value_name = "SAMPLER:COUNT[:GATHER]")]
     pub error_image: Option<String>,
+    /// Refine the truth to at most this level (default 5); past it the study says the truth
+    /// did not converge and prints its last change between levels
+    #[arg(long, value_name = "LEVEL")]
+    pub truth_levels: Option<u32>,
     /// Where the truth is cached, keyed by the scene's content (default: the user's cache
     /// folder, translucent/truth)
     #[arg(long)]
@@ -53,15 +67,66 @@ fn parse_error_image(spec: &str) -> Result<(Method, usize, GatherMode)> {
     Ok((method, count, gather))
 }
 
-pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
-    let chosen = args.error_image.as_deref().map(parse_error_image).transpose()?;
+/// One `--gathers` entry: a gather's name, the hierarchical one with its epsilon.
+fn parse_gather(spec: &str) -> Result<(GatherMode, Option<f32>)> {
+    let (name, epsilon) = match spec.split_once(':') {
+        Some((n, e)) => (n, Some(e)),
+        None => (spec, None),
+    };
+    let mode: GatherMode = name.parse().map_err(|e: String| anyhow::anyhow!("--gathers {spec:?}: {e}"))?;
+    match (mode, epsilon) {
+        (GatherMode::Hierarchical, None) => {
+            bail!("--gathers {spec:?}: name the hierarchical gather's epsilon, e.g. hierarchical:0.1")
+        }
+        (GatherMode::Hierarchical, Some(e)) => {
+            let eps: f32 = e.parse().with_context(|| format!("--gathers {spec:?}: {e:?} is not a number"))?;
+            if !(0.0..=MAX_GATHER_EPSILON).contains(&eps) {
+                bail!("--gathers {spec:?}: epsilon must be 0 to {MAX_GATHER_EPSILON}");
+            }
+            Ok((mode, Some(eps)))
+        }
+        (_, Some(_)) => bail!("--gathers {spec:?}: only the hierarchical gather takes an epsilon"),
+        (_, None) => Ok((mode, None)),
+    }
+}
+
+/// The sweep the arguments ask for.
+fn config(args: &Args) -> Result<StudyConfig> {
     let mut config = if args.quick { StudyConfig::quick() } else { StudyConfig::full() };
+    if !args.samplers.is_empty() {
+        config.samplers = args
+            .samplers
+            .iter()
+            .map(|s| s.parse().map_err(|e: String| anyhow::anyhow!("--samplers {s:?}: {e}")))
+            .collect::<Result<_>>()?;
+    }
+    if !args.counts.is_empty() {
+        if let Some(&n) = args.counts.iter().find(|&&n| n == 0 || n > MAX_SAMPLE_COUNT) {
+            bail!("--counts {n}: a sample count must be 1 to {MAX_SAMPLE_COUNT}");
+        }
+        config.counts = args.counts.clone();
+    }
+    if !args.gathers.is_empty() {
+        config.gathers = args.gathers.iter().map(|g| parse_gather(g)).collect::<Result<_>>()?;
+    }
+    if let Some(level) = args.truth_levels {
+        if level == 0 || level > truth::MAX_LEVEL {
+            bail!("--truth-levels {level}: must be 1 to {} (level 0 has nothing to compare with)", truth::MAX_LEVEL);
+        }
+        config.truth.max_level = level;
+    }
     if let Some(n) = args.seeds {
         if n == 0 {
             bail!("--seeds must be at least 1");
         }
         config.seeds = (1..=n).collect();
     }
+    Ok(config)
+}
+
+pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
+    let chosen = args.error_image.as_deref().map(parse_error_image).transpose()?;
+    let config = config(args)?;
     if let Some((m, n, g)) = chosen {
         let swept =
             config.samplers.contains(&m) && config.counts.contains(&n) && config.gathers.iter().any(|x| x.0 == g);
@@ -138,6 +203,23 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         if study.truth_cached { ", read from the cache" } else { "" },
         100.0 * truth::LIT_FLOOR,
     );
+    let reference = study.reference.as_ref().map_or(String::new(), |t| {
+        let r = &study.rows[t.row];
+        format!(
+            "\n\nGPU against the f64 CPU reference (`reference::splat` + `reference::gather`, the same sum in f64, \
+             {} threads), {} {} vertex seed {}, same run: GPU frame {:.1} ms (splat + gather {:.1} ms), CPU {:.0} ms: \
+             the GPU's splat and gather are {:.0}x faster.",
+            t.threads,
+            r.sampler,
+            r.samples,
+            r.seed,
+            r.frame_ms,
+            r.splat_ms + r.gather_ms,
+            t.cpu_ms,
+            t.cpu_ms / (r.splat_ms + r.gather_ms)
+        )
+    });
+    let preamble = preamble + &reference;
     let summaries = report::summarise(&study.rows);
     let md = report::markdown(&format!("Accuracy study: {}", scene.name), &preamble, &summaries);
     let [w, h] = study.truth_image.size;
@@ -162,8 +244,9 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
             .position(|r| r.sampler == m.name() && r.samples == n && r.gather == g.name())
             .expect("checked to be in the sweep");
         let estimate = study.exitance[i].as_ref().expect("not the pixel gather");
-        let rgba = study::error_image(&study.prepared, &t.exitance, estimate, 0.1).map_err(anyhow::Error::msg)?;
-        set.png(&outputs[4], w, h, &rgba)?;
+        let (rgba, width) =
+            study::error_image(&study.prepared, &t.exitance, estimate, 0.1).map_err(anyhow::Error::msg)?;
+        set.png(&outputs[4], width, h, &rgba)?;
     }
     for p in set.commit()? {
         out!("wrote {}", p.display());

@@ -34,6 +34,8 @@ pub struct StudyConfig {
     pub seeds: Vec<u64>,
     /// Timed frames per configuration (median taken), after one warm-up frame.
     pub frames: usize,
+    /// How far the truth is refined (its tolerance and deepest level).
+    pub truth: TruthOptions,
 }
 
 impl StudyConfig {
@@ -53,6 +55,7 @@ impl StudyConfig {
             ],
             seeds: vec![1, 2, 3],
             frames: 5,
+            truth: TruthOptions::default(),
         }
     }
 
@@ -65,6 +68,7 @@ impl StudyConfig {
             gathers: vec![(GatherMode::Vertex, None)],
             seeds: vec![1],
             frames: 3,
+            truth: TruthOptions::default(),
         }
     }
 
@@ -187,6 +191,46 @@ pub struct Study {
     pub prepared: PreparedScene,
     /// Each configuration's per-vertex exitance, for `--error-image` (same order as `rows`).
     pub exitance: Vec<Option<Vec<Vec<[f32; 3]>>>>,
+    /// The f64 CPU reference timed on one swept configuration, beside the GPU's time for it.
+    pub reference: Option<ReferenceTiming>,
+}
+
+/// The GPU against the f64 CPU reference (`reference::splat` then `reference::gather`, the same
+/// discrete sum in f64 with rayon) on one configuration, timed in the same run.
+#[derive(Clone, Debug)]
+pub struct ReferenceTiming {
+    /// Which configuration (index into `Study::rows`, its first seed).
+    pub row: usize,
+    /// Median wall time of the reference's splat and gather, ms (three runs).
+    pub cpu_ms: f64,
+    /// CPU threads the reference ran on.
+    pub threads: usize,
+}
+
+/// Time the f64 reference on the swept configuration closest to the scene's own (its sampler
+/// and count if swept, with the vertex gather), so the GPU's speed-up is measured in one run.
+fn time_reference(
+    base: &PreparedScene,
+    config: &StudyConfig,
+    rows: &[Row],
+) -> Result<Option<ReferenceTiming>, StudyError> {
+    let own = &base.scene.file.sampling;
+    let vertex_rows = || rows.iter().enumerate().filter(|(_, r)| r.gather == GatherMode::Vertex.name());
+    let pick = vertex_rows()
+        .find(|(_, r)| r.sampler == own.method.name() && r.samples == own.count)
+        .or_else(|| vertex_rows().next());
+    let Some((row, r)) = pick else { return Ok(None) };
+    let method = *config.samplers.iter().find(|m| m.name() == r.sampler).expect("a swept sampler");
+    let (scene, _) = configure(base, method, r.samples, r.seed, (GatherMode::Vertex, None))?;
+    let occluders = crate::reference::occluders(&scene);
+    let mut times = Vec::new();
+    for _ in 0..3 {
+        let start = std::time::Instant::now();
+        let irradiance = crate::reference::splat(&scene, &occluders);
+        std::hint::black_box(crate::reference::gather(&scene, &irradiance));
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok(Some(ReferenceTiming { row, cpu_ms: median(times), threads: rayon::current_num_threads() }))
 }
 
 /// The scene for one configuration: `base` (prepared once, geometry and lights) with new
@@ -247,7 +291,7 @@ pub fn run(
         return Err(StudyError::NothingTranslucent);
     }
     let (truth, truth_cached) =
-        truth::cached(&base, &TruthOptions::default(), truth_dir, &|l, d, n| progress(Event::Truth(l, d, n)))?;
+        truth::cached(&base, &config.truth, truth_dir, &|l, d, n| progress(Event::Truth(l, d, n)))?;
     if truth_cached {
         progress(Event::TruthCached);
     }
@@ -324,18 +368,24 @@ pub fn run(
             }
         }
     }
-    Ok(Study { rows, truth, truth_cached, truth_image, prepared: base, exitance: exitances })
+    let reference = time_reference(&base, config, &rows)?;
+    Ok(Study { rows, truth, truth_cached, truth_image, prepared: base, exitance: exitances, reference })
 }
+
+/// Width of the strip beside the model that holds the error image's legend, pixels.
+pub const LEGEND_STRIP: u32 = 120;
 
 /// A false-colour picture of per-vertex relative error `|M - M_true| / M_true` drawn on the
 /// model from the scene's camera, `0` to `scale` mapped through `raster::colormap`; dark
-/// receivers (under [`LIT_FLOOR`]) are grey. RGBA8 of the camera's resolution, with a legend.
+/// receivers (under [`LIT_FLOOR`]) are grey. RGBA8 of the camera's resolution with a white
+/// strip of [`LEGEND_STRIP`] pixels on the right for the legend (so the legend never covers
+/// the model); returns the pixels and the image's width.
 pub fn error_image(
     scene: &PreparedScene,
     truth: &[Vec<[f64; 3]>],
     estimate: &[Vec<[f32; 3]>],
     scale: f64,
-) -> Result<Vec<u8>, String> {
+) -> Result<(Vec<u8>, u32), String> {
     let [w, h] = scene.scene.file.camera.resolution;
     let camera = crate::render::renderer::CameraView::of_scene(scene);
     let view_proj = camera.projection * camera.view;
@@ -359,11 +409,17 @@ pub fn error_image(
             });
         }
     }
-    let mut rgba = raster::rasterise(&positions, &triangles, &colours, view_proj, w, h, [255, 255, 255]);
+    let model = raster::rasterise(&positions, &triangles, &colours, view_proj, w, h, [255, 255, 255]);
     let labels = ["0".to_string(), format!("{:.2}%", 50.0 * scale), format!(">= {:.2}%", 100.0 * scale)];
-    // The legend needs room (220x80); a smaller image goes without.
-    if w >= 220 && h >= 80 {
-        raster::legend_bar(&mut rgba, w, h, [&labels[0], &labels[1], &labels[2]])?;
+    // The legend needs some height (80 pixels); a flatter image goes without.
+    if h < 80 {
+        return Ok((model, w));
     }
-    Ok(rgba)
+    let width = w + LEGEND_STRIP;
+    let mut rgba = vec![255u8; width as usize * h as usize * 4];
+    for (dst, src) in rgba.chunks_exact_mut(width as usize * 4).zip(model.chunks_exact(w as usize * 4)) {
+        dst[..src.len()].copy_from_slice(src);
+    }
+    raster::legend_bar(&mut rgba, width, h, [&labels[0], &labels[1], &labels[2]])?;
+    Ok((rgba, width))
 }

@@ -128,7 +128,7 @@ pub fn legend_bar(rgba: &mut [u8], width: u32, height: u32, labels: [&str; 3]) -
         return Err(format!("image has {} bytes, {width}x{height} RGBA8 needs {}", rgba.len(), width * height * 4));
     }
     const PANEL: i32 = 110;
-    if width < 2 * PANEL as u32 || height < 80 {
+    if width <= PANEL as u32 || height < 80 {
         return Err(format!("image {width}x{height} is too small for a legend"));
     }
     ensure_font();
