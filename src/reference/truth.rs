@@ -19,8 +19,9 @@
 //!   cells) and taken as linear inside each cell. Every light is ray cast on the triangle's
 //!   base grid; on finer grids only the lights whose shadow edge crosses it (reaching some base
 //!   points, blocked at others). Where a strong light's edge crosses ([`STRONG_LIGHT`]) the grid
-//!   is [`EDGE_EXTRA_DEPTH`] levels finer. This is the only place rays are cast, and it does not
-//!   depend on the receiver. Each triangle keeps the exact flux and centroid of
+//!   is [`EDGE_EXTRA_DEPTH`] levels finer. (So a shadow narrower than the base grid that touches
+//!   none of its points is missed at every level: the one assumption the levels cannot check.)
+//!   This is the only place rays are cast, and it does not depend on the receiver. Each triangle keeps the exact flux and centroid of
 //!   every coarser piece of its grid (a pyramid of moments).
 //! - The kernel integral is adaptive per receiver: a piece of surface of radius `R` at distance
 //!   `d` from `x` is fine enough when `2 R kappa <= eta_l` with
