@@ -1,10 +1,9 @@
-//! Experiment: bias of the vertex gather's near field on a uniformly lit square, against the
-//! exact integral. `near_bias METHOD COUNT [SEEDS]`.
-use glam::DVec3;
-use translucent::optics::kernel;
+//! Experiment: bias of the vertex gather (f64 twin) on a uniformly lit square, against the exact
+//! integral: the interior (defect 1), the edges and the corners (defect 3). `near_bias METHOD
+//! COUNT [SEEDS]`.
 use translucent::reference::{self, truth};
 use translucent::scene::Scene;
-use translucent::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
+use translucent::scene::build::{Overrides, PreparedScene};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -25,53 +24,8 @@ material = {{ type = \"translucent\", preset = \"marble\", mm_per_unit = 10.0 }}
     for seed in 1..=seeds {
         let scene = PreparedScene::new(&Scene::parse(&text(seed), "p", None).unwrap(), &Overrides::default()).unwrap();
         let o = &scene.objects[0];
-        let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else { panic!() };
         let irr = reference::splat(&scene, &reference::occluders(&scene));
         let m = &reference::gather(&scene, &irr)[0];
-        // Shepard share of each sample by a fine grid over the square.
-        let pts: Vec<(DVec3, f64)> = o.samples.iter().map(|s| (s.position.as_dvec3(), s.area)).collect();
-        let h = (3600.0 / pts.len() as f64).sqrt() / 6.0;
-        let n = (60.0 / h).ceil() as usize;
-        let g = 60.0 / n as f64;
-        let mut share = vec![0.0; pts.len()];
-        for i in 0..n {
-            for j in 0..n {
-                let y = DVec3::new(-30.0 + (i as f64 + 0.5) * g, 0.0, -30.0 + (j as f64 + 0.5) * g);
-                let w: Vec<f64> = pts.iter().map(|(p, a)| kernel::near_blend_weight(y.distance(*p), *a)).collect();
-                let sum: f64 = w.iter().sum();
-                if sum > 0.0 {
-                    w.iter().zip(&mut share).for_each(|(w, s)| *s += g * g * w / sum);
-                } else {
-                    let k =
-                        (0..pts.len()).min_by(|&a, &b| y.distance(pts[a].0).total_cmp(&y.distance(pts[b].0))).unwrap();
-                    share[k] += g * g;
-                }
-            }
-        }
-        let scale: Vec<f64> = pts.iter().zip(&share).map(|((_, a), s)| a / s).collect();
-        let (smin, smax) = scale.iter().fold((f64::MAX, 0.0f64), |(a, b), &s| (a.min(s), b.max(s)));
-        // Corrected near field.
-        let corrected: Vec<[f64; 3]> = o
-            .mesh
-            .positions()
-            .iter()
-            .enumerate()
-            .map(|(v, x)| {
-                let x = x.as_dvec3();
-                let (mut near, mut plain, mut wsum) = ([0.0; 3], [0.0; 3], 0.0);
-                for (k, (p, a)) in pts.iter().enumerate() {
-                    let w = kernel::near_blend_weight(x.distance(*p), *a);
-                    wsum += w;
-                    let b = kernel::B_PER_SQRT_AREA * a.sqrt();
-                    for c in 0..3 {
-                        let e = irr[k][c] * kernel::near_energy(&dipoles[c], b);
-                        near[c] += w * e * scale[k];
-                        plain[c] += w * e;
-                    }
-                }
-                [0, 1, 2].map(|c| if wsum > 0.0 { m[v][c] + (near[c] - plain[c]) / wsum } else { m[v][c] })
-            })
-            .collect();
         let report = |name: &str, est: &[[f64; 3]]| {
             let (mut inner, mut ni, mut edge, mut ne, mut corner, mut nc) = ([0.0; 3], 0, [0.0; 3], 0, [0.0; 3], 0);
             for (v, x) in o.mesh.positions().iter().enumerate() {
@@ -108,7 +62,5 @@ material = {{ type = \"translucent\", preset = \"marble\", mm_per_unit = 10.0 }}
             );
         };
         report("gather", m);
-        report("corrected", &corrected);
-        println!("   near scale range {smin:.3} .. {smax:.3}");
     }
 }

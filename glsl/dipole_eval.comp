@@ -41,6 +41,7 @@ struct EvalOutput {
     float fresnel_r;      // F_r(cos_theta_i, eta)
     float fresnel_t;      // F_t(cos_theta_o, eta)
     float s_d;
+    float near_kept_edge; // dipole_near_kept_at_edge(b, t = r)
 };
 
 layout(std430, set = 0, binding = 0) readonly buffer Inputs { EvalInput inputs[]; };
@@ -74,5 +75,6 @@ void main() {
     o.fresnel_r = dipole_fresnel_reflectance(p.cos_theta_i, p.eta);
     o.fresnel_t = dipole_fresnel_transmittance(p.cos_theta_o, p.eta);
     o.s_d = dipole_s_d(ch, p.eta, p.r, p.cos_theta_i, p.cos_theta_o, p.t_eta);
+    o.near_kept_edge = dipole_near_kept_at_edge(ch, b, p.r);
     outputs[i] = o;
 }

@@ -11,7 +11,8 @@
 //
 // Bindings: 0 = vertices (VertexRecord[], read), 1 = samples (SampleRecord[], read), 2 = splat
 // (SplatRecord[], read), 3 = objects (ObjectRecord[], read), 4 = exitance (vec4 per vertex, write),
-// 5 = tree nodes (TreeNodeRecord[]), 6 = tree order (uint[]). Push: GatherPush.
+// 5 = tree nodes (TreeNodeRecord[]), 6 = tree order (uint[]), 7 = boundary distances (vec2 per
+// vertex, mesh::Mesh::boundary_distances). Push: GatherPush.
 #include "dipole.glsl"
 #include "scene.glsl"
 #include "gather.glsl"
@@ -25,6 +26,7 @@ layout(std430, set = 0, binding = 3) readonly buffer Objects { ObjectRecord obje
 layout(std430, set = 0, binding = 4) writeonly buffer Exitance { vec4 exitance[]; };
 layout(std430, set = 0, binding = 5) readonly buffer TreeNodes { TreeNodeRecord tree_nodes[]; };
 layout(std430, set = 0, binding = 6) readonly buffer TreeOrder { uint tree_order[]; };
+layout(std430, set = 0, binding = 7) readonly buffer VertexBoundary { vec2 vertex_boundary[]; };
 struct GatherPush {
     uint object;            // the receiving object's index
     uint first_node;        // its root in tree_nodes
@@ -72,5 +74,5 @@ void main() {
         uint s = tree_nearest_sample(x, push.first_node, push.node_count);
         g.nearest_near = splat[s].irradiance_area.rgb * splat[s].near_energy.rgb;
     }
-    exitance[first_vertex + v] = vec4(gather_end(g), 1.0);
+    exitance[first_vertex + v] = vec4(gather_end(g, ch, vertex_boundary[vi]), 1.0);
 }

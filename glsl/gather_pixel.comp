@@ -49,5 +49,8 @@ void main() {
         gather_add(g, ch, s.xyz, samples[i].position_area, splat[i].irradiance_area.rgb, splat[i].near_energy.rgb);
         if (((i - first) & 63u) == 63u) gather_flush(g);
     }
-    imageStore(hdr, p, vec4(radiance.rgb + gather_end(g) * gathered * radiance.a, 1.0));
+    // A pixel does not know its distance to an open boundary: the near field is taken whole
+    // (the vertex gathers correct it; docs/STUDY.md, defect 3).
+    vec2 no_boundary = vec2(GATHER_NO_BOUNDARY);
+    imageStore(hdr, p, vec4(radiance.rgb + gather_end(g, ch, no_boundary) * gathered * radiance.a, 1.0));
 }

@@ -21,7 +21,8 @@
 // (SplatRecord[]), 3 = objects (ObjectRecord[]), 4 = tree nodes (TreeNodeRecord[]), 5 = tree
 // order (uint[]), 6 = node power (NodePowerRecord[], written by stage 0, read by stage 1),
 // 7 = receiver order (uint[]), 8 = receiver groups (ReceiverGroupRecord[]), 9 = group items
-// (uint[]), 10 = exitance (vec4 per vertex, written by stage 1). Push: GatherTreePush.
+// (uint[]), 10 = exitance (vec4 per vertex, written by stage 1), 11 = boundary distances (vec2
+// per vertex, mesh::Mesh::boundary_distances). Push: GatherTreePush.
 #include "dipole.glsl"
 #include "scene.glsl"
 #include "gather.glsl"
@@ -39,6 +40,7 @@ layout(std430, set = 0, binding = 7) readonly buffer ReceiverOrder { uint receiv
 layout(std430, set = 0, binding = 8) readonly buffer ReceiverGroups { ReceiverGroupRecord receiver_groups[]; };
 layout(std430, set = 0, binding = 9) readonly buffer GroupItems { uint group_items[]; };
 layout(std430, set = 0, binding = 10) writeonly buffer Exitance { vec4 exitance[]; };
+layout(std430, set = 0, binding = 11) readonly buffer VertexBoundary { vec2 vertex_boundary[]; };
 struct GatherTreePush {
     uint object;            // the receiving object's index
     uint stage;             // 0: aggregate the nodes; 1: gather at the vertices
@@ -156,5 +158,5 @@ void main() {
         uint s = tree_nearest_sample(x, push.first_node, push.node_count);
         g.nearest_near = splat[s].irradiance_area.rgb * splat[s].near_energy.rgb;
     }
-    exitance[v] = vec4(gather_end(g), 1.0);
+    exitance[v] = vec4(gather_end(g, ch, vertex_boundary[v]), 1.0);
 }

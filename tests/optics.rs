@@ -528,6 +528,60 @@ fn near_energy_is_accurate_in_both_branches() {
     }
 }
 
+/// The half-plane beyond an edge `t` from the receiver, integrated directly: `R_near = R_d - R_far`
+/// in polar coordinates about the receiver, Simpson in `ln r` from where each ray leaves the
+/// surface, midpoints in the angle. Independent of `near_tail`'s closed form and of the factor's
+/// 8-point angular rule.
+fn near_missing_direct(d: &Dipole, b: f64, t: f64) -> f64 {
+    let near = |r: f64| (d.r_d(r) - kernel::r_d_far(d, r, b)).max(0.0);
+    let steps = 200;
+    let mut sum = 0.0;
+    for k in 0..steps {
+        let theta = (k as f64 + 0.5) / steps as f64 * (PI / 2.0);
+        let from = (t / theta.cos()).max(1e-6 * b);
+        // radial_integral carries 2 pi; the angle's measure is dtheta / (2 pi) of it, twice
+        // (both halves of the even integrand).
+        sum += radial_integral(near, from, from + 200.0 * b + 50.0 * d.z_v, 2000) * (PI / 2.0) / steps as f64 / PI;
+    }
+    sum
+}
+
+#[test]
+fn near_energy_kept_at_an_open_edge_matches_a_direct_half_plane_integral() {
+    // For a marble-like and a ketchup-like channel at spacings from well under to well over the
+    // diffusion length: the factor against 1 - (direct half-plane integral) / E_near, half on
+    // the edge, and nothing missing from NEAR_EDGE_REACH b on.
+    let cases = [("marble", presets::find("marble").unwrap()), ("ketchup", presets::find("ketchup").unwrap())];
+    println!("material  channel  b/z_r   t/b   kept    direct");
+    for (name, preset) in cases {
+        for (c, d) in preset.material().dipoles(1.0).unwrap().iter().enumerate() {
+            for b_rel in [0.3, 3.0, 30.0] {
+                let b = b_rel * d.z_r;
+                let total = near_energy(d, b);
+                // near_tail at 0 is E_near.
+                assert!(rel(kernel::near_tail(d, b * b, 0.0), total) < 1e-12, "{name} {c}");
+                for t_rel in [0.0, 0.01, 0.1, 0.3, 0.7, 1.5, 3.0] {
+                    let t = t_rel * b;
+                    let kept = kernel::near_kept_at_edge(d, b, t);
+                    let direct = 1.0 - near_missing_direct(d, b, t) / total;
+                    println!("{name:8}  {c}  {b_rel:6.1}  {t_rel:5.2}  {kept:.5}  {direct:.5}");
+                    assert!(
+                        (kept - direct).abs() < 1e-3,
+                        "{name} [{c}] b {b_rel} z_r, t {t_rel} b: {kept} vs {direct}"
+                    );
+                    if t_rel == 0.0 {
+                        assert!((kept - 0.5).abs() < 1e-9, "on the edge half stays: {kept}");
+                    }
+                }
+                let reach = kernel::NEAR_EDGE_REACH * (d.z_v * d.z_v + b * b).sqrt();
+                let beyond = near_missing_direct(d, b, reach) / total;
+                assert!(beyond < 1e-4, "{name} [{c}] b {b_rel} z_r: {beyond} of E_near lies beyond the reach");
+                assert_eq!(kernel::near_kept_at_edge(d, b, reach), 1.0);
+            }
+        }
+    }
+}
+
 #[test]
 fn kernel_stays_finite_in_hard_cases() {
     let mut count = 0;
@@ -575,7 +629,8 @@ fn std430_records_have_pinned_layouts() {
     assert_eq!(offset_of!(DipoleEvalInput, area), 20);
     assert_eq!(offset_of!(DipoleEvalInput, cos_theta_o), 28);
     assert_eq!(offset_of!(DipoleEvalInput, t_eta), 32);
-    assert_eq!(size_of::<DipoleEvalOutput>(), 68);
+    assert_eq!(size_of::<DipoleEvalOutput>(), 72);
+    assert_eq!(offset_of!(DipoleEvalOutput, near_kept_edge), 68);
     assert_eq!(offset_of!(DipoleEvalOutput, F_dr), 12);
     assert_eq!(offset_of!(DipoleEvalOutput, r_d), 28);
     assert_eq!(offset_of!(DipoleEvalOutput, kernel), 40);

@@ -111,7 +111,7 @@ fn records(case: &Case, d: &Dipole, t_eta: f32) -> Vec<(DipoleEvalInput, usize)>
 }
 
 /// The f64 reference of every output field, from the f32 input widened to f64.
-fn reference(d: &Dipole, p: &DipoleEvalInput) -> [f64; 17] {
+fn reference(d: &Dipole, p: &DipoleEvalInput) -> [f64; 18] {
     let (r, area) = (p.r as f64, p.area as f64);
     let b = kernel::B_PER_SQRT_AREA * area.sqrt();
     let (cos_i, cos_o) = (p.cos_theta_i as f64, p.cos_theta_o as f64);
@@ -133,10 +133,11 @@ fn reference(d: &Dipole, p: &DipoleEvalInput) -> [f64; 17] {
         fresnel_reflectance(cos_i, d.eta),
         fresnel_transmittance(cos_o, d.eta),
         d.s_d(r, cos_i, cos_o, p.t_eta as f64),
+        kernel::near_kept_at_edge(d, b, r),
     ]
 }
 
-fn fields(o: &DipoleEvalOutput) -> [f32; 17] {
+fn fields(o: &DipoleEvalOutput) -> [f32; 18] {
     [
         o.sigma_t_prime,
         o.alpha_prime,
@@ -155,10 +156,11 @@ fn fields(o: &DipoleEvalOutput) -> [f32; 17] {
         o.fresnel_r,
         o.fresnel_t,
         o.s_d,
+        o.near_kept_edge,
     ]
 }
 
-const NAMES: [&str; 17] = [
+const NAMES: [&str; 18] = [
     "sigma_t'",
     "alpha'",
     "sigma_tr",
@@ -176,6 +178,7 @@ const NAMES: [&str; 17] = [
     "F_r",
     "F_t",
     "S_d",
+    "E_near kept at an edge",
 ];
 
 fn run_on_gpu(inputs: &[DipoleEvalInput]) -> Vec<DipoleEvalOutput> {
@@ -226,7 +229,7 @@ fn glsl_twin_matches_f64_reference() {
         }
     }
 
-    let mut worst: Vec<(f64, String)> = vec![(0.0, String::new()); 17];
+    let mut worst: Vec<(f64, String)> = vec![(0.0, String::new()); 18];
     let (mut compared, mut floor_only, mut failures) = (0usize, 0usize, Vec::new());
     for (i, (out, r)) in outputs.iter().zip(&refs).enumerate() {
         let p = &inputs[i];

@@ -52,6 +52,66 @@ fn uniformly_lit_plane_reflects_total_diffuse_reflectance() {
 }
 
 #[test]
+fn open_edges_and_corners_of_a_plane_read_the_half_and_quarter_plane_integrals() {
+    // The near field's energy past an open boundary leaves the surface (kernel::near_kept_at_edge):
+    // before, edges read twice and corners four times these (the study's defect 3). The samples
+    // lie many diffusion lengths apart, so most of the exitance is near field.
+    with_gpu(|gpu| {
+        for (preset, gather) in [
+            ("marble", GatherMode::Vertex),
+            ("ketchup", GatherMode::Vertex),
+            ("marble", GatherMode::Sparse),
+            ("marble", GatherMode::Hierarchical),
+        ] {
+            let overrides =
+                Overrides { gather: Some(gather), transport: Some(TransportMode::Gather), ..Default::default() };
+            let prepared = prepare(&plane_scene(preset, 1000.0, 3000, ""), &overrides);
+            let material = Material::preset(preset).unwrap();
+            let dipoles = material.dipoles(1.0).unwrap();
+            let f_t = fresnel::fresnel_transmittance(1.0, material.eta);
+            let mesh = prepared.objects[0].mesh.clone();
+            if gather == GatherMode::Vertex {
+                // The GPU's edge factor against its f64 twin, on the same irradiance.
+                let irradiance = reference::splat(&prepared, &reference::occluders(&prepared));
+                let expected = reference::gather(&prepared, &irradiance);
+                let got = gather_from(gpu, prepared.clone(), &irradiance);
+                for (v, (g, e)) in got.iter().zip(&expected[0]).enumerate() {
+                    for c in 0..3 {
+                        let err = (g[c] as f64 - e[c]).abs() / e[c];
+                        assert!(err < 1e-3, "{preset} vertex {v} channel {c}: GPU {} vs f64 {}", g[c], e[c]);
+                    }
+                }
+            }
+            let exitance = run_all(gpu, prepared).exitance(0).unwrap();
+            let (mut edge, mut corner) = (Vec::new(), Vec::new());
+            for (v, p) in mesh.positions().iter().enumerate() {
+                let (on_x, on_z) = (p.x.abs() > 499.9, p.z.abs() > 499.9);
+                if on_x && on_z {
+                    corner.push(v);
+                } else if (on_x || on_z) && p.x.abs().min(p.z.abs()) < 300.0 {
+                    edge.push(v);
+                }
+            }
+            assert_eq!(corner.len(), 4);
+            for c in 0..3 {
+                let whole = dipoles[c].r_d_total() * f_t;
+                let mean = |vs: &[usize]| vs.iter().map(|&v| exitance[v][c] as f64).sum::<f64>() / vs.len() as f64;
+                let (e, k) = (mean(&edge) / (0.5 * whole), mean(&corner) / (0.25 * whole));
+                eprintln!("{preset} ({gather} gather) channel {c}: edge {e:.4}, corner {k:.4} of the exact integral");
+                assert!(
+                    (e - 1.0).abs() < 0.01,
+                    "{preset} {gather} channel {c}: edges read {e} of the half-plane integral"
+                );
+                assert!(
+                    (k - 1.0).abs() < 0.03,
+                    "{preset} {gather} channel {c}: corners read {k} of the quarter-plane's"
+                );
+            }
+        }
+    });
+}
+
+#[test]
 fn gather_matches_the_f64_reference_on_the_default_scene() {
     with_gpu(|gpu| {
         let overrides = Overrides { resolution: Some([64, 64]), ..Default::default() };

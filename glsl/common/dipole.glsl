@@ -210,6 +210,47 @@ float dipole_near_energy(DipoleChannel ch, float b) {
         * (dipole_taylor_remainder(ch.z_r, ch.sigma_tr, beta) + dipole_taylor_remainder(ch.z_v, ch.sigma_tr, beta));
 }
 
+// The near energy farther than `radius` from its receiver, integral_{r > R} R_near 2 pi r dr:
+// each pole's Taylor remainder taken at R^2 + z^2 (kernel::near_tail).
+float dipole_near_tail(DipoleChannel ch, float beta, float radius) {
+    float qr = sqrt(radius * radius + ch.z_r * ch.z_r);
+    float qv = sqrt(radius * radius + ch.z_v * ch.z_v);
+    return 0.5 * ch.alpha_prime
+        * ((ch.z_r / qr) * dipole_taylor_remainder(qr, ch.sigma_tr, beta)
+           + (ch.z_v / qv) * dipole_taylor_remainder(qv, ch.sigma_tr, beta));
+}
+
+// The fraction of E_near(b) a receiver keeps when an open boundary passes t from it:
+// 1 - (1 / pi E_near) integral_0^inf T(t cosh v) / cosh v dv, in panels of at most one unit of
+// v, 4-point Gauss-Legendre each (kernel::near_kept_at_edge).
+float dipole_near_kept_at_edge(DipoleChannel ch, float b, float t) {
+    float beta = b * b;
+    float ell = sqrt(ch.z_v * ch.z_v + beta);
+    if (isnan(t) || t >= DIPOLE_NEAR_EDGE_REACH * ell || b <= 0.0) return 1.0;
+    float total = dipole_near_tail(ch, beta, 0.0);
+    if (total <= 0.0) return 1.0;
+    if (t <= DIPOLE_NEAR_EDGE_TOUCH * ell) return 0.5;
+    float ratio = DIPOLE_NEAR_EDGE_REACH * ell / t;
+    float v_max = log(ratio + sqrt(ratio * ratio - 1.0)); // acosh, written out for large ratios
+    float panels = clamp(ceil(v_max), 1.0, DIPOLE_NEAR_EDGE_PANELS);
+    float h = v_max / panels;
+    const float X[2] = float[2](0.339981043584856, 0.861136311594053);
+    const float W[2] = float[2](0.652145154862546, 0.347854845137454);
+    float sum = 0.0;
+    for (float p = 0.0; p < panels; p += 1.0) {
+        float centre = (p + 0.5) * h;
+        for (int k = 0; k < 2; ++k) {
+            for (int side = -1; side <= 1; side += 2) {
+                float v = centre + float(side) * 0.5 * h * X[k];
+                float c = cosh(v);
+                sum += W[k] * dipole_near_tail(ch, beta, t * c) / c;
+            }
+        }
+    }
+    float missing = 0.5 * h * sum / DIPOLE_PI;
+    return clamp(1.0 - missing / total, 0.0, 1.0);
+}
+
 // Footprint weight w(r / rho): 1 inside, smoothstep edge, integral w 2 pi r dr = dA. Computed
 // as S(1 - t), not 1 - S(t), so the tiny values near the outer edge keep their digits.
 float dipole_footprint_weight(float x) {

@@ -6,18 +6,22 @@
 #ifndef GATHER_GLSL
 #define GATHER_GLSL
 
+// mesh::NO_BOUNDARY: the distance stored where no open boundary is near (f32::MAX).
+const float GATHER_NO_BOUNDARY = 3.40282347e38;
+
 struct GatherSum {
     vec3 far;            // Kahan-compensated far sum of the flushed terms
     vec3 compensation;
     vec3 partial;        // plain f32 sum of the terms since the last gather_flush
     vec3 near_sum;
     float weight_sum;
+    float area_sum;      // sum of w A over the blend: its mean area sets b for the edge factor
     float nearest_r_sq;
     vec3 nearest_near;
 };
 
 GatherSum gather_begin() {
-    return GatherSum(vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 3.4e38, vec3(0.0));
+    return GatherSum(vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0.0, 3.4e38, vec3(0.0));
 }
 
 DipoleChannel[3] gather_channels(ObjectRecord o) {
@@ -44,6 +48,7 @@ void gather_add(inout GatherSum g, DipoleChannel ch[3], vec3 x, vec4 position_ar
     vec3 near_exitance = e * near_energy;
     g.near_sum += w * near_exitance;
     g.weight_sum += w;
+    g.area_sum += w * area;
 #ifdef GATHER_TRACK_NEAREST
     // Gathers without the sample hierarchy track the nearest sample for the fallback where no
     // Shepard weight reaches; the others find it afterwards by walking the hierarchy, which
@@ -68,10 +73,27 @@ void gather_flush(inout GatherSum g) {
     g.partial = vec3(0.0);
 }
 
-// The radiant exitance; never negative.
-vec3 gather_end(GatherSum g) {
+// Per channel, the share of the blended near exitance a receiver keeps beside open boundaries
+// `boundary` away (the two nearest directions, mesh::Mesh::boundary_distances; NO_BOUNDARY far
+// from any), for samples of mean area `area` (optics::kernel::near_kept_at_edge, once per side).
+vec3 gather_near_kept(DipoleChannel ch[3], float area, vec2 boundary) {
+    float b = DIPOLE_B_PER_SQRT_AREA * sqrt(area);
+    vec3 kept;
+    for (int c = 0; c < 3; ++c) {
+        kept[c] = dipole_near_kept_at_edge(ch[c], b, boundary.x) * dipole_near_kept_at_edge(ch[c], b, boundary.y);
+    }
+    return kept;
+}
+
+// The radiant exitance; never negative. `boundary` as gather_near_kept takes it: the near
+// field's energy past an open boundary leaves the surface (the nearest-sample fallback, where no
+// blend weight reaches, keeps all).
+vec3 gather_end(GatherSum g, DipoleChannel ch[3], vec2 boundary) {
     gather_flush(g);
-    vec3 near = g.weight_sum > 0.0 ? g.near_sum / g.weight_sum : g.nearest_near;
+    vec3 near = g.nearest_near;
+    if (g.weight_sum > 0.0) {
+        near = g.near_sum / g.weight_sum * gather_near_kept(ch, g.area_sum / g.weight_sum, boundary);
+    }
     return max(g.far + near, vec3(0.0));
 }
 

@@ -43,6 +43,11 @@ pub struct Args {
     /// did not converge and prints its last change between levels
     #[arg(long, value_name = "LEVEL")]
     pub truth_levels: Option<u32>,
+    /// Compute the truth at no more than this many vertices per object, spread over the mesh
+    /// (for large meshes; per-vertex errors then cover those vertices and the image errors and
+    /// truth.png are left out)
+    #[arg(long, value_name = "N")]
+    pub truth_receivers: Option<usize>,
     /// Where the truth is cached, keyed by the scene's content (default: the user's cache
     /// folder, translucent/truth)
     #[arg(long)]
@@ -114,6 +119,12 @@ fn config(args: &Args) -> Result<StudyConfig> {
             bail!("--truth-levels {level}: must be 1 to {} (level 0 has nothing to compare with)", truth::MAX_LEVEL);
         }
         config.truth.max_level = level;
+    }
+    if let Some(n) = args.truth_receivers {
+        if n < 100 {
+            bail!("--truth-receivers {n}: must be at least 100 (fewer make the per-vertex statistics noise)");
+        }
+        config.truth.receivers = Some(n);
     }
     if let Some(n) = args.seeds {
         if n == 0 {
@@ -190,13 +201,16 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let preamble = format!(
         "Scene `{}`, device {device}, {} configurations x seeds. Times: median of {} frames after one warm-up, \
          a moving light's frame (splat, gather, shade), {timing}.\n\n\
-         Truth: the exact dipole integral at every vertex (`reference::truth`), {} (last change between levels \
+         Truth: the exact dipole integral at {} (`reference::truth`), {} (last change between levels \
          {:.2e} RMS relative over lit vertices; tolerance {:.0e}){}. Per-vertex errors are relative, over \
          vertices at least {:.0}% of the object's brightest in each channel.\n\n\
          | level | eta | E_t points | change RMS | change max | seconds |\n|---|---|---|---|---|---|\n{levels}",
         scene.name,
         config.runs() / config.seeds.len(),
         config.frames,
+        t.subset.map_or("every vertex".to_string(), |n| format!(
+            "{n} vertices per object spread over the mesh (so no truth image and no image errors)"
+        )),
         if t.converged { "converged" } else { "NOT converged" },
         t.change(),
         t.tolerance,
@@ -222,7 +236,7 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let preamble = preamble + &reference;
     let summaries = report::summarise(&study.rows);
     let md = report::markdown(&format!("Accuracy study: {}", scene.name), &preamble, &summaries);
-    let [w, h] = study.truth_image.size;
+    let [w, h] = study.prepared.scene.file.camera.resolution;
     let plot = report_plot(&summaries, &scene.name)?;
 
     std::fs::create_dir_all(&args.output).with_context(|| format!("cannot make {}", args.output.display()))?;
@@ -236,7 +250,9 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     text(&mut set, &outputs[0], report::csv(&study.rows))?;
     text(&mut set, &outputs[1], md)?;
     set.png(&outputs[2], 960, 640, &plot)?;
-    set.png(&outputs[3], w, h, &study.truth_image.ldr)?;
+    if let Some(image) = &study.truth_image {
+        set.png(&outputs[3], w, h, &image.ldr)?;
+    }
     if let Some((m, n, g)) = chosen {
         let i = study
             .rows

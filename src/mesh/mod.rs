@@ -8,6 +8,7 @@
 //! vertices, then derive topology and geometry. What the pipeline changed or found is kept in a
 //! [`MeshReport`].
 
+mod boundary;
 mod curvature;
 mod obj;
 mod topology;
@@ -16,6 +17,7 @@ use std::path::PathBuf;
 
 use glam::{DVec3, Vec3};
 
+pub use boundary::NO_BOUNDARY;
 pub use obj::LoadOptions;
 
 /// Marks an edge with no single neighbouring triangle (an open boundary or a non-manifold edge).

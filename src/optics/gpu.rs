@@ -98,4 +98,6 @@ pub struct DipoleEvalOutput {
     pub fresnel_t: f32,
     /// `S_d(r, cos_theta_i, cos_theta_o)` (seed Eq. 9, normalized by `t_eta`).
     pub s_d: f32,
+    /// [`crate::optics::kernel::near_kept_at_edge`]`(b, t = r)`.
+    pub near_kept_edge: f32,
 }

@@ -174,6 +174,79 @@ pub fn taylor_remainder(z: f64, s: f64, beta: f64) -> f64 {
     }
 }
 
+/// `integral over r > R of R_near(r) 2 pi r dr`: the near energy lying farther than `R` from
+/// its receiver, `R_near = R_d - R_far` with `b^2 = beta`. With `q0 = sqrt(R^2 + z^2)`, each
+/// pole's tail is the Taylor remainder of `G_z` at `q0^2` instead of `z^2` (the module doc's
+/// `E_near`, integrated from `R` rather than 0), and `G_z = (z / q0) G_q0`, so
+/// `(alpha'/2) sum_z (z / q0) taylor_remainder(q0, sigma_tr, beta)`; at `R = 0` it is `E_near`.
+pub fn near_tail(dipole: &Dipole, beta: f64, radius: f64) -> f64 {
+    let s = dipole.sigma_tr;
+    let pole = |z: f64| {
+        let q0 = (radius * radius + z * z).sqrt();
+        (z / q0) * taylor_remainder(q0, s, beta)
+    };
+    0.5 * dipole.alpha_prime * (pole(dipole.z_r) + pole(dipole.z_v))
+}
+
+/// Gauss-Legendre nodes (positive half) and weights, 4 points on `[-1, 1]`.
+const GL4_X: [f64; 2] = [0.339_981_043_584_856, 0.861_136_311_594_053];
+const GL4_W: [f64; 2] = [0.652_145_154_862_546, 0.347_854_845_137_454];
+
+/// The fraction of a receiver's near energy `E_near(b)` that stays on the surface when an open
+/// boundary (taken as a straight edge) passes `t` from it: `1 - missing / E_near` with
+///
+/// ```text
+/// missing = integral over the half-plane beyond the edge of R_near dA
+///         = (1 / 2 pi) integral_{-pi/2}^{pi/2} T(t / cos theta) d theta     (T = near_tail)
+///         = (1 / pi) integral_0^inf T(t cosh v) / cosh v dv
+/// ```
+///
+/// (polar coordinates about the receiver: the ray at angle `theta` from the edge's normal leaves
+/// the surface at `t / cos theta`; then `t / cos theta = t cosh v`, which spreads the sharp
+/// turn the first form has near `theta = pi/2` when `t` is small next to `T`'s width over about
+/// one unit of `v`). `1/2` on the edge, rising to 1 within a few `l = sqrt(z_v^2 + b^2)`, the
+/// width of `R_near`; 1 from [`NEAR_EDGE_REACH`]` l` on.
+///
+/// Why: the near-field blend assumes a whole plane around every receiver (the module doc's
+/// `E_near`), so without this factor a receiver on an open boundary keeps the near energy that
+/// should have left through it: the rim of an open mesh reads up to twice the exact half-plane
+/// integral, and a corner four times (the study's defect 3, docs/STUDY.md). The gathers multiply
+/// the blended near exitance by this factor for each of the two nearest boundary directions
+/// (`mesh::boundary`), which is exact at a right-angled corner for a separable kernel and close
+/// for this one.
+///
+/// The `v` integral runs to `acosh(NEAR_EDGE_REACH l / t)` in panels of at most one unit, 4-point
+/// Gauss-Legendre each (tests/optics.rs checks it against a direct quadrature of the half-plane).
+pub fn near_kept_at_edge(dipole: &Dipole, b: f64, t: f64) -> f64 {
+    let beta = b * b;
+    let ell = (dipole.z_v * dipole.z_v + beta).sqrt();
+    if t.is_nan() || t >= NEAR_EDGE_REACH * ell || b <= 0.0 {
+        return 1.0;
+    }
+    let total = near_tail(dipole, beta, 0.0);
+    if total <= 0.0 {
+        return 1.0;
+    }
+    if t <= NEAR_EDGE_TOUCH * ell {
+        return 0.5;
+    }
+    let v_max = (NEAR_EDGE_REACH * ell / t).acosh();
+    let panels = v_max.ceil().clamp(1.0, NEAR_EDGE_PANELS);
+    let h = v_max / panels;
+    let mut sum = 0.0;
+    for p in 0..panels as usize {
+        let centre = (p as f64 + 0.5) * h;
+        for k in 0..2 {
+            for sign in [-1.0, 1.0] {
+                let v = centre + sign * 0.5 * h * GL4_X[k];
+                sum += GL4_W[k] * near_tail(dipole, beta, t * v.cosh()) / v.cosh();
+            }
+        }
+    }
+    let missing = 0.5 * h * sum / PI;
+    (1.0 - missing / total).clamp(0.0, 1.0)
+}
+
 /// The footprint weight `w(x)`, `x = r / rho`: 1 inside, a smoothstep edge of half-width
 /// [`BUMP_DELTA`] centred at `c = sqrt(1 - delta^2 / 5)`, so that `integral w(x) 2x dx = 1`
 /// (the edge's derivative is a Beta(2,2) bump of variance `delta^2 / 5`).

@@ -22,4 +22,13 @@ kernel_constants! {
     /// light, it could add at most this fraction of `R_d,total` in every channel
     /// ([`negligible_cluster`]).
     TREE_PRUNE_FRACTION = 1e-6;
+    /// Beyond this many `l = sqrt(z_v^2 + b^2)` (the width of the near part `R_near`) from an
+    /// open boundary a receiver keeps all its near energy ([`near_kept_at_edge`] is 1): what lies
+    /// beyond is under 1e-4 of `E_near` (tests/optics.rs).
+    NEAR_EDGE_REACH = 6.0;
+    /// Within this many `l` of an open boundary a receiver is on it and keeps half.
+    NEAR_EDGE_TOUCH = 1e-6;
+    /// At most this many panels of the edge factor's angular integral (one per unit of `v`,
+    /// which runs to `acosh(NEAR_EDGE_REACH / NEAR_EDGE_TOUCH)`, about 16.3).
+    NEAR_EDGE_PANELS = 17.0;
 }

@@ -145,7 +145,9 @@ pub fn transmitted_irradiance_known(
 
 /// Radiant exitance at every vertex of every object (zero for opaque ones), from per-sample
 /// transmitted irradiance in scene order: the far kernel summed plus the near field blended
-/// over neighbouring samples (`optics::kernel::far_kernel` explains the split).
+/// over neighbouring samples (`optics::kernel::far_kernel` explains the split), times the share
+/// of it kept beside an open boundary (`optics::kernel::near_kept_at_edge` for each of the two
+/// nearest boundary directions, with `b` from the blend's mean sample area).
 pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3]>> {
     per_translucent_object(scene, |o, dipoles, first| {
         let samples: Vec<(DVec3, f64, [f64; 3])> =
@@ -158,10 +160,12 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3
                 (*p, *area, [0, 1, 2].map(|c| e[c] * kernel::near_energy(&dipoles[c], b)))
             })
             .collect();
+        let boundary = o.mesh.boundary_distances();
         o.mesh
             .positions()
             .par_iter()
-            .map(|x| {
+            .zip(&boundary)
+            .map(|(x, t)| {
                 let x = x.as_dvec3();
                 let mut far = [0.0; 3];
                 for (p, area, e) in &samples {
@@ -170,18 +174,36 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3
                         far[c] += e[c] * kernel::far_kernel(&dipoles[c], r, *area);
                     }
                 }
-                let near = near_blend(x, &near);
-                [0, 1, 2].map(|c| far[c] + near[c])
+                let (near, mean_area) = near_blend(x, &near);
+                let kept = near_kept(dipoles, mean_area, *t);
+                [0, 1, 2].map(|c| far[c] + near[c] * kept[c])
             })
             .collect()
     })
 }
 
+/// Per channel, the share of the blended near exitance a receiver keeps beside open boundaries
+/// `boundary` away (`mesh::Mesh::boundary_distances`): `kernel::near_kept_at_edge` for each of
+/// the two directions, with `b` of the blend's mean sample area; all of it when no blend weight
+/// reached (`mean_area` none). The twin of `gather_near_kept` in glsl/common/gather.glsl.
+pub(crate) fn near_kept(dipoles: &[Dipole; 3], mean_area: Option<f64>, boundary: [f32; 2]) -> [f64; 3] {
+    [0, 1, 2].map(|c| {
+        mean_area.map_or(1.0, |area| {
+            let b = kernel::B_PER_SQRT_AREA * area.sqrt();
+            boundary.iter().map(|&t| kernel::near_kept_at_edge(&dipoles[c], b, f64::from(t))).product()
+        })
+    })
+}
+
+/// A sample's position, area and a per-channel value to blend between samples ([`near_blend`]).
+type Blended = (DVec3, f64, [f64; 3]);
+
 /// Blend per-sample values to `x` with the near-field Shepard weights
 /// (`kernel::near_blend_weight`), or take the nearest sample's where no weight reaches: the twin
-/// of the blend in glsl/common/gather.glsl and glsl/gather_sparse.comp.
-pub(crate) fn near_blend(x: DVec3, values: &[(DVec3, f64, [f64; 3])]) -> [f64; 3] {
-    let (mut sum, mut weight_sum) = ([0.0; 3], 0.0);
+/// of the blend in glsl/common/gather.glsl and glsl/gather_sparse.comp. Also the blend's mean
+/// sample area (`sum w A / sum w`), none where no weight reaches.
+pub(crate) fn near_blend(x: DVec3, values: &[(DVec3, f64, [f64; 3])]) -> ([f64; 3], Option<f64>) {
+    let (mut sum, mut weight_sum, mut area_sum) = ([0.0; 3], 0.0, 0.0);
     let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; 3]);
     for (p, area, v) in values {
         let r = x.distance(*p);
@@ -190,19 +212,21 @@ pub(crate) fn near_blend(x: DVec3, values: &[(DVec3, f64, [f64; 3])]) -> [f64; 3
             sum[c] += w * v[c];
         }
         weight_sum += w;
+        area_sum += w * area;
         if r < nearest_r {
             (nearest_r, nearest) = (r, *v);
         }
     }
-    if weight_sum > 0.0 { sum.map(|v| v / weight_sum) } else { nearest }
+    if weight_sum > 0.0 { (sum.map(|v| v / weight_sum), Some(area_sum / weight_sum)) } else { (nearest, None) }
 }
 
-/// The sparse gather (`render.gather = "sparse"`, glsl/gather_sparse.comp) in f64: exitance at
-/// each sample (far sum plus its own near exitance), blended to every vertex with the
-/// near-field Shepard weights.
+/// The sparse gather (`render.gather = "sparse"`, glsl/gather_sparse.comp) in f64: the far sum
+/// at each sample, blended to every vertex with the near-field Shepard weights together with
+/// the samples' own near exitance, which is scaled by the share kept beside open boundaries
+/// ([`near_kept`]).
 pub fn gather_sparse(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3]>> {
     per_translucent_object(scene, |o, dipoles, first| {
-        let at_samples: Vec<(DVec3, f64, [f64; 3])> = o
+        let at_samples: Vec<(Blended, Blended)> = o
             .samples
             .par_iter()
             .enumerate()
@@ -216,13 +240,23 @@ pub fn gather_sparse(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<
                     }
                 }
                 let b = kernel::B_PER_SQRT_AREA * sj.area.sqrt();
-                for c in 0..3 {
-                    t[c] = t[c].max(0.0) + irradiance[first + j][c] * kernel::near_energy(&dipoles[c], b);
-                }
-                (x, sj.area, t)
+                let near = [0, 1, 2].map(|c| irradiance[first + j][c] * kernel::near_energy(&dipoles[c], b));
+                ((x, sj.area, t.map(|v| v.max(0.0))), (x, sj.area, near))
             })
             .collect();
-        o.mesh.positions().par_iter().map(|x| near_blend(x.as_dvec3(), &at_samples)).collect()
+        let (far, near): (Vec<_>, Vec<_>) = at_samples.into_iter().unzip();
+        let boundary = o.mesh.boundary_distances();
+        o.mesh
+            .positions()
+            .par_iter()
+            .zip(&boundary)
+            .map(|(x, t)| {
+                let x = x.as_dvec3();
+                let ((f, _), (n, mean_area)) = (near_blend(x, &far), near_blend(x, &near));
+                let kept = near_kept(dipoles, mean_area, *t);
+                [0, 1, 2].map(|c| f[c] + n[c] * kept[c])
+            })
+            .collect()
     })
 }
 

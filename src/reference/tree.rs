@@ -67,7 +67,7 @@ fn center_of(n: &TreeNode) -> DVec3 {
 /// sample's far kernel and near exitance as in the flat sum, a node's power times the cluster
 /// kernel (`kernel::r_d_far_cluster`: its centroid, the `b` of its mean area, its spread); the
 /// near field blended over the listed samples (the nearest sample of the object where no weight
-/// reaches).
+/// reaches), times the share kept beside open boundaries `boundary` away (`super::near_kept`).
 #[allow(clippy::too_many_arguments)]
 pub fn gather_items(
     x: DVec3,
@@ -78,6 +78,7 @@ pub fn gather_items(
     positions: &[DVec3],
     areas: &[f64],
     e: &[[f64; 3]],
+    boundary: [f32; 2],
 ) -> [f64; 3] {
     let mut far = [0.0f64; 3];
     let mut near = Vec::new();
@@ -105,7 +106,9 @@ pub fn gather_items(
             near.push((positions[s], areas[s], [0, 1, 2].map(|c| e[s][c] * kernel::near_energy(&dipoles[c], b))));
         }
     }
-    let mut blended = near_blend(x, &near);
+    let (blended, mean_area) = near_blend(x, &near);
+    let kept = super::near_kept(dipoles, mean_area, boundary);
+    let mut blended = [0, 1, 2].map(|c| blended[c] * kept[c]);
     if !near.iter().any(|(p, area, _)| kernel::near_blend_weight(x.distance(*p), *area) > 0.0) {
         // No weight reached x: the nearest sample of the whole object, as the flat sum takes it.
         let nearest = (0..positions.len())
@@ -131,6 +134,7 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]], epsilon: f64) -> V
         let groups = o.receiver_groups();
         let cuts = o.gather_cuts(&tree, &groups, epsilon);
         let mesh = o.mesh.positions();
+        let boundary = o.mesh.boundary_distances();
         let computed: Vec<(usize, [f64; 3])> = groups
             .order
             .par_iter()
@@ -138,7 +142,10 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]], epsilon: f64) -> V
             .map(|(k, &v)| {
                 let x = mesh[v as usize].as_dvec3();
                 let items = &cuts[k / RECEIVER_GROUP_SIZE];
-                (v as usize, gather_items(x, items, &tree, &power, dipoles, &positions, &areas, e))
+                (
+                    v as usize,
+                    gather_items(x, items, &tree, &power, dipoles, &positions, &areas, e, boundary[v as usize]),
+                )
             })
             .collect();
         let mut exitance = vec![[0.0; 3]; mesh.len()];

@@ -40,6 +40,13 @@
 //! relative, over lit receivers, estimates the coarser level's error; levels are added until
 //! its RMS is under the tolerance (1e-4), and the finer level is kept. `Truth::levels` reports
 //! every step, so a reader can see it converge.
+//!
+//! # Receivers
+//!
+//! On a large mesh the truth may be asked for at a subset of the vertices
+//! ([`TruthOptions::receivers`]): the quadrature at each receiver does not depend on the
+//! others, so a subset costs in proportion and its values are exactly those of the full truth.
+//! Vertices left out hold NaN ("not computed"), which every statistic over lit receivers skips.
 
 use super::bvh::Bvh;
 use super::{Visibility, occluders, ray_offset, transmitted_irradiance_known};
@@ -99,8 +106,14 @@ pub struct Truth {
     pub version: u32,
     /// The scene content it belongs to ([`content_key`]).
     pub key: String,
-    /// Per object (scene order), per vertex, RGB exitance; all zero for an opaque object.
+    /// Per object (scene order), per vertex, RGB exitance; all zero for an opaque object, NaN
+    /// at a vertex outside the receiver subset (`subset`).
+    #[serde(with = "nan_as_null")]
     pub exitance: Vec<Vec<[f64; 3]>>,
+    /// At most this many receivers per object when the truth covers a subset of the vertices
+    /// ([`TruthOptions::receivers`]); `None` when it covers them all.
+    #[serde(default)]
+    pub subset: Option<usize>,
     /// Every level computed, in order.
     pub levels: Vec<Level>,
     /// The tolerance it was asked for.
@@ -124,11 +137,42 @@ pub struct TruthOptions {
     pub tolerance: f64,
     /// Give up (reporting `converged: false`) after this level.
     pub max_level: u32,
+    /// At most this many receivers per translucent object, spread evenly over its vertex order
+    /// ([`receiver_subset`]); `None`: every vertex. The others hold NaN.
+    pub receivers: Option<usize>,
 }
 
 impl Default for TruthOptions {
     fn default() -> Self {
-        TruthOptions { tolerance: TOLERANCE, max_level: MAX_LEVEL }
+        TruthOptions { tolerance: TOLERANCE, max_level: MAX_LEVEL, receivers: None }
+    }
+}
+
+/// The vertices of a mesh of `count` vertices at which the truth is computed: all of them, or
+/// `max` spread evenly over the vertex order (vertex `floor((i + 1/2) count / max)` for
+/// `i < max`), so the subset is the same on every run.
+pub fn receiver_subset(count: usize, max: Option<usize>) -> Vec<usize> {
+    match max {
+        Some(m) if m < count => (0..m).map(|i| ((2 * i + 1) * count) / (2 * m)).collect(),
+        _ => (0..count).collect(),
+    }
+}
+
+/// Serialises NaN ("not computed") as JSON null, which plain `f64` cannot read back.
+mod nan_as_null {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    type Values = Vec<Vec<[f64; 3]>>;
+
+    pub fn serialize<S: Serializer>(v: &Values, s: S) -> Result<S::Ok, S::Error> {
+        let opt: Vec<Vec<[Option<f64>; 3]>> =
+            v.iter().map(|o| o.iter().map(|m| m.map(|x| (!x.is_nan()).then_some(x))).collect()).collect();
+        opt.serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Values, D::Error> {
+        let opt = Vec::<Vec<[Option<f64>; 3]>>::deserialize(d)?;
+        Ok(opt.into_iter().map(|o| o.into_iter().map(|m| m.map(|x| x.unwrap_or(f64::NAN))).collect()).collect())
     }
 }
 
@@ -148,7 +192,8 @@ pub fn compute(scene: &PreparedScene, options: &TruthOptions, progress: Progress
         let start = std::time::Instant::now();
         let eta = 0.4 * 0.5f64.powf(f64::from(level) / 2.0);
         let mut points = 0;
-        let receivers = scene.vertex_count();
+        let receivers: usize =
+            scene.objects.iter().map(|o| receiver_subset(o.mesh.positions().len(), options.receivers).len()).sum();
         let done = AtomicUsize::new(0);
         let exitance: Vec<Vec<[f64; 3]>> = scene
             .objects
@@ -157,13 +202,17 @@ pub fn compute(scene: &PreparedScene, options: &TruthOptions, progress: Progress
                 ResolvedMaterial::Translucent { material, dipoles, .. } => {
                     let sources = sources(scene, &occluders, o, material.eta, level, eps);
                     points += sources.iter().map(|s| s.grid.len()).sum::<usize>();
-                    exitance_at_vertices(o, dipoles, &sources, eta, &|n| {
+                    let subset = receiver_subset(o.mesh.positions().len(), options.receivers);
+                    exitance_at_vertices(o, &subset, dipoles, &sources, eta, &|n| {
                         let d = done.fetch_add(n, Ordering::Relaxed) + n;
                         progress(level, d, receivers);
                     })
                 }
                 ResolvedMaterial::Opaque { .. } => {
-                    done.fetch_add(o.mesh.positions().len(), Ordering::Relaxed);
+                    done.fetch_add(
+                        receiver_subset(o.mesh.positions().len(), options.receivers).len(),
+                        Ordering::Relaxed,
+                    );
                     vec![[0.0; 3]; o.mesh.positions().len()]
                 }
             })
@@ -193,6 +242,7 @@ pub fn compute(scene: &PreparedScene, options: &TruthOptions, progress: Progress
         version: VERSION,
         key: content_key(scene, options),
         exitance: previous.unwrap_or_default(),
+        subset: options.receivers.filter(|&m| scene.objects.iter().any(|o| m < o.mesh.positions().len())),
         levels,
         tolerance: options.tolerance,
         converged,
@@ -259,6 +309,10 @@ pub fn content_key(scene: &PreparedScene, options: &TruthOptions) -> String {
     h.u64(u64::from(VERSION));
     h.f64(options.tolerance);
     h.u64(u64::from(options.max_level));
+    // Only a subset changes the key, so the caches of whole truths stay valid.
+    if let Some(m) = options.receivers {
+        h.u64(m as u64);
+    }
     for o in &scene.objects {
         h.u64(o.mesh.positions().len() as u64);
         for p in o.mesh.positions() {
@@ -580,6 +634,7 @@ const RADON: [([f64; 3], f64); 7] = {
 /// to the diffusion length).
 fn exitance_at_vertices(
     o: &PreparedObject,
+    subset: &[usize],
     dipoles: &[Dipole; 3],
     sources: &[Source],
     eta: f64,
@@ -590,7 +645,8 @@ fn exitance_at_vertices(
         return vec![[0.0; 3]; o.mesh.positions().len()];
     }
     let tree = Clusters::new(&lit);
-    let positions = o.mesh.positions();
+    let all = o.mesh.positions();
+    let positions: Vec<glam::Vec3> = subset.iter().map(|&v| all[v]).collect();
     let coarse: Vec<[f64; 3]> = positions
         .par_iter()
         .map(|x| {
@@ -605,7 +661,7 @@ fn exitance_at_vertices(
         .collect();
     let floor = [0, 1, 2].map(|c| LIT_FLOOR * coarse.iter().map(|m| m[c]).fold(0.0, f64::max));
     let chunk = 64;
-    positions
+    let at_subset: Vec<[f64; 3]> = positions
         .par_chunks(chunk)
         .zip(coarse.par_chunks(chunk))
         .flat_map_iter(|(xs, m0)| {
@@ -633,7 +689,15 @@ fn exitance_at_vertices(
             progress(xs.len());
             out
         })
-        .collect()
+        .collect();
+    if subset.len() == all.len() {
+        return at_subset;
+    }
+    let mut exitance = vec![[f64::NAN; 3]; all.len()];
+    for (&v, m) in subset.iter().zip(at_subset) {
+        exitance[v] = m;
+    }
+    exitance
 }
 
 /// The coarse pass takes a cluster whole once its radius is at most this fraction of its

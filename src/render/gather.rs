@@ -3,7 +3,7 @@
 //! (`optics::kernel`), samples staged through shared memory, Kahan-compensated f32 sums.
 //!
 //! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = exitance, 5 = tree nodes,
-//! 6 = tree order. Push: `GatherPush`.
+//! 6 = tree order, 7 = boundary distances. Push: `GatherPush`.
 //! One dispatch per translucent object, over its vertex range.
 
 use super::gpu_scene::GpuScene;
@@ -46,6 +46,7 @@ impl GatherPass {
             Binding::Buffer(&scene.exitance),
             Binding::Buffer(&scene.tree_nodes),
             Binding::Buffer(&scene.tree_order),
+            Binding::Buffer(&scene.vertex_boundary),
         ])?;
         Ok(GatherPass { pipeline, set })
     }

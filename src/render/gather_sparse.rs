@@ -9,7 +9,7 @@
 //!
 //! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = sample exitance,
 //! 5 = exitance, 6 = tree nodes, 7 = tree order, 8 = receiver order, 9 = receiver groups,
-//! 10 = blend items. Push: `GatherSparsePush`.
+//! 10 = blend items, 11 = boundary distances. Push: `GatherSparsePush`.
 
 use super::gather::exitance_written;
 use super::gpu_scene::GpuScene;
@@ -53,6 +53,7 @@ impl GatherSparsePass {
             Binding::Buffer(&scene.receiver_order),
             Binding::Buffer(&scene.receiver_groups),
             Binding::Buffer(&scene.blend_items),
+            Binding::Buffer(&scene.vertex_boundary),
         ])?;
         Ok(GatherSparsePass { pipeline, set, _sample_exitance: sample_exitance })
     }
@@ -66,7 +67,9 @@ impl RenderPass for GatherSparsePass {
         }
         // Stage 1 reads what stage 0 wrote.
         memory_barrier(frame.gpu.device(), cmd, &[Access::ComputeWrite], &[Access::ComputeRead]);
-        for r in &frame.scene.receivers {
+        // Only where stage 0 ran: an object the plan computes wholly locally has no sample
+        // exitance this frame, and blending it would spread whatever the buffer held.
+        for r in frame.scene.receivers.iter().filter(|r| frame.plan.gathers(r.object as usize)) {
             self.pipeline.dispatch(cmd, &self.set, &push(r, 1), [r.vertex_count, 1, 1]);
         }
         exitance_written(frame, cmd);

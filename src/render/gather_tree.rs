@@ -8,7 +8,7 @@
 //! whole; 0 is the flat sum. `reference::tree::gather` is its f64 twin.
 //!
 //! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = tree nodes, 5 = tree order,
-//! 6 = node power, 7 = receiver order, 8 = receiver groups, 9 = group items, 10 = exitance.
+//! 6 = node power, 7 = receiver order, 8 = receiver groups, 9 = group items, 10 = exitance, 11 = boundary distances.
 //! Push: `GatherTreePush`.
 
 use super::gather::exitance_written;
@@ -75,6 +75,7 @@ impl GatherTreePass {
             Binding::Buffer(&scene.receiver_groups),
             Binding::Buffer(&scene.group_items),
             Binding::Buffer(&scene.exitance),
+            Binding::Buffer(&scene.vertex_boundary),
         ])?;
         Ok(GatherTreePass { pipeline, set })
     }

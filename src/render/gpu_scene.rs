@@ -71,6 +71,10 @@ pub struct GpuScene {
     /// Radiant exitance per vertex (vec4), written by the vertex and sparse gathers; zero on
     /// opaque objects.
     pub exitance: Buffer,
+    /// Per vertex (vec2), the distances to the two nearest open-boundary directions of a
+    /// translucent object (`mesh::Mesh::boundary_distances`; `mesh::NO_BOUNDARY` on closed
+    /// meshes and opaque objects), for the gathers' near-field edge factor.
+    pub vertex_boundary: Buffer,
     /// Irradiance from the environment's directions per vertex (vec4), from the vertex-light pass.
     pub environment_irradiance: Buffer,
     /// `ObjectRecord` per object, in scene order.
@@ -151,6 +155,7 @@ impl GpuScene {
     pub fn new(gpu: &Arc<Gpu>, scene: &PreparedScene) -> GpuResult<GpuScene> {
         let (mut vertices, mut indices, mut objects, mut samples) =
             (Vec::new(), Vec::<u32>::new(), Vec::new(), Vec::new());
+        let mut vertex_boundary: Vec<[f32; 2]> = Vec::new();
         let (mut draws, mut casters, mut receivers) = (Vec::new(), Vec::new(), Vec::new());
         let (mut tree_nodes, mut tree_order) = (Vec::new(), Vec::<u32>::new());
         let (mut receiver_order, mut receiver_groups) = (Vec::<u32>::new(), Vec::<ReceiverGroupRecord>::new());
@@ -169,6 +174,11 @@ impl GpuScene {
                     .zip(normals)
                     .map(|(p, n)| Vertex { position: p.to_array(), normal: n.to_array() }),
             );
+            if matches!(o.material, crate::scene::build::ResolvedMaterial::Translucent { .. }) {
+                vertex_boundary.extend(o.mesh.boundary_distances());
+            } else {
+                vertex_boundary.extend(std::iter::repeat_n([crate::mesh::NO_BOUNDARY; 2], o.mesh.positions().len()));
+            }
             let draw = DrawRange {
                 first_index: indices.len() as u32,
                 index_count: 3 * o.mesh.triangles().len() as u32,
@@ -251,6 +261,7 @@ impl GpuScene {
             // Opaque vertices keep zero exitance; translucent ones are written by the gather.
             exitance: upload(gpu, "exitance", &zeros, vertex_usage)?,
             environment_irradiance: upload(gpu, "environment irradiance", &zeros, vertex_usage)?,
+            vertex_boundary: upload(gpu, "vertex boundary", &vertex_boundary, vk::BufferUsageFlags::empty())?,
             objects: upload(gpu, "objects", &objects, vk::BufferUsageFlags::empty())?,
             samples: upload(gpu, "samples", &samples, vk::BufferUsageFlags::empty())?,
             splat: storage(

@@ -185,8 +185,9 @@ pub struct Study {
     pub truth: Truth,
     /// Whether the truth came from the cache.
     pub truth_cached: bool,
-    /// The scene shaded with the true exitance (vertex interpolation, like the vertex gather).
-    pub truth_image: Images,
+    /// The scene shaded with the true exitance (vertex interpolation, like the vertex gather);
+    /// none when the truth covers a subset of the vertices.
+    pub truth_image: Option<Images>,
     /// The scene prepared as the truth saw it (the study's first configuration's geometry).
     pub prepared: PreparedScene,
     /// Each configuration's per-vertex exitance, for `--error-image` (same order as `rows`).
@@ -296,18 +297,22 @@ pub fn run(
         progress(Event::TruthCached);
     }
 
-    // The truth's image: a full frame for shadows and sky, then the exact exitance shaded.
-    let mut renderer = Renderer::new(gpu, base.clone())?;
-    renderer.frame(&renderer.plan(Change::Everything))?;
-    for (i, m) in truth.exitance.iter().enumerate() {
-        if matches!(base.objects[i].material, ResolvedMaterial::Translucent { .. }) {
-            let values: Vec<[f32; 3]> = m.iter().map(|v| v.map(|x| x as f32)).collect();
-            renderer.set_exitance(i, &values)?;
+    // The truth's image: a full frame for shadows and sky, then the exact exitance shaded. A
+    // truth at a subset of the vertices has no image (the others are unknown), so no image error.
+    let truth_image = if truth.subset.is_some() {
+        None
+    } else {
+        let mut renderer = Renderer::new(gpu, base.clone())?;
+        renderer.frame(&renderer.plan(Change::Everything))?;
+        for (i, m) in truth.exitance.iter().enumerate() {
+            if matches!(base.objects[i].material, ResolvedMaterial::Translucent { .. }) {
+                let values: Vec<[f32; 3]> = m.iter().map(|v| v.map(|x| x as f32)).collect();
+                renderer.set_exitance(i, &values)?;
+            }
         }
-    }
-    renderer.frame(&renderer.plan(Change::Camera))?;
-    let truth_image = images(&renderer)?;
-    drop(renderer);
+        renderer.frame(&renderer.plan(Change::Camera))?;
+        Some(images(&renderer)?)
+    };
 
     let name = scene.name.clone();
     let (mut rows, mut exitances) = (Vec::new(), Vec::new());
@@ -359,9 +364,12 @@ pub fn run(
                         p99: error.map_or(nan, |e| e.p99),
                         max: error.map_or(nan, |e| e.max),
                         bias: error.map_or(nan, |e| e.bias),
-                        image_rel_rmse: image_rel_rmse(&truth_image.hdr, &image.hdr),
-                        flip_mean: flip::flip_mean(&truth_image.ldr, &image.ldr, image.size[0], image.size[1])
-                            .map_err(StudyError::Report)?,
+                        image_rel_rmse: truth_image.as_ref().map_or(f64::NAN, |t| image_rel_rmse(&t.hdr, &image.hdr)),
+                        flip_mean: match &truth_image {
+                            Some(t) => flip::flip_mean(&t.ldr, &image.ldr, image.size[0], image.size[1])
+                                .map_err(StudyError::Report)?,
+                            None => f64::NAN,
+                        },
                     });
                     exitances.push(exitance);
                 }
