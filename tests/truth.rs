@@ -200,3 +200,48 @@ irradiance = [1.0, 1.0, 1.0]
     assert!(!was_cached);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A truth at a vertex subset is the full truth at those vertices (each receiver's quadrature
+/// ignores the others but for the threshold of what is negligible, set from the brightest
+/// receiver) and NaN ("not computed") elsewhere, survives the cache's JSON round trip
+/// (where NaN is null), and has a key of its own.
+#[test]
+fn truth_at_a_vertex_subset_equals_the_full_truth_there_and_is_cached_apart() {
+    let scene = prepare(
+        r#"
+[[object]]
+shape = { type = "sphere", radius = 10.0, divisions = 4 }
+material = { type = "translucent", preset = "marble", mm_per_unit = 1.0 }
+
+[[light]]
+type = "directional"
+direction = [0.3, 1.0, 0.0]
+irradiance = [1.0, 1.0, 1.0]
+"#,
+    );
+    let full_options = truth::TruthOptions { max_level: 1, ..Default::default() };
+    let n = scene.objects[0].mesh.positions().len();
+    let subset_options = truth::TruthOptions { receivers: Some(n / 3), ..full_options };
+    let full = truth::compute(&scene, &full_options, &quiet);
+    let dir = std::env::temp_dir().join(format!("translucent-truth-subset-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let (part, _) = truth::cached(&scene, &subset_options, &dir, &quiet).unwrap();
+    let (again, was_cached) = truth::cached(&scene, &subset_options, &dir, &quiet).unwrap();
+    assert!(was_cached);
+    assert_eq!(part.subset, Some(n / 3));
+    assert_ne!(truth::content_key(&scene, &full_options), truth::content_key(&scene, &subset_options));
+    let chosen = truth::receiver_subset(n, Some(n / 3));
+    assert_eq!(chosen.len(), n / 3);
+    for v in 0..n {
+        for t in [&part, &again] {
+            let m = t.exitance[0][v];
+            if chosen.contains(&v) {
+                let f = full.exitance[0][v];
+                assert!((0..3).all(|c| (m[c] - f[c]).abs() <= 1e-6 * f[c].abs()), "vertex {v}: {m:?} vs {f:?}");
+            } else {
+                assert!(m.iter().all(|x| x.is_nan()), "vertex {v} outside the subset: {m:?}");
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -18,7 +18,7 @@
 //! - `E_t` is evaluated on a grid over each mesh triangle (the triangle split in `4^depth`
 //!   cells) and taken as linear inside each cell. Every light is ray cast on the triangle's
 //!   base grid; on finer grids only the lights whose shadow edge crosses it (reaching some base
-//!   points, blocked at others). Where a strong light's edge crosses ([`STRONG_LIGHT`]) the grid
+//!   points, blocked at others) and those facing none of its base points. Where a strong light's edge crosses ([`STRONG_LIGHT`]) the grid
 //!   is [`EDGE_EXTRA_DEPTH`] levels finer. (So a shadow narrower than the base grid that touches
 //!   none of its points is missed at every level: the one assumption the levels cannot check.)
 //!   This is the only place rays are cast, and it does not depend on the receiver. Each triangle keeps the exact flux and centroid of
@@ -45,7 +45,8 @@
 //!
 //! On a large mesh the truth may be asked for at a subset of the vertices
 //! ([`TruthOptions::receivers`]): the quadrature at each receiver does not depend on the
-//! others, so a subset costs in proportion and its values are exactly those of the full truth.
+//! others (but for the threshold of what is negligible, set from the brightest receiver of the
+//! subset), so a subset costs in proportion and its values are those of the full truth.
 //! Vertices left out hold NaN ("not computed"), which every statistic over lit receivers skips.
 
 use super::bvh::Bvh;
@@ -77,7 +78,7 @@ pub const EDGE_EXTRA_DEPTH: u32 = 2;
 /// triangle that any of 16 sky directions half-shadows would refine nearly all of them.
 pub const STRONG_LIGHT: f64 = 0.1;
 /// Bumped whenever the quadrature changes, so an old cache is not read as the truth.
-pub const VERSION: u32 = 4;
+pub const VERSION: u32 = 5;
 /// Deepest split of one piece of surface (a guard: `kappa` bounds the depth long before).
 const MAX_DEPTH: u32 = 40;
 
@@ -547,17 +548,20 @@ fn sources(scene: &PreparedScene, occluders: &Bvh, o: &PreparedObject, eta: f64,
             let base = (spread / NORMAL_SPREAD).log2().ceil().clamp(0.0, 8.0) as u32;
             // Every light is ray cast on the base grid. A light that reaches some of its points
             // and is blocked at others casts a shadow edge across the triangle (the terminator
-            // is no edge: E_t falls to zero there continuously, as cos^2); only such lights are
-            // ray cast on the finer grids, the others keep the base grid's verdict. A shadow
-            // narrower than the base grid that touches none of its points is therefore missed
-            // at every level.
+            // is no edge: E_t falls to zero there continuously, as cos^2); such lights are ray
+            // cast on the finer grids, and so are those that face none of the base points (the
+            // triangle straddles their terminator, so the base grid says nothing of their
+            // shadows; back-facing points cost no ray). The others keep the base grid's
+            // verdict, so a shadow narrower than the base grid that touches none of its points
+            // is missed at every level.
             let (base_grid, reached, blocked) = grid_at(base, Visibility::TRACE_ALL);
             let edges = reached & blocked;
+            let unknown = !(reached | blocked);
             let depth = base + level + if edges & strong != 0 { EDGE_EXTRA_DEPTH } else { 0 };
             let grid = if depth == base {
                 base_grid
             } else {
-                grid_at(depth, Visibility { trace: edges, blocked: blocked & !reached }).0
+                grid_at(depth, Visibility { trace: edges | unknown, blocked: blocked & !reached }).0
             };
             let area = mesh.triangle_areas()[t];
             let centre = (corners[0] + corners[1] + corners[2]) / 3.0;

@@ -1,0 +1,165 @@
+//! Experiment for the study's defect 2 (the vertex gather reads low beside the terminator): the
+//! f64 twin's error against the exact integral, binned by `n.l` at the vertex, split into what the
+//! far sum and the near-field blend contribute. `terminator SCENE COUNT [CACHE_DIR]` (one
+//! directional light; the scene's sampler).
+use translucent::optics::kernel;
+use translucent::reference::{self, truth};
+use translucent::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
+use translucent::scene::lights::LightKind;
+use translucent::scene::{GatherMode, Scene, TransportMode};
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let scene = Scene::load(std::path::Path::new(&args[1])).unwrap();
+    let count: usize = args[2].parse().unwrap();
+    let overrides = Overrides {
+        transport: Some(TransportMode::Gather),
+        gather: Some(GatherMode::Vertex),
+        samples: Some(count),
+        ..Overrides::default()
+    };
+    let scene = PreparedScene::new(&scene, &overrides).unwrap();
+    let dir = args.get(3).map_or_else(truth::default_cache_dir, std::path::PathBuf::from);
+    let (t, _) = truth::cached(&scene, &truth::TruthOptions::default(), &dir, &|_, _, _| {}).unwrap();
+    let LightKind::Directional { direction, .. } = scene.lights[0].kind else { panic!("one directional light") };
+    let l = direction.as_dvec3().normalize();
+    let occluders = reference::occluders(&scene);
+    let eps = reference::ray_offset(&scene);
+    let irradiance = reference::splat(&scene, &occluders);
+    let o = &scene.objects[0];
+    let ResolvedMaterial::Translucent { dipoles, material, .. } = &o.material else { panic!() };
+    let samples: Vec<_> = o.samples.iter().zip(&irradiance).collect();
+    let bins = [(-0.3, -0.1), (-0.1, 0.0), (0.0, 0.1), (0.1, 0.2), (0.2, 0.4), (0.4, 0.7)];
+    // Per bin: sum of relative errors of (gather, far + exact near), near share, count.
+    let mut acc = vec![([0.0f64; 3], [0.0f64; 3], [0.0f64; 3], [0.0f64; 3], 0usize); bins.len()];
+    // The exact near part, integral R_near(|x - y|; b) E_t(y) dA(y), by brute force over the
+    // triangles within reach (pieces of a twentieth of R_near's width), for the band's vertices.
+    let mut split = vec![([0.0f64; 3], [0.0f64; 3], 0usize); bins.len()];
+    let normals = o.mesh.vertex_normals();
+    for (v, (x, n)) in o.mesh.positions().iter().zip(normals).enumerate() {
+        let (x, n) = (x.as_dvec3(), n.as_dvec3());
+        let nl = n.dot(l);
+        let Some(bin) = bins.iter().position(|&(a, b)| nl >= a && nl < b) else { continue };
+        let (mut far, mut near, mut wsum, mut asum) = ([0.0; 3], [0.0; 3], 0.0, 0.0);
+        for (s, e) in &samples {
+            let r = x.distance(s.position.as_dvec3());
+            let b = kernel::B_PER_SQRT_AREA * s.area.sqrt();
+            let w = kernel::near_blend_weight(r, s.area);
+            wsum += w;
+            asum += w * s.area;
+            for c in 0..3 {
+                far[c] += e[c] * kernel::far_kernel(&dipoles[c], r, s.area);
+                near[c] += w * e[c] * kernel::near_energy(&dipoles[c], b);
+            }
+        }
+        let (e_x, ..) = reference::transmitted_irradiance(&scene, &occluders, x, n, material.eta, eps);
+        let b_mean = kernel::B_PER_SQRT_AREA * (asum / wsum.max(1e-300)).sqrt();
+        let exact = t.exitance[0][v];
+        let a = &mut acc[bin];
+        for c in 0..3 {
+            if exact[c] <= 0.0 {
+                continue;
+            }
+            let blend = if wsum > 0.0 { near[c] / wsum } else { 0.0 };
+            let exact_near = e_x[c] * kernel::near_energy(&dipoles[c], b_mean);
+            a.0[c] += (far[c] + blend - exact[c]) / exact[c];
+            a.1[c] += (far[c] + exact_near - exact[c]) / exact[c];
+            a.2[c] += blend / exact[c];
+            a.3[c] += (blend - exact_near) / exact[c];
+        }
+        a.4 += 1;
+        if nl.abs() < 0.2 || (0.4..0.7).contains(&nl) {
+            let ell = (dipoles.iter().map(|d| d.z_v * d.z_v).fold(0.0, f64::max) + b_mean * b_mean).sqrt();
+            let reach = 8.0 * ell;
+            let mut exact_near = [0.0; 3];
+            for tri in 0..o.mesh.triangles().len() {
+                let [p0, p1, p2] = o.mesh.corners(tri);
+                if x.distance(p0).min(x.distance(p1)).min(x.distance(p2)) > reach + p0.distance(p1).max(p1.distance(p2))
+                {
+                    continue;
+                }
+                let area = 0.5 * (p1 - p0).cross(p2 - p0).length();
+                let m = ((p0.distance(p1).max(p1.distance(p2)).max(p2.distance(p0))) / (ell / 20.0)).ceil().max(1.0)
+                    as usize;
+                let each = area / (m * m) as f64;
+                let inv = 1.0 / m as f64;
+                let mut piece = |u: f64, w: f64| {
+                    let bary = [1.0 - u - w, u, w];
+                    let y = p0 * bary[0] + p1 * bary[1] + p2 * bary[2];
+                    let r = x.distance(y);
+                    if r > reach {
+                        return;
+                    }
+                    let ny = o.mesh.normal_at(tri, bary).as_dvec3();
+                    let (e, ..) = reference::transmitted_irradiance(&scene, &occluders, y, ny, material.eta, eps);
+                    for c in 0..3 {
+                        let near_k = (dipoles[c].r_d(r) - kernel::r_d_far(&dipoles[c], r, b_mean)).max(0.0);
+                        exact_near[c] += near_k * e[c] * each;
+                    }
+                };
+                for i in 0..m {
+                    for j in 0..m - i {
+                        piece((i as f64 + 1.0 / 3.0) * inv, (j as f64 + 1.0 / 3.0) * inv);
+                        if i + j + 1 < m {
+                            piece((i as f64 + 2.0 / 3.0) * inv, (j as f64 + 2.0 / 3.0) * inv);
+                        }
+                    }
+                }
+            }
+            let sp = &mut split[bin];
+            for c in 0..3 {
+                if exact[c] <= 0.0 {
+                    continue;
+                }
+                let blend = if wsum > 0.0 { near[c] / wsum } else { 0.0 };
+                // far sum against exact far (truth - exact near), blend against exact near
+                sp.0[c] += (far[c] - (exact[c] - exact_near[c])) / exact[c];
+                sp.1[c] += (blend - exact_near[c]) / exact[c];
+            }
+            sp.2 += 1;
+        }
+    }
+    println!("{} {count}: mean relative error per n.l bin, r/g/b", args[1]);
+    for (bin, a) in bins.iter().zip(&acc) {
+        let f = |v: [f64; 3]| {
+            format!(
+                "{:+.2}/{:+.2}/{:+.2}%",
+                100.0 * v[0] / a.4 as f64,
+                100.0 * v[1] / a.4 as f64,
+                100.0 * v[2] / a.4 as f64
+            )
+        };
+        println!(
+            "[{:+.1},{:+.1}) n={:4}  gather {}  far+E_t(x)E_near {}  near share {}  blend-minus-local {}",
+            bin.0,
+            bin.1,
+            a.4,
+            f(a.0),
+            f(a.1),
+            f(a.2),
+            f(a.3)
+        );
+    }
+    println!("split against the exact near part (brute force):");
+    for (bin, sp) in bins.iter().zip(&split) {
+        if sp.2 == 0 {
+            continue;
+        }
+        let f = |v: [f64; 3]| {
+            format!(
+                "{:+.2}/{:+.2}/{:+.2}%",
+                100.0 * v[0] / sp.2 as f64,
+                100.0 * v[1] / sp.2 as f64,
+                100.0 * v[2] / sp.2 as f64
+            )
+        };
+        println!(
+            "[{:+.1},{:+.1}) n={:4}  far sum - exact far {}  blend - exact near {}",
+            bin.0,
+            bin.1,
+            sp.2,
+            f(sp.0),
+            f(sp.1)
+        );
+    }
+}
