@@ -128,6 +128,7 @@ fn study_rejects_a_bad_sweep_selection_naming_the_flag_and_writes_nothing() {
         ("--counts", "0", "1 to"),
         ("--samplers", "sobol", "sobol"),
         ("--truth-levels", "0", "1 to"),
+        ("--truth-receivers", "10", "at least 100"),
     ] {
         let run = translucent(&["study", "-o", out.to_str().unwrap(), flag, value], &[]);
         let err = text(&run.stderr);
@@ -135,4 +136,11 @@ fn study_rejects_a_bad_sweep_selection_naming_the_flag_and_writes_nothing() {
         assert!(err.contains(flag) && err.contains(says), "{flag} {value}: {err}");
         assert!(!out.exists(), "{flag} {value} made the output folder");
     }
+    let run = translucent(
+        &["study", "-o", out.to_str().unwrap(), "--truth-receivers", "500", "--error-image", "turk:400"],
+        &[],
+    );
+    let err = text(&run.stderr);
+    assert!(!run.status.success() && err.contains("--error-image") && err.contains("--truth-receivers"), "{err}");
+    assert!(!out.exists(), "--error-image with --truth-receivers made the output folder");
 }

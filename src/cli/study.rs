@@ -138,6 +138,10 @@ fn config(args: &Args) -> Result<StudyConfig> {
 pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let chosen = args.error_image.as_deref().map(parse_error_image).transpose()?;
     let config = config(args)?;
+    if chosen.is_some() && config.truth.receivers.is_some() {
+        // The picture colours every vertex by its error; a subset truth knows only some.
+        bail!("--error-image needs the truth at every vertex: leave out --truth-receivers");
+    }
     if let Some((m, n, g)) = chosen {
         let swept =
             config.samplers.contains(&m) && config.counts.contains(&n) && config.gathers.iter().any(|x| x.0 == g);
