@@ -121,14 +121,7 @@ fn main() {
     }
     println!("{} {count}: mean relative error per n.l bin, r/g/b", args[1]);
     for (bin, a) in bins.iter().zip(&acc) {
-        let f = |v: [f64; 3]| {
-            format!(
-                "{:+.2}/{:+.2}/{:+.2}%",
-                100.0 * v[0] / a.4 as f64,
-                100.0 * v[1] / a.4 as f64,
-                100.0 * v[2] / a.4 as f64
-            )
-        };
+        let f = |v: [f64; 3]| mean_percent(v, a.4);
         println!(
             "[{:+.1},{:+.1}) n={:4}  gather {}  far+E_t(x)E_near {}  near share {}  blend-minus-local {}",
             bin.0,
@@ -145,14 +138,7 @@ fn main() {
         if sp.2 == 0 {
             continue;
         }
-        let f = |v: [f64; 3]| {
-            format!(
-                "{:+.2}/{:+.2}/{:+.2}%",
-                100.0 * v[0] / sp.2 as f64,
-                100.0 * v[1] / sp.2 as f64,
-                100.0 * v[2] / sp.2 as f64
-            )
-        };
+        let f = |v: [f64; 3]| mean_percent(v, sp.2);
         println!(
             "[{:+.1},{:+.1}) n={:4}  far sum - exact far {}  blend - exact near {}",
             bin.0,
@@ -162,4 +148,10 @@ fn main() {
             f(sp.1)
         );
     }
+}
+
+/// The mean of `n` summed relative errors per channel, as "r/g/b%".
+fn mean_percent(sum: [f64; 3], n: usize) -> String {
+    let m = sum.map(|v| 100.0 * v / n as f64);
+    format!("{:+.2}/{:+.2}/{:+.2}%", m[0], m[1], m[2])
 }

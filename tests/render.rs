@@ -3,7 +3,7 @@
 mod common;
 
 use common::{builtin, gather_from, plane_scene, run_all, with_gpu};
-use translucent::optics::{Material, fresnel};
+use translucent::optics::{Dipole, Material, fresnel};
 use translucent::reference;
 use translucent::render::plan::{Change, Pass};
 use translucent::render::renderer::Renderer;
@@ -15,6 +15,18 @@ fn prepare(toml: &str, overrides: &Overrides) -> PreparedScene {
     PreparedScene::new(&scene, overrides).expect("test scene prepares")
 }
 
+/// A 1 m square of `preset` lit straight from above, 3,000 Poisson samples, gathered with
+/// `gather` in every channel (the samples lie several profile radii apart, where the planner
+/// would compute some channels locally and leave the gather nothing to show); with its dipoles
+/// at 1 mm per unit and the Fresnel transmittance at normal incidence.
+fn lit_plane(preset: &str, gather: GatherMode) -> (PreparedScene, [Dipole; 3], f64) {
+    let overrides = Overrides { gather: Some(gather), transport: Some(TransportMode::Gather), ..Default::default() };
+    let prepared = prepare(&plane_scene(preset, 1000.0, 3000, ""), &overrides);
+    let material = Material::preset(preset).unwrap();
+    let dipoles = material.dipoles(1.0).unwrap();
+    (prepared, dipoles, fresnel::fresnel_transmittance(1.0, material.eta))
+}
+
 #[test]
 fn uniformly_lit_plane_reflects_total_diffuse_reflectance() {
     with_gpu(|gpu| {
@@ -23,14 +35,7 @@ fn uniformly_lit_plane_reflects_total_diffuse_reflectance() {
             .into_iter()
             .chain([("marble", GatherMode::Sparse), ("skimmilk", GatherMode::Sparse)]);
         for (preset, gather) in cases {
-            // Every channel gathered: the samples lie several profile radii apart, where the
-            // planner would compute some channels locally and leave the gather nothing to show.
-            let overrides =
-                Overrides { gather: Some(gather), transport: Some(TransportMode::Gather), ..Default::default() };
-            let prepared = prepare(&plane_scene(preset, 1000.0, 3000, ""), &overrides);
-            let material = Material::preset(preset).unwrap();
-            let dipoles = material.dipoles(1.0).unwrap();
-            let f_t = fresnel::fresnel_transmittance(1.0, material.eta);
+            let (prepared, dipoles, f_t) = lit_plane(preset, gather);
             let mesh = prepared.objects[0].mesh.clone();
             let renderer = run_all(gpu, prepared);
             let exitance = renderer.exitance(0).unwrap();
@@ -63,12 +68,7 @@ fn open_edges_and_corners_of_a_plane_read_the_half_and_quarter_plane_integrals()
             ("marble", GatherMode::Sparse),
             ("marble", GatherMode::Hierarchical),
         ] {
-            let overrides =
-                Overrides { gather: Some(gather), transport: Some(TransportMode::Gather), ..Default::default() };
-            let prepared = prepare(&plane_scene(preset, 1000.0, 3000, ""), &overrides);
-            let material = Material::preset(preset).unwrap();
-            let dipoles = material.dipoles(1.0).unwrap();
-            let f_t = fresnel::fresnel_transmittance(1.0, material.eta);
+            let (prepared, dipoles, f_t) = lit_plane(preset, gather);
             let mesh = prepared.objects[0].mesh.clone();
             if gather == GatherMode::Vertex {
                 // The GPU's edge factor against its f64 twin, on the same irradiance.

@@ -16,27 +16,10 @@ const SAME_DIRECTION: f64 = std::f64::consts::FRAC_1_SQRT_2;
 
 impl Mesh {
     /// The edges used by exactly one triangle (an open boundary; edges shared by three or more
-    /// go on into the surface and are not boundaries), as vertex pairs.
-    pub fn boundary_edges(&self) -> Vec<[u32; 2]> {
-        let mut edges: Vec<(u32, u32)> = self
-            .triangles()
-            .iter()
-            .flat_map(|t| (0..3).map(move |e| (t[e].min(t[(e + 1) % 3]), t[e].max(t[(e + 1) % 3]))))
-            .collect();
-        edges.sort_unstable();
-        let mut out = Vec::new();
-        let mut i = 0;
-        while i < edges.len() {
-            let mut j = i + 1;
-            while j < edges.len() && edges[j] == edges[i] {
-                j += 1;
-            }
-            if j - i == 1 {
-                out.push([edges[i].0, edges[i].1]);
-            }
-            i = j;
-        }
-        out
+    /// go on into the surface and are not boundaries), as vertex pairs, found with the rest of
+    /// the edge adjacency when the mesh was built.
+    pub fn boundary_edges(&self) -> &[[u32; 2]] {
+        &self.boundary_edges
     }
 
     /// Per vertex, the distance to the nearest boundary edge and the distance to the nearest

@@ -168,6 +168,7 @@ pub struct Mesh {
     gaussian_curvature: Vec<f64>,
     mixed_areas: Vec<f64>,
     boundary_vertex: Vec<bool>,
+    boundary_edges: Vec<[u32; 2]>,
     neighbours: Vec<[u32; 3]>,
     ring_offsets: Vec<u32>,
     ring: Vec<u32>,
@@ -250,7 +251,7 @@ impl Mesh {
         report.unreferenced_vertices = unreferenced;
 
         let topo = topology::build(positions.len(), &triangles);
-        report.boundary_edges = topo.boundary_edges;
+        report.boundary_edges = topo.boundary_edges.len();
         report.non_manifold_edges = topo.non_manifold_edges;
         report.inconsistently_oriented_edges = topo.inconsistent_edges;
 
@@ -275,6 +276,7 @@ impl Mesh {
             gaussian_curvature: geo.gaussian_curvature,
             mixed_areas: geo.mixed_areas,
             boundary_vertex: topo.boundary_vertex,
+            boundary_edges: topo.boundary_edges,
             neighbours: topo.neighbours,
             ring_offsets: topo.ring_offsets,
             ring: topo.ring,

@@ -7,7 +7,8 @@ use super::NO_NEIGHBOUR;
 
 pub(super) struct Topology {
     pub neighbours: Vec<[u32; 3]>,
-    pub boundary_edges: usize,
+    /// The edges used by exactly one triangle (low vertex, high vertex).
+    pub boundary_edges: Vec<[u32; 2]>,
     pub non_manifold_edges: usize,
     pub inconsistent_edges: usize,
     pub boundary_vertex: Vec<bool>,
@@ -28,7 +29,8 @@ pub(super) fn build(vertex_count: usize, triangles: &[[u32; 3]]) -> Topology {
 
     let mut neighbours = vec![[NO_NEIGHBOUR; 3]; triangles.len()];
     let mut boundary_vertex = vec![false; vertex_count];
-    let (mut boundary_edges, mut non_manifold_edges, mut inconsistent_edges) = (0, 0, 0);
+    let mut boundary_edges = Vec::new();
+    let (mut non_manifold_edges, mut inconsistent_edges) = (0, 0);
     let mut ring_counts = vec![0u32; vertex_count + 1];
 
     let mut start = 0;
@@ -55,7 +57,7 @@ pub(super) fn build(vertex_count: usize, triangles: &[[u32; 3]]) -> Topology {
             }
             count => {
                 if count == 1 {
-                    boundary_edges += 1;
+                    boundary_edges.push([a, b]);
                 } else {
                     non_manifold_edges += 1;
                 }

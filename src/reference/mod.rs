@@ -195,20 +195,18 @@ pub(crate) fn near_kept(dipoles: &[Dipole; 3], mean_area: Option<f64>, boundary:
     })
 }
 
-/// A sample's position, area and a per-channel value to blend between samples ([`near_blend`]).
-type Blended = (DVec3, f64, [f64; 3]);
-
 /// Blend per-sample values to `x` with the near-field Shepard weights
 /// (`kernel::near_blend_weight`), or take the nearest sample's where no weight reaches: the twin
 /// of the blend in glsl/common/gather.glsl and glsl/gather_sparse.comp. Also the blend's mean
-/// sample area (`sum w A / sum w`), none where no weight reaches.
-pub(crate) fn near_blend(x: DVec3, values: &[(DVec3, f64, [f64; 3])]) -> ([f64; 3], Option<f64>) {
-    let (mut sum, mut weight_sum, mut area_sum) = ([0.0; 3], 0.0, 0.0);
-    let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; 3]);
+/// sample area (`sum w A / sum w`), none where no weight reaches. `N` values per sample: the
+/// sparse gather blends its far and near parts (six) with one set of weights.
+pub(crate) fn near_blend<const N: usize>(x: DVec3, values: &[(DVec3, f64, [f64; N])]) -> ([f64; N], Option<f64>) {
+    let (mut sum, mut weight_sum, mut area_sum) = ([0.0; N], 0.0, 0.0);
+    let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; N]);
     for (p, area, v) in values {
         let r = x.distance(*p);
         let w = kernel::near_blend_weight(r, *area);
-        for c in 0..3 {
+        for c in 0..N {
             sum[c] += w * v[c];
         }
         weight_sum += w;
@@ -226,7 +224,8 @@ pub(crate) fn near_blend(x: DVec3, values: &[(DVec3, f64, [f64; 3])]) -> ([f64; 
 /// ([`near_kept`]).
 pub fn gather_sparse(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3]>> {
     per_translucent_object(scene, |o, dipoles, first| {
-        let at_samples: Vec<(Blended, Blended)> = o
+        // Per sample: the far sum there (r, g, b), then its own near exitance (r, g, b).
+        let at_samples: Vec<(DVec3, f64, [f64; 6])> = o
             .samples
             .par_iter()
             .enumerate()
@@ -240,11 +239,11 @@ pub fn gather_sparse(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<
                     }
                 }
                 let b = kernel::B_PER_SQRT_AREA * sj.area.sqrt();
-                let near = [0, 1, 2].map(|c| irradiance[first + j][c] * kernel::near_energy(&dipoles[c], b));
-                ((x, sj.area, t.map(|v| v.max(0.0))), (x, sj.area, near))
+                let near = |c: usize| irradiance[first + j][c] * kernel::near_energy(&dipoles[c], b);
+                let values = [t[0].max(0.0), t[1].max(0.0), t[2].max(0.0), near(0), near(1), near(2)];
+                (x, sj.area, values)
             })
             .collect();
-        let (far, near): (Vec<_>, Vec<_>) = at_samples.into_iter().unzip();
         let boundary = o.mesh.boundary_distances();
         o.mesh
             .positions()
@@ -252,9 +251,9 @@ pub fn gather_sparse(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<
             .zip(&boundary)
             .map(|(x, t)| {
                 let x = x.as_dvec3();
-                let ((f, _), (n, mean_area)) = (near_blend(x, &far), near_blend(x, &near));
+                let (m, mean_area) = near_blend(x, &at_samples);
                 let kept = near_kept(dipoles, mean_area, *t);
-                [0, 1, 2].map(|c| f[c] + n[c] * kept[c])
+                [0, 1, 2].map(|c| m[c] + m[3 + c] * kept[c])
             })
             .collect()
     })
