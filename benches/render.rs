@@ -2,7 +2,7 @@
 //! seed paper's FPS-against-sample-count comparison (its Figure 7), on whatever device the
 //! loader offers (TRANSLUCENT_DEVICE to choose). Prints figures; asserts nothing.
 //!
-//!     cargo bench --bench render [-- frames|hierarchy|planner|gathers]
+//!     cargo bench --bench render [-- frames|savings|levels|hierarchy|planner|gathers]
 //!
 //! Two timings per pass: GPU timestamp queries inside one submission, and the wall time of the
 //! pass submitted alone (submission to fence). On lavapipe, compute dispatches run
@@ -146,7 +146,8 @@ fn gather_alone_ms(renderer: &mut Renderer) -> f64 {
 /// Exitance of the first translucent object after a full first frame with `overrides`, and the
 /// renderer, on the default scene at 512x512.
 fn prepared_renderer(gpu: &Arc<Gpu>, overrides: Overrides) -> Renderer {
-    let overrides = Overrides { resolution: Some([512, 512]), ..overrides };
+    // Per-vertex comparisons need every vertex gathered.
+    let overrides = Overrides { resolution: Some([512, 512]), level_of_detail: Some(false), ..overrides };
     let prepared = PreparedScene::new(&Scene::builtin(), &overrides).expect("scene");
     let mut renderer = Renderer::new(gpu, prepared).expect("renderer");
     renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
@@ -234,6 +235,146 @@ fn slope(x: &[f64], y: &[f64]) -> f64 {
     let cov: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
     let var: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
     cov / var
+}
+
+/// One orbit step of what `change` moves: the key light or the camera, 3 degrees.
+fn step(renderer: &mut Renderer, change: Change) {
+    match change {
+        Change::Light(i) => {
+            let scene = renderer.scene();
+            let moved = lights::orbit(&scene.scene.file.lights[i], scene.bounds.0, 3.0).expect("a key light");
+            renderer.set_light(i, moved).expect("orbit");
+        }
+        _ => renderer.set_camera(renderer.camera().orbited(renderer.scene().bounds.0, 3.0)),
+    }
+}
+
+/// What a benchmark renderer does instead of the planner's choice.
+#[derive(Clone, Copy, Default)]
+struct Force {
+    /// Every object at this level of detail (or its coarsest).
+    level: Option<usize>,
+    /// The shadow filter: one tap (true) or the four-tap tent (false).
+    one_tap: Option<bool>,
+}
+
+/// Renderers on the default scene at 512x512, one per configuration, stepped side by side
+/// through the same frames (alternating, so outside load falls on all alike), each with its
+/// `Force`. Returns each one's median frame wall time (ms) and its last image (RGBA8).
+fn side_by_side(renderers: &mut [(Renderer, Force)], change: Change, frames: usize) -> Vec<(f64, Vec<u8>)> {
+    let mut times = vec![Vec::new(); renderers.len()];
+    for frame in 0..WARM_UP + frames {
+        for ((renderer, force), t) in renderers.iter_mut().zip(&mut times) {
+            step(renderer, change);
+            let mut plan = renderer.plan(change);
+            if let Some(level) = force.level {
+                for o in &mut plan.objects {
+                    o.level = level.min(renderer.needs().objects[o.object].levels.len() - 1);
+                }
+            }
+            if let Some(one_tap) = force.one_tap {
+                plan.one_tap_shadows = one_tap;
+            }
+            let start = Instant::now();
+            renderer.frame(&plan).expect("frame");
+            if frame >= WARM_UP {
+                t.push(start.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+    }
+    renderers.iter().zip(&mut times).map(|((r, _), t)| (median(t), r.image().expect("image").0)).collect()
+}
+
+fn default_renderer(gpu: &Arc<Gpu>, overrides: Overrides) -> Renderer {
+    let overrides = Overrides { resolution: Some([512, 512]), ..overrides };
+    let prepared = PreparedScene::new(&Scene::builtin(), &overrides).expect("default scene");
+    let mut renderer = Renderer::new(gpu, prepared).expect("renderer");
+    renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
+    renderer
+}
+
+fn flip(reference: &[u8], test: &[u8]) -> f64 {
+    translucent::study::flip::flip_mean(reference, test, 512, 512).expect("flip")
+}
+
+/// What each saving buys: frames per second with every saving on, then with each switched off
+/// in turn, light moving and camera moving, and the FLIP mean of each image against the
+/// full-detail render of the same frame.
+fn savings(gpu: &Arc<Gpu>) {
+    let full_detail = Overrides { level_of_detail: Some(false), ..Default::default() };
+    let configs: Vec<(&str, Overrides, Force)> = vec![
+        ("every saving on (the default)", Overrides::default(), Force::default()),
+        ("level of detail off", full_detail.clone(), Force::default()),
+        ("four-tap shadow filter", Overrides::default(), Force { one_tap: Some(false), ..Force::default() }),
+        ("full detail, four taps", full_detail, Force { one_tap: Some(false), ..Force::default() }),
+    ];
+    println!(
+        "\nWhat each saving buys, default scene 512x512, 400 samples, whole-frame wall time (median of {FRAMES} after \
+         {WARM_UP} warm-up), renderers side by side; FLIP mean against the full-detail frame:"
+    );
+    println!(
+        "  {:<32} {:>14} {:>10} {:>15} {:>10} {:>10}",
+        "", "light ms", "frames/s", "camera ms", "frames/s", "FLIP"
+    );
+    let mut renderers: Vec<(Renderer, Force)> =
+        configs.iter().map(|(_, o, f)| (default_renderer(gpu, o.clone()), *f)).collect();
+    let light = side_by_side(&mut renderers, Change::Light(0), FRAMES);
+    let camera = side_by_side(&mut renderers, Change::Camera, FRAMES);
+    // Every saving off: the reference image.
+    let full = configs.len() - 1;
+    for (i, (name, _, _)) in configs.iter().enumerate() {
+        let (l, c) = (&light[i], &camera[i]);
+        println!(
+            "  {name:<32} {:>14.1} {:>10.2} {:>15.1} {:>10.2} {:>10.4}",
+            l.0,
+            1e3 / l.0,
+            c.0,
+            1e3 / c.0,
+            flip(&camera[full].1, &c.1)
+        );
+    }
+    println!("device memory in use (all renderers): {:.1} MiB", gpu.memory_usage().0 as f64 / (1 << 20) as f64);
+}
+
+/// Each level of detail of the default scene's bunny forced in turn: triangles, receivers,
+/// frame times and the FLIP mean against level 0 (the whole mesh), with the planner's choice.
+fn levels(gpu: &Arc<Gpu>) {
+    let probe = default_renderer(gpu, Overrides::default());
+    let facts = probe.needs().objects.clone();
+    let chosen: Vec<usize> = probe.plan(Change::Camera).objects.iter().map(|o| o.level).collect();
+    drop(probe);
+    let count = facts.iter().map(|f| f.levels.len()).max().unwrap_or(1);
+    println!(
+        "\nLevels of detail forced in turn, default scene 512x512 (planner's choice: levels {chosen:?}), side by side:"
+    );
+    println!(
+        "  {:>5} {:>10} {:>10} {:>9} {:>9} {:>10} {:>10} {:>10}",
+        "level", "triangles", "receivers", "edge px", "error px", "light ms", "camera ms", "FLIP"
+    );
+    let mut renderers: Vec<(Renderer, Force)> = (0..count)
+        .map(|l| (default_renderer(gpu, Overrides::default()), Force { level: Some(l), one_tap: Some(false) }))
+        .collect();
+    let light = side_by_side(&mut renderers, Change::Light(0), FRAMES);
+    let camera = side_by_side(&mut renderers, Change::Camera, FRAMES);
+    let view = renderers[0].0.view();
+    for l in 0..count {
+        let sum = |f: &dyn Fn(&translucent::scene::needs::LevelFacts) -> usize| -> usize {
+            facts.iter().map(|o| f(&o.levels[l.min(o.levels.len() - 1)])).sum()
+        };
+        let bunny = facts.iter().max_by_key(|o| o.levels.len()).expect("an object");
+        let level = &bunny.levels[l.min(bunny.levels.len() - 1)];
+        let px = view.pixel_footprint(glam::Vec3::from(bunny.center).distance(view.eye) as f64);
+        println!(
+            "  {l:>5} {:>10} {:>10} {:>9.2} {:>9.3} {:>10.1} {:>10.1} {:>10.4}",
+            sum(&|f| f.triangles),
+            sum(&|f| f.vertices),
+            level.mean_edge / px,
+            level.error / px,
+            light[l].0,
+            camera[l].0,
+            flip(&camera[0].1, &camera[l].1)
+        );
+    }
 }
 
 /// Sections to run: those named on the command line (`cargo bench --bench render -- hierarchy`),
@@ -422,6 +563,12 @@ fn main() {
         println!("  ours  {ours:>8.1} ms = {:>7.1} Mpairs/s", pairs / ours / 1e3);
         println!("  naive {naive:>8.1} ms = {:>7.1} Mpairs/s", pairs / naive / 1e3);
         println!("  throughput ratio ours / naive = {:.2}", naive / ours);
+    }
+    if wanted("savings") {
+        savings(&gpu);
+    }
+    if wanted("levels") {
+        levels(&gpu);
     }
     if wanted("hierarchy") {
         hierarchy(&gpu);

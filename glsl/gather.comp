@@ -1,6 +1,7 @@
 #version 450
 // Dipole gather (seed Eq. 11 with the near-field treatment of src/optics/kernel.rs): the radiant
-// exitance at every receiver vertex of one translucent object, over that object's samples,
+// exitance at the receiver vertices of one translucent object (those its level of detail uses,
+// listed in level_vertices), over that object's samples,
 //     M(x) = sum_i E_i far_kernel(r_i, A_i) + sum_i phi_i E_i E_near,i / sum_i phi_i
 // (kernel::far_kernel explains the split). Samples are staged through shared memory in tiles of 64 (one
 // load per tile for the whole workgroup); each tile's far sum is added to a Kahan-compensated
@@ -12,7 +13,8 @@
 // Bindings: 0 = vertices (VertexRecord[], read), 1 = samples (SampleRecord[], read), 2 = splat
 // (SplatRecord[], read), 3 = objects (ObjectRecord[], read), 4 = exitance (vec4 per vertex, write),
 // 5 = tree nodes (TreeNodeRecord[]), 6 = tree order (uint[]), 7 = boundary distances (vec2 per
-// vertex, mesh::Mesh::boundary_distances). Push: GatherPush.
+// vertex, mesh::Mesh::boundary_distances), 8 = level vertices (object-relative vertex indices,
+// GpuScene::level_vertices). Push: GatherPush.
 #include "dipole.glsl"
 #include "scene.glsl"
 #include "gather.glsl"
@@ -27,10 +29,13 @@ layout(std430, set = 0, binding = 4) writeonly buffer Exitance { vec4 exitance[]
 layout(std430, set = 0, binding = 5) readonly buffer TreeNodes { TreeNodeRecord tree_nodes[]; };
 layout(std430, set = 0, binding = 6) readonly buffer TreeOrder { uint tree_order[]; };
 layout(std430, set = 0, binding = 7) readonly buffer VertexBoundary { vec2 vertex_boundary[]; };
+layout(std430, set = 0, binding = 8) readonly buffer LevelVertices { uint level_vertices[]; };
 struct GatherPush {
     uint object;            // the receiving object's index
     uint first_node;        // its root in tree_nodes
     uint node_count;        // its node count
+    uint first_entry;       // its level's first entry in level_vertices
+    uint receiver_count;    // the vertices its level uses
 };
 layout(push_constant) uniform GatherPushBlock { GatherPush push; };
 
@@ -42,12 +47,12 @@ shared vec4 tile_near_energy[TILE];
 
 void main() {
     ObjectRecord o = objects[push.object];
-    uint first_vertex = o.ranges.x, vertex_count = o.ranges.y;
+    uint first_vertex = o.ranges.x, receiver_count = push.receiver_count;
     uint first_sample = o.ranges.z, sample_count = o.ranges.w;
     uint local = gl_LocalInvocationID.x;
-    uint v = gl_GlobalInvocationID.x;
-    bool is_receiver = v < vertex_count;
-    uint vi = first_vertex + min(v, max(vertex_count, 1u) - 1u);
+    bool is_receiver = gl_GlobalInvocationID.x < receiver_count;
+    uint v = level_vertices[push.first_entry + min(gl_GlobalInvocationID.x, max(receiver_count, 1u) - 1u)];
+    uint vi = first_vertex + v;
     vec3 x = vertex_position(vertices[vi]);
     DipoleChannel ch[3] = gather_channels(o);
     GatherSum g = gather_begin();

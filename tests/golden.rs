@@ -34,6 +34,7 @@ fn default_scene_matches_the_golden_image() {
     let total: u64 = expected.as_raw().iter().zip(&rgba).map(|(a, b)| a.abs_diff(*b) as u64).sum();
     let mean = total as f64 / rgba.len() as f64;
     let differing = expected.as_raw().chunks(4).zip(rgba.chunks(4)).filter(|(a, b)| a != b).count();
-    eprintln!("golden: mean absolute difference {mean:.4} (of 255), {differing} pixels differ");
+    let flip = translucent::study::flip::flip_mean(expected.as_raw(), &rgba, 256, 256).unwrap();
+    eprintln!("golden: mean absolute difference {mean:.4} (of 255), {differing} pixels differ, FLIP mean {flip:.4}");
     assert!(mean < 1.0, "mean absolute difference {mean:.3}/255 from {}", golden.display());
 }

@@ -99,7 +99,12 @@ fn default_epsilon_is_within_half_a_percent_rms_of_the_flat_gather() {
 /// would compute some channels locally and leave the gather nothing to show).
 fn plane(preset: &str, gather: GatherMode) -> PreparedScene {
     let scene = Scene::parse(&plane_scene(preset, 1000.0, 3000, ""), "plane", None).unwrap();
-    let overrides = Overrides { gather: Some(gather), transport: Some(TransportMode::Gather), ..Default::default() };
+    let overrides = Overrides {
+        gather: Some(gather),
+        transport: Some(TransportMode::Gather),
+        level_of_detail: Some(false),
+        ..Default::default()
+    };
     PreparedScene::new(&scene, &overrides).unwrap()
 }
 

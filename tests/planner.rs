@@ -14,8 +14,11 @@ use translucent::render::renderer::Renderer;
 use translucent::scene::build::{Overrides, PreparedScene};
 use translucent::scene::{Scene, Transform, TransportMode, lights};
 
+/// Whole meshes unless the test asks for levels of detail: the counts below are of the passes a
+/// change calls for, and the exitance read back is every vertex's.
 fn prepare(text: &str, overrides: &Overrides) -> PreparedScene {
-    PreparedScene::new(&Scene::parse(text, "planner.toml", None).unwrap(), overrides).unwrap()
+    let overrides = Overrides { level_of_detail: overrides.level_of_detail.or(Some(false)), ..overrides.clone() };
+    PreparedScene::new(&Scene::parse(text, "planner.toml", None).unwrap(), &overrides).unwrap()
 }
 
 /// Render the frame the renderer's pending change calls for; what it recorded.
@@ -174,7 +177,7 @@ fn marble_at_five_centimetres_is_gathered_in_every_channel() {
     let prepared = prepare(&text, &Overrides { samples: Some(400), ..Overrides::default() });
     let camera = translucent::render::renderer::CameraView::of_scene(&prepared);
     let view = translucent::render::plan::View::of_camera(&camera, 256);
-    let plan = translucent::render::plan::plan(&prepared.needs(), &view, &[true], Change::Everything);
+    let plan = translucent::render::plan::plan(&prepared.needs(), &view, &[true], &[usize::MAX], Change::Everything);
     assert!(plan.objects[0].channels.iter().all(|c| c.transport == Transport::Gather), "{plan}");
 }
 

@@ -10,9 +10,12 @@ use translucent::render::renderer::Renderer;
 use translucent::scene::build::{Overrides, PreparedScene};
 use translucent::scene::{GatherMode, Scene, TransportMode, lights};
 
+/// Whole meshes unless the test asks for levels of detail: these tests compare every vertex's
+/// exitance.
 fn prepare(toml: &str, overrides: &Overrides) -> PreparedScene {
     let scene = Scene::parse(toml, "test scene", None).expect("test scene parses");
-    PreparedScene::new(&scene, overrides).expect("test scene prepares")
+    let overrides = Overrides { level_of_detail: overrides.level_of_detail.or(Some(false)), ..overrides.clone() };
+    PreparedScene::new(&scene, &overrides).expect("test scene prepares")
 }
 
 /// A 1 m square of `preset` lit straight from above, 3,000 Poisson samples, gathered with
@@ -415,5 +418,54 @@ fn resize_and_set_camera_mark_only_shading_and_change_the_image() {
         let (turned, _) = renderer.image().unwrap();
         let differ = after.iter().zip(&turned).filter(|(a, b)| a != b).count();
         assert!(differ > 1000, "only {differ} bytes changed when the camera turned");
+    });
+}
+
+#[test]
+fn a_level_of_detail_holds_the_whole_mesh_exitance_at_its_vertices_bit_for_bit() {
+    with_gpu(|gpu| {
+        // The built-in scene at 128x128: the bunny is small on screen and drawn simplified.
+        let lod = Overrides { resolution: Some([128, 128]), ..Default::default() };
+        let whole = Overrides { level_of_detail: Some(false), ..lod.clone() };
+        let mut simplified = run_all(gpu, builtin(&lod));
+        let full = run_all(gpu, builtin(&whole));
+        let plan = simplified.plan(Change::Camera);
+        let bunny = plan.objects.iter().find(|o| !o.channels.is_empty()).expect("a translucent object");
+        assert!(bunny.level > 0, "the bunny should be simplified at 128x128: {plan}");
+        let level = &simplified.scene().objects[bunny.object].levels[bunny.level];
+        assert!(level.triangles.len() * 4 < simplified.scene().objects[bunny.object].mesh.triangles().len());
+        let level = level.clone();
+        // Its other vertices were not gathered: reading every vertex is refused, not stale.
+        assert!(simplified.exitance(bunny.object).is_err());
+        let image = simplified.image().unwrap().0;
+        let at_level: Vec<[f32; 4]> = simplified.buffers().exitance.read().unwrap();
+        // The same frame gathered at every vertex (level 0 forced): the same values, bit for bit.
+        let mut every = simplified.plan(Change::Everything);
+        every.objects.iter_mut().for_each(|o| o.level = 0);
+        simplified.frame(&every).unwrap();
+        let at_all: Vec<[f32; 4]> = simplified.buffers().exitance.read().unwrap();
+        let first = simplified.buffers().object_range(bunny.object).first_vertex as usize;
+        for &v in &level.vertices {
+            assert_eq!(at_level[first + v as usize], at_all[first + v as usize], "vertex {v}");
+        }
+        assert!(simplified.exitance(bunny.object).is_ok(), "gathered at every vertex now");
+        // Against the renderer with whole meshes throughout: its shadow maps draw the bunny whole
+        // where this one draws it within half a texel, so the splat differs slightly.
+        let whole_exitance: Vec<[f32; 4]> = full.buffers().exitance.read().unwrap();
+        let pairs: Vec<(f64, f64)> = level
+            .vertices
+            .iter()
+            .flat_map(|&v| (0..3).map(move |c| (v as usize, c)))
+            .map(|(v, c)| (at_level[first + v][c] as f64, whole_exitance[first + v][c] as f64))
+            .collect();
+        let peak = pairs.iter().map(|p| p.1).fold(0.0, f64::max);
+        let worst = pairs.iter().map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / peak;
+        let rms = (pairs.iter().map(|(x, y)| (x - y).powi(2)).sum::<f64>() / pairs.len() as f64).sqrt() / peak;
+        eprintln!("against whole meshes throughout, of the peak: largest {worst:.2e}, RMS {rms:.2e}");
+        assert!(worst < 3e-2 && rms < 2e-3, "largest {worst}, RMS {rms} of the peak");
+        let whole_image = full.image().unwrap().0;
+        let flip = translucent::study::flip::flip_mean(&whole_image, &image, 128, 128).unwrap();
+        eprintln!("level {} of the bunny at 128x128: FLIP mean {flip:.4} against the whole mesh", bunny.level);
+        assert!(flip < 0.02, "FLIP mean {flip} against the whole mesh");
     });
 }

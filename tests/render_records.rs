@@ -157,7 +157,7 @@ fn push_blocks_match_glsl_and_spirv() {
             include_str!("../glsl/gather.comp"),
             "GatherPush",
             size_of::<GatherPush>(),
-            &["object", "first_node", "node_count"],
+            &["object", "first_node", "node_count", "first_entry", "receiver_count"],
         ),
         (
             "gather_sparse.comp",

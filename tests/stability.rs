@@ -66,7 +66,9 @@ fn sweep(gpu: &Arc<Gpu>, materials: &[&MeasuredMaterial], scales: &[f64], counts
         for &count in counts {
             let text = scene_text(materials, mm, count);
             let scene = Scene::parse(&text, "sweep", None).expect("sweep scene");
-            let prepared = PreparedScene::new(&scene, &Overrides::default()).expect("prepared");
+            // Every vertex's exitance is checked: whole meshes.
+            let full = Overrides { level_of_detail: Some(false), ..Overrides::default() };
+            let prepared = PreparedScene::new(&scene, &full).expect("prepared");
             for gather in GatherMode::ALL {
                 let mut prepared = prepared.clone();
                 prepared.scene.file.render.gather = gather;

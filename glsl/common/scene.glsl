@@ -8,7 +8,8 @@ const uint MATERIAL_OPAQUE = 0u;
 const uint MATERIAL_TRANSLUCENT = 1u;
 
 struct ObjectRecord {
-    vec4 albedo_roughness;  // opaque: rgb albedo; w: GGX roughness (both kinds)
+    vec4 albedo_roughness;  // rgb: albedo: opaque, Lambert's; translucent, R_d,total per channel
+                            // (dipole_r_d_total, taken once in f64); w: GGX roughness (both kinds)
     vec4 eta_norm_kind;     // x: relative index of refraction eta; y: BSSRDF normalization
                             // 1 / (pi T(eta)), T(eta) = 1 - 2 FM1(eta) (optics::Dipole::s_d);
                             // z: kind (MATERIAL_*); w: channels computed locally, a bit

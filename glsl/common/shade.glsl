@@ -2,7 +2,8 @@
 // Translucent: the BSSRDF's outgoing lobe turns exitance into radiance,
 //     L_o = M F_t(cos theta_o, eta) / (pi T(eta))         (seed Eq. 9 normalized, Dipole::s_d),
 // plus a dielectric GGX specular lobe per light. Opaque: Lambert plus GGX. Key lights are
-// evaluated per pixel, shadowed with their shadow maps (4-tap PCF); the environment's directions
+// evaluated per pixel, shadowed with their shadow maps (4-tap PCF, or one tap where the planner
+// finds a texel small on screen: render::plan::SHADOW_ONE_TAP_PIXELS); the environment's directions
 // reach diffuse surfaces through the per-vertex irradiance cached by vertex_light.comp (and
 // translucent ones through the splat and gather), and add no specular lobe.
 // Bindings: 0 = objects (ObjectRecord[]), 1 = lights (Light[]), 2 = shadow maps.
@@ -67,7 +68,7 @@ void main() {
         light_incidence(lights[l], v_position, wi, irradiance);
         float cos_i = dot(n, wi);
         if (cos_i <= 0.0) continue;
-        float v = light_visibility(lights[l], shadow_maps, v_position, n, 1);
+        float v = light_visibility(lights[l], shadow_maps, v_position, n, int(push.counts.z));
         vec3 h = normalize(wi + wo);
         float fresnel = dipole_fresnel_reflectance(max(dot(wi, h), 0.0), eta);
         vec3 lit = irradiance * v;
@@ -80,8 +81,8 @@ void main() {
         // gather, which adds its own afterwards). Local ones: M = R_d,total E_t, the dipole
         // integral when E_t is uniform over the profile's width (render::plan).
         vec3 gathered = object_gathered_channels(o);
-        vec3 r_d_total = vec3(dipole_r_d_total(o.dipole[0]), dipole_r_d_total(o.dipole[1]), dipole_r_d_total(o.dipole[2]));
-        radiance += mix(r_d_total * transmitted, v_exitance, gathered) * exitance_to_radiance;
+        // R_d,total is the record's albedo (ObjectRecord::new), not recomputed per pixel.
+        radiance += mix(o.albedo_roughness.rgb * transmitted, v_exitance, gathered) * exitance_to_radiance;
     }
     // Nothing non-finite leaves this pass (the tone map counts any that would).
 #ifdef PIXEL_GATHER

@@ -6,7 +6,8 @@
 struct ShadePush {
     mat4 view_proj;
     vec4 eye_object;        // xyz: camera position; w: object index
-    uvec4 counts;           // x: light count; y: key (non-environment) lights, first in the buffer
+    uvec4 counts;           // x: light count; y: key (non-environment) lights, first in the buffer;
+                            // z: shadow filter radius (light_visibility: 0 one tap, 1 four)
 };
 layout(push_constant) uniform ShadePushBlock { ShadePush push; };
 

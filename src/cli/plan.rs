@@ -39,12 +39,17 @@ pub fn run(args: &Args) -> Result<()> {
     let needs = prepared.needs();
     let view = plan::View::of_camera(&CameraView::of_scene(&prepared), prepared.scene.file.camera.resolution[1]);
     let objects = prepared.objects.len();
-    // The first frame computes everything; every other change follows a frame that did.
+    // The first frame computes everything; every other change follows a frame that did, at the
+    // levels of detail it chose.
+    let none = vec![usize::MAX; objects];
+    let first = plan::plan(&needs, &view, &vec![true; objects], &none, Change::Everything);
+    let levels: Vec<usize> = first.objects.iter().map(|o| o.level).collect();
     let frames: Vec<(Change, plan::Plan)> = Change::all(prepared.scene.file.lights.len(), objects)
         .into_iter()
         .map(|change| {
-            let stale = vec![change == Change::Everything; objects];
-            (change, plan::plan(&needs, &view, &stale, change))
+            let everything = change == Change::Everything;
+            let stale = vec![everything; objects];
+            (change, plan::plan(&needs, &view, &stale, if everything { &none } else { &levels }, change))
         })
         .collect();
     if args.json {

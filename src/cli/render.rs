@@ -63,8 +63,13 @@ pub struct Args {
     #[arg(long, value_parser = super::one_of::<TransportMode>(&TransportMode::ALL.map(TransportMode::name)))]
     pub transport: Option<TransportMode>,
     /// Write each translucent vertex's world position and RGB radiant exitance to a PLY
+    /// (implies --full-detail: every vertex gathered)
     #[arg(long)]
     pub export_exitance: Option<PathBuf>,
+    /// Draw, shadow and gather every mesh whole, at every vertex (overrides
+    /// render.level_of_detail)
+    #[arg(long)]
+    pub full_detail: bool,
 }
 
 /// What changes between frames (`--moving`).
@@ -97,6 +102,7 @@ impl Default for Args {
             explain: false,
             transport: None,
             export_exitance: None,
+            full_detail: false,
         }
     }
 }
@@ -156,6 +162,8 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
                 TransportMode::Gather
             })
         }),
+        // Exported exitance is every vertex's.
+        level_of_detail: (args.full_detail || args.export_exitance.is_some()).then_some(false),
     };
     let spinner = ProgressBar::new_spinner().with_message(format!("preparing {} (meshes, sample points)", scene.name));
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));

@@ -10,6 +10,7 @@
 
 mod boundary;
 mod curvature;
+mod lod;
 mod obj;
 mod topology;
 
@@ -18,6 +19,7 @@ use std::path::PathBuf;
 use glam::{DVec3, Vec3};
 
 pub use boundary::NO_BOUNDARY;
+pub use lod::{LodLevel, MIN_LEVEL_TRIANGLES};
 pub use obj::LoadOptions;
 
 /// Marks an edge with no single neighbouring triangle (an open boundary or a non-manifold edge).

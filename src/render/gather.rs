@@ -3,8 +3,8 @@
 //! (`optics::kernel`), samples staged through shared memory, Kahan-compensated f32 sums.
 //!
 //! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = exitance, 5 = tree nodes,
-//! 6 = tree order, 7 = boundary distances. Push: `GatherPush`.
-//! One dispatch per translucent object, over its vertex range.
+//! 6 = tree order, 7 = boundary distances, 8 = level vertices. Push: `GatherPush`.
+//! One dispatch per translucent object, over the vertices of its level of detail this frame.
 
 use super::gpu_scene::GpuScene;
 use super::pass::{FrameInputs, RenderPass};
@@ -23,6 +23,10 @@ pub struct GatherPush {
     pub first_node: u32,
     /// Its node count.
     pub node_count: u32,
+    /// First entry of its level of detail's vertex list in `GpuScene::level_vertices`.
+    pub first_entry: u32,
+    /// Vertices in that list: the receivers of the dispatch.
+    pub receiver_count: u32,
 }
 
 /// The vertex gather: one dispatch of glsl/gather.comp per translucent object
@@ -47,6 +51,7 @@ impl GatherPass {
             Binding::Buffer(&scene.tree_nodes),
             Binding::Buffer(&scene.tree_order),
             Binding::Buffer(&scene.vertex_boundary),
+            Binding::Buffer(&scene.level_vertices),
         ])?;
         Ok(GatherPass { pipeline, set })
     }
@@ -55,8 +60,15 @@ impl GatherPass {
 impl RenderPass for GatherPass {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         for r in frame.scene.receivers.iter().filter(|r| frame.plan.gathers(r.object as usize)) {
-            let push = GatherPush { object: r.object, first_node: r.first_node, node_count: r.node_count };
-            self.pipeline.dispatch(cmd, &self.set, &push, [r.vertex_count, 1, 1]);
+            let level = frame.scene.level(r.object as usize, frame.plan.level(r.object as usize));
+            let push = GatherPush {
+                object: r.object,
+                first_node: r.first_node,
+                node_count: r.node_count,
+                first_entry: level.first_entry,
+                receiver_count: level.vertex_count,
+            };
+            self.pipeline.dispatch(cmd, &self.set, &push, [level.vertex_count, 1, 1]);
         }
         exitance_written(frame, cmd);
     }

@@ -12,6 +12,18 @@ use crate::scene::build::PreparedScene;
 use ash::vk;
 use std::sync::Arc;
 
+/// One level of detail of an object (`mesh::LodLevel`): its draw, and its vertices (the
+/// gather's receivers at that level) as a range of `GpuScene::level_vertices`.
+#[derive(Clone, Copy, Debug)]
+pub struct LevelRange {
+    /// Its triangles in the shared index buffer.
+    pub draw: DrawRange,
+    /// First entry of its vertex list in `level_vertices`.
+    pub first_entry: u32,
+    /// Vertices it uses.
+    pub vertex_count: u32,
+}
+
 /// A draw of one object: index range and vertex offset in the shared buffers.
 #[derive(Clone, Copy, Debug)]
 pub struct DrawRange {
@@ -110,10 +122,16 @@ pub struct GpuScene {
     /// `LightGpu` per prepared light, key lights first; rewritten inside a frame's command buffer
     /// when lights change (`record_uploads`).
     pub lights: Buffer,
-    /// One per object, in scene order.
-    pub draws: Vec<DrawRange>,
-    /// The objects that cast shadows.
-    pub casters: Vec<DrawRange>,
+    /// Per object, in scene order: its levels of detail, the whole mesh first.
+    pub levels: Vec<Vec<LevelRange>>,
+    /// The objects that cast shadows: (scene index, the level of detail drawn into shadow maps).
+    /// The level is the coarsest within half a shadow-map texel of the whole mesh (a texel of a
+    /// map spanning the casters' bounding sphere), so the full-detail surface the splat and
+    /// shading look up from never falls behind a simplified caster (self-shadowing).
+    pub casters: Vec<(usize, usize)>,
+    /// Per level of detail of every object, one after another: the object-relative indices of
+    /// the vertices it uses, ascending (`LevelRange::first_entry`).
+    pub level_vertices: Buffer,
     /// World -> clip matrix of each shadow-map layer.
     pub light_matrices: Vec<[[f32; 4]; 4]>,
     /// The translucent objects, in scene order: what the gathers dispatch over.
@@ -156,7 +174,8 @@ impl GpuScene {
         let (mut vertices, mut indices, mut objects, mut samples) =
             (Vec::new(), Vec::<u32>::new(), Vec::new(), Vec::new());
         let mut vertex_boundary: Vec<[f32; 2]> = Vec::new();
-        let (mut draws, mut casters, mut receivers) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut levels, mut casters, mut receivers) = (Vec::new(), Vec::new(), Vec::new());
+        let mut level_vertices = Vec::<u32>::new();
         let (mut tree_nodes, mut tree_order) = (Vec::new(), Vec::<u32>::new());
         let (mut receiver_order, mut receiver_groups) = (Vec::<u32>::new(), Vec::<ReceiverGroupRecord>::new());
         let (mut group_items, mut blend_items) = (Vec::<u32>::new(), Vec::<u32>::new());
@@ -179,15 +198,23 @@ impl GpuScene {
             } else {
                 vertex_boundary.extend(std::iter::repeat_n([crate::mesh::NO_BOUNDARY; 2], o.mesh.positions().len()));
             }
-            let draw = DrawRange {
-                first_index: indices.len() as u32,
-                index_count: 3 * o.mesh.triangles().len() as u32,
-                vertex_offset: first_vertex as i32,
-            };
-            indices.extend(o.mesh.triangles().iter().flatten());
-            draws.push(draw);
+            let mut ranges = Vec::new();
+            for level in &o.levels {
+                let draw = DrawRange {
+                    first_index: indices.len() as u32,
+                    index_count: 3 * level.triangles.len() as u32,
+                    vertex_offset: first_vertex as i32,
+                };
+                indices.extend(level.triangles.iter().flatten());
+                let first_entry = level_vertices.len() as u32;
+                level_vertices.extend(&level.vertices);
+                ranges.push(LevelRange { draw, first_entry, vertex_count: level.vertices.len() as u32 });
+            }
+            levels.push(ranges);
             if o.casts_shadow {
-                casters.push(draw);
+                let texel = 2.0 * scene.caster_bounds.1 as f64 / render.shadow_map_size as f64;
+                let level = o.levels.iter().rposition(|l| l.error <= 0.5 * texel).unwrap_or(0);
+                casters.push((i, level));
             }
             samples.extend(o.samples.iter().map(|s| SampleRecord::new(s, i)));
             let vertex_count = o.mesh.positions().len() as u32;
@@ -288,7 +315,8 @@ impl GpuScene {
                 (std::mem::size_of::<LightGpu>() * scene.lights.len()) as u64,
                 vk::BufferUsageFlags::empty(),
             )?,
-            draws,
+            level_vertices: upload(gpu, "level vertices", &level_vertices, vk::BufferUsageFlags::empty())?,
+            levels,
             casters,
             light_matrices: Vec::new(),
             receivers,
@@ -330,6 +358,12 @@ impl GpuScene {
             let eta = if translucent { r.eta_norm_kind[0] } else { 0.0 };
             ObjectRange { first_vertex, vertex_count, first_sample, sample_count, eta }
         })
+    }
+
+    /// Object `object` at level of detail `level`, or at its coarsest when it has fewer levels.
+    pub fn level(&self, object: usize, level: usize) -> LevelRange {
+        let levels = &self.levels[object];
+        levels[level.min(levels.len() - 1)]
     }
 
     /// Object `object`'s range (`object_ranges`).

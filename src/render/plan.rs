@@ -176,6 +176,11 @@ pub struct ObjectPlan {
     /// Whether its gathered exitance still needs recomputing after this frame (lights or its
     /// material changed and it was not gathered).
     pub stale_after: bool,
+    /// The level of detail it is drawn, shadowed and gathered at (0: the whole mesh;
+    /// `choose_level`).
+    pub level: usize,
+    /// Why that level, with the figures.
+    pub level_why: String,
 }
 
 impl ObjectPlan {
@@ -200,6 +205,12 @@ pub struct Plan {
     pub shadow_light: Option<usize>,
     /// Per object, in scene order (empty in a plan made by hand: every object runs).
     pub objects: Vec<ObjectPlan>,
+    /// Shading looks each key light's shadow up with one bilinear tap instead of four (a 3x3
+    /// texel tent): a texel is small on screen, so the tent's softening is below a pixel or
+    /// two (`SHADOW_ONE_TAP_PIXELS`). False in a plan made by hand.
+    pub one_tap_shadows: bool,
+    /// Why that filter, with the figures.
+    pub shadow_filter_why: String,
 }
 
 impl Plan {
@@ -218,6 +229,12 @@ impl Plan {
         self.objects.get(object).is_none_or(|o| o.gather)
     }
 
+    /// The level of detail object `object` is drawn and gathered at (0, the whole mesh, in a
+    /// plan made by hand).
+    pub fn level(&self, object: usize) -> usize {
+        self.objects.get(object).map_or(0, |o| o.level)
+    }
+
     /// The plan as JSON, the shape `translucent plan --json` prints (docs/PLAN.md):
     /// `{change, passes: [{pass, why}], skipped: [{pass, why}], shadow_light, objects: [...]}`.
     pub fn to_json(&self) -> serde_json::Value {
@@ -229,6 +246,8 @@ impl Plan {
             "passes": list(&self.passes),
             "skipped": list(&self.skipped),
             "shadow_light": self.shadow_light,
+            "one_tap_shadows": self.one_tap_shadows,
+            "shadow_filter_why": self.shadow_filter_why,
             "objects": self.objects,
         })
     }
@@ -242,8 +261,12 @@ impl fmt::Display for Plan {
         for (p, why) in &self.skipped {
             writeln!(f, "  skip {:<12} {why}", p.name())?;
         }
-        for o in self.objects.iter().filter(|o| !o.channels.is_empty()) {
+        if !self.shadow_filter_why.is_empty() {
+            writeln!(f, "  shadow filter: {}", self.shadow_filter_why)?;
+        }
+        for o in self.objects.iter().filter(|o| !o.channels.is_empty() || o.level > 0) {
             writeln!(f, "  object {} ({}): {}", o.object, o.name, o.why)?;
+            writeln!(f, "    level {}: {}", o.level, o.level_why)?;
             for (c, ch) in ["R", "G", "B"].iter().zip(&o.channels) {
                 let t = match ch.transport {
                     Transport::Local => "local ",
@@ -295,6 +318,48 @@ impl View {
         let per_unit = 2.0 / (p11 * self.height.max(1) as f64);
         if self.projection.w_axis.w == 1.0 { per_unit } else { per_unit * distance }
     }
+}
+
+/// Largest shadow-map texel, in pixels at the casters' centre, that shading looks up with one
+/// bilinear tap rather than the four-tap tent: the tent widens a shadow edge by about two
+/// texels, under two pixels here. Measured on the default scene (README "Performance").
+pub const SHADOW_ONE_TAP_PIXELS: f64 = 1.0;
+
+/// Longest mean edge, in pixels at the object's centre, that a level of detail may have:
+/// triangles of a few pixels each. Measured on the default scene against the full mesh (FLIP,
+/// README "Performance").
+pub const LOD_EDGE_PIXELS: f64 = 12.0;
+/// Largest distance from the full mesh, in pixels at the object's centre, that a level
+/// may have: the silhouette moves by less than half a pixel.
+pub const LOD_ERROR_PIXELS: f64 = 0.5;
+
+/// The coarsest of `facts.levels` whose mean edge and distance from the full mesh stay within
+/// `LOD_EDGE_PIXELS` and `LOD_ERROR_PIXELS` pixels of footprint `footprint` (scene units per
+/// pixel at the object's centre); out of view (`None`), the coarsest level, which only
+/// its shadow shows. Returns the level and why.
+pub fn choose_level(facts: &ObjectFacts, footprint: Option<f64>) -> (usize, String) {
+    let last = facts.levels.len().saturating_sub(1);
+    if last == 0 {
+        return (0, "drawn whole (one level: render.level_of_detail off, or per-vertex sky light)".into());
+    }
+    let Some(px) = footprint else {
+        return (last, "out of view: its coarsest level, for the shadows it casts".into());
+    };
+    let fits =
+        |l: &crate::scene::needs::LevelFacts| l.mean_edge <= LOD_EDGE_PIXELS * px && l.error <= LOD_ERROR_PIXELS * px;
+    let level = (0..=last).rev().find(|&i| fits(&facts.levels[i])).unwrap_or(0);
+    let l = &facts.levels[level];
+    let why = format!(
+        "{} of {} triangles, {} receivers: edges {:.2} px, error {:.2} px at {:.3e} units/px (limits {LOD_EDGE_PIXELS}, \
+         {LOD_ERROR_PIXELS})",
+        l.triangles,
+        facts.levels[0].triangles,
+        l.vertices,
+        l.mean_edge / px,
+        l.error / px,
+        px
+    );
+    (level, why)
 }
 
 /// The choice for each channel of a translucent object seen with pixel footprint `footprint`
@@ -352,7 +417,11 @@ pub fn choose(facts: &ObjectFacts, footprint: Option<f64>, mode: TransportMode) 
 /// i's gathered exitance was already out of date (lights or material changed while it was out
 /// of view or local). The rules are in the module doc. The pixel gather runs after shading, the
 /// other gathers before it.
-pub fn plan(needs: &SceneNeeds, view: &View, stale: &[bool], change: Change) -> Plan {
+///
+/// `stale[i]`: object i's gathered exitance is out of date. `gathered[i]`: the finest level of
+/// detail whose vertices hold object i's current exitance (`usize::MAX`: none); a finer level
+/// coming into use is gathered again, from the samples' irradiance as it is.
+pub fn plan(needs: &SceneNeeds, view: &View, stale: &[bool], gathered: &[usize], change: Change) -> Plan {
     let mut plan = Plan { change: Some(change), ..Plan::default() };
     let lights_stale = matches!(change, Change::Everything | Change::Lights | Change::Light(_) | Change::Geometry(_));
     let has_shadows = needs.shadow_layers > 0;
@@ -420,6 +489,11 @@ pub fn plan(needs: &SceneNeeds, view: &View, stale: &[bool], change: Change) -> 
         let nearest = (center.distance(view.eye) - facts.radius).max(0.0) as f64;
         let footprint = in_view.then(|| view.pixel_footprint(nearest));
         let channels = choose(facts, footprint, mode);
+        // Levels are judged at the centre's distance: the bounding sphere's nearest point lies
+        // well in front of most of the surface, and would keep far more triangles than pixels.
+        let centre_footprint = in_view.then(|| view.pixel_footprint(center.distance(view.eye) as f64));
+        let (level, level_why) = choose_level(facts, centre_footprint);
+        let finer = gathered.get(i).is_some_and(|&g| level < g);
         let stale_now = stale.get(i).copied().unwrap_or(true) || lights_stale || change == Change::Material(i);
         let gathered = channels.iter().any(|c| c.transport == Transport::Gather);
         let (splat, gather, why) = if channels.is_empty() {
@@ -446,6 +520,14 @@ pub fn plan(needs: &SceneNeeds, view: &View, stale: &[bool], change: Change) -> 
             (true, true, why.to_string())
         } else if needs.pixel_gather {
             (false, true, "pixel gather: redone for the pixels in view every frame, sample irradiance reused".into())
+        } else if finer {
+            (
+                false,
+                true,
+                format!(
+                    "level {level} is finer than the last gathered: its vertices gathered, sample irradiance reused"
+                ),
+            )
         } else {
             (false, false, "lights and material unchanged: exitance is view-independent, reused".into())
         };
@@ -460,6 +542,8 @@ pub fn plan(needs: &SceneNeeds, view: &View, stale: &[bool], change: Change) -> 
             gather,
             why,
             stale_after,
+            level,
+            level_why,
         });
     }
     let list = |f: &dyn Fn(&ObjectPlan) -> bool| -> Vec<usize> {
@@ -513,13 +597,22 @@ pub fn plan(needs: &SceneNeeds, view: &View, stale: &[bool], change: Change) -> 
     );
     plan.passes = passes;
     plan.skipped = skipped;
+    if has_shadows {
+        let px = view.pixel_footprint(Vec3::from(needs.caster_center).distance(view.eye) as f64);
+        let texel = needs.shadow_texel / px;
+        plan.one_tap_shadows = texel <= SHADOW_ONE_TAP_PIXELS;
+        plan.shadow_filter_why = format!(
+            "{}: a shadow-map texel spans {texel:.2} px at the casters' centre (one tap up to {SHADOW_ONE_TAP_PIXELS})",
+            if plan.one_tap_shadows { "one bilinear tap" } else { "four-tap tent" }
+        );
+    }
     plan
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::needs::ChannelFacts;
+    use crate::scene::needs::{ChannelFacts, LevelFacts};
 
     fn object(radius: f32, spacing: f64, profile: f64) -> ObjectFacts {
         let channel = ChannelFacts { diffusion_length: profile, z_v: profile, profile_radius: profile, r_d_total: 0.5 };
@@ -530,7 +623,16 @@ mod tests {
             sample_spacing: spacing,
             vertex_spacing: spacing / 4.0,
             channels: Some([channel; 3]),
+            levels: vec![LevelFacts { triangles: 1000, vertices: 500, mean_edge: spacing / 4.0, error: 0.0 }],
         }
+    }
+
+    /// Three levels: 0.5, 5 and 20 pixels per edge at the origin in `view()` (0.1 units a
+    /// pixel), 0, 0.2 and 0.1 pixels from the whole mesh.
+    fn levels() -> Vec<LevelFacts> {
+        [(1000, 0.05, 0.0), (250, 0.5, 0.02), (60, 2.0, 0.01)]
+            .map(|(triangles, mean_edge, error)| LevelFacts { triangles, vertices: triangles / 2, mean_edge, error })
+            .to_vec()
     }
 
     fn needs(shadow_layers: u32, translucent_objects: usize) -> SceneNeeds {
@@ -543,6 +645,8 @@ mod tests {
             host_target: false,
             transport: TransportMode::Auto,
             objects: (0..translucent_objects).map(|_| object(1.0, 0.1, 0.3)).collect(),
+            shadow_texel: 0.01,
+            caster_center: [0.0; 3],
         }
     }
 
@@ -554,7 +658,53 @@ mod tests {
     }
 
     fn run(needs: &SceneNeeds, change: Change) -> Plan {
-        plan(needs, &view(), &vec![false; needs.objects.len()], change)
+        plan(needs, &view(), &vec![false; needs.objects.len()], &vec![0; needs.objects.len()], change)
+    }
+
+    #[test]
+    fn the_coarsest_level_within_the_edge_and_error_limits_is_drawn() {
+        let mut n = needs(1, 1);
+        n.objects[0].levels = levels();
+        let p = run(&n, Change::Camera);
+        // Level 2's 20-pixel edges are past LOD_EDGE_PIXELS; level 1's 5 are within.
+        assert_eq!(p.objects[0].level, 1, "{p}");
+        assert!(p.objects[0].level_why.contains("250 of 1000 triangles"), "{p}");
+        // Half a pixel from the whole mesh is the other limit: level 1 at 0.6 pixels is out.
+        n.objects[0].levels[1].error = 0.06;
+        assert_eq!(run(&n, Change::Camera).objects[0].level, 0);
+    }
+
+    #[test]
+    fn a_finer_level_coming_into_use_is_gathered_again_without_a_splat() {
+        let mut n = needs(1, 1);
+        n.objects[0].levels = levels();
+        // The last gather ran at level 2; this frame draws level 1, whose extra vertices lack it.
+        let p = plan(&n, &view(), &[false], &[2], Change::Camera);
+        assert!(p.runs(Pass::Gather) && p.objects[0].gather, "{p}");
+        assert!(!p.runs(Pass::Splat), "the samples' irradiance is current: {p}");
+        // At the level last gathered, or a coarser one, nothing is redone.
+        let p = plan(&n, &view(), &[false], &[1], Change::Camera);
+        assert!(!p.runs(Pass::Gather), "{p}");
+    }
+
+    #[test]
+    fn out_of_view_an_object_takes_its_coarsest_level() {
+        let mut n = needs(1, 1);
+        n.objects[0].levels = levels();
+        n.objects[0].center = [0.0, 0.0, 50.0];
+        let p = run(&n, Change::Camera);
+        assert!(!p.objects[0].in_view);
+        assert_eq!(p.objects[0].level, 2, "{p}");
+    }
+
+    #[test]
+    fn shadow_texels_smaller_than_a_pixel_are_looked_up_with_one_tap() {
+        // 0.01 units a texel against 0.1 a pixel at the casters' centre.
+        let mut n = needs(1, 1);
+        assert!(run(&n, Change::Camera).one_tap_shadows);
+        n.shadow_texel = 0.5;
+        let p = run(&n, Change::Camera);
+        assert!(!p.one_tap_shadows && p.shadow_filter_why.contains("four-tap"), "{p}");
     }
 
     #[test]
@@ -633,7 +783,7 @@ mod tests {
         assert!(p.objects[0].stale_after);
         // Back in view with nothing else changed: it is gathered then.
         n.objects[0].center = [0.0, 0.0, 0.0];
-        let p = plan(&n, &view(), &[true], Change::Camera);
+        let p = plan(&n, &view(), &[true], &[usize::MAX], Change::Camera);
         assert!(p.objects[0].in_view && p.runs(Pass::Splat) && p.runs(Pass::Gather));
         assert!(!p.objects[0].stale_after);
     }

@@ -30,7 +30,11 @@ pub const LIGHT_SPOT: f32 = 2.0;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct ObjectRecord {
-    /// rgb: albedo of an opaque object (zero for a translucent one); w: GGX roughness (both kinds).
+    /// rgb: the diffuse albedo. Opaque: the Lambert albedo. Translucent: the total diffuse
+    /// reflectance `R_d,total` per channel (`Dipole::r_d_total`), a constant of the material
+    /// that shading multiplies locally computed channels by; taken here in f64 once rather
+    /// than per pixel in f32 (it was a quarter of the shading pass on lavapipe). w: GGX
+    /// roughness (both kinds).
     pub albedo_roughness: [f32; 4],
     /// x: relative index of refraction eta; y: the BSSRDF normalization 1 / (pi T(eta)) (0 for
     /// opaque); z: kind (`MATERIAL_*`); w: the channels computed locally, a bit mask as a
@@ -49,7 +53,12 @@ impl ObjectRecord {
             ResolvedMaterial::Translucent { material, dipoles, roughness, .. } => {
                 let t_eta = fresnel::diffuse_transmittance(material.eta);
                 ObjectRecord {
-                    albedo_roughness: [0.0, 0.0, 0.0, *roughness],
+                    albedo_roughness: [
+                        dipoles[0].r_d_total() as f32,
+                        dipoles[1].r_d_total() as f32,
+                        dipoles[2].r_d_total() as f32,
+                        *roughness,
+                    ],
                     eta_norm_kind: [
                         material.eta as f32,
                         // The BSSRDF's normalization 1 / (pi T(eta)) (optics::Dipole::s_d).

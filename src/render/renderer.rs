@@ -165,6 +165,9 @@ pub struct Renderer {
     /// Per object: its gathered exitance is out of date (lights or its material changed while
     /// it was out of view or local), so the next frame that gathers it must splat it first.
     stale: Vec<bool>,
+    /// Per object: the finest level of detail whose vertices hold its current exitance
+    /// (`usize::MAX`: none yet); a finer level coming into view is gathered again.
+    gathered: Vec<usize>,
 }
 
 impl Renderer {
@@ -223,6 +226,7 @@ impl Renderer {
             camera: CameraView::of_scene(&scene),
             pending: Some(Change::Everything),
             stale: vec![true; scene.objects.len()],
+            gathered: vec![usize::MAX; scene.objects.len()],
             scene,
         })
     }
@@ -245,7 +249,7 @@ impl Renderer {
     /// The passes a frame with this change would run, seen from the current camera, and what
     /// each object gets.
     pub fn plan(&self, change: Change) -> Plan {
-        plan::plan(&self.needs, &self.view(), &self.stale, change)
+        plan::plan(&self.needs, &self.view(), &self.stale, &self.gathered, change)
     }
 
     /// The current camera as the planner sees it.
@@ -364,8 +368,13 @@ impl Renderer {
         self.record(cmd, plan, timer, target);
         self.timers = timers;
         self.pending = None;
+        // Only the vertex gather works at a level's vertices; the others reach every vertex.
+        let by_level = self.scene.scene.file.render.gather == GatherMode::Vertex;
         for o in &plan.objects {
             self.stale[o.object] = o.stale_after;
+            if o.gather && plan.runs(Pass::Gather) {
+                self.gathered[o.object] = if by_level { o.level } else { 0 };
+            }
         }
         Ok(RecordedFrame { passes: plan.passes.iter().map(|(p, _)| *p).collect(), slot })
     }
@@ -455,6 +464,12 @@ impl Renderer {
     /// Radiant exitance (RGB, W/m^2 for the scene's light units) at every vertex of object
     /// `object`, from the last vertex gather (zero in pixel-gather mode).
     pub fn exitance(&self, object: usize) -> Result<Vec<[f32; 3]>, RenderError> {
+        if self.gathered.get(object).is_some_and(|&g| g > 0 && g != usize::MAX) {
+            return Err(RenderError::Target(
+                "exitance at every vertex: the last gather of this object ran at a coarser level of detail \
+                 (render.level_of_detail = false, or --full-detail, keeps every vertex current)",
+            ));
+        }
         let all: Vec<[f32; 4]> = self.buffers.exitance.read()?;
         let first = self.buffers.object_range(object).first_vertex as usize;
         let count = self.scene.objects[object].mesh.positions().len();
@@ -473,6 +488,7 @@ impl Renderer {
         let first = u64::from(self.buffers.object_range(object).first_vertex);
         let values: Vec<[f32; 4]> = exitance.iter().map(|e| [e[0], e[1], e[2], 1.0]).collect();
         self.buffers.exitance.write(first * 16, &values)?;
+        self.gathered[object] = 0;
         Ok(())
     }
 

@@ -171,7 +171,7 @@ impl ShadePass {
 }
 
 impl RenderPass for ShadePass {
-    /// Clear to the background, draw every object (`scene.draws[i]` is object i), leave the HDR
+    /// Clear to the background, draw every object at the plan's level of detail, leave the HDR
     /// (and surface) image readable by compute for the tone map (and the pixel gather).
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         let device = frame.gpu.device();
@@ -237,11 +237,12 @@ impl RenderPass for ShadePass {
             device.cmd_bind_index_buffer(cmd, scene.indices.raw(), 0, vk::IndexType::UINT32);
         }
         let eye = frame.eye;
-        for (i, d) in scene.draws.iter().enumerate() {
+        for i in 0..scene.levels.len() {
+            let d = scene.level(i, frame.plan.level(i)).draw;
             let push = ShadePush {
                 view_proj: frame.view_proj.to_cols_array_2d(),
                 eye_object: [eye.x, eye.y, eye.z, i as f32],
-                counts: [scene.light_count, scene.key_light_count, 0, 0],
+                counts: [scene.light_count, scene.key_light_count, u32::from(!frame.plan.one_tap_shadows), 0],
             };
             self.pipeline.bind(cmd, Some(&self.set), &push, extent);
             self.pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);

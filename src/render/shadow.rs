@@ -155,7 +155,8 @@ impl RenderPass for ShadowPass {
                 device.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.raw()], &[0]);
                 device.cmd_bind_index_buffer(cmd, scene.indices.raw(), 0, vk::IndexType::UINT32);
             }
-            for d in &scene.casters {
+            for &(object, level) in &scene.casters {
+                let d = scene.level(object, level).draw;
                 self.pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
             }
         }

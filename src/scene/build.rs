@@ -57,6 +57,10 @@ pub struct PreparedObject {
     pub casts_shadow: bool,
     /// World-space sample points with area weights (translucent objects only).
     pub samples: Vec<SamplePoint>,
+    /// Its levels of detail, finest (the mesh itself) first; only the mesh itself when
+    /// `render.level_of_detail` is off or the object's shading rests on per-vertex data the
+    /// simplifier cannot see (`lod_allowed`).
+    pub levels: Vec<crate::mesh::LodLevel>,
 }
 
 impl PreparedObject {
@@ -115,6 +119,15 @@ pub struct PreparedScene {
     pub any_caster: bool,
 }
 
+/// Whether an object may be drawn simplified. An opaque object under an environment light
+/// carries its sky light (soft shadows included) in per-vertex values that a simplifier
+/// measuring only positions cannot see: a flat floor would collapse to its outline and lose the
+/// shadow under what stands on it. Translucent objects carry gathered exitance, which varies
+/// over the width of the diffusion profile, and every level keeps its vertices' values exactly.
+fn lod_allowed(material: &ResolvedMaterial, environment_lit: bool) -> bool {
+    matches!(material, ResolvedMaterial::Translucent { .. }) || !environment_lit
+}
+
 /// Overrides from the command line, applied on top of the scene file.
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
@@ -131,6 +144,8 @@ pub struct Overrides {
     pub resolution: Option<[u32; 2]>,
     /// `--transport`: replaces `render.transport`.
     pub transport: Option<crate::scene::TransportMode>,
+    /// `--full-detail` (false): replaces `render.level_of_detail`.
+    pub level_of_detail: Option<bool>,
 }
 
 impl PreparedScene {
@@ -164,10 +179,14 @@ impl PreparedScene {
         if let Some(t) = overrides.transport {
             scene.file.render.transport = t;
         }
+        if let Some(l) = overrides.level_of_detail {
+            scene.file.render.level_of_detail = l;
+        }
         if let Some(r) = overrides.resolution {
             scene.file.camera.resolution = r;
         }
         let method = scene.file.sampling.method;
+        let environment_lit = scene.file.lights.iter().any(|l| matches!(l, Light::Environment { .. }));
 
         let mut objects = Vec::new();
         for (i, o) in scene.file.objects.iter().enumerate() {
@@ -224,7 +243,12 @@ impl PreparedScene {
                 }
                 ResolvedMaterial::Opaque { .. } => Vec::new(),
             };
-            objects.push(PreparedObject { name, mesh, material, casts_shadow: o.casts_shadow, samples });
+            let levels = if scene.file.render.level_of_detail && lod_allowed(&material, environment_lit) {
+                mesh.levels_of_detail()
+            } else {
+                vec![mesh.full_level()]
+            };
+            objects.push(PreparedObject { name, mesh, material, casts_shadow: o.casts_shadow, samples, levels });
         }
 
         for (i, o) in objects.iter().enumerate() {

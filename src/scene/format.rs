@@ -301,6 +301,11 @@ pub struct RenderSettings {
     /// Linear background radiance where nothing is hit, per channel (non-negative). Default:
     /// the environment light's radiance at the horizon, or black without one.
     pub background: Option<[f32; 3]>,
+    /// Draw, shadow and gather each mesh at a level of detail chosen per frame from its size
+    /// on screen (default true; `mesh::Mesh::levels_of_detail`, `render::plan`). False keeps
+    /// every mesh whole, and every vertex's exitance current (what per-vertex studies need).
+    #[serde(default = "yes")]
+    pub level_of_detail: bool,
 }
 
 /// Where exitance is gathered: `render.gather` in a scene, `--gather` on the command line.
@@ -405,6 +410,7 @@ impl Default for RenderSettings {
             exposure: 1.0,
             shadow_map_size: shadow_size(),
             background: None,
+            level_of_detail: true,
         }
     }
 }

@@ -24,6 +24,11 @@ pub struct SceneNeeds {
     pub transport: super::TransportMode,
     /// Per object, in scene order: what the planner weighs for it.
     pub objects: Vec<ObjectFacts>,
+    /// Scene units a shadow-map texel spans: the casters' bounding sphere's diameter over
+    /// `render.shadow_map_size` (exact for directional lights, whose maps span that sphere).
+    pub shadow_texel: f64,
+    /// Centre of the casters' bounding sphere.
+    pub caster_center: [f32; 3],
 }
 
 /// What the planner weighs for one object: where it is, how finely it is sampled and meshed, and
@@ -42,6 +47,21 @@ pub struct ObjectFacts {
     pub vertex_spacing: f64,
     /// Per channel (R, G, B) of a translucent object; `None` for an opaque one.
     pub channels: Option<[ChannelFacts; 3]>,
+    /// Its levels of detail, finest (the mesh itself) first (`PreparedObject::levels`).
+    pub levels: Vec<LevelFacts>,
+}
+
+/// One level of detail as the planner weighs it (`mesh::LodLevel`). Lengths in scene units.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct LevelFacts {
+    /// Triangles drawn.
+    pub triangles: usize,
+    /// Vertices its triangles use: the gather's receivers at this level.
+    pub vertices: usize,
+    /// Mean edge length.
+    pub mean_edge: f64,
+    /// Bound on its distance from the full mesh.
+    pub error: f64,
 }
 
 /// One colour channel of a translucent material at the scene's scale (`optics::Dipole`).
@@ -88,6 +108,16 @@ impl ObjectFacts {
             sample_spacing: if samples > 0 { (mesh.total_area() / samples as f64).sqrt() } else { 0.0 },
             vertex_spacing: edges / (3 * triangles.len()).max(1) as f64,
             channels,
+            levels: object
+                .levels
+                .iter()
+                .map(|l| LevelFacts {
+                    triangles: l.triangles.len(),
+                    vertices: l.vertices.len(),
+                    mean_edge: l.mean_edge,
+                    error: l.error,
+                })
+                .collect(),
         }
     }
 }
@@ -107,6 +137,8 @@ impl PreparedScene {
             host_target: false,
             transport: self.scene.file.render.transport,
             objects: self.objects.iter().map(ObjectFacts::of).collect(),
+            shadow_texel: 2.0 * self.caster_bounds.1 as f64 / self.scene.file.render.shadow_map_size as f64,
+            caster_center: self.caster_bounds.0.to_array(),
         }
     }
 

@@ -285,8 +285,13 @@ pub fn run(
     truth_dir: &Path,
     progress: &(dyn Fn(Event) + Sync),
 ) -> Result<Study, StudyError> {
-    let overrides =
-        Overrides { transport: Some(TransportMode::Gather), gather: Some(GatherMode::Vertex), ..Overrides::default() };
+    // Every vertex is measured: whole meshes.
+    let overrides = Overrides {
+        transport: Some(TransportMode::Gather),
+        gather: Some(GatherMode::Vertex),
+        level_of_detail: Some(false),
+        ..Overrides::default()
+    };
     let base = PreparedScene::new(scene, &overrides)?;
     if !base.has_translucent() {
         return Err(StudyError::NothingTranslucent);

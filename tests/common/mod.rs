@@ -185,6 +185,8 @@ pub fn gather_from(gpu: &Arc<Gpu>, prepared: PreparedScene, irradiance: &[[f64; 
     set_splat_irradiance(&mut renderer, &as_f32);
     let mut plan = renderer.plan(Change::Everything);
     plan.passes.retain(|(p, _)| *p == Pass::Gather);
+    // Every vertex, whatever level of detail the view would pick.
+    plan.objects.iter_mut().for_each(|o| o.level = 0);
     renderer.frame(&plan).unwrap();
     renderer.exitance(0).unwrap()
 }
