@@ -47,8 +47,8 @@ pub struct Args {
     /// What each frame after the first recomputes
     #[arg(long, value_enum, default_value_t = Moving::Light)]
     pub moving: Moving,
-    /// Submit each pass separately and time it from submission to fence (wall clock), for
-    /// devices whose timestamps do not wait for asynchronous compute (lavapipe)
+    /// Submit each pass separately and time it from submission to fence (wall clock): the
+    /// check on the timestamp figures
     #[arg(long)]
     pub isolate: bool,
     /// Print per-pass GPU milliseconds (median over the frames after the first)

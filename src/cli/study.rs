@@ -198,7 +198,7 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         );
     }
     let timing = if device.contains("llvmpipe") {
-        "each pass in a submission of its own, submission to fence (lavapipe's timestamps do not wait for compute)"
+        "each pass in a submission of its own, submission to fence (isolated, as the committed studies were measured)"
     } else {
         "each pass in a submission of its own, submission to fence"
     };

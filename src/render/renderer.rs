@@ -432,9 +432,9 @@ impl Renderer {
     }
 
     /// Render one frame with every pass in a submission of its own, and return each pass's
-    /// time from submission to fence (wall clock, milliseconds). Slower than `frame`, but on
-    /// devices whose timestamps do not wait for compute work (lavapipe runs dispatches
-    /// asynchronously), this is the figure that bounds each pass.
+    /// time from submission to fence (wall clock, milliseconds): the check on the timestamps
+    /// of `frame` (on lavapipe they once disagreed for compute passes; `GpuTimer::begin` says
+    /// why and how that was cured).
     pub fn frame_isolated(&mut self, plan: &Plan) -> Result<FrameTimings, RenderError> {
         let gpu = self.gpu.clone();
         let mut passes = Vec::new();
