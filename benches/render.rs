@@ -2,7 +2,7 @@
 //! seed paper's FPS-against-sample-count comparison (its Figure 7), on whatever device the
 //! loader offers (TRANSLUCENT_DEVICE to choose). Prints figures; asserts nothing.
 //!
-//!     cargo bench --bench render [-- frames|savings|levels|hierarchy|planner|gathers]
+//!     cargo bench --bench render [-- frames|savings|levels|terms|hierarchy|planner|gathers]
 //!
 //! Two timings per pass: GPU timestamp queries inside one submission, and the wall time of the
 //! pass submitted alone (submission to fence). On lavapipe a timestamp used to be taken only at
@@ -259,6 +259,10 @@ struct Force {
     level: Option<usize>,
     /// The shadow filter: one tap (true) or the four-tap tent (false).
     one_tap: Option<bool>,
+    /// Opaque objects drawn whole (their levels baked from sky light unused).
+    whole_opaque: bool,
+    /// Shading terms left out (`Plan::skip_terms`).
+    skip_terms: u32,
 }
 
 /// Renderers on the default scene at 512x512, one per configuration, stepped side by side
@@ -277,6 +281,10 @@ fn side_by_side(renderers: &mut [(Renderer, Force)], change: Change, frames: usi
             }
             if let Some(one_tap) = force.one_tap {
                 plan.one_tap_shadows = one_tap;
+            }
+            plan.skip_terms = force.skip_terms;
+            if force.whole_opaque {
+                plan.objects.iter_mut().filter(|o| o.channels.is_empty()).for_each(|o| o.level = 0);
             }
             let start = Instant::now();
             renderer.frame(&plan).expect("frame");
@@ -308,6 +316,7 @@ fn savings(gpu: &Arc<Gpu>) {
     let configs: Vec<(&str, Overrides, Force)> = vec![
         ("every saving on (the default)", Overrides::default(), Force::default()),
         ("level of detail off", full_detail.clone(), Force::default()),
+        ("floor whole (sky light unbaked)", Overrides::default(), Force { whole_opaque: true, ..Force::default() }),
         ("four-tap shadow filter", Overrides::default(), Force { one_tap: Some(false), ..Force::default() }),
         ("full detail, four taps", full_detail, Force { one_tap: Some(false), ..Force::default() }),
     ];
@@ -355,7 +364,10 @@ fn levels(gpu: &Arc<Gpu>) {
         "level", "triangles", "receivers", "edge px", "error px", "light ms", "camera ms", "FLIP"
     );
     let mut renderers: Vec<(Renderer, Force)> = (0..count)
-        .map(|l| (default_renderer(gpu, Overrides::default()), Force { level: Some(l), one_tap: Some(false) }))
+        .map(|l| {
+            let force = Force { level: Some(l), one_tap: Some(false), ..Force::default() };
+            (default_renderer(gpu, Overrides::default()), force)
+        })
         .collect();
     let light = side_by_side(&mut renderers, Change::Light(0), FRAMES);
     let camera = side_by_side(&mut renderers, Change::Camera, FRAMES);
@@ -376,6 +388,38 @@ fn levels(gpu: &Arc<Gpu>) {
             light[l].0,
             camera[l].0,
             flip(&camera[0].1, &camera[l].1)
+        );
+    }
+}
+
+/// What each term of the shading pass costs: camera-only frames (shade and tone map) side by
+/// side, each with one term left out, with every saving on; the FLIP mean says what the term
+/// does to the image.
+fn terms(gpu: &Arc<Gpu>) {
+    use translucent::render::shade::{TERM_ALL, TERM_FRESNEL, TERM_SHADOW, TERM_SPECULAR};
+    let rows = [
+        ("every term", 0),
+        ("no shadow lookup", TERM_SHADOW),
+        ("no GGX specular", TERM_SPECULAR),
+        ("no Fresnel transmittance", TERM_FRESNEL),
+        ("inputs only (raster, interpolation)", TERM_ALL),
+    ];
+    let mut renderers: Vec<(Renderer, Force)> = rows
+        .iter()
+        .map(|&(_, skip)| (default_renderer(gpu, Overrides::default()), Force { skip_terms: skip, ..Force::default() }))
+        .collect();
+    let camera = side_by_side(&mut renderers, Change::Camera, GATHER_FRAMES);
+    println!(
+        "\nShading terms, default scene 512x512, every saving on, camera-only frames side by side (median of \
+         {GATHER_FRAMES}):"
+    );
+    println!("  {:<38} {:>10} {:>12} {:>10}", "", "frame ms", "term costs", "FLIP");
+    for (i, (name, _)) in rows.iter().enumerate() {
+        println!(
+            "  {name:<38} {:>10.1} {:>12.1} {:>10.4}",
+            camera[i].0,
+            camera[0].0 - camera[i].0,
+            flip(&camera[0].1, &camera[i].1)
         );
     }
 }
@@ -572,6 +616,9 @@ fn main() {
     }
     if wanted("levels") {
         levels(&gpu);
+    }
+    if wanted("terms") {
+        terms(&gpu);
     }
     if wanted("hierarchy") {
         hierarchy(&gpu);

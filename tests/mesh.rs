@@ -526,3 +526,61 @@ fn files_without_faces_or_area_are_errors() {
     assert!(matches!(err, MeshError::NoArea { .. }), "{err}");
     assert!(err.to_string().contains("flat.obj"));
 }
+
+#[test]
+fn each_level_of_detail_halves_the_triangles_of_the_last_and_keeps_a_subset_of_its_vertices() {
+    let mesh = load_asset("bunny-1.8k.obj");
+    let levels = mesh.levels_of_detail();
+    assert!(levels.len() >= 3, "{} levels", levels.len());
+    assert_eq!(levels[0].triangles, mesh.triangles(), "level 0 is the mesh itself");
+    assert_eq!(levels[0].error, 0.0);
+    for pair in levels.windows(2) {
+        let (finer, coarser) = (&pair[0], &pair[1]);
+        let share = coarser.triangles.len() as f64 / finer.triangles.len() as f64;
+        assert!((0.4..=0.8).contains(&share), "{share}");
+        // Made of the finer level's vertices: values there carry over unchanged.
+        assert!(coarser.vertices.iter().all(|v| finer.vertices.binary_search(v).is_ok()));
+        assert!(coarser.triangles.iter().flatten().all(|v| coarser.vertices.binary_search(v).is_ok()));
+        assert!(coarser.error >= finer.error && coarser.mean_edge > finer.mean_edge);
+        assert!(!coarser.locked);
+    }
+    assert!(levels.last().unwrap().triangles.len() >= translucent::mesh::MIN_LEVEL_TRIANGLES / 2);
+}
+
+#[test]
+fn a_flat_grid_is_simplified_only_where_its_vertex_values_do_not_vary() {
+    let (positions, triangles) = grid(41, 0.0, Mat4::IDENTITY);
+    let mesh = Mesh::from_triangles(positions, triangles).unwrap();
+    // A soft dip in one corner (a shadow), flat elsewhere.
+    let values: Vec<[f32; 3]> = mesh
+        .positions()
+        .iter()
+        .map(|p| {
+            let d = p.truncate().distance(glam::Vec2::new(0.2, 0.2));
+            [1.0 - 0.5 * (-d * d / 0.01).exp(); 3]
+        })
+        .collect();
+    let locked = mesh.locks_where_varying(&values, 0.002);
+    let count = locked.iter().filter(|&&l| l).count();
+    assert!(count > 20 && count < mesh.positions().len() / 2, "{count} locked");
+    // A vertex far from the dip is free, one in it is locked.
+    let near = |x: f32, y: f32| {
+        (0..mesh.positions().len())
+            .min_by(|&a, &b| {
+                let d = |v: usize| mesh.positions()[v].truncate().distance(glam::Vec2::new(x, y));
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap()
+    };
+    assert!(locked[near(0.2, 0.2)] && !locked[near(0.5, 0.9)]);
+    let levels = mesh.levels_of_detail_locked(&locked);
+    let last = levels.last().unwrap();
+    assert!(levels.len() > 1 && last.locked);
+    assert!(last.triangles.len() * 2 < mesh.triangles().len(), "{} triangles left", last.triangles.len());
+    for (v, _) in locked.iter().enumerate().filter(|(_, l)| **l) {
+        assert!(last.vertices.binary_search(&(v as u32)).is_ok(), "locked vertex {v} was removed");
+    }
+    // Flat: the simplifier's error bound stays far under a pixel of anything that shows a
+    // unit grid (it bounds more than the distance from the plane, which is zero).
+    assert!(last.error < 1e-3, "{}", last.error);
+}

@@ -45,6 +45,13 @@ float ggx_specular(vec3 n, vec3 wi, vec3 wo, float alpha) {
 }
 
 void main() {
+    if (shade_skips(SHADE_SKIP_ALL)) {
+        out_radiance = vec4(v_exitance + v_environment, 1.0);
+#ifdef PIXEL_GATHER
+        out_surface = vec4(0.0);
+#endif
+        return;
+    }
     ObjectRecord o = objects[uint(push.eye_object.w)];
     vec3 n = normalize(v_normal);
     vec3 wo = normalize(push.eye_object.xyz - v_position);
@@ -56,7 +63,8 @@ void main() {
     float roughness = o.albedo_roughness.w;
     float alpha = max(roughness * roughness, 1e-3);
     vec3 radiance = vec3(0.0);
-    float exitance_to_radiance = translucent ? dipole_fresnel_transmittance(cos_o, eta) * o.eta_norm_kind.y : 0.0;
+    float exitance_to_radiance = !translucent ? 0.0
+        : (shade_skips(SHADE_SKIP_FRESNEL) ? 1.0 : dipole_fresnel_transmittance(cos_o, eta)) * o.eta_norm_kind.y;
     // Irradiance transmitted into a translucent surface here, for the channels the planner
     // computes locally: the environment's part arrives per vertex (vertex_light.comp weighs it
     // by F_t for translucent objects), the key lights' is added below.
@@ -68,13 +76,15 @@ void main() {
         light_incidence(lights[l], v_position, wi, irradiance);
         float cos_i = dot(n, wi);
         if (cos_i <= 0.0) continue;
-        float v = light_visibility(lights[l], shadow_maps, v_position, n, int(push.counts.z));
-        vec3 h = normalize(wi + wo);
-        float fresnel = dipole_fresnel_reflectance(max(dot(wi, h), 0.0), eta);
+        float v = shade_skips(SHADE_SKIP_SHADOW) ? 1.0 : light_visibility(lights[l], shadow_maps, v_position, n, int(push.counts.z));
         vec3 lit = irradiance * v;
-        radiance += lit * (fresnel * ggx_specular(n, wi, wo, alpha));
+        if (!shade_skips(SHADE_SKIP_SPECULAR)) {
+            vec3 h = normalize(wi + wo);
+            float fresnel = dipole_fresnel_reflectance(max(dot(wi, h), 0.0), eta);
+            radiance += lit * (fresnel * ggx_specular(n, wi, wo, alpha));
+        }
         if (!translucent) radiance += lit * (o.albedo_roughness.rgb / DIPOLE_PI * cos_i);
-        else transmitted += lit * (cos_i * dipole_fresnel_transmittance(cos_i, eta));
+        else transmitted += lit * (cos_i * (shade_skips(SHADE_SKIP_FRESNEL) ? 1.0 : dipole_fresnel_transmittance(cos_i, eta)));
     }
     if (translucent) {
         // Gathered channels: the exitance interpolated from the vertices (zero under the pixel

@@ -7,8 +7,19 @@ struct ShadePush {
     mat4 view_proj;
     vec4 eye_object;        // xyz: camera position; w: object index
     uvec4 counts;           // x: light count; y: key (non-environment) lights, first in the buffer;
-                            // z: shadow filter radius (light_visibility: 0 one tap, 1 four)
+                            // z: shadow filter radius (light_visibility: 0 one tap, 1 four);
+                            // w: terms left out, to measure their cost (SHADE_SKIP_*)
 };
 layout(push_constant) uniform ShadePushBlock { ShadePush push; };
+
+// Bits of counts.w, mirrored by shade::TERM_* in src/render/shade.rs.
+const uint SHADE_SKIP_SHADOW = 1u;
+const uint SHADE_SKIP_SPECULAR = 2u;
+const uint SHADE_SKIP_FRESNEL = 4u;
+const uint SHADE_SKIP_ALL = 8u;
+
+bool shade_skips(uint term) {
+    return (push.counts.w & term) != 0u;
+}
 
 #endif

@@ -32,6 +32,10 @@ pub struct LodLevel {
     /// Bound on its distance from the full mesh, scene units: the simplifier's error of each
     /// step from the level before, summed (0 for the full mesh).
     pub error: f64,
+    /// Simplified around locked vertices (`Mesh::levels_of_detail_locked`): where the caller's
+    /// per-vertex values vary, its vertices are all kept, so its triangles' size says nothing
+    /// of how well it carries them.
+    pub locked: bool,
 }
 
 impl Mesh {
@@ -40,6 +44,15 @@ impl Mesh {
     /// the simplifier stalls. Open borders are locked, so an open mesh keeps its outline (and
     /// its boundary vertices their distances to it).
     pub fn levels_of_detail(&self) -> Vec<LodLevel> {
+        self.levels_of_detail_locked(&[])
+    }
+
+    /// [`Mesh::levels_of_detail`] keeping the vertices `locked` marks (one flag per vertex, or
+    /// none): a caller whose per-vertex values vary where the geometry does not (sky light
+    /// and its soft shadows across a flat floor) locks the vertices where they vary, and the
+    /// simplifier removes only the others. The levels' errors stay geometric.
+    pub fn levels_of_detail_locked(&self, locked: &[bool]) -> Vec<LodLevel> {
+        assert!(locked.is_empty() || locked.len() == self.positions().len(), "one lock flag per vertex");
         let positions = self.positions();
         let bytes: &[u8] = bytemuck::cast_slice(positions);
         let adapter = meshopt::VertexDataAdapter::new(bytes, std::mem::size_of::<glam::Vec3>(), 0)
@@ -54,22 +67,50 @@ impl Mesh {
             }
             let indices: &[u32] = bytemuck::cast_slice(&last.triangles);
             let mut step_error = 0.0f32;
-            let simplified = meshopt::simplify(
-                indices,
-                &adapter,
-                3 * (count / 2),
-                STEP_ERROR,
-                meshopt::SimplifyOptions::LockBorder,
-                Some(&mut step_error),
-            );
+            let (target, options) = (3 * (count / 2), meshopt::SimplifyOptions::LockBorder);
+            let simplified = if locked.is_empty() {
+                meshopt::simplify(indices, &adapter, target, STEP_ERROR, options, Some(&mut step_error))
+            } else {
+                // No attributes: only the locks differ from the plain simplifier.
+                meshopt::simplify_with_attributes_and_locks(
+                    indices,
+                    &adapter,
+                    &[],
+                    &[],
+                    0,
+                    locked,
+                    target,
+                    STEP_ERROR,
+                    options,
+                    Some(&mut step_error),
+                )
+            };
             let triangles: Vec<[u32; 3]> = bytemuck::cast_slice(&simplified).to_vec();
             if triangles.len() as f64 > STALLED_SHARE * count as f64 || triangles.len() < MIN_LEVEL_TRIANGLES / 2 {
                 break;
             }
             let error = last.error + step_error as f64 * scale;
-            levels.push(self.level(triangles, error));
+            let mut level = self.level(triangles, error);
+            level.locked = !locked.is_empty();
+            levels.push(level);
         }
         levels
+    }
+
+    /// Lock flags for [`Mesh::levels_of_detail_locked`]: the vertices where per-vertex `values`
+    /// (RGB) differ from a neighbour's by more than `share` of their largest component over the
+    /// mesh, in any channel. Both ends of such an edge are locked.
+    pub fn locks_where_varying(&self, values: &[[f32; 3]], share: f32) -> Vec<bool> {
+        assert_eq!(values.len(), self.positions().len(), "one value per vertex");
+        let peak = values.iter().flatten().fold(0.0f32, |a, &b| a.max(b.abs()));
+        let limit = share * peak;
+        (0..values.len())
+            .map(|v| {
+                self.vertex_neighbours(v)
+                    .iter()
+                    .any(|&n| (0..3).any(|c| (values[v][c] - values[n as usize][c]).abs() > limit))
+            })
+            .collect()
     }
 
     /// The mesh itself as a level (level 0), for objects drawn whole.
@@ -89,6 +130,6 @@ impl Mesh {
         }
         let vertices = (0..positions.len() as u32).filter(|&v| used[v as usize]).collect();
         let mean_edge = edges / (3 * triangles.len()).max(1) as f64;
-        LodLevel { triangles, vertices, mean_edge, error }
+        LodLevel { triangles, vertices, mean_edge, error, locked: false }
     }
 }

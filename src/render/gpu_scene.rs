@@ -20,7 +20,7 @@ pub struct LevelRange {
     pub draw: DrawRange,
     /// First entry of its vertex list in `level_vertices`.
     pub first_entry: u32,
-    /// Vertices it uses.
+    /// Vertices it uses (0 for an opaque object, which is never gathered).
     pub vertex_count: u32,
 }
 
@@ -152,6 +152,50 @@ pub struct GpuScene {
     pending_objects: bool,
 }
 
+/// Every object's levels of detail packed (`pack_levels`).
+struct PackedLevels {
+    /// The shared index buffer's contents.
+    indices: Vec<u32>,
+    /// Each object's level ranges.
+    levels: Vec<Vec<LevelRange>>,
+    /// The shadow casters with the level drawn into shadow maps.
+    casters: Vec<(usize, usize)>,
+    /// The translucent objects' level vertex lists (opaque objects have none: they are never
+    /// gathered).
+    level_vertices: Vec<u32>,
+}
+
+fn pack_levels(scene: &PreparedScene) -> PackedLevels {
+    let (mut indices, mut levels, mut casters, mut level_vertices) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut first_vertex = 0u32;
+    for (i, o) in scene.objects.iter().enumerate() {
+        let translucent = matches!(o.material, crate::scene::build::ResolvedMaterial::Translucent { .. });
+        let mut ranges = Vec::new();
+        for level in &o.levels {
+            let draw = DrawRange {
+                first_index: indices.len() as u32,
+                index_count: 3 * level.triangles.len() as u32,
+                vertex_offset: first_vertex as i32,
+            };
+            indices.extend(level.triangles.iter().flatten());
+            let first_entry = level_vertices.len() as u32;
+            if translucent {
+                level_vertices.extend(&level.vertices);
+            }
+            ranges.push(LevelRange { draw, first_entry, vertex_count: level_vertices.len() as u32 - first_entry });
+        }
+        levels.push(ranges);
+        if o.casts_shadow {
+            let render = &scene.scene.file.render;
+            let texel = 2.0 * scene.caster_bounds.1 as f64 / render.shadow_map_size as f64;
+            let level = o.levels.iter().rposition(|l| l.error <= 0.5 * texel).unwrap_or(0);
+            casters.push((i, level));
+        }
+        first_vertex += o.mesh.positions().len() as u32;
+    }
+    PackedLevels { indices, levels, casters, level_vertices }
+}
+
 fn storage(gpu: &Arc<Gpu>, name: &str, bytes: u64, extra: vk::BufferUsageFlags) -> GpuResult<Buffer> {
     Buffer::new(gpu, &BufferDesc::gpu_only(name, bytes.max(16), vk::BufferUsageFlags::STORAGE_BUFFER | extra))
 }
@@ -171,11 +215,10 @@ impl GpuScene {
     /// buffer is left for the splat pass. Every buffer has at least 16 bytes, so an empty part of
     /// the scene still binds.
     pub fn new(gpu: &Arc<Gpu>, scene: &PreparedScene) -> GpuResult<GpuScene> {
-        let (mut vertices, mut indices, mut objects, mut samples) =
-            (Vec::new(), Vec::<u32>::new(), Vec::new(), Vec::new());
+        let (mut vertices, mut objects, mut samples) = (Vec::new(), Vec::new(), Vec::new());
+        let PackedLevels { indices, levels, casters, level_vertices } = pack_levels(scene);
         let mut vertex_boundary: Vec<[f32; 2]> = Vec::new();
-        let (mut levels, mut casters, mut receivers) = (Vec::new(), Vec::new(), Vec::new());
-        let mut level_vertices = Vec::<u32>::new();
+        let mut receivers = Vec::new();
         let (mut tree_nodes, mut tree_order) = (Vec::new(), Vec::<u32>::new());
         let (mut receiver_order, mut receiver_groups) = (Vec::<u32>::new(), Vec::<ReceiverGroupRecord>::new());
         let (mut group_items, mut blend_items) = (Vec::<u32>::new(), Vec::<u32>::new());
@@ -197,24 +240,6 @@ impl GpuScene {
                 vertex_boundary.extend(o.mesh.boundary_distances());
             } else {
                 vertex_boundary.extend(std::iter::repeat_n([crate::mesh::NO_BOUNDARY; 2], o.mesh.positions().len()));
-            }
-            let mut ranges = Vec::new();
-            for level in &o.levels {
-                let draw = DrawRange {
-                    first_index: indices.len() as u32,
-                    index_count: 3 * level.triangles.len() as u32,
-                    vertex_offset: first_vertex as i32,
-                };
-                indices.extend(level.triangles.iter().flatten());
-                let first_entry = level_vertices.len() as u32;
-                level_vertices.extend(&level.vertices);
-                ranges.push(LevelRange { draw, first_entry, vertex_count: level.vertices.len() as u32 });
-            }
-            levels.push(ranges);
-            if o.casts_shadow {
-                let texel = 2.0 * scene.caster_bounds.1 as f64 / render.shadow_map_size as f64;
-                let level = o.levels.iter().rposition(|l| l.error <= 0.5 * texel).unwrap_or(0);
-                casters.push((i, level));
             }
             samples.extend(o.samples.iter().map(|s| SampleRecord::new(s, i)));
             let vertex_count = o.mesh.positions().len() as u32;
@@ -358,6 +383,18 @@ impl GpuScene {
             let eta = if translucent { r.eta_norm_kind[0] } else { 0.0 };
             ObjectRange { first_vertex, vertex_count, first_sample, sample_count, eta }
         })
+    }
+
+    /// Take the objects' levels of detail anew (`PreparedObject::levels` changed: an opaque
+    /// object's levels baked from its sky light, `Renderer::bake_static_levels`): the index
+    /// buffer is replaced. The translucent objects' levels, and so `level_vertices`, which the
+    /// gathers' descriptor sets hold, must be as before. Call with no frame in flight.
+    pub fn set_levels(&mut self, gpu: &Arc<Gpu>, scene: &PreparedScene) -> GpuResult<()> {
+        let PackedLevels { indices, levels, casters, .. } = pack_levels(scene);
+        self.indices = upload(gpu, "indices", &indices, vk::BufferUsageFlags::INDEX_BUFFER)?;
+        self.levels = levels;
+        self.casters = casters;
+        Ok(())
     }
 
     /// Object `object` at level of detail `level`, or at its coarsest when it has fewer levels.

@@ -211,6 +211,9 @@ pub struct Plan {
     pub one_tap_shadows: bool,
     /// Why that filter, with the figures.
     pub shadow_filter_why: String,
+    /// Terms of the shading pass left out (`shade::TERM_*` bits), to measure what each costs
+    /// (the benchmark's `terms` section); 0, every term, in any plan the planner makes.
+    pub skip_terms: u32,
 }
 
 impl Plan {
@@ -345,12 +348,15 @@ pub fn choose_level(facts: &ObjectFacts, footprint: Option<f64>) -> (usize, Stri
     let Some(px) = footprint else {
         return (last, "out of view: its coarsest level, for the shadows it casts".into());
     };
-    let fits =
-        |l: &crate::scene::needs::LevelFacts| l.mean_edge <= LOD_EDGE_PIXELS * px && l.error <= LOD_ERROR_PIXELS * px;
+    // A level simplified around the vertices where its values vary keeps them wherever they
+    // vary: only its distance from the whole mesh limits it.
+    let fits = |l: &crate::scene::needs::LevelFacts| {
+        (l.locked || l.mean_edge <= LOD_EDGE_PIXELS * px) && l.error <= LOD_ERROR_PIXELS * px
+    };
     let level = (0..=last).rev().find(|&i| fits(&facts.levels[i])).unwrap_or(0);
     let l = &facts.levels[level];
     let why = format!(
-        "{} of {} triangles, {} receivers: edges {:.2} px, error {:.2} px at {:.3e} units/px (limits {LOD_EDGE_PIXELS}, \
+        "{} of {} triangles, {} vertices: edges {:.2} px, error {:.2} px at {:.3e} units/px (limits {LOD_EDGE_PIXELS}, \
          {LOD_ERROR_PIXELS})",
         l.triangles,
         facts.levels[0].triangles,
@@ -623,7 +629,13 @@ mod tests {
             sample_spacing: spacing,
             vertex_spacing: spacing / 4.0,
             channels: Some([channel; 3]),
-            levels: vec![LevelFacts { triangles: 1000, vertices: 500, mean_edge: spacing / 4.0, error: 0.0 }],
+            levels: vec![LevelFacts {
+                triangles: 1000,
+                vertices: 500,
+                mean_edge: spacing / 4.0,
+                error: 0.0,
+                locked: false,
+            }],
         }
     }
 
@@ -631,7 +643,13 @@ mod tests {
     /// pixel), 0, 0.2 and 0.1 pixels from the whole mesh.
     fn levels() -> Vec<LevelFacts> {
         [(1000, 0.05, 0.0), (250, 0.5, 0.02), (60, 2.0, 0.01)]
-            .map(|(triangles, mean_edge, error)| LevelFacts { triangles, vertices: triangles / 2, mean_edge, error })
+            .map(|(triangles, mean_edge, error)| LevelFacts {
+                triangles,
+                vertices: triangles / 2,
+                mean_edge,
+                error,
+                locked: false,
+            })
             .to_vec()
     }
 

@@ -168,7 +168,16 @@ pub struct Renderer {
     /// Per object: the finest level of detail whose vertices hold its current exitance
     /// (`usize::MAX`: none yet); a finer level coming into view is gathered again.
     gathered: Vec<usize>,
+    /// The sky light changed since opaque objects' levels were baked from it
+    /// (`bake_static_levels`): until they are baked again they are drawn whole.
+    sky_levels_stale: bool,
 }
+
+/// Share of an opaque object's brightest per-vertex sky light by which two neighbouring
+/// vertices may differ and still be simplified away (`Renderer::bake_static_levels`): 0.2%,
+/// under what a person sees in a smooth gradient. Measured on the default scene's floor
+/// (README, "Performance").
+pub const SKY_LOCK_SHARE: f32 = 0.002;
 
 impl Renderer {
     /// Frames a host may have in flight at once: each has its own timestamp queries.
@@ -227,6 +236,7 @@ impl Renderer {
             pending: Some(Change::Everything),
             stale: vec![true; scene.objects.len()],
             gathered: vec![usize::MAX; scene.objects.len()],
+            sky_levels_stale: true,
             scene,
         })
     }
@@ -249,7 +259,50 @@ impl Renderer {
     /// The passes a frame with this change would run, seen from the current camera, and what
     /// each object gets.
     pub fn plan(&self, change: Change) -> Plan {
-        plan::plan(&self.needs, &self.view(), &self.stale, &self.gathered, change)
+        let mut plan = plan::plan(&self.needs, &self.view(), &self.stale, &self.gathered, change);
+        if self.sky_levels_stale || plan.runs(Pass::VertexLight) {
+            for o in plan.objects.iter_mut().filter(|o| o.channels.is_empty() && o.level > 0) {
+                if self.needs.environment.is_some() {
+                    o.level = 0;
+                    o.level_why = "whole: its levels were baked from sky light that has changed since".into();
+                }
+            }
+        }
+        plan
+    }
+
+    /// Bake the levels of detail of opaque objects under an environment light from their
+    /// per-vertex sky light as the last vertex-light pass left it (read back): the vertices
+    /// where it varies by more than `SKY_LOCK_SHARE` of the object's brightest are kept, the
+    /// others simplified away like any mesh's (`mesh::Mesh::levels_of_detail_locked`). So a
+    /// flat floor keeps its density only around the soft shadows on it. `frame` calls this
+    /// after each frame that ran the vertex-light pass; a host recording its own frames calls
+    /// it after the fence of such a frame, with no frame in flight (the index buffer is
+    /// replaced). Until then those objects are drawn whole. Returns whether anything was baked.
+    pub fn bake_static_levels(&mut self) -> Result<bool, RenderError> {
+        if !self.scene.scene.file.render.level_of_detail || self.needs.environment.is_none() {
+            self.sky_levels_stale = false;
+            return Ok(false);
+        }
+        let sky: Vec<[f32; 4]> = self.buffers.environment_irradiance.read()?;
+        let mut baked = false;
+        let mut first = 0;
+        for o in &mut self.scene.objects {
+            let count = o.mesh.positions().len();
+            if matches!(o.material, crate::scene::build::ResolvedMaterial::Opaque { .. }) {
+                let values: Vec<[f32; 3]> = sky[first..first + count].iter().map(|e| [e[0], e[1], e[2]]).collect();
+                let locked = o.mesh.locks_where_varying(&values, SKY_LOCK_SHARE);
+                o.levels = o.mesh.levels_of_detail_locked(&locked);
+                baked = true;
+            }
+            first += count;
+        }
+        if baked {
+            self.buffers.set_levels(&self.gpu, &self.scene)?;
+            self.needs = Self::needs_of(&self.scene, self.target);
+        }
+        self.sky_levels_stale = false;
+        Ok(baked)
     }
 
     /// The current camera as the planner sees it.
@@ -355,6 +408,9 @@ impl Renderer {
         for o in &plan.objects {
             self.buffers.set_local_channels(o.object, o.local_mask());
         }
+        if plan.runs(Pass::VertexLight) {
+            self.sky_levels_stale = true;
+        }
         let device = self.gpu.device();
         // Against the frame before, which may still run: its reads of what this frame writes.
         memory_barrier(device, cmd, &[Access::Everything], &[Access::Everything]);
@@ -428,7 +484,11 @@ impl Renderer {
     pub fn frame(&mut self, plan: &Plan) -> Result<FrameTimings, RenderError> {
         let gpu = self.gpu.clone();
         let recorded = gpu.one_shot("frame", |cmd| self.record_plan(cmd, plan, None))??;
-        self.read_timings(&recorded)
+        let timings = self.read_timings(&recorded)?;
+        if plan.runs(Pass::VertexLight) {
+            self.bake_static_levels()?;
+        }
+        Ok(timings)
     }
 
     /// Render one frame with every pass in a submission of its own, and return each pass's
@@ -443,6 +503,9 @@ impl Renderer {
             let start = std::time::Instant::now();
             gpu.one_shot(pass.name(), |cmd| self.record_plan(cmd, &alone, None))??;
             passes.push((pass.name().to_string(), start.elapsed().as_secs_f64() * 1e3));
+        }
+        if plan.runs(Pass::VertexLight) {
+            self.bake_static_levels()?;
         }
         Ok(FrameTimings { passes })
     }

@@ -26,6 +26,16 @@ pub const HDR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const SURFACE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
+/// `Plan::skip_terms` bit: key lights' shadow lookups (every light counts as visible).
+pub const TERM_SHADOW: u32 = 1;
+/// `Plan::skip_terms` bit: the GGX specular lobe.
+pub const TERM_SPECULAR: u32 = 2;
+/// `Plan::skip_terms` bit: the Fresnel transmittances of translucent surfaces (taken as 1).
+pub const TERM_FRESNEL: u32 = 4;
+/// `Plan::skip_terms` bit: everything but the interpolated inputs (exitance plus sky light):
+/// what rasterising and interpolating alone cost.
+pub const TERM_ALL: u32 = 8;
+
 /// `ShadePush` in glsl/common/shade_push.glsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -242,7 +252,12 @@ impl RenderPass for ShadePass {
             let push = ShadePush {
                 view_proj: frame.view_proj.to_cols_array_2d(),
                 eye_object: [eye.x, eye.y, eye.z, i as f32],
-                counts: [scene.light_count, scene.key_light_count, u32::from(!frame.plan.one_tap_shadows), 0],
+                counts: [
+                    scene.light_count,
+                    scene.key_light_count,
+                    u32::from(!frame.plan.one_tap_shadows),
+                    frame.plan.skip_terms,
+                ],
             };
             self.pipeline.bind(cmd, Some(&self.set), &push, extent);
             self.pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);

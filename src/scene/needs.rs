@@ -62,6 +62,9 @@ pub struct LevelFacts {
     pub mean_edge: f64,
     /// Bound on its distance from the full mesh.
     pub error: f64,
+    /// Simplified around the vertices where its per-vertex values vary (`LodLevel::locked`):
+    /// judged by its distance from the full mesh alone.
+    pub locked: bool,
 }
 
 /// One colour channel of a translucent material at the scene's scale (`optics::Dipole`).
@@ -116,6 +119,7 @@ impl ObjectFacts {
                     vertices: l.vertices.len(),
                     mean_edge: l.mean_edge,
                     error: l.error,
+                    locked: l.locked,
                 })
                 .collect(),
         }
