@@ -325,12 +325,15 @@ impl View {
 
 /// Largest shadow-map texel, in pixels at the casters' centre, that shading looks up with one
 /// bilinear tap rather than the four-tap tent: the tent widens a shadow edge by about two
-/// texels, under two pixels here. Measured on the default scene (README "Performance").
+/// texels, which is then under two pixels. (On llvmpipe one compare tap costs nearly what four
+/// do, README "Performance"; on a GPU the saving is the taps.)
 pub const SHADOW_ONE_TAP_PIXELS: f64 = 1.0;
 
-/// Longest mean edge, in pixels at the object's centre, that a level of detail may have:
-/// triangles of a few pixels each. Measured on the default scene against the full mesh (FLIP,
-/// README "Performance").
+/// Longest mean edge, in pixels at the object's centre, that a level of detail may have. The
+/// exitance a level carries varies over the diffusion profile's width (20 to 36 px on the
+/// default scene), so edges well past a few pixels still carry it; on the default scene the
+/// error limit binds first, and levels with 11 and 16 px edges stay under FLIP 0.02 against
+/// the whole mesh (`cargo bench --bench render -- levels`, README "Performance").
 pub const LOD_EDGE_PIXELS: f64 = 12.0;
 /// Largest distance from the full mesh, in pixels at the object's centre, that a level
 /// may have: the silhouette moves by less than half a pixel.
@@ -338,15 +341,15 @@ pub const LOD_ERROR_PIXELS: f64 = 0.5;
 
 /// The coarsest of `facts.levels` whose mean edge and distance from the full mesh stay within
 /// `LOD_EDGE_PIXELS` and `LOD_ERROR_PIXELS` pixels of footprint `footprint` (scene units per
-/// pixel at the object's centre); out of view (`None`), the coarsest level, which only
-/// its shadow shows. Returns the level and why.
+/// pixel at the object's centre); out of view (`None`), the coarsest level (its draw is clipped
+/// away, and shadow maps choose their own level, `GpuScene::casters`). Returns the level and why.
 pub fn choose_level(facts: &ObjectFacts, footprint: Option<f64>) -> (usize, String) {
     let last = facts.levels.len().saturating_sub(1);
     if last == 0 {
         return (0, "drawn whole (one level: render.level_of_detail off, or per-vertex sky light)".into());
     }
     let Some(px) = footprint else {
-        return (last, "out of view: its coarsest level, for the shadows it casts".into());
+        return (last, "out of view: its coarsest level (clipped away; shadow maps choose their own)".into());
     };
     // A level simplified around the vertices where its values vary keeps them wherever they
     // vary: only its distance from the whole mesh limits it.
