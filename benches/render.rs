@@ -146,15 +146,11 @@ fn gather_alone_ms(renderer: &mut Renderer) -> f64 {
     median(&mut times)
 }
 
-/// Exitance of the first translucent object after a full first frame with `overrides`, and the
-/// renderer, on the default scene at 512x512.
+/// The default scene at 512x512 with `overrides` and every mesh whole, after a first frame:
+/// for per-vertex comparisons.
 fn prepared_renderer(gpu: &Arc<Gpu>, overrides: Overrides) -> Renderer {
     // Per-vertex comparisons need every vertex gathered.
-    let overrides = Overrides { resolution: Some([512, 512]), level_of_detail: Some(false), ..overrides };
-    let prepared = PreparedScene::new(&Scene::builtin(), &overrides).expect("scene");
-    let mut renderer = Renderer::new(gpu, prepared).expect("renderer");
-    renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
-    renderer
+    default_renderer(gpu, Overrides { level_of_detail: Some(false), ..overrides })
 }
 
 fn first_exitance(renderer: &Renderer) -> Vec<[f32; 3]> {
@@ -296,6 +292,7 @@ fn side_by_side(renderers: &mut [(Renderer, Force)], change: Change, frames: usi
     renderers.iter().zip(&mut times).map(|((r, _), t)| (median(t), r.image().expect("image").0)).collect()
 }
 
+/// The default scene at 512x512 with `overrides`, after a first frame of everything.
 fn default_renderer(gpu: &Arc<Gpu>, overrides: Overrides) -> Renderer {
     let overrides = Overrides { resolution: Some([512, 512]), ..overrides };
     let prepared = PreparedScene::new(&Scene::builtin(), &overrides).expect("default scene");
@@ -430,18 +427,10 @@ fn terms(gpu: &Arc<Gpu>) {
 /// degrees a frame) in two renderers side by side, alternating: `planned` records what its plan
 /// asks for, `forced` records every pass for every object each frame, every channel gathered.
 fn planned_against_forced(planned: &mut Renderer, forced: &mut Renderer, change: Change) -> (f64, f64) {
-    let step = |r: &mut Renderer| match change {
-        Change::Light(i) => {
-            let scene = r.scene();
-            let moved = lights::orbit(&scene.scene.file.lights[i], scene.bounds.0, 3.0).expect("a key light");
-            r.set_light(i, moved).expect("orbit");
-        }
-        _ => r.set_camera(r.camera().orbited(r.scene().bounds.0, 3.0)),
-    };
     let (mut a, mut b) = (Vec::new(), Vec::new());
     for frame in 0..WARM_UP + FRAMES {
         for (renderer, times, force) in [(&mut *planned, &mut a, false), (&mut *forced, &mut b, true)] {
-            step(renderer);
+            step(renderer, change);
             let plan = renderer.plan(if force { Change::Everything } else { change });
             let start = Instant::now();
             renderer.frame(&plan).expect("frame");

@@ -15,6 +15,23 @@ fn prepare(text: &str) -> PreparedScene {
 
 fn quiet(_: u32, _: usize, _: usize) {}
 
+/// A marble sphere of radius 10 (1 unit = 1 mm), 4 divisions, under one directional light from
+/// `[x, 1, 0]`.
+fn lit_marble_sphere(x: f32) -> String {
+    format!(
+        r#"
+[[object]]
+shape = {{ type = "sphere", radius = 10.0, divisions = 4 }}
+material = {{ type = "translucent", preset = "marble", mm_per_unit = 1.0 }}
+
+[[light]]
+type = "directional"
+direction = [{x}, 1.0, 0.0]
+irradiance = [1.0, 1.0, 1.0]
+"#
+    )
+}
+
 /// A square of side 60 units, 1 unit = 10 mm of marble (red diffusion length 0.85 units), lit
 /// from straight above: at the centre the integral is the whole plane's, `R_d,total E_t`; on the
 /// middle of an edge, half of it; at a corner, a quarter (a radial kernel over a half- or
@@ -171,30 +188,16 @@ count = {count}
 /// A cached truth is read back instead of recomputed, and a changed scene gets a new key.
 #[test]
 fn truth_is_cached_by_scene_content() {
-    let text = |x: f32| {
-        format!(
-            r#"
-[[object]]
-shape = {{ type = "sphere", radius = 10.0, divisions = 4 }}
-material = {{ type = "translucent", preset = "marble", mm_per_unit = 1.0 }}
-
-[[light]]
-type = "directional"
-direction = [{x}, 1.0, 0.0]
-irradiance = [1.0, 1.0, 1.0]
-"#
-        )
-    };
     let dir = std::env::temp_dir().join(format!("translucent-truth-cache-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let options = truth::TruthOptions { max_level: 1, ..Default::default() };
-    let scene = prepare(&text(0.0));
+    let scene = prepare(&lit_marble_sphere(0.0));
     let (first, was_cached) = truth::cached(&scene, &options, &dir, &quiet).unwrap();
     assert!(!was_cached);
     let (second, was_cached) = truth::cached(&scene, &options, &dir, &quiet).unwrap();
     assert!(was_cached);
     assert_eq!(first.exitance, second.exitance);
-    let moved = prepare(&text(0.5));
+    let moved = prepare(&lit_marble_sphere(0.5));
     assert_ne!(truth::content_key(&scene, &options), truth::content_key(&moved, &options));
     let (_, was_cached) = truth::cached(&moved, &options, &dir, &quiet).unwrap();
     assert!(!was_cached);
@@ -207,18 +210,7 @@ irradiance = [1.0, 1.0, 1.0]
 /// (where NaN is null), and has a key of its own.
 #[test]
 fn truth_at_a_vertex_subset_equals_the_full_truth_there_and_is_cached_apart() {
-    let scene = prepare(
-        r#"
-[[object]]
-shape = { type = "sphere", radius = 10.0, divisions = 4 }
-material = { type = "translucent", preset = "marble", mm_per_unit = 1.0 }
-
-[[light]]
-type = "directional"
-direction = [0.3, 1.0, 0.0]
-irradiance = [1.0, 1.0, 1.0]
-"#,
-    );
+    let scene = prepare(&lit_marble_sphere(0.3));
     let full_options = truth::TruthOptions { max_level: 1, ..Default::default() };
     let n = scene.objects[0].mesh.positions().len();
     let subset_options = truth::TruthOptions { receivers: Some(n / 3), ..full_options };

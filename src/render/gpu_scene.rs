@@ -186,9 +186,7 @@ fn pack_levels(scene: &PreparedScene) -> PackedLevels {
         }
         levels.push(ranges);
         if o.casts_shadow {
-            let render = &scene.scene.file.render;
-            let texel = 2.0 * scene.caster_bounds.1 as f64 / render.shadow_map_size as f64;
-            let level = o.levels.iter().rposition(|l| l.error <= 0.5 * texel).unwrap_or(0);
+            let level = o.levels.iter().rposition(|l| l.error <= 0.5 * scene.shadow_texel()).unwrap_or(0);
             casters.push((i, level));
         }
         first_vertex += o.mesh.positions().len() as u32;

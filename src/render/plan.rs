@@ -501,7 +501,11 @@ pub fn plan(needs: &SceneNeeds, view: &View, stale: &[bool], gathered: &[usize],
         // Levels are judged at the centre's distance: the bounding sphere's nearest point lies
         // well in front of most of the surface, and would keep far more triangles than pixels.
         let centre_footprint = in_view.then(|| view.pixel_footprint(center.distance(view.eye) as f64));
-        let (level, level_why) = choose_level(facts, centre_footprint);
+        let (mut level, mut level_why) = choose_level(facts, centre_footprint);
+        if needs.environment.is_some() && environment_stale && facts.levels.iter().any(|l| l.locked) {
+            level = 0;
+            level_why = "whole: this frame recomputes the sky light its levels were baked from".into();
+        }
         let finer = gathered.get(i).is_some_and(|&g| level < g);
         let stale_now = stale.get(i).copied().unwrap_or(true) || lights_stale || change == Change::Material(i);
         let gathered = channels.iter().any(|c| c.transport == Transport::Gather);
@@ -706,6 +710,22 @@ mod tests {
         // At the level last gathered, or a coarser one, nothing is redone.
         let p = plan(&n, &view(), &[false], &[1], Change::Camera);
         assert!(!p.runs(Pass::Gather), "{p}");
+    }
+
+    #[test]
+    fn levels_baked_from_sky_light_are_not_drawn_on_a_frame_that_recomputes_it() {
+        // Light 1 is the environment (`needs` with 3 shadow layers).
+        let mut n = needs(3, 1);
+        n.objects[0].levels = levels();
+        n.objects[0].levels.iter_mut().skip(1).for_each(|l| l.locked = true);
+        // Locked levels are judged by their error alone: level 2's long edges do not count.
+        assert_eq!(run(&n, Change::Camera).objects[0].level, 2);
+        let p = run(&n, Change::Light(1));
+        assert!(p.runs(Pass::VertexLight));
+        assert_eq!(p.objects[0].level, 0, "{p}");
+        assert!(p.objects[0].level_why.contains("recomputes the sky light"), "{p}");
+        // The key light moving leaves the sky light, and the baked levels, as they are.
+        assert_eq!(run(&n, Change::Light(0)).objects[0].level, 2);
     }
 
     #[test]

@@ -168,9 +168,6 @@ pub struct Renderer {
     /// Per object: the finest level of detail whose vertices hold its current exitance
     /// (`usize::MAX`: none yet); a finer level coming into view is gathered again.
     gathered: Vec<usize>,
-    /// The sky light changed since opaque objects' levels were baked from it
-    /// (`bake_static_levels`): until they are baked again they are drawn whole.
-    sky_levels_stale: bool,
 }
 
 /// Share of an opaque object's brightest per-vertex sky light by which two neighbouring
@@ -236,7 +233,6 @@ impl Renderer {
             pending: Some(Change::Everything),
             stale: vec![true; scene.objects.len()],
             gathered: vec![usize::MAX; scene.objects.len()],
-            sky_levels_stale: true,
             scene,
         })
     }
@@ -259,16 +255,7 @@ impl Renderer {
     /// The passes a frame with this change would run, seen from the current camera, and what
     /// each object gets.
     pub fn plan(&self, change: Change) -> Plan {
-        let mut plan = plan::plan(&self.needs, &self.view(), &self.stale, &self.gathered, change);
-        if self.sky_levels_stale || plan.runs(Pass::VertexLight) {
-            for o in plan.objects.iter_mut().filter(|o| o.channels.is_empty() && o.level > 0) {
-                if self.needs.environment.is_some() {
-                    o.level = 0;
-                    o.level_why = "whole: its levels were baked from sky light that has changed since".into();
-                }
-            }
-        }
-        plan
+        plan::plan(&self.needs, &self.view(), &self.stale, &self.gathered, change)
     }
 
     /// Bake the levels of detail of opaque objects under an environment light from their
@@ -278,10 +265,11 @@ impl Renderer {
     /// flat floor keeps its density only around the soft shadows on it. `frame` calls this
     /// after each frame that ran the vertex-light pass; a host recording its own frames calls
     /// it after the fence of such a frame, with no frame in flight (the index buffer is
-    /// replaced). Until then those objects are drawn whole. Returns whether anything was baked.
+    /// replaced). From the frame that recomputes the sky light until then, those objects are
+    /// drawn whole (the planner, and `record_plan` withdrawing their baked levels). Returns
+    /// whether anything was baked.
     pub fn bake_static_levels(&mut self) -> Result<bool, RenderError> {
         if !self.scene.scene.file.render.level_of_detail || self.needs.environment.is_none() {
-            self.sky_levels_stale = false;
             return Ok(false);
         }
         let sky: Vec<[f32; 4]> = self.buffers.environment_irradiance.read()?;
@@ -301,8 +289,15 @@ impl Renderer {
             self.buffers.set_levels(&self.gpu, &self.scene)?;
             self.needs = Self::needs_of(&self.scene, self.target);
         }
-        self.sky_levels_stale = false;
         Ok(baked)
+    }
+
+    /// After a frame of `plan` has finished: bake levels from the sky light it recomputed.
+    fn bake_after(&mut self, plan: &Plan) -> Result<(), RenderError> {
+        if plan.runs(Pass::VertexLight) {
+            self.bake_static_levels()?;
+        }
+        Ok(())
     }
 
     /// The current camera as the planner sees it.
@@ -409,7 +404,11 @@ impl Renderer {
             self.buffers.set_local_channels(o.object, o.local_mask());
         }
         if plan.runs(Pass::VertexLight) {
-            self.sky_levels_stale = true;
+            // Levels baked from the old sky light are offered no more until baked again (the
+            // index buffer keeps them: frames in flight may draw them).
+            for facts in self.needs.objects.iter_mut().filter(|f| f.levels.iter().any(|l| l.locked)) {
+                facts.levels.truncate(1);
+            }
         }
         let device = self.gpu.device();
         // Against the frame before, which may still run: its reads of what this frame writes.
@@ -485,9 +484,7 @@ impl Renderer {
         let gpu = self.gpu.clone();
         let recorded = gpu.one_shot("frame", |cmd| self.record_plan(cmd, plan, None))??;
         let timings = self.read_timings(&recorded)?;
-        if plan.runs(Pass::VertexLight) {
-            self.bake_static_levels()?;
-        }
+        self.bake_after(plan)?;
         Ok(timings)
     }
 
@@ -504,9 +501,7 @@ impl Renderer {
             gpu.one_shot(pass.name(), |cmd| self.record_plan(cmd, &alone, None))??;
             passes.push((pass.name().to_string(), start.elapsed().as_secs_f64() * 1e3));
         }
-        if plan.runs(Pass::VertexLight) {
-            self.bake_static_levels()?;
-        }
+        self.bake_after(plan)?;
         Ok(FrameTimings { passes })
     }
 

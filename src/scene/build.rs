@@ -149,6 +149,12 @@ pub struct Overrides {
 }
 
 impl PreparedScene {
+    /// Scene units a shadow-map texel spans: the casters' bounding sphere's diameter over
+    /// `render.shadow_map_size` (exact for directional lights, whose maps span that sphere).
+    pub fn shadow_texel(&self) -> f64 {
+        2.0 * self.caster_bounds.1 as f64 / self.scene.file.render.shadow_map_size as f64
+    }
+
     /// Apply `overrides`, then load, transform and check every object's mesh, resolve its
     /// material, place its sample points (translucent objects only, seed `sampling.seed + i`
     /// for object `i`), load the environment and prepare the lights. Errors say which object

@@ -24,8 +24,7 @@ pub struct SceneNeeds {
     pub transport: super::TransportMode,
     /// Per object, in scene order: what the planner weighs for it.
     pub objects: Vec<ObjectFacts>,
-    /// Scene units a shadow-map texel spans: the casters' bounding sphere's diameter over
-    /// `render.shadow_map_size` (exact for directional lights, whose maps span that sphere).
+    /// Scene units a shadow-map texel spans (`PreparedScene::shadow_texel`).
     pub shadow_texel: f64,
     /// Centre of the casters' bounding sphere.
     pub caster_center: [f32; 3],
@@ -87,13 +86,6 @@ impl ObjectFacts {
         let (lo, hi) = mesh.bounds();
         let center = (lo + hi) * 0.5;
         let radius = mesh.positions().iter().map(|p| p.distance(center)).fold(0.0f32, f32::max);
-        let triangles = mesh.triangles();
-        let positions = mesh.positions();
-        let edges: f64 = triangles
-            .iter()
-            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
-            .map(|(a, b)| positions[a as usize].distance(positions[b as usize]) as f64)
-            .sum();
         let samples = object.samples.len();
         let channels = match &object.material {
             super::build::ResolvedMaterial::Translucent { dipoles, .. } => Some(dipoles.map(|d| ChannelFacts {
@@ -109,7 +101,8 @@ impl ObjectFacts {
             center: center.to_array(),
             radius,
             sample_spacing: if samples > 0 { (mesh.total_area() / samples as f64).sqrt() } else { 0.0 },
-            vertex_spacing: edges / (3 * triangles.len()).max(1) as f64,
+            // Level 0 is the whole mesh.
+            vertex_spacing: object.levels[0].mean_edge,
             channels,
             levels: object
                 .levels
@@ -141,7 +134,7 @@ impl PreparedScene {
             host_target: false,
             transport: self.scene.file.render.transport,
             objects: self.objects.iter().map(ObjectFacts::of).collect(),
-            shadow_texel: 2.0 * self.caster_bounds.1 as f64 / self.scene.file.render.shadow_map_size as f64,
+            shadow_texel: self.shadow_texel(),
             caster_center: self.caster_bounds.0.to_array(),
         }
     }
