@@ -1,7 +1,8 @@
 //! Experiment for the study's defect 2 (the vertex gather reads low beside the terminator): the
 //! f64 twin's error against the exact integral, binned by `n.l` at the vertex, split into what the
-//! far sum and the near-field blend contribute. `terminator SCENE COUNT [CACHE_DIR]` (one
-//! directional light; the scene's sampler).
+//! far sum and the near-field blend contribute, and the error over every lit vertex.
+//! `terminator SCENE COUNT [CACHE_DIR]` (one directional light; the scene's sampler);
+//! `BLEND_K=kr,kg,kb` replaces the blend's radii, `SKIP_SPLIT=1` skips the slow split.
 use translucent::optics::kernel;
 use translucent::reference::{self, truth};
 use translucent::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
@@ -29,6 +30,17 @@ fn main() {
     let o = &scene.objects[0];
     let ResolvedMaterial::Translucent { dipoles, material, .. } = &o.material else { panic!() };
     let samples: Vec<_> = o.samples.iter().zip(&irradiance).collect();
+    // The blend's radius factor per channel: the renderer's (kernel::near_blend_radii), or
+    // BLEND_K=kr,kg,kb to try others (1.5,1.5,1.5 is the single radius used before).
+    let k: [f64; 3] = match std::env::var("BLEND_K") {
+        Ok(v) => {
+            let k: Vec<f64> = v.split(',').map(|x| x.parse().unwrap()).collect();
+            [k[0], k[1], k[2]]
+        }
+        Err(_) => o.near_blend_radii(),
+    };
+    println!("blend radius r/g/b: {:.3}/{:.3}/{:.3} sqrt(dA)", k[0], k[1], k[2]);
+    let radius_sq: Vec<[f64; 3]> = o.samples.iter().map(|s| k.map(|k| k * k * s.area)).collect();
     let bins = [(-0.3, -0.1), (-0.1, 0.0), (0.0, 0.1), (0.1, 0.2), (0.2, 0.4), (0.4, 0.7)];
     // Per bin: sum of relative errors of (gather, far + exact near), near share, count.
     let mut acc = vec![([0.0f64; 3], [0.0f64; 3], [0.0f64; 3], [0.0f64; 3], 0usize); bins.len()];
@@ -36,31 +48,40 @@ fn main() {
     // triangles within reach (pieces of a twentieth of R_near's width), for the band's vertices.
     let mut split = vec![([0.0f64; 3], [0.0f64; 3], 0usize); bins.len()];
     let normals = o.mesh.vertex_normals();
+    let mut estimate = vec![[0.0f32; 3]; o.mesh.positions().len()];
     for (v, (x, n)) in o.mesh.positions().iter().zip(normals).enumerate() {
         let (x, n) = (x.as_dvec3(), n.as_dvec3());
         let nl = n.dot(l);
-        let Some(bin) = bins.iter().position(|&(a, b)| nl >= a && nl < b) else { continue };
-        let (mut far, mut near, mut wsum, mut asum) = ([0.0; 3], [0.0; 3], 0.0, 0.0);
-        for (s, e) in &samples {
+        let (mut far, mut near, mut wsum, mut asum) = ([0.0; 3], [0.0; 3], [0.0; 3], 0.0);
+        for ((s, e), rsq) in samples.iter().zip(&radius_sq) {
             let r = x.distance(s.position.as_dvec3());
             let b = kernel::B_PER_SQRT_AREA * s.area.sqrt();
-            let w = kernel::near_blend_weight(r, s.area);
-            wsum += w;
-            asum += w * s.area;
+            asum += kernel::near_blend_weight(r, s.area, kernel::NEAR_BLEND_RADIUS) * s.area;
             for c in 0..3 {
+                let t = if r * r < rsq[c] { 1.0 - r * r / rsq[c] } else { 0.0 };
+                let w = t * t * t;
+                wsum[c] += w;
                 far[c] += e[c] * kernel::far_kernel(&dipoles[c], r, s.area);
                 near[c] += w * e[c] * kernel::near_energy(&dipoles[c], b);
             }
         }
+        let wsum1: f64 = samples
+            .iter()
+            .map(|(s, _)| {
+                kernel::near_blend_weight(x.distance(s.position.as_dvec3()), s.area, kernel::NEAR_BLEND_RADIUS)
+            })
+            .sum();
+        estimate[v] = std::array::from_fn(|c| (far[c] + if wsum[c] > 0.0 { near[c] / wsum[c] } else { 0.0 }) as f32);
+        let Some(bin) = bins.iter().position(|&(a, b)| nl >= a && nl < b) else { continue };
         let (e_x, ..) = reference::transmitted_irradiance(&scene, &occluders, x, n, material.eta, eps);
-        let b_mean = kernel::B_PER_SQRT_AREA * (asum / wsum.max(1e-300)).sqrt();
+        let b_mean = kernel::B_PER_SQRT_AREA * (asum / wsum1.max(1e-300)).sqrt();
         let exact = t.exitance[0][v];
         let a = &mut acc[bin];
         for c in 0..3 {
             if exact[c] <= 0.0 {
                 continue;
             }
-            let blend = if wsum > 0.0 { near[c] / wsum } else { 0.0 };
+            let blend = if wsum[c] > 0.0 { near[c] / wsum[c] } else { 0.0 };
             let exact_near = e_x[c] * kernel::near_energy(&dipoles[c], b_mean);
             a.0[c] += (far[c] + blend - exact[c]) / exact[c];
             a.1[c] += (far[c] + exact_near - exact[c]) / exact[c];
@@ -111,13 +132,25 @@ fn main() {
                 if exact[c] <= 0.0 {
                     continue;
                 }
-                let blend = if wsum > 0.0 { near[c] / wsum } else { 0.0 };
+                let blend = if wsum[c] > 0.0 { near[c] / wsum[c] } else { 0.0 };
                 // far sum against exact far (truth - exact near), blend against exact near
                 sp.0[c] += (far[c] - (exact[c] - exact_near[c])) / exact[c];
                 sp.1[c] += (blend - exact_near[c]) / exact[c];
             }
             sp.2 += 1;
         }
+    }
+    let err = translucent::study::vertex_error(&t.exitance, &[estimate]);
+    let pc = |v: [f64; 3]| format!("{:.3}/{:.3}/{:.3}%", 100.0 * v[0], 100.0 * v[1], 100.0 * v[2]);
+    println!(
+        "all lit vertices: rms {}  bias {}  p99 {}  max {}",
+        pc(err.rel_rms),
+        pc(err.bias),
+        pc(err.p99),
+        pc(err.max)
+    );
+    if std::env::var("SKIP_SPLIT").is_ok() {
+        return;
     }
     println!("{} {count}: mean relative error per n.l bin, r/g/b", args[1]);
     for (bin, a) in bins.iter().zip(&acc) {

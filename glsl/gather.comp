@@ -68,14 +68,14 @@ void main() {
         uint n = min(TILE, sample_count - base);
         if (is_receiver) {
             for (uint k = 0u; k < n; ++k) {
-                gather_add(g, ch, x, tile_position_area[k], tile_irradiance[k].rgb, tile_near_energy[k].rgb);
+                gather_add(g, ch, o.near_blend.rgb, x, tile_position_area[k], tile_irradiance[k].rgb, tile_near_energy[k].rgb);
             }
             gather_flush(g);
         }
         barrier();
     }
     if (!is_receiver) return;
-    if (g.weight_sum == 0.0 && push.node_count > 0u) {
+    if (any(equal(g.weight_sum, vec3(0.0))) && push.node_count > 0u) {
         uint s = tree_nearest_sample(x, push.first_node, push.node_count);
         g.nearest_near = splat[s].irradiance_area.rgb * splat[s].near_energy.rgb;
     }

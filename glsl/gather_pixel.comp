@@ -46,7 +46,7 @@ void main() {
     DipoleChannel ch[3] = gather_channels(o);
     GatherSum g = gather_begin();
     for (uint i = first; i < first + count; ++i) {
-        gather_add(g, ch, s.xyz, samples[i].position_area, splat[i].irradiance_area.rgb, splat[i].near_energy.rgb);
+        gather_add(g, ch, o.near_blend.rgb, s.xyz, samples[i].position_area, splat[i].irradiance_area.rgb, splat[i].near_energy.rgb);
         if (((i - first) & 63u) == 63u) gather_flush(g);
     }
     // A pixel does not know its distance to an open boundary: the near field is taken whole

@@ -66,7 +66,7 @@ void main() {
         DipoleChannel ch[3] = gather_channels(o);
         GatherSum g = gather_begin();
         for (uint i = first_sample; i < first_sample + sample_count; ++i) {
-            gather_add(g, ch, x, samples[i].position_area, splat[i].irradiance_area.rgb, vec3(0.0));
+            gather_add(g, ch, vec3(0.0), x, samples[i].position_area, splat[i].irradiance_area.rgb, vec3(0.0));
             if (((i - first_sample) & 63u) == 63u) gather_flush(g);
         }
         gather_flush(g);
@@ -93,7 +93,7 @@ void main() {
         uint n = min(TILE, list.y - base);
         for (uint t = 0u; t < n; ++t) {
             vec4 pa = tile_position_area[t];
-            float w = dipole_near_blend_weight(distance(x, pa.xyz), pa.w);
+            float w = dipole_near_blend_weight(distance(x, pa.xyz), pa.w, DIPOLE_NEAR_BLEND_RADIUS);
             sum += w * tile_exitance[t].rgb;
             near_sum += w * tile_near[t].rgb;
             weight_sum += w;

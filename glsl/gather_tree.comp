@@ -145,14 +145,14 @@ void main() {
         uint n = min(TILE, list.z - base);
         if (is_receiver) {
             for (uint t = 0u; t < n; ++t) {
-                gather_add(g, ch, x, tile_position_area[t], tile_irradiance[t].rgb, tile_near_energy[t].rgb);
+                gather_add(g, ch, o.near_blend.rgb, x, tile_position_area[t], tile_irradiance[t].rgb, tile_near_energy[t].rgb);
             }
             gather_flush(g);
         }
         barrier();
     }
     if (!is_receiver) return;
-    if (g.weight_sum == 0.0 && push.node_count > 0u) {
+    if (any(equal(g.weight_sum, vec3(0.0))) && push.node_count > 0u) {
         // No Shepard weight reached x: the nearest sample's near exitance, found anywhere in the
         // hierarchy (a node item may hold it), as the flat gather takes it.
         uint s = tree_nearest_sample(x, push.first_node, push.node_count);

@@ -60,6 +60,7 @@ fn scene_records_match_glsl() {
         ("eta_norm_kind", offset_of!(ObjectRecord, eta_norm_kind)),
         ("dipole", offset_of!(ObjectRecord, dipole)),
         ("ranges", offset_of!(ObjectRecord, ranges)),
+        ("near_blend", offset_of!(ObjectRecord, near_blend)),
     ];
     assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
 

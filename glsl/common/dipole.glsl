@@ -286,9 +286,9 @@ float dipole_kernel(DipoleChannel ch, float r, float area) {
 }
 
 
-// Shepard weight (1 - (r/R)^2)^3 inside R = 1.5 sqrt(area) (kernel::near_blend_weight).
-float dipole_near_blend_weight(float r, float area) {
-    float radius = DIPOLE_NEAR_BLEND_RADIUS * sqrt(max(area, 0.0));
+// Shepard weight (1 - (r/R)^2)^3 inside R = k sqrt(area) (kernel::near_blend_weight).
+float dipole_near_blend_weight(float r, float area, float k) {
+    float radius = k * sqrt(max(area, 0.0));
     if (!(r < radius)) return 0.0;
     float x = r / radius;
     float t = 1.0 - x * x;

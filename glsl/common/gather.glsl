@@ -2,6 +2,7 @@
 // gather (gather_pixel.comp): the far kernel summed with Kahan compensation plus the near
 // exitance blended over neighbouring samples (src/optics/kernel.rs, far_kernel's doc):
 //     M(x) = sum_i E_i far_kernel(r_i, A_i) + sum_i phi_i E_i E_near,i / sum_i phi_i
+// with a blend radius per channel (kernel::near_blend_radii, ObjectRecord::near_blend).
 // Include after dipole.glsl and scene.glsl.
 #ifndef GATHER_GLSL
 #define GATHER_GLSL
@@ -13,25 +14,26 @@ struct GatherSum {
     vec3 far;            // Kahan-compensated far sum of the flushed terms
     vec3 compensation;
     vec3 partial;        // plain f32 sum of the terms since the last gather_flush
-    vec3 near_sum;
-    float weight_sum;
-    float area_sum;      // sum of w A over the blend: its mean area sets b for the edge factor
+    vec3 near_sum;       // per channel, each with its own blend radius
+    vec3 weight_sum;
+    vec3 area_sum;       // sum of w A over the blend: its mean area sets b for the edge factor
     float nearest_r_sq;
     vec3 nearest_near;
 };
 
 GatherSum gather_begin() {
-    return GatherSum(vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), 0.0, 0.0, 3.4e38, vec3(0.0));
+    return GatherSum(vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0), 3.4e38, vec3(0.0));
 }
 
 DipoleChannel[3] gather_channels(ObjectRecord o) {
     return o.dipole;
 }
 
-// Add one sample (position and area, transmitted irradiance E, near energy per channel). The
-// kernel's b^2 and the blend radius^2 are multiples of the area, so no square root is taken here
-// beyond the poles' own; distances stay squared.
-void gather_add(inout GatherSum g, DipoleChannel ch[3], vec3 x, vec4 position_area, vec3 e, vec3 near_energy) {
+// Add one sample (position and area, transmitted irradiance E, near energy per channel);
+// `blend_k_sq` is ObjectRecord::near_blend.rgb. The kernel's b^2 and the blend radii^2 are
+// multiples of the area, so no square root is taken here beyond the poles' own; distances stay
+// squared.
+void gather_add(inout GatherSum g, DipoleChannel ch[3], vec3 blend_k_sq, vec3 x, vec4 position_area, vec3 e, vec3 near_energy) {
     vec3 d = x - position_area.xyz;
     float r_sq = dot(d, d);
     float area = position_area.w;
@@ -41,10 +43,11 @@ void gather_add(inout GatherSum g, DipoleChannel ch[3], vec3 x, vec4 position_ar
         term[c] = e[c] * area * dipole_r_d_far_sq(ch[c], r_sq, beta);
     }
     g.partial += area > 0.0 ? term : vec3(0.0);
-    // Shepard weight (1 - r^2/R^2)^3 inside R = NEAR_BLEND_RADIUS sqrt(area) (dipole_near_blend_weight).
-    float radius_sq = DIPOLE_NEAR_BLEND_RADIUS * DIPOLE_NEAR_BLEND_RADIUS * area;
-    float t = r_sq < radius_sq ? 1.0 - r_sq / radius_sq : 0.0;
-    float w = t * t * t;
+    // Shepard weights (1 - r^2/R^2)^3 inside R = k sqrt(area), per channel (dipole_near_blend_weight).
+    vec3 radius_sq = blend_k_sq * area;
+    // A select, not max(): at zero area the quotient is NaN.
+    vec3 t = mix(vec3(0.0), vec3(1.0) - r_sq / radius_sq, lessThan(vec3(r_sq), radius_sq));
+    vec3 w = t * t * t;
     vec3 near_exitance = e * near_energy;
     g.near_sum += w * near_exitance;
     g.weight_sum += w;
@@ -91,8 +94,13 @@ vec3 gather_near_kept(DipoleChannel ch[3], float area, vec2 boundary) {
 vec3 gather_end(GatherSum g, DipoleChannel ch[3], vec2 boundary) {
     gather_flush(g);
     vec3 near = g.nearest_near;
-    if (g.weight_sum > 0.0) {
-        near = g.near_sum / g.weight_sum * gather_near_kept(ch, g.area_sum / g.weight_sum, boundary);
+    for (int c = 0; c < 3; ++c) {
+        if (g.weight_sum[c] > 0.0) {
+            float area = g.area_sum[c] / g.weight_sum[c];
+            float b = DIPOLE_B_PER_SQRT_AREA * sqrt(area);
+            near[c] = g.near_sum[c] / g.weight_sum[c] * dipole_near_kept_at_edge(ch[c], b, boundary.x)
+                * dipole_near_kept_at_edge(ch[c], b, boundary.y);
+        }
     }
     return max(g.far + near, vec3(0.0));
 }

@@ -188,6 +188,34 @@ pub fn near_tail(dipole: &Dipole, beta: f64, radius: f64) -> f64 {
     0.5 * dipole.alpha_prime * (pole(dipole.z_r) + pole(dipole.z_v))
 }
 
+/// The second moment of the near part about its receiver, `integral r^2 R_near(r) 2 pi r dr /
+/// E_near` (scene units squared, `b^2 = beta`), from its tail: integrating by parts,
+/// `integral r^2 R_near 2 pi r dr = integral_0^inf 2 R near_tail(R) dR`. Taken in `u = ln R`
+/// (`2 R^2 near_tail(R) du`), in panels of half a unit, 4-point Gauss-Legendre each, from
+/// `1e-4 l` to `1e4 l` with `l = sqrt(z_v^2 + b^2)`: the tail falls as `b^4 / R^4` past `l`,
+/// so what lies beyond is below `1e-8` of the whole. Zero when there is no near energy.
+pub fn near_second_moment(dipole: &Dipole, beta: f64) -> f64 {
+    let total = near_tail(dipole, beta, 0.0);
+    if total <= 0.0 || beta <= 0.0 {
+        return 0.0;
+    }
+    let ell = (dipole.z_v * dipole.z_v + beta).sqrt();
+    let (u0, u1) = ((1e-4 * ell).ln(), (1e4 * ell).ln());
+    let panels = ((u1 - u0) / 0.5).ceil();
+    let h = (u1 - u0) / panels;
+    let mut sum = 0.0;
+    for p in 0..panels as usize {
+        let centre = u0 + (p as f64 + 0.5) * h;
+        for k in 0..2 {
+            for sign in [-1.0, 1.0] {
+                let r = (centre + sign * 0.5 * h * GL4_X[k]).exp();
+                sum += GL4_W[k] * 2.0 * r * r * near_tail(dipole, beta, r);
+            }
+        }
+    }
+    0.5 * h * sum / total
+}
+
 /// Gauss-Legendre nodes (positive half) and weights, 4 points on `[-1, 1]`.
 const GL4_X: [f64; 2] = [0.339_981_043_584_856, 0.861_136_311_594_053];
 const GL4_W: [f64; 2] = [0.652_145_154_862_546, 0.347_854_845_137_454];
@@ -300,14 +328,45 @@ pub fn far_kernel(dipole: &Dipole, r: f64, area: f64) -> f64 {
 }
 
 /// Shepard weight of a sample in the near-field blend at distance `r`: `(1 - (r/R)^2)^3` inside
-/// `R = NEAR_BLEND_RADIUS sqrt(dA)`, 0 outside; smooth (C2) at the rim.
-pub fn near_blend_weight(r: f64, area: f64) -> f64 {
-    let radius = NEAR_BLEND_RADIUS * area.max(0.0).sqrt();
+/// `R = k sqrt(dA)`, 0 outside; smooth (C2) at the rim. `k` is the channel's factor from
+/// [`near_blend_radii`] (the sparse gather's is [`NEAR_BLEND_RADIUS`]).
+pub fn near_blend_weight(r: f64, area: f64, k: f64) -> f64 {
+    let radius = k * area.max(0.0).sqrt();
     if r.is_nan() || r >= radius {
         return 0.0;
     }
     let t = 1.0 - (r / radius) * (r / radius);
     t * t * t
+}
+
+/// Per channel, the radius factor `k` of the near-field blend (`R = k sqrt(dA)`,
+/// [`near_blend_weight`]) for samples of mean area `mean_area`: the one whose blend smooths the
+/// near exitance as much as the exact near part does,
+///
+/// ```text
+/// k^2 dA / 5 = m2 = integral r^2 R_near(r) 2 pi r dr / E_near      ([`near_second_moment`]),
+/// ```
+///
+/// clamped to [`NEAR_BLEND_RADIUS`], [`NEAR_BLEND_RADIUS_MAX`].
+///
+/// Why: the exact near part `integral R_near(|x - y|) E_t(y) dA(y)` is `E_near` times `E_t`
+/// smoothed by `R_near`, which to second order is `E_t(x) + (m2 / 4) lap E_t(x)`; the blend
+/// smooths with its own weights instead, whose second moment in the plane is `R^2 / 5`
+/// (`integral (1 - u)^3 u du / integral (1 - u)^3 du` with `u = r^2 / R^2`). With one radius for
+/// every channel the two differ, and the vertex gather read low wherever `E_t` bends up (up to
+/// 1.8% of the exitance beside the terminator) and high where it bends down: the study's
+/// defect 2 (docs/STUDY.md). `R_near`'s width is `sqrt(z_v^2 + b^2)`, so it differs by channel.
+/// The floor keeps neighbours overlapping where `R_near` is narrower than the spacing (there the
+/// planner computes the channel locally instead, `render::plan`).
+pub fn near_blend_radii(dipoles: &[Dipole; 3], mean_area: f64) -> [f64; 3] {
+    if mean_area.is_nan() || mean_area <= 0.0 {
+        return [NEAR_BLEND_RADIUS; 3];
+    }
+    let beta = B_PER_SQRT_AREA * B_PER_SQRT_AREA * mean_area;
+    dipoles.each_ref().map(|d| {
+        let k = (5.0 * near_second_moment(d, beta) / mean_area).sqrt();
+        if k.is_nan() { NEAR_BLEND_RADIUS } else { k.clamp(NEAR_BLEND_RADIUS, NEAR_BLEND_RADIUS_MAX) }
+    })
 }
 
 /// Whether a cluster of samples of total area `area`, all at least `dist` away from a receiver,

@@ -12,12 +12,17 @@ kernel_constants! {
     REMAINDER_MAX_SPREAD = 0.1;
     /// ... and `sigma_tr (d1 - z)` is at most this; otherwise the closed form cancels little.
     REMAINDER_MAX_DECAY = 0.5;
-    /// Radius of a sample's near-field blend weight, in units of `sqrt(dA)`: wide enough that
-    /// neighbours overlap (spacing is about `sqrt(dA)`), narrow enough to keep light local. Across a
-    /// shadow edge on marble (tests/render.rs, measured with the earlier Richardson far part) 2.0
-    /// bleeds 7.7% of the lit level too far, 1.5 2.3%, 1.25 1.75%; 1.5 keeps more overlap for
-    /// irregular sample sets.
+    /// The least radius of a sample's near-field blend weight, in units of `sqrt(dA)`, and the
+    /// sparse gather's radius: wide enough that neighbours overlap (spacing is about `sqrt(dA)`),
+    /// so the blend is a partition of unity with no gaps even for irregular sample sets.
+    /// [`near_blend_radii`] widens it per channel to match `R_near`'s second moment.
     NEAR_BLEND_RADIUS = 1.5;
+    /// The greatest near-blend radius, in units of `sqrt(dA)`. A channel whose `R_near` is wider
+    /// (its `z_v` large next to the spacing) has little near energy, so matching it further buys
+    /// little: on the ketchup sphere at 6,400 samples, a cap of 3 left green at 0.58% RMS, 4 at
+    /// 0.25%, none at 0.25% (red wanted 16, and read the same at every cap); every blend weight
+    /// costs the hierarchical and sparse gathers' reach `k^2` in samples.
+    NEAR_BLEND_RADIUS_MAX = 4.0;
     /// The hierarchical gather drops a cluster of samples (with its subtree) when, under uniform
     /// light, it could add at most this fraction of `R_d,total` in every channel
     /// ([`negligible_cluster`]).

@@ -145,9 +145,10 @@ pub fn transmitted_irradiance_known(
 
 /// Radiant exitance at every vertex of every object (zero for opaque ones), from per-sample
 /// transmitted irradiance in scene order: the far kernel summed plus the near field blended
-/// over neighbouring samples (`optics::kernel::far_kernel` explains the split), times the share
-/// of it kept beside an open boundary (`optics::kernel::near_kept_at_edge` for each of the two
-/// nearest boundary directions, with `b` from the blend's mean sample area).
+/// over neighbouring samples with each channel's radius (`optics::kernel::far_kernel` explains
+/// the split, `near_blend_radii` the radii), times the share of it kept beside an open boundary
+/// (`optics::kernel::near_kept_at_edge` for each of the two nearest boundary directions, with
+/// `b` from the blend's mean sample area).
 pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3]>> {
     per_translucent_object(scene, |o, dipoles, first| {
         let samples: Vec<(DVec3, f64, [f64; 3])> =
@@ -161,6 +162,7 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3
             })
             .collect();
         let boundary = o.mesh.boundary_distances();
+        let radii = o.near_blend_radii();
         o.mesh
             .positions()
             .par_iter()
@@ -174,7 +176,7 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3
                         far[c] += e[c] * kernel::far_kernel(&dipoles[c], r, *area);
                     }
                 }
-                let (near, mean_area) = near_blend(x, &near);
+                let (near, mean_area) = near_blend(x, &near, radii);
                 let kept = near_kept(dipoles, mean_area, *t);
                 [0, 1, 2].map(|c| far[c] + near[c] * kept[c])
             })
@@ -184,11 +186,12 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<[f64; 3
 
 /// Per channel, the share of the blended near exitance a receiver keeps beside open boundaries
 /// `boundary` away (`mesh::Mesh::boundary_distances`): `kernel::near_kept_at_edge` for each of
-/// the two directions, with `b` of the blend's mean sample area; all of it when no blend weight
-/// reached (`mean_area` none). The twin of `gather_near_kept` in glsl/common/gather.glsl.
-pub(crate) fn near_kept(dipoles: &[Dipole; 3], mean_area: Option<f64>, boundary: [f32; 2]) -> [f64; 3] {
+/// the two directions, with `b` of the channel's blend's mean sample area; all of it when no
+/// blend weight reached (`mean_area` none). The twin of `gather_end` and `gather_near_kept` in
+/// glsl/common/gather.glsl.
+pub(crate) fn near_kept(dipoles: &[Dipole; 3], mean_area: [Option<f64>; 3], boundary: [f32; 2]) -> [f64; 3] {
     [0, 1, 2].map(|c| {
-        mean_area.map_or(1.0, |area| {
+        mean_area[c].map_or(1.0, |area| {
             let b = kernel::B_PER_SQRT_AREA * area.sqrt();
             boundary.iter().map(|&t| kernel::near_kept_at_edge(&dipoles[c], b, f64::from(t))).product()
         })
@@ -196,26 +199,32 @@ pub(crate) fn near_kept(dipoles: &[Dipole; 3], mean_area: Option<f64>, boundary:
 }
 
 /// Blend per-sample values to `x` with the near-field Shepard weights
-/// (`kernel::near_blend_weight`), or take the nearest sample's where no weight reaches: the twin
-/// of the blend in glsl/common/gather.glsl and glsl/gather_sparse.comp. Also the blend's mean
-/// sample area (`sum w A / sum w`), none where no weight reaches. `N` values per sample: the
-/// sparse gather blends its far and near parts (six) with one set of weights.
-pub(crate) fn near_blend<const N: usize>(x: DVec3, values: &[(DVec3, f64, [f64; N])]) -> ([f64; N], Option<f64>) {
-    let (mut sum, mut weight_sum, mut area_sum) = ([0.0; N], 0.0, 0.0);
+/// (`kernel::near_blend_weight`), value `c` with radius factor `radii[c]`, or take the nearest
+/// sample's where no weight reaches: the twin of the blend in glsl/common/gather.glsl and
+/// glsl/gather_sparse.comp. Also each value's blend's mean sample area (`sum w A / sum w`), none
+/// where no weight reaches. `N` values per sample: the sparse gather blends its far and near
+/// parts (six) with one radius.
+pub(crate) fn near_blend<const N: usize>(
+    x: DVec3,
+    values: &[(DVec3, f64, [f64; N])],
+    radii: [f64; N],
+) -> ([f64; N], [Option<f64>; N]) {
+    let (mut sum, mut weight_sum, mut area_sum) = ([0.0; N], [0.0; N], [0.0; N]);
     let (mut nearest_r, mut nearest) = (f64::INFINITY, [0.0; N]);
     for (p, area, v) in values {
         let r = x.distance(*p);
-        let w = kernel::near_blend_weight(r, *area);
         for c in 0..N {
+            let w = kernel::near_blend_weight(r, *area, radii[c]);
             sum[c] += w * v[c];
+            weight_sum[c] += w;
+            area_sum[c] += w * area;
         }
-        weight_sum += w;
-        area_sum += w * area;
         if r < nearest_r {
             (nearest_r, nearest) = (r, *v);
         }
     }
-    if weight_sum > 0.0 { (sum.map(|v| v / weight_sum), Some(area_sum / weight_sum)) } else { (nearest, None) }
+    let blended = std::array::from_fn(|c| if weight_sum[c] > 0.0 { sum[c] / weight_sum[c] } else { nearest[c] });
+    (blended, std::array::from_fn(|c| (weight_sum[c] > 0.0).then(|| area_sum[c] / weight_sum[c])))
 }
 
 /// The sparse gather (`render.gather = "sparse"`, glsl/gather_sparse.comp) in f64: the far sum
@@ -251,8 +260,8 @@ pub fn gather_sparse(scene: &PreparedScene, irradiance: &[[f64; 3]]) -> Vec<Vec<
             .zip(&boundary)
             .map(|(x, t)| {
                 let x = x.as_dvec3();
-                let (m, mean_area) = near_blend(x, &at_samples);
-                let kept = near_kept(dipoles, mean_area, *t);
+                let (m, mean_area) = near_blend(x, &at_samples, [kernel::NEAR_BLEND_RADIUS; 6]);
+                let kept = near_kept(dipoles, [mean_area[0]; 3], *t);
                 [0, 1, 2].map(|c| m[c] + m[3 + c] * kept[c])
             })
             .collect()

@@ -66,8 +66,9 @@ fn center_of(n: &TreeNode) -> DVec3 {
 /// Stage 1 at one receiver `x` whose group's cut is `items` (`sampling::SampleTree::cut`): a
 /// sample's far kernel and near exitance as in the flat sum, a node's power times the cluster
 /// kernel (`kernel::r_d_far_cluster`: its centroid, the `b` of its mean area, its spread); the
-/// near field blended over the listed samples (the nearest sample of the object where no weight
-/// reaches), times the share kept beside open boundaries `boundary` away (`super::near_kept`).
+/// near field blended over the listed samples with each channel's radius factor `radii` (the
+/// nearest sample of the object where no weight reaches), times the share kept beside open
+/// boundaries `boundary` away (`super::near_kept`).
 #[allow(clippy::too_many_arguments)]
 pub fn gather_items(
     x: DVec3,
@@ -79,6 +80,7 @@ pub fn gather_items(
     areas: &[f64],
     e: &[[f64; 3]],
     boundary: [f32; 2],
+    radii: [f64; 3],
 ) -> [f64; 3] {
     let mut far = [0.0f64; 3];
     let mut near = Vec::new();
@@ -106,16 +108,18 @@ pub fn gather_items(
             near.push((positions[s], areas[s], [0, 1, 2].map(|c| e[s][c] * kernel::near_energy(&dipoles[c], b))));
         }
     }
-    let (blended, mean_area) = near_blend(x, &near);
+    let (blended, mean_area) = near_blend(x, &near, radii);
     let kept = super::near_kept(dipoles, mean_area, boundary);
     let mut blended = [0, 1, 2].map(|c| blended[c] * kept[c]);
-    if !near.iter().any(|(p, area, _)| kernel::near_blend_weight(x.distance(*p), *area) > 0.0) {
-        // No weight reached x: the nearest sample of the whole object, as the flat sum takes it.
-        let nearest = (0..positions.len())
-            .min_by(|&a, &b| x.distance(positions[a]).total_cmp(&x.distance(positions[b])).then(a.cmp(&b)));
-        if let Some(s) = nearest {
-            let b = B_PER_SQRT_AREA * areas[s].sqrt();
-            blended = [0, 1, 2].map(|c| e[s][c] * kernel::near_energy(&dipoles[c], b));
+    // A channel no weight reached: the nearest sample of the whole object, as the flat sum takes it.
+    let nearest = || {
+        (0..positions.len())
+            .min_by(|&a, &b| x.distance(positions[a]).total_cmp(&x.distance(positions[b])).then(a.cmp(&b)))
+    };
+    if let Some(s) = mean_area.iter().any(Option::is_none).then(nearest).flatten() {
+        let b = B_PER_SQRT_AREA * areas[s].sqrt();
+        for c in (0..3).filter(|&c| mean_area[c].is_none()) {
+            blended[c] = e[s][c] * kernel::near_energy(&dipoles[c], b);
         }
     }
     [0, 1, 2].map(|c| (far[c] + blended[c]).max(0.0))
@@ -135,6 +139,7 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]], epsilon: f64) -> V
         let cuts = o.gather_cuts(&tree, &groups, epsilon);
         let mesh = o.mesh.positions();
         let boundary = o.mesh.boundary_distances();
+        let radii = o.near_blend_radii();
         let computed: Vec<(usize, [f64; 3])> = groups
             .order
             .par_iter()
@@ -144,7 +149,7 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]], epsilon: f64) -> V
                 let items = &cuts[k / RECEIVER_GROUP_SIZE];
                 (
                     v as usize,
-                    gather_items(x, items, &tree, &power, dipoles, &positions, &areas, e, boundary[v as usize]),
+                    gather_items(x, items, &tree, &power, dipoles, &positions, &areas, e, boundary[v as usize], radii),
                 )
             })
             .collect();

@@ -7,6 +7,7 @@ use super::records::{
     LightGpu, NodePowerRecord, ObjectRecord, ReceiverGroupRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
 };
 use crate::gpu::{Access, Buffer, BufferDesc, Gpu, GpuResult, memory_barrier};
+use crate::optics::kernel::NEAR_BLEND_RADIUS;
 use crate::sampling::NODE_ITEM;
 use crate::scene::build::PreparedScene;
 use ash::vk;
@@ -269,8 +270,11 @@ impl GpuScene {
                     let sample_count = group_items.len() as u32 - first - node_count;
                     let first_blend = blend_items.len() as u32;
                     if sparse {
-                        blend_items
-                            .extend(tree.within_reach(group, &positions, &areas).iter().map(|s| s + first_sample));
+                        blend_items.extend(
+                            tree.within_reach(group, &positions, &areas, NEAR_BLEND_RADIUS)
+                                .iter()
+                                .map(|s| s + first_sample),
+                        );
                     }
                     let ([x, y, z], r) = group;
                     receiver_groups.push(ReceiverGroupRecord {

@@ -44,6 +44,9 @@ pub struct ObjectRecord {
     pub dipole: [DipoleChannelGpu; 3],
     /// First vertex, vertex count, first sample, sample count.
     pub ranges: [u32; 4],
+    /// rgb: per channel, the square of the near-field blend's radius in units of `sqrt(dA)`
+    /// (`PreparedObject::near_blend_radii`); w: 0.
+    pub near_blend: [f32; 4],
 }
 
 impl ObjectRecord {
@@ -68,6 +71,10 @@ impl ObjectRecord {
                     ],
                     dipole: dipoles.each_ref().map(DipoleChannelGpu::from),
                     ranges,
+                    near_blend: {
+                        let k = object.near_blend_radii();
+                        [(k[0] * k[0]) as f32, (k[1] * k[1]) as f32, (k[2] * k[2]) as f32, 0.0]
+                    },
                 }
             }
             ResolvedMaterial::Opaque { albedo, roughness } => ObjectRecord {
@@ -75,6 +82,7 @@ impl ObjectRecord {
                 eta_norm_kind: [1.5, 0.0, MATERIAL_OPAQUE, 0.0],
                 dipole: [DipoleChannelGpu::default(); 3],
                 ranges,
+                near_blend: [0.0; 4],
             },
         }
     }

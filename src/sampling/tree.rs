@@ -159,10 +159,18 @@ impl SampleTree {
 }
 
 impl SampleTree {
-    /// The samples whose near-field blend radius (`blend_radius sqrt(dA)`; positions and
-    /// areas in the object's sample order) reaches into the sphere `group`: every sample that can
-    /// give a receiver of the group a Shepard weight, found by walking only the nodes within reach.
-    pub fn within_reach(&self, group: ([f32; 3], f32), positions: &[DVec3], areas: &[f64]) -> Vec<u32> {
+    /// The samples whose near-field blend radius (`blend_radius sqrt(dA)`, at most the tree's
+    /// own; positions and areas in the object's sample order) reaches into the sphere `group`:
+    /// every sample that can give a receiver of the group a Shepard weight, found by walking only
+    /// the nodes within the tree's reach. The sparse gather blends with a narrower radius than
+    /// the widest channel's that the tree is built for.
+    pub fn within_reach(
+        &self,
+        group: ([f32; 3], f32),
+        positions: &[DVec3],
+        areas: &[f64],
+        blend_radius: f64,
+    ) -> Vec<u32> {
         let (center, radius) = (glam::Vec3::from(group.0).as_dvec3(), group.1 as f64);
         let mut found = Vec::new();
         let mut i = 0;
@@ -176,7 +184,7 @@ impl SampleTree {
                     // A sample of the leaf is within reach when its own radius reaches the sphere
                     // (f32 rounding is covered by the node's rounded-out reach and radius).
                     if positions[s as usize].distance(center) - radius
-                        < self.blend_radius * areas[s as usize].sqrt() * (1.0 + 1e-6)
+                        < blend_radius.min(self.blend_radius) * areas[s as usize].sqrt() * (1.0 + 1e-6)
                     {
                         found.push(s);
                     }
@@ -342,14 +350,17 @@ mod tests {
         let (p, a) = points(1000);
         let t = SampleTree::new(&p, &a, BLEND);
         let groups = ReceiverGroups::new(&p);
-        for &group in &groups.bounds {
-            let mut got = t.within_reach(group, &p, &a);
-            got.sort_unstable();
-            let c = glam::Vec3::from(group.0).as_dvec3();
-            let want: Vec<u32> = (0..1000u32)
-                .filter(|&s| p[s as usize].distance(c) - (group.1 as f64) < BLEND * a[s as usize].sqrt())
-                .collect();
-            assert_eq!(got, want);
+        // The tree's own radius, and a narrower one (the sparse gather's beside wider channels).
+        for radius in [BLEND, 0.6 * BLEND] {
+            for &group in &groups.bounds {
+                let mut got = t.within_reach(group, &p, &a, radius);
+                got.sort_unstable();
+                let c = glam::Vec3::from(group.0).as_dvec3();
+                let want: Vec<u32> = (0..1000u32)
+                    .filter(|&s| p[s as usize].distance(c) - (group.1 as f64) < radius * a[s as usize].sqrt())
+                    .collect();
+                assert_eq!(got, want);
+            }
         }
     }
 

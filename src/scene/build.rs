@@ -65,11 +65,27 @@ pub struct PreparedObject {
 
 impl PreparedObject {
     /// The hierarchy over its samples for the hierarchical gather (built on each call; the
-    /// renderer and the f64 reference each build it once, identically).
+    /// renderer and the f64 reference each build it once, identically). Its reach is the widest
+    /// channel's near-blend radius.
     pub fn sample_tree(&self) -> sampling::SampleTree {
         let positions: Vec<glam::DVec3> = self.samples.iter().map(|s| s.position.as_dvec3()).collect();
         let areas: Vec<f64> = self.samples.iter().map(|s| s.area).collect();
-        sampling::SampleTree::new(&positions, &areas, crate::optics::kernel::NEAR_BLEND_RADIUS)
+        let widest = self.near_blend_radii().into_iter().fold(crate::optics::kernel::NEAR_BLEND_RADIUS, f64::max);
+        sampling::SampleTree::new(&positions, &areas, widest)
+    }
+
+    /// Per channel, the near-field blend's radius in units of `sqrt(dA)` for its samples
+    /// (`optics::kernel::near_blend_radii` at their mean area); the least radius for an opaque
+    /// object or one without samples.
+    pub fn near_blend_radii(&self) -> [f64; 3] {
+        use crate::optics::kernel;
+        match &self.material {
+            ResolvedMaterial::Translucent { dipoles, .. } if !self.samples.is_empty() => {
+                let mean_area = self.samples.iter().map(|s| s.area).sum::<f64>() / self.samples.len() as f64;
+                kernel::near_blend_radii(dipoles, mean_area)
+            }
+            _ => [kernel::NEAR_BLEND_RADIUS; 3],
+        }
     }
 
     /// The hierarchical gather's items for each receiver group at accuracy `epsilon`
