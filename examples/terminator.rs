@@ -2,7 +2,10 @@
 //! f64 twin's error against the exact integral, binned by `n.l` at the vertex, split into what the
 //! far sum and the near-field blend contribute, and the error over every lit vertex.
 //! `terminator SCENE COUNT [CACHE_DIR]` (one directional light; the scene's sampler);
-//! `BLEND_K=kr,kg,kb` replaces the blend's radii, `SKIP_SPLIT=1` skips the slow split.
+//! `BLEND_K=kr,kg,kb` replaces the blend's radii, `SKIP_SPLIT=1` skips the slow split,
+//! `SAMPLER=random` replaces the scene's sampler. Defect 1's cures tried (docs/STUDY.md):
+//! `UNIFORM_B=1` takes every sample's `b` from the object's mean area; `COMMON_R=1` blends with
+//! weights `A_i phi(r / R(x))`, one radius per receiver from its local mean area.
 use translucent::optics::kernel;
 use translucent::reference::{self, truth};
 use translucent::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
@@ -17,6 +20,7 @@ fn main() {
         transport: Some(TransportMode::Gather),
         gather: Some(GatherMode::Vertex),
         samples: Some(count),
+        sampler: std::env::var("SAMPLER").ok().map(|m| m.parse().unwrap()),
         ..Overrides::default()
     };
     let scene = PreparedScene::new(&scene, &overrides).unwrap();
@@ -40,6 +44,8 @@ fn main() {
         Err(_) => o.near_blend_radii(),
     };
     println!("blend radius r/g/b: {:.3}/{:.3}/{:.3} sqrt(dA)", k[0], k[1], k[2]);
+    let uniform_b = std::env::var("UNIFORM_B").is_ok();
+    let mean_area_all = o.samples.iter().map(|s| s.area).sum::<f64>() / o.samples.len() as f64;
     let radius_sq: Vec<[f64; 3]> = o.samples.iter().map(|s| k.map(|k| k * k * s.area)).collect();
     let bins = [(-0.3, -0.1), (-0.1, 0.0), (0.0, 0.1), (0.1, 0.2), (0.2, 0.4), (0.4, 0.7)];
     // Per bin: sum of relative errors of (gather, far + exact near), near share, count.
@@ -55,13 +61,13 @@ fn main() {
         let (mut far, mut near, mut wsum, mut asum) = ([0.0; 3], [0.0; 3], [0.0; 3], 0.0);
         for ((s, e), rsq) in samples.iter().zip(&radius_sq) {
             let r = x.distance(s.position.as_dvec3());
-            let b = kernel::B_PER_SQRT_AREA * s.area.sqrt();
+            let b = kernel::B_PER_SQRT_AREA * if uniform_b { mean_area_all } else { s.area }.sqrt();
             asum += kernel::near_blend_weight(r, s.area, kernel::NEAR_BLEND_RADIUS) * s.area;
             for c in 0..3 {
                 let t = if r * r < rsq[c] { 1.0 - r * r / rsq[c] } else { 0.0 };
                 let w = t * t * t;
                 wsum[c] += w;
-                far[c] += e[c] * kernel::far_kernel(&dipoles[c], r, s.area);
+                far[c] += e[c] * s.area * kernel::r_d_far(&dipoles[c], r, b);
                 near[c] += w * e[c] * kernel::near_energy(&dipoles[c], b);
             }
         }
@@ -71,6 +77,23 @@ fn main() {
                 kernel::near_blend_weight(x.distance(s.position.as_dvec3()), s.area, kernel::NEAR_BLEND_RADIUS)
             })
             .sum();
+        if std::env::var("COMMON_R").is_ok() && wsum1 > 0.0 {
+            // One radius per receiver and channel, from the local mean area; weights A_i phi.
+            let a_local = asum / wsum1;
+            near = [0.0; 3];
+            wsum = [0.0; 3];
+            for (s, e) in samples.iter() {
+                let r = x.distance(s.position.as_dvec3());
+                let b = kernel::B_PER_SQRT_AREA * s.area.sqrt();
+                for c in 0..3 {
+                    let rsq = k[c] * k[c] * a_local;
+                    let t = if r * r < rsq { 1.0 - r * r / rsq } else { 0.0 };
+                    let w = s.area * t * t * t;
+                    wsum[c] += w;
+                    near[c] += w * e[c] * kernel::near_energy(&dipoles[c], b);
+                }
+            }
+        }
         estimate[v] = std::array::from_fn(|c| (far[c] + if wsum[c] > 0.0 { near[c] / wsum[c] } else { 0.0 }) as f32);
         let Some(bin) = bins.iter().position(|&(a, b)| nl >= a && nl < b) else { continue };
         let (e_x, ..) = reference::transmitted_irradiance(&scene, &occluders, x, n, material.eta, eps);
