@@ -65,8 +65,9 @@ void main() {
         vec3 x = samples[j].position_area.xyz;
         DipoleChannel ch[3] = gather_channels(o);
         GatherSum g = gather_begin();
+        // Only the far sum is kept here (no near energy is passed), so the blend radius is moot.
         for (uint i = first_sample; i < first_sample + sample_count; ++i) {
-            gather_add(g, ch, vec3(0.0), x, samples[i].position_area, splat[i].irradiance_area.rgb, vec3(0.0));
+            gather_add(g, ch, vec3(1.0), x, samples[i].position_area, splat[i].irradiance_area.rgb, vec3(0.0));
             if (((i - first_sample) & 63u) == 63u) gather_flush(g);
         }
         gather_flush(g);

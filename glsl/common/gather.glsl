@@ -30,10 +30,10 @@ DipoleChannel[3] gather_channels(ObjectRecord o) {
 }
 
 // Add one sample (position and area, transmitted irradiance E, near energy per channel);
-// `blend_k_sq` is ObjectRecord::near_blend.rgb. The kernel's b^2 and the blend radii^2 are
-// multiples of the area, so no square root is taken here beyond the poles' own; distances stay
-// squared.
-void gather_add(inout GatherSum g, DipoleChannel ch[3], vec3 blend_k_sq, vec3 x, vec4 position_area, vec3 e, vec3 near_energy) {
+// `blend_inv_k_sq` is ObjectRecord::near_blend.rgb, 1 / k^2 per channel. The kernel's b^2 and
+// the blend radii^2 are multiples of the area, so no square root is taken here beyond the
+// poles' own; distances stay squared, and one division serves the three radii.
+void gather_add(inout GatherSum g, DipoleChannel ch[3], vec3 blend_inv_k_sq, vec3 x, vec4 position_area, vec3 e, vec3 near_energy) {
     vec3 d = x - position_area.xyz;
     float r_sq = dot(d, d);
     float area = position_area.w;
@@ -44,9 +44,9 @@ void gather_add(inout GatherSum g, DipoleChannel ch[3], vec3 blend_k_sq, vec3 x,
     }
     g.partial += area > 0.0 ? term : vec3(0.0);
     // Shepard weights (1 - r^2/R^2)^3 inside R = k sqrt(area), per channel (dipole_near_blend_weight).
-    vec3 radius_sq = blend_k_sq * area;
-    // A select, not max(): at zero area the quotient is NaN.
-    vec3 t = mix(vec3(0.0), vec3(1.0) - r_sq / radius_sq, lessThan(vec3(r_sq), radius_sq));
+    vec3 t = vec3(1.0) - (r_sq / area) * blend_inv_k_sq;
+    // A select, not max(): at zero area and distance the quotient is NaN.
+    t = mix(vec3(0.0), t, greaterThan(t, vec3(0.0)));
     vec3 w = t * t * t;
     vec3 near_exitance = e * near_energy;
     g.near_sum += w * near_exitance;

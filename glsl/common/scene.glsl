@@ -16,8 +16,8 @@ struct ObjectRecord {
                             // mask as float (bit c: channel c; render::plan)
     DipoleChannel dipole[3]; // per channel: alpha', sigma_tr, z_r, z_v in scene units
     uvec4 ranges;           // x: first vertex, y: vertex count, z: first sample, w: sample count
-    vec4 near_blend;        // rgb: per channel, the near blend's radius in units of sqrt(dA),
-                            // squared (kernel::near_blend_radii); w: 0
+    vec4 near_blend;        // rgb: per channel, 1 / k^2 for the near blend's radius k sqrt(dA)
+                            // (kernel::near_blend_radii); w: 0
 };
 
 // 1 in each channel whose exitance is gathered, 0 in each the planner computes locally

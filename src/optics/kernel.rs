@@ -192,8 +192,10 @@ pub fn near_tail(dipole: &Dipole, beta: f64, radius: f64) -> f64 {
 /// E_near` (scene units squared, `b^2 = beta`), from its tail: integrating by parts,
 /// `integral r^2 R_near 2 pi r dr = integral_0^inf 2 R near_tail(R) dR`. Taken in `u = ln R`
 /// (`2 R^2 near_tail(R) du`), in panels of half a unit, 4-point Gauss-Legendre each, from
-/// `1e-4 l` to `1e4 l` with `l = sqrt(z_v^2 + b^2)`: the tail falls as `b^4 / R^4` past `l`,
-/// so what lies beyond is below `1e-8` of the whole. Zero when there is no near energy.
+/// `1e-4 l` to `1e4 l` with `l = sqrt(z_v^2 + b^2)`, `R_near`'s width: below, the integrand is
+/// at most `2 R E_near`; above, `R_near` is `R_d` times `O(b^4 / r^4)`; either side holds under
+/// `1e-8` of the whole (`tests/optics.rs` checks it against a direct integral to 1e-3). Zero when
+/// there is no near energy.
 pub fn near_second_moment(dipole: &Dipole, beta: f64) -> f64 {
     let total = near_tail(dipole, beta, 0.0);
     if total <= 0.0 || beta <= 0.0 {

@@ -20,8 +20,8 @@ kernel_constants! {
     /// The greatest near-blend radius, in units of `sqrt(dA)`. A channel whose `R_near` is wider
     /// (its `z_v` large next to the spacing) has little near energy, so matching it further buys
     /// little: on the ketchup sphere at 6,400 samples, a cap of 3 left green at 0.58% RMS, 4 at
-    /// 0.25%, none at 0.25% (red wanted 16, and read the same at every cap); every blend weight
-    /// costs the hierarchical and sparse gathers' reach `k^2` in samples.
+    /// 0.25%, none at 0.25% (red wanted 16, and read the same at every cap); a wider radius
+    /// costs the hierarchical gather `k^2` more samples summed one by one near each receiver.
     NEAR_BLEND_RADIUS_MAX = 4.0;
     /// The hierarchical gather drops a cluster of samples (with its subtree) when, under uniform
     /// light, it could add at most this fraction of `R_d,total` in every channel

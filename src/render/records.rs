@@ -44,8 +44,9 @@ pub struct ObjectRecord {
     pub dipole: [DipoleChannelGpu; 3],
     /// First vertex, vertex count, first sample, sample count.
     pub ranges: [u32; 4],
-    /// rgb: per channel, the square of the near-field blend's radius in units of `sqrt(dA)`
-    /// (`PreparedObject::near_blend_radii`); w: 0.
+    /// rgb: per channel, `1 / k^2` for the near-field blend's radius `k sqrt(dA)`
+    /// (`PreparedObject::near_blend_radii`; the gathers divide by the area once and multiply
+    /// per channel); w: 0.
     pub near_blend: [f32; 4],
 }
 
@@ -73,7 +74,7 @@ impl ObjectRecord {
                     ranges,
                     near_blend: {
                         let k = object.near_blend_radii();
-                        [(k[0] * k[0]) as f32, (k[1] * k[1]) as f32, (k[2] * k[2]) as f32, 0.0]
+                        [(1.0 / (k[0] * k[0])) as f32, (1.0 / (k[1] * k[1])) as f32, (1.0 / (k[2] * k[2])) as f32, 0.0]
                     },
                 }
             }
