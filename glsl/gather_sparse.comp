@@ -105,7 +105,7 @@ void main() {
     if (!is_receiver) return;
     vec3 blended = vec3(0.0);
     if (weight_sum > 0.0) {
-        vec3 kept = gather_near_kept(gather_channels(o), area_sum / weight_sum, vertex_boundary[v]);
+        vec3 kept = gather_near_kept(gather_channels(o), vec3(area_sum / weight_sum), vertex_boundary[v]);
         blended = (sum + near_sum * kept) / weight_sum;
     } else if (push.node_count > 0u) {
         uint s = tree_nearest_sample(x, push.first_node, push.node_count);

@@ -78,12 +78,13 @@ void gather_flush(inout GatherSum g) {
 
 // Per channel, the share of the blended near exitance a receiver keeps beside open boundaries
 // `boundary` away (the two nearest directions, mesh::Mesh::boundary_distances; NO_BOUNDARY far
-// from any), for samples of mean area `area` (optics::kernel::near_kept_at_edge, once per side).
-vec3 gather_near_kept(DipoleChannel ch[3], float area, vec2 boundary) {
-    float b = DIPOLE_B_PER_SQRT_AREA * sqrt(area);
+// from any), for samples of mean area `area` per channel (optics::kernel::near_kept_at_edge,
+// once per side; reference::near_kept is the twin).
+vec3 gather_near_kept(DipoleChannel ch[3], vec3 area, vec2 boundary) {
+    vec3 b = DIPOLE_B_PER_SQRT_AREA * sqrt(area);
     vec3 kept;
     for (int c = 0; c < 3; ++c) {
-        kept[c] = dipole_near_kept_at_edge(ch[c], b, boundary.x) * dipole_near_kept_at_edge(ch[c], b, boundary.y);
+        kept[c] = dipole_near_kept_at_edge(ch[c], b[c], boundary.x) * dipole_near_kept_at_edge(ch[c], b[c], boundary.y);
     }
     return kept;
 }
@@ -93,16 +94,12 @@ vec3 gather_near_kept(DipoleChannel ch[3], float area, vec2 boundary) {
 // blend weight reaches, keeps all).
 vec3 gather_end(GatherSum g, DipoleChannel ch[3], vec2 boundary) {
     gather_flush(g);
-    vec3 near = g.nearest_near;
-    for (int c = 0; c < 3; ++c) {
-        if (g.weight_sum[c] > 0.0) {
-            float area = g.area_sum[c] / g.weight_sum[c];
-            float b = DIPOLE_B_PER_SQRT_AREA * sqrt(area);
-            near[c] = g.near_sum[c] / g.weight_sum[c] * dipole_near_kept_at_edge(ch[c], b, boundary.x)
-                * dipole_near_kept_at_edge(ch[c], b, boundary.y);
-        }
-    }
-    return max(g.far + near, vec3(0.0));
+    // Per channel: the blend where a weight reached, else the nearest sample's (whose area sum
+    // is 0 too, so its edge factor is 1 and unused).
+    bvec3 blended = greaterThan(g.weight_sum, vec3(0.0));
+    vec3 weight = mix(vec3(1.0), g.weight_sum, blended);
+    vec3 kept = gather_near_kept(ch, g.area_sum / weight, boundary);
+    return max(g.far + mix(g.nearest_near, g.near_sum / weight * kept, blended), vec3(0.0));
 }
 
 #endif
