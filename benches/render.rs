@@ -14,6 +14,7 @@ use ash::vk;
 use std::sync::Arc;
 use std::time::Instant;
 use translucent::gpu::{Binding, Buffer, BufferDesc, ComputePipeline, Gpu, GpuOptions, median};
+use translucent::render::graph::Resource;
 use translucent::render::plan::{Change, Pass};
 use translucent::render::renderer::Renderer;
 use translucent::sampling::Method;
@@ -102,11 +103,11 @@ fn gather_against_naive(gpu: &Arc<Gpu>, renderer: &mut Renderer) -> (f64, f64, f
     .expect("buffer");
     let set = naive
         .descriptor_set(&[
-            Binding::Buffer(&b.vertices),
-            Binding::Buffer(&b.samples),
-            Binding::Buffer(&b.splat),
-            Binding::Buffer(&b.objects),
-            Binding::Buffer(&out),
+            Resource::Vertices.bind(Binding::Buffer(&b.vertices)),
+            Resource::Samples.bind(Binding::Buffer(&b.samples)),
+            Resource::Splat.bind(Binding::Buffer(&b.splat)),
+            Resource::Objects.bind(Binding::Buffer(&b.objects)),
+            Resource::Exitance.bind(Binding::Buffer(&out)),
         ])
         .expect("descriptor set");
     let receivers = b.receivers.clone();

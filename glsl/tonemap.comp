@@ -6,7 +6,7 @@
 // 2 = counters (storage): [0] = non-finite pixels seen. Push: TonemapPush.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform sampler2D hdr;
-layout(std430, set = 0, binding = 1) writeonly buffer Out { uint rgba8[]; };
+layout(std430, set = 0, binding = 1) writeonly buffer Tonemapped { uint rgba8[]; };
 layout(std430, set = 0, binding = 2) buffer Counters { uint non_finite; };
 struct TonemapPush {
     uint width;

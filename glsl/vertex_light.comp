@@ -17,7 +17,7 @@ layout(local_size_x = 64) in;
 layout(std430, set = 0, binding = 0) readonly buffer Vertices { VertexRecord vertices[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Lights { Light lights[]; };
 layout(set = 0, binding = 2) uniform sampler2DArrayShadow shadow_maps;
-layout(std430, set = 0, binding = 3) writeonly buffer Irradiance { vec4 irradiance_out[]; };
+layout(std430, set = 0, binding = 3) writeonly buffer EnvironmentIrradiance { vec4 irradiance_out[]; };
 struct VertexLightPush {
     uint first_vertex;
     uint vertex_count;

@@ -5,7 +5,7 @@ mod common;
 use ash::vk;
 use common::with_gpu;
 use translucent::gpu::{
-    Access, Binding, Buffer, GpuTimer, GraphicsDesc, GraphicsPipeline, Image, ImageBarrier, ImageDesc, shaders,
+    Access, Binding, Buffer, Named, GpuTimer, GraphicsDesc, GraphicsPipeline, Image, ImageBarrier, ImageDesc, shaders,
 };
 use translucent::render::smoke;
 
@@ -112,7 +112,7 @@ fn graphics_pipeline_draws_a_triangle() {
         desc.color_formats = vec![format];
         desc.depth_format = Some(depth_format);
         let pipeline = GraphicsPipeline::new(gpu, &desc).unwrap();
-        let set = pipeline.descriptor_set(&[Binding::Buffer(&tint)]).unwrap();
+        let set = pipeline.descriptor_set(&[Named { name: "Tint", binding: Binding::Buffer(&tint) }]).unwrap();
         let device = gpu.device();
         gpu.one_shot("draw", |cmd| {
             ImageBarrier::new(

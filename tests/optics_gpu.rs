@@ -14,7 +14,7 @@ mod common;
 use ash::vk;
 use common::with_gpu;
 use std::collections::HashMap;
-use translucent::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, memory_barrier};
+use translucent::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, Named, memory_barrier};
 use translucent::optics::fresnel::{self, fresnel_reflectance, fresnel_transmittance};
 use translucent::optics::gpu::{DipoleEvalInput, DipoleEvalOutput};
 use translucent::optics::kernel::{self, footprint_kernel, near_energy, r_d_far};
@@ -191,7 +191,11 @@ fn run_on_gpu(inputs: &[DipoleEvalInput]) -> Vec<DipoleEvalOutput> {
         let dst =
             Buffer::new(gpu, &BufferDesc::readback("dipole_eval outputs", bytes, vk::BufferUsageFlags::STORAGE_BUFFER))
                 .expect("output buffer");
-        let set = pipeline.descriptor_set(&[Binding::Buffer(&src), Binding::Buffer(&dst)]).expect("descriptor set");
+        let set = pipeline
+            .descriptor_set(&[
+                Named { name: "Inputs", binding: Binding::Buffer(&src) },
+                Named { name: "Outputs", binding: Binding::Buffer(&dst) },
+            ]).expect("descriptor set");
         gpu.one_shot("dipole_eval", |cmd| {
             pipeline.dispatch(cmd, &set, &count, [count, 1, 1]);
             memory_barrier(gpu.device(), cmd, &[Access::ComputeWrite], &[Access::HostRead]);

@@ -14,6 +14,8 @@ pub enum Access {
     ComputeWrite,
     /// Storage-buffer reads in a compute shader.
     ComputeRead,
+    /// Storage-buffer reads and writes in a compute shader (atomics).
+    ComputeReadWrite,
     /// Sampled-image reads in a compute shader.
     ComputeSampledRead,
     /// Storage-image reads and writes in a compute shader (GENERAL layout).
@@ -39,11 +41,29 @@ pub enum Access {
 }
 
 impl Access {
-    fn stage(self) -> vk::PipelineStageFlags2 {
+    /// Whether the access writes (its results must be made visible to what follows).
+    pub fn writes(self) -> bool {
+        matches!(
+            self,
+            Access::ComputeWrite
+                | Access::ComputeReadWrite
+                | Access::ComputeImageReadWrite
+                | Access::ColorAttachmentWrite
+                | Access::DepthAttachmentReadWrite
+                | Access::TransferWrite
+                | Access::Everything
+        )
+    }
+
+    pub(crate) fn stage(self) -> vk::PipelineStageFlags2 {
         use vk::PipelineStageFlags2 as S;
         match self {
             Access::Nothing => S::NONE,
-            Access::ComputeWrite | Access::ComputeRead | Access::ComputeSampledRead | Access::ComputeImageReadWrite => {
+            Access::ComputeWrite
+            | Access::ComputeRead
+            | Access::ComputeReadWrite
+            | Access::ComputeSampledRead
+            | Access::ComputeImageReadWrite => {
                 S::COMPUTE_SHADER
             }
             Access::FragmentSampledRead | Access::FragmentRead => S::FRAGMENT_SHADER,
@@ -58,7 +78,7 @@ impl Access {
         }
     }
 
-    fn access(self) -> vk::AccessFlags2 {
+    pub(crate) fn access(self) -> vk::AccessFlags2 {
         use vk::AccessFlags2 as A;
         match self {
             Access::Nothing => A::NONE,
@@ -66,7 +86,9 @@ impl Access {
             Access::ComputeRead | Access::FragmentRead => A::SHADER_STORAGE_READ,
             Access::Everything => A::MEMORY_READ | A::MEMORY_WRITE,
             Access::ComputeSampledRead | Access::FragmentSampledRead => A::SHADER_SAMPLED_READ,
-            Access::ComputeImageReadWrite => A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE,
+            Access::ComputeImageReadWrite | Access::ComputeReadWrite => {
+                A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE
+            }
             Access::VertexAttributeRead => A::VERTEX_ATTRIBUTE_READ,
             Access::ColorAttachmentWrite => A::COLOR_ATTACHMENT_WRITE,
             Access::DepthAttachmentReadWrite => A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE,
@@ -77,12 +99,13 @@ impl Access {
     }
 
     /// The image layout this access needs.
-    fn layout(self) -> vk::ImageLayout {
+    pub(crate) fn layout(self) -> vk::ImageLayout {
         use vk::ImageLayout as L;
         match self {
             Access::Nothing => L::UNDEFINED,
             Access::ComputeWrite
             | Access::ComputeImageReadWrite
+            | Access::ComputeReadWrite
             | Access::ComputeRead
             | Access::FragmentRead
             | Access::Everything

@@ -44,7 +44,8 @@ impl BindingKind {
     }
 }
 
-/// What to bind at one binding; a set is given as a list, binding i being the i-th entry.
+/// What to bind at one binding; a set is given as a list of `Named` bindings, binding i being
+/// the i-th entry.
 pub enum Binding<'a> {
     /// A whole buffer (offset 0, VK_WHOLE_SIZE) for a storage or uniform binding.
     Buffer(&'a Buffer),
@@ -58,6 +59,55 @@ pub enum Binding<'a> {
         /// The sampler of a combined image sampler; `vk::Sampler::null()` for a storage image.
         sampler: vk::Sampler,
     },
+}
+
+/// One entry of a descriptor set: the GLSL name it is meant for (the block or variable name the
+/// shader declares at that binding) and the resource. The name is checked against the shader's
+/// reflected one, so two swapped resources fail with both names instead of binding silently.
+pub struct Named<'a> {
+    /// The GLSL block or variable name, e.g. "Exitance" or "shadow_maps".
+    pub name: &'a str,
+    /// The resource.
+    pub binding: Binding<'a>,
+}
+
+/// What a set's bindings must match: each binding's kind and GLSL name, as reflected, and the
+/// shader they come from (for messages).
+pub(crate) struct SetInterface<'a> {
+    pub shader: &'a str,
+    pub kinds: &'a [Option<BindingKind>],
+    pub names: &'a [Option<String>],
+}
+
+impl SetInterface<'_> {
+    /// Every declared binding has a resource, and each resource's name is the one the GLSL
+    /// declares at its binding. A resource past the declared bindings, or at a number the
+    /// optimiser removed as unused, is dropped unchecked.
+    fn check(&self, bindings: &[Named<'_>]) -> GpuResult<()> {
+        if let Some(missing) = self.kinds.iter().enumerate().skip(bindings.len()).find(|(_, k)| k.is_some()) {
+            return Err(GpuError::Invalid(format!(
+                "{}: the shader declares binding {}, only {} resources were given",
+                self.shader,
+                missing.0,
+                bindings.len()
+            )));
+        }
+        for (i, given) in bindings.iter().enumerate() {
+            let declared = self.names.get(i).and_then(Option::as_deref);
+            match declared {
+                Some(declared) if self.kinds[i].is_some() && declared != given.name => {
+                    return Err(GpuError::BindingMismatch {
+                        shader: self.shader.to_string(),
+                        binding: i as u32,
+                        declared: declared.to_string(),
+                        given: given.name.to_string(),
+                    });
+                }
+                _ => {}
+            }
+        }
+        Ok(())
+    }
 }
 
 pub(crate) fn create_set_layout(
@@ -96,18 +146,11 @@ impl DescriptorSet {
     pub(crate) fn new(
         gpu: &Arc<Gpu>,
         layout: vk::DescriptorSetLayout,
-        kinds: &[Option<BindingKind>],
-        bindings: &[Binding<'_>],
+        interface: &SetInterface<'_>,
+        bindings: &[Named<'_>],
     ) -> GpuResult<DescriptorSet> {
-        // A resource for a binding the shader does not declare (or that the optimiser removed
-        // as unused) is dropped; a declared binding without a resource is an error.
-        if let Some(missing) = kinds.iter().enumerate().skip(bindings.len()).find(|(_, k)| k.is_some()) {
-            return Err(GpuError::Invalid(format!(
-                "the shader declares binding {}, only {} resources were given",
-                missing.0,
-                bindings.len()
-            )));
-        }
+        interface.check(bindings)?;
+        let kinds = interface.kinds;
         let device = gpu.device();
         let sizes: Vec<_> =
             kinds.iter().flatten().map(|k| vk::DescriptorPoolSize { ty: k.vk(), descriptor_count: 1 }).collect();
@@ -123,10 +166,10 @@ impl DescriptorSet {
     }
 
     /// Point the bindings at other resources (same kinds). Not while the set is in use by the GPU.
-    pub(crate) fn update(&mut self, kinds: &[Option<BindingKind>], bindings: &[Binding<'_>]) -> GpuResult<()> {
+    fn update(&mut self, kinds: &[Option<BindingKind>], bindings: &[Named<'_>]) -> GpuResult<()> {
         let mut buffer_infos = Vec::new();
         let mut image_infos = Vec::new();
-        for (i, (kind, binding)) in kinds.iter().zip(bindings).enumerate() {
+        for (i, (kind, Named { binding, .. })) in kinds.iter().zip(bindings).enumerate() {
             let Some(kind) = kind else { continue };
             match (kind, binding) {
                 (BindingKind::StorageBuffer | BindingKind::UniformBuffer, Binding::Buffer(b)) => buffer_infos

@@ -89,6 +89,19 @@ pub enum GpuError {
         /// The limit's name, in Vulkan's terms.
         name: &'static str,
     },
+    /// A descriptor set gives binding `binding` a resource meant for another GLSL name than the
+    /// shader declares there (two bindings swapped, or a shader edited without its pass).
+    #[error("{shader} binding {binding} is `{declared}` in the GLSL, but the pass binds `{given}` there")]
+    BindingMismatch {
+        /// The shader (or vertex + fragment pair) the set is for.
+        shader: String,
+        /// The binding number.
+        binding: u32,
+        /// The name the GLSL gives that binding (its block or variable name).
+        declared: String,
+        /// The name of the resource the pass gave for it.
+        given: String,
+    },
     /// A caller's mistake or malformed input, described in the message: an empty buffer or image, a
     /// write past a buffer's end, a shader interface that does not fit, a device without
     /// timestamps.

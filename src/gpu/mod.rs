@@ -1,6 +1,7 @@
 //! The Vulkan core (ash), one Vulkan concept per file: instance (loader, validation), debug
 //! (messenger and message counts), device (choice and logical device), context (`Gpu`),
-//! buffer, image, sampler, descriptor, pipeline, command (one-shot submission), barrier, timer, shaders.
+//! buffer, image, sampler, descriptor, pipeline, command (one-shot submission), barrier, hazard
+//! (barriers derived from declared accesses), timer, shaders.
 //!
 //! Every Vulkan object is owned by a Rust value that destroys it on Drop and holds an
 //! `Arc<Gpu>`, so the device always outlives what was made from it.
@@ -14,6 +15,7 @@ mod debug;
 mod descriptor;
 mod device;
 mod error;
+mod hazard;
 mod image;
 mod instance;
 mod pipeline;
@@ -27,9 +29,10 @@ pub use buffer::{Buffer, BufferDesc};
 pub use context::{EnabledFeatures, Gpu, HostVulkan, RequiredFeatures, required_features};
 pub use counter::{RecordCounter, RecordCounts};
 pub use debug::ValidationCounters;
-pub use descriptor::{Binding, BindingKind, DescriptorSet};
+pub use descriptor::{Binding, BindingKind, DescriptorSet, Named};
 pub use device::{DeviceInfo, select as select_device};
 pub use error::{GpuError, GpuResult};
+pub use hazard::{Hazards, Use};
 pub use gpu_allocator::MemoryLocation;
 pub use image::{Image, ImageDesc, aspect_of};
 pub use pipeline::{ComputePipeline, GraphicsDesc, GraphicsPipeline};

@@ -3,7 +3,7 @@
 //! and workgroup size are reflected from the SPIR-V (`shaders::ShaderInterface`).
 
 use super::context::Gpu;
-use super::descriptor::{Binding, BindingKind, DescriptorSet, create_set_layout};
+use super::descriptor::{BindingKind, DescriptorSet, Named, SetInterface, create_set_layout};
 use super::error::{GpuError, GpuResult, VkContext};
 use super::shaders::{self, ShaderInterface};
 use ash::vk;
@@ -15,12 +15,21 @@ struct Layout {
     set_layout: vk::DescriptorSetLayout,
     pipeline_layout: vk::PipelineLayout,
     kinds: Vec<Option<BindingKind>>,
+    /// Each binding's GLSL name, as reflected (`ShaderInterface::names`).
+    names: Vec<Option<String>>,
+    /// The shader(s), for messages: "gather.comp", "shade.vert + shade.frag".
+    shader: String,
     stages: vk::ShaderStageFlags,
     push_bytes: u32,
 }
 
 impl Layout {
-    fn new(gpu: &Arc<Gpu>, interface: &ShaderInterface, stages: vk::ShaderStageFlags) -> GpuResult<Layout> {
+    fn new(
+        gpu: &Arc<Gpu>,
+        shader: &str,
+        interface: &ShaderInterface,
+        stages: vk::ShaderStageFlags,
+    ) -> GpuResult<Layout> {
         let (kinds, push_bytes) = (&interface.bindings, interface.push_bytes);
         if !push_bytes.is_multiple_of(4) || push_bytes > gpu.properties().limits.max_push_constants_size {
             return Err(GpuError::Invalid(format!("push-constant block of {push_bytes} bytes is not allowed")));
@@ -31,6 +40,8 @@ impl Layout {
             set_layout,
             pipeline_layout: vk::PipelineLayout::null(),
             kinds: kinds.to_vec(),
+            names: interface.names.clone(),
+            shader: shader.to_string(),
             stages,
             push_bytes,
         };
@@ -44,6 +55,12 @@ impl Layout {
         layout.pipeline_layout =
             unsafe { gpu.device().create_pipeline_layout(&info, None) }.vk("vkCreatePipelineLayout")?;
         Ok(layout)
+    }
+
+    /// A descriptor set for set 0, each entry checked against the reflected kind and name.
+    fn descriptor_set(&self, bindings: &[Named<'_>]) -> GpuResult<DescriptorSet> {
+        let interface = SetInterface { shader: &self.shader, kinds: &self.kinds, names: &self.names };
+        DescriptorSet::new(&self.gpu, self.set_layout, &interface, bindings)
     }
 
     fn bind(&self, cmd: vk::CommandBuffer, point: vk::PipelineBindPoint, set: Option<&DescriptorSet>, push: &[u8]) {
@@ -117,7 +134,7 @@ impl ComputePipeline {
     /// `shader` is a path under `glsl/` ("smoke.comp"); its interface is reflected.
     pub fn new(gpu: &Arc<Gpu>, shader: &str) -> GpuResult<ComputePipeline> {
         let interface = ShaderInterface::of(shader)?;
-        let layout = Layout::new(gpu, &interface, vk::ShaderStageFlags::COMPUTE)?;
+        let layout = Layout::new(gpu, shader, &interface, vk::ShaderStageFlags::COMPUTE)?;
         let module = Module::new(gpu, shader)?;
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
@@ -150,9 +167,10 @@ impl ComputePipeline {
         }
     }
 
-    /// A descriptor set for this pipeline's set 0.
-    pub fn descriptor_set(&self, bindings: &[Binding<'_>]) -> GpuResult<DescriptorSet> {
-        DescriptorSet::new(&self.layout.gpu, self.layout.set_layout, &self.layout.kinds, bindings)
+    /// A descriptor set for this pipeline's set 0, binding i being `bindings[i]`, whose name must
+    /// be the GLSL's at binding i (`GpuError::BindingMismatch`).
+    pub fn descriptor_set(&self, bindings: &[Named<'_>]) -> GpuResult<DescriptorSet> {
+        self.layout.descriptor_set(bindings)
     }
 
     /// Record a dispatch of enough workgroups for `threads` invocations, with push block `push`.
@@ -242,7 +260,11 @@ impl GraphicsPipeline {
         if let Some(f) = &desc.fragment {
             interfaces.push(ShaderInterface::of(f)?);
         }
-        let layout = Layout::new(gpu, &ShaderInterface::merge(&interfaces)?, stages_flags)?;
+        let shader = match &desc.fragment {
+            Some(f) => format!("{} + {f}", desc.vertex),
+            None => desc.vertex.clone(),
+        };
+        let layout = Layout::new(gpu, &shader, &ShaderInterface::merge(&interfaces)?, stages_flags)?;
         let vertex = Module::new(gpu, &desc.vertex)?;
         let fragment = desc.fragment.as_deref().map(|f| Module::new(gpu, f)).transpose()?;
         let mut stages = vec![
@@ -308,9 +330,10 @@ impl GraphicsPipeline {
         Ok(GraphicsPipeline { pipeline, layout, name: desc.vertex.clone() })
     }
 
-    /// A descriptor set for this pipeline's set 0, binding i being `bindings[i]`.
-    pub fn descriptor_set(&self, bindings: &[Binding<'_>]) -> GpuResult<DescriptorSet> {
-        DescriptorSet::new(&self.layout.gpu, self.layout.set_layout, &self.layout.kinds, bindings)
+    /// A descriptor set for this pipeline's set 0, binding i being `bindings[i]`, whose name must
+    /// be the GLSL's at binding i (`GpuError::BindingMismatch`).
+    pub fn descriptor_set(&self, bindings: &[Named<'_>]) -> GpuResult<DescriptorSet> {
+        self.layout.descriptor_set(bindings)
     }
 
     /// Bind the pipeline, its set and push block, and set a full-extent viewport and scissor.

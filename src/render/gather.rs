@@ -2,13 +2,12 @@
 //! object, the discrete dipole sum of seed Eq. 11 with the energy-conserving near-field kernel
 //! (`optics::kernel`), samples staged through shared memory, Kahan-compensated f32 sums.
 //!
-//! Bindings: 0 = vertices, 1 = samples, 2 = splat, 3 = objects, 4 = exitance, 5 = tree nodes,
-//! 6 = tree order, 7 = boundary distances, 8 = level vertices. Push: `GatherPush`.
+//! Bindings: `BINDINGS`, in binding order. Push: `GatherPush`.
 //! One dispatch per translucent object, over the vertices of its level of detail this frame.
 
-use super::gpu_scene::GpuScene;
+use super::graph::{Resource, Resources, Use, compute_uses};
 use super::pass::{FrameInputs, RenderPass};
-use crate::gpu::{Access, Binding, ComputePipeline, DescriptorSet, Gpu, GpuResult, memory_barrier};
+use crate::gpu::{ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use ash::vk;
 use std::sync::Arc;
 
@@ -29,35 +28,41 @@ pub struct GatherPush {
     pub receiver_count: u32,
 }
 
-/// The vertex gather: one dispatch of glsl/gather.comp per translucent object
-/// (`GpuScene::receivers`), writing exitance at its vertices into `GpuScene::exitance`, then a
-/// barrier to vertex-attribute reads by shading and to host reads.
+/// glsl/gather.comp's bindings, in binding order.
+const BINDINGS: [Resource; 9] = [
+    Resource::Vertices,
+    Resource::Samples,
+    Resource::Splat,
+    Resource::Objects,
+    Resource::Exitance,
+    Resource::TreeNodes,
+    Resource::TreeOrder,
+    Resource::VertexBoundary,
+    Resource::LevelVertices,
+];
+
+/// The vertex gather: one dispatch of glsl/gather.comp per translucent object the plan gathers
+/// (`GpuScene::receivers`), writing exitance at the vertices of its level of detail into
+/// `GpuScene::exitance`.
 pub struct GatherPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
 }
 
 impl GatherPass {
-    /// The pipeline and one descriptor set over the scene's vertices, samples, splat, objects and
-    /// exitance buffers.
-    pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene) -> GpuResult<GatherPass> {
+    /// The pipeline and one descriptor set over `BINDINGS`.
+    pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<GatherPass> {
         let pipeline = ComputePipeline::new(gpu, "gather.comp")?;
-        let set = pipeline.descriptor_set(&[
-            Binding::Buffer(&scene.vertices),
-            Binding::Buffer(&scene.samples),
-            Binding::Buffer(&scene.splat),
-            Binding::Buffer(&scene.objects),
-            Binding::Buffer(&scene.exitance),
-            Binding::Buffer(&scene.tree_nodes),
-            Binding::Buffer(&scene.tree_order),
-            Binding::Buffer(&scene.vertex_boundary),
-            Binding::Buffer(&scene.level_vertices),
-        ])?;
+        let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
         Ok(GatherPass { pipeline, set })
     }
 }
 
 impl RenderPass for GatherPass {
+    fn uses(&self, _: &FrameInputs) -> Vec<Use> {
+        compute_uses(&BINDINGS, &[Resource::Exitance])
+    }
+
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         for r in frame.scene.receivers.iter().filter(|r| frame.plan.gathers(r.object as usize)) {
             let level = frame.scene.level(r.object as usize, frame.plan.level(r.object as usize));
@@ -70,13 +75,5 @@ impl RenderPass for GatherPass {
             };
             self.pipeline.dispatch(cmd, &self.set, &push, [level.vertex_count, 1, 1]);
         }
-        exitance_written(frame, cmd);
     }
-}
-
-/// After a gather into the per-vertex exitance buffer: shading reads it as a vertex attribute,
-/// the host may read it back.
-pub(super) fn exitance_written(frame: &FrameInputs, cmd: vk::CommandBuffer) {
-    let next = [Access::VertexAttributeRead, Access::HostRead];
-    memory_barrier(frame.gpu.device(), cmd, &[Access::ComputeWrite], &next);
 }

@@ -4,12 +4,12 @@
 //! alpha. Exact at each visible point and only where the surface is seen; it must rerun whenever
 //! the view changes.
 //!
-//! Bindings: 0 = surface (sampled), 1 = samples, 2 = splat, 3 = objects, 4 = HDR (storage image).
-//! Push: `GatherPixelPush`.
+//! Bindings: `BINDINGS`, in binding order (the HDR image as a storage image). Push:
+//! `GatherPixelPush`.
 
-use super::gpu_scene::GpuScene;
+use super::graph::{Resource, Resources, Use, read, write};
 use super::pass::{FrameInputs, RenderPass};
-use crate::gpu::{Access, Binding, ComputePipeline, DescriptorSet, Gpu, GpuResult, Image, ImageBarrier, Sampler};
+use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuError, GpuResult};
 use ash::vk;
 use std::sync::Arc;
 
@@ -23,48 +23,49 @@ pub struct GatherPixelPush {
     pub height: u32,
 }
 
-/// The pixel gather: one dispatch of glsl/gather_pixel.comp over the HDR image, reading the shading
-/// pass's surface image and adding exitance into the HDR image in place (moved to GENERAL for the
-/// dispatch and back to sampled reads after). It owns the nearest sampler it reads the surface
-/// with; both images belong to the `ShadePass`, which must outlive it.
+/// glsl/gather_pixel.comp's bindings, in binding order.
+const BINDINGS: [Resource; 5] =
+    [Resource::Surface, Resource::Samples, Resource::Splat, Resource::Objects, Resource::Hdr];
+
+/// The pixel gather: one dispatch of glsl/gather_pixel.comp over the HDR image, reading the
+/// surface image the shading pass drew and adding exitance into the HDR image in place (a
+/// storage image, GENERAL, for the dispatch). Both images are frame targets
+/// (`FrameTargets::camera`), which must outlive it.
 pub struct GatherPixelPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
-    _sampler: Sampler,
-    hdr: vk::Image,
     push: GatherPixelPush,
 }
 
 impl GatherPixelPass {
-    /// `surface` and `hdr` are the shading pass's images, which it leaves readable by compute.
-    pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene, surface: &Image, hdr: &Image) -> GpuResult<GatherPixelPass> {
+    /// The pipeline and one descriptor set over `BINDINGS`; the frame targets must have the
+    /// camera's HDR and surface images.
+    pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<GatherPixelPass> {
         let pipeline = ComputePipeline::new(gpu, "gather_pixel.comp")?;
-        let sampler = Sampler::new(gpu, vk::Filter::NEAREST)?;
-        let set = pipeline.descriptor_set(&[
-            Binding::Image {
-                view: surface.view(),
-                layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                sampler: sampler.raw(),
-            },
-            Binding::Buffer(&scene.samples),
-            Binding::Buffer(&scene.splat),
-            Binding::Buffer(&scene.objects),
-            Binding::Image { view: hdr.view(), layout: vk::ImageLayout::GENERAL, sampler: vk::Sampler::null() },
-        ])?;
+        let missing = || GpuError::Invalid("the pixel gather needs the renderer's own HDR and surface images".into());
+        let hdr = resources.targets.hdr().ok_or_else(missing)?;
+        let mut bindings = resources.bind_all(&BINDINGS[..4])?;
+        bindings.push(Resource::Hdr.bind(resources.targets.storage_hdr().ok_or_else(missing)?));
+        let set = pipeline.descriptor_set(&bindings)?;
         let extent = hdr.extent();
         let push = GatherPixelPush { width: extent.width, height: extent.height };
-        Ok(GatherPixelPass { pipeline, set, _sampler: sampler, hdr: hdr.raw(), push })
+        Ok(GatherPixelPass { pipeline, set, push })
     }
 }
 
 impl RenderPass for GatherPixelPass {
-    /// HDR to GENERAL, the gather adding in place, HDR back to sampled reads for the tone map.
-    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        let device = frame.gpu.device();
-        let (sampled, storage) = ([Access::ComputeSampledRead], [Access::ComputeImageReadWrite]);
-        let color = vk::ImageAspectFlags::COLOR;
-        ImageBarrier::new(self.hdr, color, &sampled, &storage).record(device, cmd);
+    fn uses(&self, _: &FrameInputs) -> Vec<Use> {
+        vec![
+            read(Resource::Surface, Access::ComputeSampledRead),
+            read(Resource::Samples, Access::ComputeRead),
+            read(Resource::Splat, Access::ComputeRead),
+            read(Resource::Objects, Access::ComputeRead),
+            write(Resource::Hdr, Access::ComputeImageReadWrite),
+        ]
+    }
+
+    /// The gather adding into the HDR image in place.
+    fn record(&self, cmd: vk::CommandBuffer, _: &FrameInputs) {
         self.pipeline.dispatch(cmd, &self.set, &self.push, [self.push.width, self.push.height, 1]);
-        ImageBarrier::new(self.hdr, color, &storage, &sampled).record(device, cmd);
     }
 }

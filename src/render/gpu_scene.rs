@@ -6,7 +6,8 @@
 use super::records::{
     LightGpu, NodePowerRecord, ObjectRecord, ReceiverGroupRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
 };
-use crate::gpu::{Access, Buffer, BufferDesc, Gpu, GpuResult, memory_barrier};
+use super::graph::Resource;
+use crate::gpu::{Buffer, BufferDesc, Gpu, GpuResult};
 use crate::optics::kernel::NEAR_BLEND_RADIUS;
 use crate::sampling::NODE_ITEM;
 use crate::scene::build::PreparedScene;
@@ -430,20 +431,29 @@ impl GpuScene {
         self.pending_objects = true;
     }
 
+    /// The buffers the next `record_uploads` writes (by transfer): the lights and the object
+    /// records, when they changed.
+    pub fn pending_uploads(&self) -> Vec<Resource> {
+        let lights = self.pending_lights.as_ref().is_some_and(|r| !r.is_empty());
+        let mut pending = Vec::new();
+        if lights {
+            pending.push(Resource::Lights);
+        }
+        if self.pending_objects {
+            pending.push(Resource::Objects);
+        }
+        pending
+    }
+
     /// Record the copy of pending light and object records into their buffers
     /// (vkCmdUpdateBuffer, in the command buffer rather than through mapped memory, so frames in
-    /// flight keep what they had), and the barrier to their readers.
+    /// flight keep what they had). The barriers around it follow from `pending_uploads`.
     pub fn record_uploads(&mut self, device: &ash::Device, cmd: vk::CommandBuffer) {
-        let lights = self.pending_lights.take().filter(|r| !r.is_empty());
-        let objects = std::mem::take(&mut self.pending_objects);
-        if let Some(records) = &lights {
-            update(device, cmd, &self.lights, bytemuck::cast_slice(records));
+        if let Some(records) = self.pending_lights.take().filter(|r| !r.is_empty()) {
+            update(device, cmd, &self.lights, bytemuck::cast_slice(&records));
         }
-        if objects {
+        if std::mem::take(&mut self.pending_objects) {
             update(device, cmd, &self.objects, bytemuck::cast_slice(&self.object_records));
-        }
-        if lights.is_some() || objects {
-            memory_barrier(device, cmd, &[Access::TransferWrite], &[Access::ComputeRead, Access::FragmentRead]);
         }
     }
 }

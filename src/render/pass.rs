@@ -1,15 +1,19 @@
-//! The one interface every GPU pass records through. A pass is built once from the scene's GPU
-//! data (`GpuScene`) and records each frame from `FrameInputs`, followed by the barriers that
-//! make its own writes visible to whatever reads them next (later passes, the next frame, or the
-//! host after the fence). Adding a pass: one GLSL file, one module implementing `RenderPass`,
-//! one entry in `plan::Pass` and in `Renderer::pass`.
+//! The one interface every GPU pass records through. A pass is built once from the frame's
+//! resources (`graph::Resources`: the scene's GPU data and the frame targets), declares each
+//! frame which named resources it reads and writes (`uses`), and records from `FrameInputs`.
+//! The pass loop records the barriers its declaration needs before it (`FrameInputs::before`),
+//! so a pass knows nothing of who reads its output. Adding a pass: one GLSL file, one module
+//! implementing `RenderPass`, one entry in `plan::Pass` and in `Renderer::pass`.
 
 use super::gpu_scene::GpuScene;
+use super::graph::{Resource, Use};
 use super::plan::Plan;
 use super::shade::HostTarget;
-use crate::gpu::Gpu;
+use super::targets::FrameTargets;
+use crate::gpu::{Gpu, Hazards};
 use ash::vk;
 use glam::{Mat4, Vec3};
+use std::cell::RefCell;
 
 /// What one frame gives the passes besides the scene data they were built with.
 pub struct FrameInputs<'a> {
@@ -17,6 +21,8 @@ pub struct FrameInputs<'a> {
     pub gpu: &'a Gpu,
     /// The scene's GPU data: buffers, draw ranges, receivers, shadow matrices.
     pub scene: &'a GpuScene,
+    /// The shadow maps and the camera's own images.
+    pub targets: &'a FrameTargets,
     /// The frame's plan.
     pub plan: &'a Plan,
     /// Shadow-map layers to redraw; `None` redraws every layer.
@@ -31,12 +37,26 @@ pub struct FrameInputs<'a> {
     pub target: Option<&'a HostTarget>,
     /// Multiplier on linear radiance before the tone curve (`render.exposure`).
     pub exposure: f32,
+    /// What every resource last went through, across frames: where barriers come from.
+    pub hazards: &'a RefCell<Hazards<Resource>>,
 }
 
-/// A GPU pass: built once over the scene's GPU data, then recorded into the command buffer of every
-/// frame whose plan runs it, followed by the barriers from its own writes to their readers.
-/// `Renderer::pass` maps each `plan::Pass` to one.
+impl FrameInputs<'_> {
+    /// Record the barrier that `uses` need against everything recorded before (this frame's
+    /// earlier passes and steps, and earlier frames). The pass loop calls it with each pass's
+    /// declaration; a pass of several steps calls it between them for what one step hands the
+    /// next.
+    pub fn before(&self, cmd: vk::CommandBuffer, uses: &[Use]) {
+        self.hazards.borrow_mut().before(self.gpu.device(), cmd, uses);
+    }
+}
+
+/// A GPU pass: built once over the frame's resources, then recorded into the command buffer of
+/// every frame whose plan runs it. `Renderer::pass` maps each `plan::Pass` to one.
 pub trait RenderPass {
-    /// Record the pass into `cmd` (recording, outside any rendering), then its barriers.
+    /// Every access this frame's recording makes: what it reads and writes, and how. The pass
+    /// loop records the barriers these need before `record`.
+    fn uses(&self, frame: &FrameInputs) -> Vec<Use>;
+    /// Record the pass into `cmd` (recording, outside any rendering).
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs);
 }

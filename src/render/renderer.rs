@@ -7,19 +7,22 @@ use super::gather_pixel::GatherPixelPass;
 use super::gather_sparse::GatherSparsePass;
 use super::gather_tree::GatherTreePass;
 use super::gpu_scene::GpuScene;
+use super::graph::{HOST_READ, Resource, Resources, read, write};
 use super::pass::{FrameInputs, RenderPass};
 use super::plan::{self, Change, Pass, Plan};
 use super::shade::{HostTarget, ShadePass, TargetDesc};
 use super::shadow::ShadowPass;
 use super::splat::SplatPass;
+use super::targets::{CameraTargets, FrameTargets};
 use super::tonemap::TonemapPass;
 use super::vertex_light::VertexLightPass;
-use crate::gpu::{Access, Gpu, GpuError, GpuTimer, ShaderInterface, memory_barrier};
+use crate::gpu::{Access, Gpu, GpuError, GpuTimer, Hazards, ShaderInterface};
 use crate::scene::build::PreparedScene;
 use crate::scene::needs::SceneNeeds;
 use crate::scene::{GatherMode, Light};
 use ash::vk;
 use glam::{Mat4, Vec3};
+use std::cell::RefCell;
 use std::sync::Arc;
 
 /// Why a renderer could not be made.
@@ -156,7 +159,11 @@ pub struct Renderer {
     /// One timer per frame that may be in flight (empty without timestamps).
     timers: Vec<GpuTimer>,
     next_slot: usize,
+    /// The shadow maps and camera images the passes' descriptor sets point into.
+    targets: FrameTargets,
     buffers: GpuScene,
+    /// What every frame resource last went through, across frames: the barriers come from it.
+    hazards: RefCell<Hazards<Resource>>,
     background: [f32; 3],
     target: TargetDesc,
     camera: CameraView,
@@ -169,6 +176,10 @@ pub struct Renderer {
     /// (`usize::MAX`: none yet); a finer level coming into view is gathered again.
     gathered: Vec<usize>,
 }
+
+/// The scene buffers a test or host may write between frames (`Renderer::buffers_mut`).
+const SCENE_BUFFERS: [Resource; 5] =
+    [Resource::Samples, Resource::Splat, Resource::Exitance, Resource::EnvironmentIrradiance, Resource::Objects];
 
 /// Share of an opaque object's brightest per-vertex sky light by which two neighbouring
 /// vertices may differ and still be simplified away (`Renderer::bake_static_levels`): 0.2%,
@@ -200,15 +211,13 @@ impl Renderer {
         }
         let buffers = GpuScene::new(gpu, &scene)?;
         let settings = &scene.scene.file.render;
-        let shadow = ShadowPass::new(gpu, settings.shadow_map_size, scene.shadow_layers)?;
-        let size = scene.scene.file.camera.resolution;
-        let shade = ShadePass::new(gpu, target, size, &buffers, &shadow, needs.pixel_gather)?;
-        let gather: Box<dyn RenderPass> = match (shade.surface(), shade.hdr()) {
-            (Some(surface), Some(hdr)) => Box::new(GatherPixelPass::new(gpu, &buffers, surface, hdr)?),
-            _ if settings.gather == GatherMode::Sparse => Box::new(GatherSparsePass::new(gpu, &buffers)?),
-            _ if settings.gather == GatherMode::Hierarchical => Box::new(GatherTreePass::new(gpu, &buffers)?),
-            _ => Box::new(GatherPass::new(gpu, &buffers)?),
-        };
+        let camera = (target == TargetDesc::Own).then_some((scene.scene.file.camera.resolution, needs.pixel_gather));
+        let targets = FrameTargets::new(gpu, settings.shadow_map_size, scene.shadow_layers, camera)?;
+        let resources = Resources { scene: &buffers, targets: &targets };
+        let shade = ShadePass::new(gpu, target, &resources, needs.pixel_gather)?;
+        let gather = Self::gather_pass(gpu, &resources, settings.gather, needs.pixel_gather)?;
+        let mut hazards = Hazards::new();
+        targets.track(&mut hazards);
         // Timing is optional: a queue without timestamps still renders.
         let timers = (0..Self::FRAMES_IN_FLIGHT)
             .map(|_| GpuTimer::new(gpu, 8))
@@ -217,15 +226,17 @@ impl Renderer {
             .unwrap_or_default();
         Ok(Renderer {
             gpu: gpu.clone(),
-            vertex_light: VertexLightPass::new(gpu, &buffers, &shadow)?,
-            splat: SplatPass::new(gpu, &buffers, &shadow)?,
-            tonemap: shade.hdr().map(|hdr| TonemapPass::new(gpu, hdr)).transpose()?,
-            shadow,
+            vertex_light: VertexLightPass::new(gpu, &resources)?,
+            splat: SplatPass::new(gpu, &resources)?,
+            tonemap: targets.hdr().is_some().then(|| TonemapPass::new(gpu, &resources)).transpose()?,
+            shadow: ShadowPass::new(gpu, scene.shadow_layers)?,
             gather,
             shade,
             timers,
             next_slot: 0,
+            targets,
             buffers,
+            hazards: RefCell::new(hazards),
             background: scene.background(),
             needs,
             target,
@@ -234,6 +245,21 @@ impl Renderer {
             stale: vec![true; scene.objects.len()],
             gathered: vec![usize::MAX; scene.objects.len()],
             scene,
+        })
+    }
+
+    /// The gather `render.gather` names (the pixel gather when the scene's needs say so).
+    fn gather_pass(
+        gpu: &Arc<Gpu>,
+        resources: &Resources,
+        mode: GatherMode,
+        pixel: bool,
+    ) -> Result<Box<dyn RenderPass>, RenderError> {
+        Ok(match mode {
+            _ if pixel => Box::new(GatherPixelPass::new(gpu, resources)?),
+            GatherMode::Sparse => Box::new(GatherSparsePass::new(gpu, resources)?),
+            GatherMode::Hierarchical => Box::new(GatherTreePass::new(gpu, resources)?),
+            _ => Box::new(GatherPass::new(gpu, resources)?),
         })
     }
 
@@ -247,8 +273,14 @@ impl Renderer {
         &self.buffers
     }
 
-    /// The scene's data on the GPU, to write (a test feeding the gather its own input).
+    /// The scene's data on the GPU, to write (a test feeding the gather its own input) with no
+    /// frame in flight: the next frame's readers of any of it wait for those writes.
     pub fn buffers_mut(&mut self) -> &mut GpuScene {
+        let mut hazards = self.hazards.borrow_mut();
+        for r in SCENE_BUFFERS {
+            hazards.written_outside(r);
+        }
+        drop(hazards);
         &mut self.buffers
     }
 
@@ -344,13 +376,14 @@ impl Renderer {
         self.scene.scene.file.camera.resolution = [width, height];
         check_fits(&self.gpu, &self.scene)?;
         let gpu = self.gpu.clone();
-        let buffers = &self.buffers;
-        let shade = ShadePass::new(&gpu, self.target, [width, height], buffers, &self.shadow, self.needs.pixel_gather)?;
-        if let (Some(surface), Some(hdr)) = (shade.surface(), shade.hdr()) {
-            self.gather = Box::new(GatherPixelPass::new(&gpu, buffers, surface, hdr)?);
+        // The old images' last frame must be done before they go (the caller's contract).
+        self.targets.camera = Some(CameraTargets::new(&gpu, [width, height], self.needs.pixel_gather)?);
+        let resources = Resources { scene: &self.buffers, targets: &self.targets };
+        if self.needs.pixel_gather {
+            self.gather = Box::new(GatherPixelPass::new(&gpu, &resources)?);
         }
-        self.tonemap = shade.hdr().map(|hdr| TonemapPass::new(&gpu, hdr)).transpose()?;
-        self.shade = shade;
+        self.tonemap = Some(TonemapPass::new(&gpu, &resources)?);
+        self.targets.track(self.hazards.get_mut());
         self.mark(Change::Camera);
         Ok(())
     }
@@ -411,8 +444,9 @@ impl Renderer {
             }
         }
         let device = self.gpu.device();
-        // Against the frame before, which may still run: its reads of what this frame writes.
-        memory_barrier(device, cmd, &[Access::Everything], &[Access::Everything]);
+        let uploads: Vec<_> =
+            self.buffers.pending_uploads().into_iter().map(|r| write(r, Access::TransferWrite)).collect();
+        self.hazards.get_mut().before(device, cmd, &uploads);
         self.buffers.record_uploads(device, cmd);
         // Taken out for the recording, which borrows `self` immutably.
         let mut timers = std::mem::take(&mut self.timers);
@@ -454,9 +488,16 @@ impl Renderer {
         target: Option<&HostTarget>,
     ) {
         let layers = plan.shadow_light.map(|source| self.scene.shadow_layers_of(source));
+        if target.is_some() {
+            // The host's contract: it drew into its attachments before this frame.
+            let mut hazards = self.hazards.borrow_mut();
+            hazards.external(Resource::HostColor, Access::ColorAttachmentWrite);
+            hazards.external(Resource::HostDepth, Access::DepthAttachmentReadWrite);
+        }
         let frame = FrameInputs {
             gpu: &self.gpu,
             scene: &self.buffers,
+            targets: &self.targets,
             plan,
             shadow_layers: layers.as_deref(),
             view_proj: self.camera.projection * self.camera.view,
@@ -464,17 +505,25 @@ impl Renderer {
             background: self.background,
             exposure: self.scene.scene.file.render.exposure,
             target,
+            hazards: &self.hazards,
         };
         for &(pass, _) in &plan.passes {
             let Some(recorder) = self.pass(pass) else { continue };
             if let Some(t) = timer.as_deref_mut() {
                 t.begin(cmd, pass.name());
             }
+            frame.before(cmd, &recorder.uses(&frame));
             recorder.record(cmd, &frame);
             if let Some(t) = timer.as_deref_mut() {
                 t.end(cmd);
             }
         }
+        // What the host reads back after the fence: directly, or by a copy of its own.
+        let host: Vec<_> = HOST_READ
+            .iter()
+            .flat_map(|&r| [read(r, Access::HostRead), read(r, Access::TransferRead)])
+            .collect();
+        frame.before(cmd, &host);
     }
 
     /// Render one frame: record the passes of `plan` in one submission of its own, wait, and
@@ -514,8 +563,11 @@ impl Renderer {
 
     /// The last linear HDR image, RGBA f32, rows top to bottom.
     pub fn hdr_image(&self) -> Result<Vec<f32>, RenderError> {
-        let hdr = self.shade.hdr().ok_or(RenderError::Target("a host target's image is the host's"))?;
-        let bytes = hdr.read(Access::ComputeSampledRead)?;
+        let hdr = self.targets.hdr().ok_or(RenderError::Target("a host target's image is the host's"))?;
+        let mut hazards = self.hazards.borrow_mut();
+        let bytes = hdr.read(hazards.last_access(Resource::Hdr))?;
+        // The copy waited for the fence and left the image in TRANSFER_SRC.
+        hazards.image(Resource::Hdr, hdr.raw(), vk::ImageAspectFlags::COLOR, Access::TransferRead);
         Ok(bytemuck::pod_collect_to_vec(&bytes))
     }
 
@@ -546,6 +598,7 @@ impl Renderer {
         let first = u64::from(self.buffers.object_range(object).first_vertex);
         let values: Vec<[f32; 4]> = exitance.iter().map(|e| [e[0], e[1], e[2], 1.0]).collect();
         self.buffers.exitance.write(first * 16, &values)?;
+        self.hazards.get_mut().written_outside(Resource::Exitance);
         self.gathered[object] = 0;
         Ok(())
     }

@@ -8,23 +8,15 @@
 //! environment irradiance (vec4 per vertex each).
 //! Bindings: 0 = objects, 1 = lights, 2 = shadow maps. Push: `ShadePush`.
 
-use super::gpu_scene::GpuScene;
+use super::graph::{Resource, Resources, Use, overwrite, read, write};
 use super::pass::{FrameInputs, RenderPass};
 use super::records::Vertex;
-use super::shadow::ShadowPass;
-use crate::gpu::{
-    Access, Binding, DescriptorSet, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline, Image, ImageBarrier, ImageDesc,
-    memory_barrier,
-};
+use crate::gpu::{Access, DescriptorSet, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline};
 use ash::vk;
 use std::sync::Arc;
 
-/// Format of the own HDR target: linear radiance, RGBA32F. With the pixel gather its alpha holds
-/// the factor gather_pixel.comp multiplies exitance by; otherwise 1.
-pub const HDR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
-/// Pixel gather only: world position and translucent object of each pixel.
-pub const SURFACE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
-const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+pub use super::targets::{HDR_FORMAT, SURFACE_FORMAT};
+use super::targets::CAMERA_DEPTH_FORMAT;
 
 /// `Plan::skip_terms` bit: key lights' shadow lookups (every light counts as visible).
 pub const TERM_SHADOW: u32 = 1;
@@ -81,25 +73,19 @@ pub struct HostTarget {
     pub load: bool,
 }
 
-#[allow(clippy::large_enum_variant)] // one per renderer, never in a hot loop
-enum Attachments {
-    Own {
-        hdr: Image,
-        depth: Image,
-        /// Pixel gather only (shade_pixel.frag's second attachment).
-        surface: Option<Image>,
-    },
-    Host,
-}
+/// glsl/common/shade.glsl's bindings, in binding order.
+const BINDINGS: [Resource; 3] = [Resource::Objects, Resource::Lights, Resource::ShadowMaps];
 
 /// The forward-shading pass: a graphics pipeline (shade.vert with shade.frag, or shade_pixel.frag
-/// for the pixel gather), its descriptor set, and its own HDR, depth (and surface) images, or none
-/// when it draws into a host's. One indexed draw per object.
+/// for the pixel gather) and its descriptor set, drawing into the frame targets' camera images
+/// (`FrameTargets::camera`) or a host's. One indexed draw per object.
 pub struct ShadePass {
     pipeline: GraphicsPipeline,
     set: DescriptorSet,
-    attachments: Attachments,
+    /// Whether it draws the surface image too (shade_pixel.frag's second attachment).
+    pixel_gather: bool,
 }
+
 /// A per-vertex vec4 stream (exitance, cached irradiance) at `binding`, read at `location`.
 fn vec4_stream(
     binding: u32,
@@ -111,20 +97,9 @@ fn vec4_stream(
     )
 }
 
-fn attachment(name: &str, [width, height]: [u32; 2], format: vk::Format, usage: vk::ImageUsageFlags) -> ImageDesc {
-    ImageDesc::new(name, width, height, format, usage)
-}
-
 impl ShadePass {
-    /// `size` is the own target's width and height (unused for a host target).
-    pub fn new(
-        gpu: &Arc<Gpu>,
-        target: TargetDesc,
-        size: [u32; 2],
-        scene: &GpuScene,
-        shadow: &ShadowPass,
-        pixel_gather: bool,
-    ) -> GpuResult<ShadePass> {
+    /// The pipeline for `target`'s formats and one descriptor set over `BINDINGS`.
+    pub fn new(gpu: &Arc<Gpu>, target: TargetDesc, resources: &Resources, pixel_gather: bool) -> GpuResult<ShadePass> {
         let fragment = if pixel_gather { "shade_pixel.frag" } else { "shade.frag" };
         let mut desc = GraphicsDesc::new("shade.vert", Some(fragment));
         let (exitance, environment) = (vec4_stream(1, 2), vec4_stream(2, 3));
@@ -132,82 +107,61 @@ impl ShadePass {
         desc.vertex_attributes =
             vec![Vertex::position_attribute(), Vertex::normal_attribute(), exitance.1, environment.1];
         let (color, depth) = match target {
-            TargetDesc::Own => (HDR_FORMAT, DEPTH_FORMAT),
+            TargetDesc::Own => (HDR_FORMAT, CAMERA_DEPTH_FORMAT),
             TargetDesc::Host { color_format, depth_format } => (color_format, depth_format),
         };
         desc.color_formats = if pixel_gather { vec![color, SURFACE_FORMAT] } else { vec![color] };
         desc.depth_format = Some(depth);
         let pipeline = GraphicsPipeline::new(gpu, &desc)?;
-        let set = pipeline.descriptor_set(&[
-            Binding::Buffer(&scene.objects),
-            Binding::Buffer(&scene.lights),
-            shadow.binding(),
-        ])?;
-        if target != TargetDesc::Own {
-            return Ok(ShadePass { pipeline, set, attachments: Attachments::Host });
-        }
-        use vk::ImageUsageFlags as U;
-        // STORAGE: the pixel gather adds its exitance in place.
-        let hdr = Image::new(
-            gpu,
-            &attachment("hdr radiance", size, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED | U::STORAGE),
-        )?;
-        let surface = pixel_gather
-            .then(|| Image::new(gpu, &attachment("surface", size, SURFACE_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED)))
-            .transpose()?;
-        let depth = Image::new(gpu, &attachment("camera depth", size, DEPTH_FORMAT, U::DEPTH_STENCIL_ATTACHMENT))?;
-        Ok(ShadePass { pipeline, set, attachments: Attachments::Own { hdr, depth, surface } })
+        let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
+        Ok(ShadePass { pipeline, set, pixel_gather })
     }
 
-    /// The own HDR image (none for a host target).
-    pub fn hdr(&self) -> Option<&Image> {
-        match &self.attachments {
-            Attachments::Own { hdr, .. } => Some(hdr),
-            Attachments::Host => None,
+    /// Views, depth view, extent and whether to load: the frame targets' camera images, or the
+    /// host's attachments.
+    fn attachments(&self, frame: &FrameInputs) -> (Vec<vk::ImageView>, vk::ImageView, vk::Extent2D, bool) {
+        match (frame.target, &frame.targets.camera) {
+            (Some(t), _) => (vec![t.color], t.depth, t.extent, t.load),
+            (None, Some(c)) => {
+                let colors = std::iter::once(&c.hdr).chain(c.surface.as_ref().filter(|_| self.pixel_gather));
+                (colors.map(|i| i.view()).collect(), c.depth.view(), c.hdr.extent(), false)
+            }
+            (None, None) => unreachable!("Renderer checks that a host target is given"),
         }
-    }
-    /// The surface image (pixel gather only), readable by compute after the pass.
-    pub fn surface(&self) -> Option<&Image> {
-        match &self.attachments {
-            Attachments::Own { surface, .. } => surface.as_ref(),
-            Attachments::Host => None,
-        }
-    }
-
-    /// The own colour images: HDR, and the surface in pixel-gather mode.
-    fn colors(&self) -> impl Iterator<Item = &Image> {
-        self.hdr().into_iter().chain(self.surface())
     }
 }
 
 impl RenderPass for ShadePass {
-    /// Clear to the background, draw every object at the plan's level of detail, leave the HDR
-    /// (and surface) image readable by compute for the tone map (and the pixel gather).
+    /// The vertex streams and shading inputs read; the camera images overwritten (cleared), or
+    /// the host's attachments written after the host's own drawing.
+    fn uses(&self, frame: &FrameInputs) -> Vec<Use> {
+        let mut uses = vec![
+            read(Resource::Vertices, Access::VertexAttributeRead),
+            read(Resource::Exitance, Access::VertexAttributeRead),
+            read(Resource::EnvironmentIrradiance, Access::VertexAttributeRead),
+            read(Resource::Objects, Access::FragmentRead),
+            read(Resource::Lights, Access::FragmentRead),
+            read(Resource::ShadowMaps, Access::FragmentSampledRead),
+        ];
+        if frame.target.is_some() {
+            uses.push(write(Resource::HostColor, Access::ColorAttachmentWrite));
+            uses.push(write(Resource::HostDepth, Access::DepthAttachmentReadWrite));
+        } else {
+            uses.push(overwrite(Resource::Hdr, Access::ColorAttachmentWrite));
+            uses.push(overwrite(Resource::CameraDepth, Access::DepthAttachmentReadWrite));
+            if self.pixel_gather {
+                uses.push(overwrite(Resource::Surface, Access::ColorAttachmentWrite));
+            }
+        }
+        uses
+    }
+
+    /// Clear to the background (or load the host's contents) and draw every object at the
+    /// plan's level of detail.
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         let device = frame.gpu.device();
         let scene = frame.scene;
-        let color = vk::ImageAspectFlags::COLOR;
-        let (readers, writes) = ([Access::ComputeSampledRead], [Access::ColorAttachmentWrite]);
-        let depth_access = [Access::DepthAttachmentReadWrite];
-        // (colour views, depth view, extent, load the host's contents)
-        let (views, depth_view, extent, load) = match (&self.attachments, frame.target) {
-            (Attachments::Own { hdr, depth, .. }, _) => {
-                for image in self.colors() {
-                    ImageBarrier::new(image.raw(), color, &readers, &writes).discard(true).record(device, cmd);
-                }
-                ImageBarrier::new(depth.raw(), vk::ImageAspectFlags::DEPTH, &depth_access, &depth_access)
-                    .discard(true)
-                    .record(device, cmd);
-                (self.colors().map(Image::view).collect::<Vec<_>>(), depth.view(), hdr.extent(), false)
-            }
-            (Attachments::Host, Some(t)) => {
-                // After the host's own drawing into the same attachments.
-                let attachments = [Access::ColorAttachmentWrite, Access::DepthAttachmentReadWrite];
-                memory_barrier(device, cmd, &attachments, &attachments);
-                (vec![t.color], t.depth, t.extent, t.load)
-            }
-            (Attachments::Host, None) => unreachable!("Renderer checks that a host target is given"),
-        };
+        let (views, depth_view, extent, load) = self.attachments(frame);
         let load_op = if load { vk::AttachmentLoadOp::LOAD } else { vk::AttachmentLoadOp::CLEAR };
         let [r, g, b] = frame.background;
         let clears = [[r, g, b, 1.0], [0.0; 4]];
@@ -263,8 +217,5 @@ impl RenderPass for ShadePass {
             self.pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
         }
         unsafe { device.cmd_end_rendering(cmd) };
-        for image in self.colors() {
-            ImageBarrier::new(image.raw(), color, &writes, &readers).record(device, cmd);
-        }
     }
 }

@@ -3,7 +3,7 @@
 //!
 //! Bindings: 0 = input f32 (storage, read), 1 = output f32 (storage, write). Push: u32 count.
 
-use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, Gpu, GpuResult, GpuTimer, memory_barrier};
+use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, Gpu, GpuResult, GpuTimer, Named, memory_barrier};
 use ash::vk;
 use std::sync::Arc;
 
@@ -30,7 +30,10 @@ pub fn run(gpu: &Arc<Gpu>, input: &[f32]) -> GpuResult<SmokeResult> {
         gpu,
         &BufferDesc::readback("smoke output", 4 * count as u64, vk::BufferUsageFlags::STORAGE_BUFFER),
     )?;
-    let set = pipeline.descriptor_set(&[Binding::Buffer(&src), Binding::Buffer(&dst)])?;
+    let set = pipeline.descriptor_set(&[
+        Named { name: "Input", binding: Binding::Buffer(&src) },
+        Named { name: "Output", binding: Binding::Buffer(&dst) },
+    ])?;
     let mut timer = GpuTimer::new(gpu, 1)?;
     gpu.one_shot("smoke dispatch", |cmd| {
         timer.reset(cmd);

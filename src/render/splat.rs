@@ -3,13 +3,12 @@
 //! visibility) and its area; together the flux `E_i A_i` each sample injects. Also each sample's
 //! near-field energy per channel, which the gather's kernel needs once per sample.
 //!
-//! Bindings: 0 = samples, 1 = objects, 2 = lights, 3 = shadow maps, 4 = splat output
-//! (`SplatRecord` per sample). Push: `SplatPush`.
+//! Reads samples, objects, lights and the shadow maps; writes the splat output (`SplatRecord`
+//! per sample), bound in that order (`BINDINGS`). Push: `SplatPush`.
 
-use super::gpu_scene::GpuScene;
+use super::graph::{Resource, Resources, Use, compute_uses};
 use super::pass::{FrameInputs, RenderPass};
-use super::shadow::ShadowPass;
-use crate::gpu::{Access, Binding, ComputePipeline, DescriptorSet, Gpu, GpuResult, memory_barrier};
+use crate::gpu::{ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use ash::vk;
 use std::sync::Arc;
 
@@ -25,8 +24,12 @@ pub struct SplatPush {
     pub light_count: u32,
 }
 
+/// glsl/splat.comp's bindings, in binding order.
+const BINDINGS: [Resource; 5] =
+    [Resource::Samples, Resource::Objects, Resource::Lights, Resource::ShadowMaps, Resource::Splat];
+
 /// The irradiance splat: one dispatch of glsl/splat.comp per object the plan splats, writing
-/// `SplatRecord`s into `GpuScene::splat`, then a barrier to compute reads (the gathers).
+/// `SplatRecord`s into `GpuScene::splat`.
 pub struct SplatPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
@@ -34,22 +37,19 @@ pub struct SplatPass {
 }
 
 impl SplatPass {
-    /// The pipeline and one descriptor set over the samples, objects, lights, shadow maps and splat
-    /// buffer.
-    pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene, shadow: &ShadowPass) -> GpuResult<SplatPass> {
+    /// The pipeline and one descriptor set over `BINDINGS`.
+    pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<SplatPass> {
         let pipeline = ComputePipeline::new(gpu, "splat.comp")?;
-        let set = pipeline.descriptor_set(&[
-            Binding::Buffer(&scene.samples),
-            Binding::Buffer(&scene.objects),
-            Binding::Buffer(&scene.lights),
-            shadow.binding(),
-            Binding::Buffer(&scene.splat),
-        ])?;
-        Ok(SplatPass { pipeline, set, light_count: scene.light_count })
+        let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
+        Ok(SplatPass { pipeline, set, light_count: resources.scene.light_count })
     }
 }
 
 impl RenderPass for SplatPass {
+    fn uses(&self, _: &FrameInputs) -> Vec<Use> {
+        compute_uses(&BINDINGS, &[Resource::Splat])
+    }
+
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         // One dispatch per object the plan splats: the others keep their last irradiance.
         for (i, r) in frame.scene.object_ranges().enumerate() {
@@ -60,6 +60,5 @@ impl RenderPass for SplatPass {
                 SplatPush { first_sample: r.first_sample, sample_count: r.sample_count, light_count: self.light_count };
             self.pipeline.dispatch(cmd, &self.set, &push, [r.sample_count, 1, 1]);
         }
-        memory_barrier(frame.gpu.device(), cmd, &[Access::ComputeWrite], &[Access::ComputeRead]);
     }
 }

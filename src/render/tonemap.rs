@@ -1,12 +1,13 @@
 //! Tone-map pass (`glsl/tonemap.comp`): linear HDR radiance to 8-bit sRGB (exposure, ACES fit
 //! of Narkowicz 2015, sRGB transfer), counting non-finite pixels so a NaN is caught, not drawn.
 //!
-//! Bindings: 0 = HDR image (combined sampler), 1 = packed RGBA8 output, 2 = counters.
+//! Bindings: 0 = HDR image (`Resource::Hdr`, sampled), 1 = packed RGBA8 output
+//! (`Resource::Tonemapped`), 2 = counters (`Resource::TonemapCounters`); the pass owns the last two.
 //! Push: `TonemapPush`.
 
+use super::graph::{Resource, Resources, Use, read, write};
 use super::pass::{FrameInputs, RenderPass};
-use crate::gpu::memory_barrier;
-use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuResult, Image, Sampler};
+use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuError, GpuResult};
 use ash::vk;
 use std::sync::Arc;
 
@@ -43,39 +44,27 @@ pub struct TonemapPass {
     set: DescriptorSet,
     output: Buffer,
     counters: Buffer,
-    _sampler: Sampler,
     width: u32,
     height: u32,
 }
 
 impl TonemapPass {
-    /// `hdr` must be readable by compute (sampled) when the pass runs.
-    pub fn new(gpu: &Arc<Gpu>, hdr: &Image) -> GpuResult<TonemapPass> {
+    /// The pipeline, its output and counter buffers, and one descriptor set over the frame
+    /// targets' HDR image and those buffers.
+    pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<TonemapPass> {
         let pipeline = ComputePipeline::new(gpu, "tonemap.comp")?;
+        let hdr = resources.targets.hdr().ok_or_else(|| GpuError::Invalid("the tone map needs an own HDR image".into()))?;
         let extent = hdr.extent();
-        let sampler = Sampler::new(gpu, vk::Filter::NEAREST)?;
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let pixels = extent.width as u64 * extent.height as u64;
         let output = Buffer::new(gpu, &BufferDesc::readback("tonemapped rgba8", 4 * pixels, usage))?;
         let counters = Buffer::new(gpu, &BufferDesc::readback("tonemap counters", 16, usage))?;
         let set = pipeline.descriptor_set(&[
-            Binding::Image {
-                view: hdr.view(),
-                layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                sampler: sampler.raw(),
-            },
-            Binding::Buffer(&output),
-            Binding::Buffer(&counters),
+            resources.bind(Resource::Hdr)?,
+            Resource::Tonemapped.bind(Binding::Buffer(&output)),
+            Resource::TonemapCounters.bind(Binding::Buffer(&counters)),
         ])?;
-        Ok(TonemapPass {
-            pipeline,
-            set,
-            output,
-            counters,
-            _sampler: sampler,
-            width: extent.width,
-            height: extent.height,
-        })
+        Ok(TonemapPass { pipeline, set, output, counters, width: extent.width, height: extent.height })
     }
 
     /// The tone-mapped image, rows top to bottom, RGBA8, and the count of non-finite pixels.
@@ -87,14 +76,20 @@ impl TonemapPass {
 }
 
 impl RenderPass for TonemapPass {
-    /// Zero the non-finite counter, tone-map, and hand both buffers to the host.
+    fn uses(&self, _: &FrameInputs) -> Vec<Use> {
+        vec![
+            read(Resource::Hdr, Access::ComputeSampledRead),
+            write(Resource::TonemapCounters, Access::TransferWrite),
+            write(Resource::Tonemapped, Access::ComputeWrite),
+        ]
+    }
+
+    /// Zero the non-finite counter, then tone-map (which counts into it).
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        let device = frame.gpu.device();
         // SAFETY: `cmd` is recording outside a render pass; the counter buffer is ours.
-        unsafe { device.cmd_fill_buffer(cmd, self.counters.raw(), 0, vk::WHOLE_SIZE, 0) };
-        memory_barrier(device, cmd, &[Access::TransferWrite], &[Access::ComputeRead, Access::ComputeWrite]);
+        unsafe { frame.gpu.device().cmd_fill_buffer(cmd, self.counters.raw(), 0, vk::WHOLE_SIZE, 0) };
+        frame.before(cmd, &[write(Resource::TonemapCounters, Access::ComputeReadWrite)]);
         let push = TonemapPush { width: self.width, height: self.height, exposure: frame.exposure };
         self.pipeline.dispatch(cmd, &self.set, &push, [self.width, self.height, 1]);
-        memory_barrier(device, cmd, &[Access::ComputeWrite], &[Access::HostRead]);
     }
 }

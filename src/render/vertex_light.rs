@@ -3,13 +3,12 @@
 //! shading pass interpolates it for diffuse surfaces, so a pixel looks up only the shadow maps
 //! of the other (key) lights; the cache is recomputed only when the environment changes.
 //!
-//! Bindings: 0 = vertices, 1 = lights, 2 = shadow maps, 3 = output (vec4 per vertex).
-//! Push: `VertexLightPush`.
+//! Reads vertices, lights and the shadow maps; writes the environment irradiance (vec4 per
+//! vertex), bound in that order (`BINDINGS`). Push: `VertexLightPush`.
 
-use super::gpu_scene::GpuScene;
+use super::graph::{Resource, Resources, Use, compute_uses};
 use super::pass::{FrameInputs, RenderPass};
-use super::shadow::ShadowPass;
-use crate::gpu::{Access, Binding, ComputePipeline, DescriptorSet, Gpu, GpuResult, memory_barrier};
+use crate::gpu::{ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use ash::vk;
 use std::sync::Arc;
 
@@ -28,8 +27,12 @@ pub struct VertexLightPush {
     pub eta: f32,
 }
 
+/// glsl/vertex_light.comp's bindings, in binding order.
+const BINDINGS: [Resource; 4] =
+    [Resource::Vertices, Resource::Lights, Resource::ShadowMaps, Resource::EnvironmentIrradiance];
+
 /// The environment cache: one dispatch of glsl/vertex_light.comp per object, writing
-/// `GpuScene::environment_irradiance`, then a barrier to vertex-attribute reads by shading.
+/// `GpuScene::environment_irradiance`.
 pub struct VertexLightPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
@@ -37,21 +40,19 @@ pub struct VertexLightPass {
 }
 
 impl VertexLightPass {
-    /// The pipeline and one descriptor set over the vertices, lights, shadow maps and irradiance
-    /// buffer.
-    pub fn new(gpu: &Arc<Gpu>, scene: &GpuScene, shadow: &ShadowPass) -> GpuResult<VertexLightPass> {
+    /// The pipeline and one descriptor set over `BINDINGS`.
+    pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<VertexLightPass> {
         let pipeline = ComputePipeline::new(gpu, "vertex_light.comp")?;
-        let set = pipeline.descriptor_set(&[
-            Binding::Buffer(&scene.vertices),
-            Binding::Buffer(&scene.lights),
-            shadow.binding(),
-            Binding::Buffer(&scene.environment_irradiance),
-        ])?;
-        Ok(VertexLightPass { pipeline, set, light_count: scene.light_count })
+        let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
+        Ok(VertexLightPass { pipeline, set, light_count: resources.scene.light_count })
     }
 }
 
 impl RenderPass for VertexLightPass {
+    fn uses(&self, _: &FrameInputs) -> Vec<Use> {
+        compute_uses(&BINDINGS, &[Resource::EnvironmentIrradiance])
+    }
+
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         for r in frame.scene.object_ranges() {
             let push = VertexLightPush {
@@ -62,6 +63,5 @@ impl RenderPass for VertexLightPass {
             };
             self.pipeline.dispatch(cmd, &self.set, &push, [r.vertex_count, 1, 1]);
         }
-        memory_barrier(frame.gpu.device(), cmd, &[Access::ComputeWrite], &[Access::VertexAttributeRead]);
     }
 }

@@ -1,0 +1,87 @@
+//! The shape the two two-stage gathers share (`gather_tree`, `gather_sparse`): stage 0 runs
+//! over something of each object the plan gathers (its hierarchy's nodes, or its samples) into
+//! a buffer stage 1 reads; stage 1 runs one workgroup per receiver group
+//! (`sampling::ReceiverGroups`, `RECEIVER_GROUP_SIZE` vertices) of the same objects, into the
+//! per-vertex exitance. Both stages run over the plan's receivers only: an object the plan does
+//! not gather this frame has no fresh stage-0 output, and its exitance must stay as it was.
+
+use super::gpu_scene::Receiver;
+use super::graph::{Resource, read};
+use super::pass::FrameInputs;
+use crate::gpu::{Access, ComputePipeline, DescriptorSet};
+use ash::vk;
+
+/// The push block of both two-stage gathers (`GatherTreePush` in glsl/gather_tree.comp,
+/// `GatherSparsePush` in glsl/gather_sparse.comp, which have the same fields).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GroupGatherPush {
+    /// Index of the receiving translucent object (its `ObjectRecord`).
+    pub object: u32,
+    /// 0 or 1.
+    pub stage: u32,
+    /// The object's root in `GpuScene::tree_nodes` (the nearest-sample fallback walks it).
+    pub first_node: u32,
+    /// Its node count.
+    pub node_count: u32,
+    /// Its first entry in `GpuScene::receiver_order`.
+    pub first_receiver: u32,
+    /// Its first group in `GpuScene::receiver_groups`.
+    pub first_group: u32,
+}
+
+impl GroupGatherPush {
+    /// The push block for `stage` of a dispatch over `receiver`.
+    pub fn new(receiver: &Receiver, stage: u32) -> GroupGatherPush {
+        GroupGatherPush {
+            object: receiver.object,
+            stage,
+            first_node: receiver.first_node,
+            node_count: receiver.node_count,
+            first_receiver: receiver.first_receiver,
+            first_group: receiver.first_group,
+        }
+    }
+}
+
+/// A two-stage gather's pipeline, its set, and what its stage 0 writes for stage 1.
+pub(super) struct GroupGather {
+    pub pipeline: ComputePipeline,
+    pub set: DescriptorSet,
+    /// Stage 0's output, read by stage 1.
+    pub handoff: Resource,
+    /// Stage 0's threads for a receiver: its nodes or its samples.
+    pub stage0_threads: fn(&Receiver) -> u32,
+}
+
+impl GroupGather {
+    /// `pipeline` must have `RECEIVER_GROUP_SIZE` as its local size: its workgroups are
+    /// receiver groups.
+    pub fn new(
+        pipeline: ComputePipeline,
+        set: DescriptorSet,
+        handoff: Resource,
+        stage0_threads: fn(&Receiver) -> u32,
+    ) -> GroupGather {
+        let n = crate::sampling::RECEIVER_GROUP_SIZE as u32;
+        assert!(
+            pipeline.groups([n, 1, 1]) == [1, 1, 1] && pipeline.groups([n + 1, 1, 1]) == [2, 1, 1],
+            "{}: local size is not RECEIVER_GROUP_SIZE",
+            pipeline.name()
+        );
+        GroupGather { pipeline, set, handoff, stage0_threads }
+    }
+
+    /// Stage 0 over the plan's receivers, the hand-off barrier, stage 1 over the same receivers.
+    pub fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        let planned = || frame.scene.receivers.iter().filter(|r| frame.plan.gathers(r.object as usize));
+        for r in planned() {
+            let threads = (self.stage0_threads)(r);
+            self.pipeline.dispatch(cmd, &self.set, &GroupGatherPush::new(r, 0), [threads, 1, 1]);
+        }
+        frame.before(cmd, &[read(self.handoff, Access::ComputeRead)]);
+        for r in planned() {
+            self.pipeline.dispatch(cmd, &self.set, &GroupGatherPush::new(r, 1), [r.vertex_count, 1, 1]);
+        }
+    }
+}
