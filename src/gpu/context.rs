@@ -102,7 +102,7 @@ impl Gpu {
     pub fn new(options: &GpuOptions) -> GpuResult<Arc<Gpu>> {
         let entry = instance::load_entry()?;
         let counters = Arc::new(ValidationCounters::default());
-        let mut owned = instance::create_instance(&entry, options.validation, &counters)?;
+        let mut owned = instance::create_instance(&entry, options.validation, options.sync_validation, &counters)?;
         // From here on, destroy the instance if anything fails.
         let built = (|| {
             let devices = device::enumerate(&owned.instance)?;

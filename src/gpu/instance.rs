@@ -23,6 +23,7 @@ pub(crate) struct OwnedInstance {
 pub(crate) fn create_instance(
     entry: &ash::Entry,
     validation: bool,
+    sync_validation: bool,
     counters: &Arc<ValidationCounters>,
 ) -> GpuResult<OwnedInstance> {
     let mut layers = Vec::new();
@@ -37,6 +38,10 @@ pub(crate) fn create_instance(
         }
         layers.push(VALIDATION_LAYER.as_ptr());
         extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+        if sync_validation {
+            // The layer itself provides the extension that carries its feature switches.
+            extensions.push(ash::ext::validation_features::NAME.as_ptr());
+        }
     }
     let app = vk::ApplicationInfo::default()
         .application_name(c"translucent")
@@ -48,8 +53,13 @@ pub(crate) fn create_instance(
         .application_info(&app)
         .enabled_layer_names(&layers)
         .enabled_extension_names(&extensions);
+    let enabled = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled);
     if validation {
         info = info.push_next(&mut debug_info);
+        if sync_validation {
+            info = info.push_next(&mut features);
+        }
     }
     // SAFETY: every pointer in `info` refers to locals that outlive the call.
     let instance = match unsafe { entry.create_instance(&info, None) } {

@@ -48,13 +48,16 @@ pub struct GpuOptions {
     pub device: Option<String>,
     /// Enable the Khronos validation layer and count its messages.
     pub validation: bool,
+    /// With `validation`, also the layer's synchronisation validation (`validate_sync`): every
+    /// missing or too-weak barrier is a message. Slow; for tests of the barriers.
+    pub sync_validation: bool,
     /// How long one submission may run before it is reported as hung.
     pub timeout: Duration,
 }
 
 impl Default for GpuOptions {
     fn default() -> Self {
-        Self { device: None, validation: false, timeout: Duration::from_secs(120) }
+        Self { device: None, validation: false, sync_validation: false, timeout: Duration::from_secs(120) }
     }
 }
 
@@ -62,7 +65,7 @@ impl Default for GpuOptions {
 pub fn list_devices() -> GpuResult<Vec<DeviceInfo>> {
     let entry = instance::load_entry()?;
     let counters = std::sync::Arc::new(ValidationCounters::default());
-    let mut owned = instance::create_instance(&entry, false, &counters)?;
+    let mut owned = instance::create_instance(&entry, false, false, &counters)?;
     let devices = device::enumerate(&owned.instance);
     // SAFETY: nothing was created from this instance.
     unsafe { owned.destroy() };
