@@ -58,7 +58,8 @@ fn measure(renderer: &mut Renderer, change: Change) -> Measured {
         }
         walls.push(wall);
         for (into, from) in [(&mut stamp, timings.passes), (&mut isolated, alone.passes)] {
-            for (name, ms) in from {
+            for (pass, ms) in from {
+                let name = pass.name().to_string();
                 match into.iter_mut().find(|(n, _)| *n == name) {
                     Some((_, v)) => v.push(ms),
                     None => into.push((name, vec![ms])),

@@ -728,6 +728,7 @@ fn run_on(host: &Host, options: &Options) -> Result<Run, String> {
                 return Err(e);
             }
             let timings = renderer.read_timings(&recorded[0]).map_err(|e| e.to_string())?.passes;
+            let timings = timings.into_iter().map(|(p, ms)| (p.name().to_string(), ms)).collect();
             frames.push(Frame { linear, rgba8, passes: recorded[0].passes.clone(), timings });
         }
         drop(second);

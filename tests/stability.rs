@@ -200,7 +200,7 @@ fn a_non_finite_value_is_traced_to_its_pass_and_object() {
         // The gather's final max(.., 0) may turn the NaN into black (llvmpipe's max returns the
         // number), so the trace does not wait for a non-finite pixel: it reads the passes' outputs.
         let found = renderer.find_non_finite().unwrap();
-        assert!(found.iter().any(|n| n.pass == "splat" && n.object == 1 && n.count == 1), "{found:?}");
+        assert!(found.iter().any(|n| n.pass == translucent::render::plan::Pass::Splat && n.object == 1 && n.count == 1), "{found:?}");
         assert!(found.iter().all(|n| n.object == 1), "object 0 is clean: {found:?}");
     });
 }

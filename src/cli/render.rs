@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use translucent::gpu::{Gpu, median};
 use translucent::output::OutputSet;
-use translucent::render::plan::Change;
+use translucent::render::plan::{Change, Pass};
 use translucent::render::renderer::Renderer;
 use translucent::sampling::Method;
 use translucent::scene::build::{Overrides, PreparedScene};
@@ -219,7 +219,7 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     } else {
         ProgressBar::hidden()
     };
-    let mut per_pass: Vec<(String, Vec<f64>)> = Vec::new();
+    let mut per_pass: Vec<(Pass, Vec<f64>)> = Vec::new();
     let mut totals = Vec::new();
     for frame in 0..args.frames {
         let change = if frame == 0 { Change::Everything } else { moving };
@@ -256,8 +256,9 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
             .iter()
             .map(|n| {
                 let o = &renderer.scene().objects[n.object];
-                let what = if n.pass == "splat" { "samples" } else { "vertices" };
-                format!("the {} pass left {} {what} of object[{}] ({}) non-finite", n.pass, n.count, n.object, o.name)
+                let what = if n.pass == Pass::Splat { "samples" } else { "vertices" };
+                let pass = n.pass.name();
+                format!("the {pass} pass left {} {what} of object[{}] ({}) non-finite", n.count, n.object, o.name)
             })
             .collect();
         let cause = if causes.is_empty() { "the shade pass produced them".to_string() } else { causes.join("; ") };
@@ -295,8 +296,8 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         let how = if args.isolate { "submission-to-fence wall time" } else { "GPU time (timestamp queries)" };
         let after = if args.frames > 1 { " after the first" } else { "" };
         out!("{how} per pass on {} (median of {frames} frame(s){after}):", gpu.info().name);
-        for (name, mut v) in per_pass {
-            out!("  {name:<8} {:>9.3} ms", median(&mut v));
+        for (pass, mut v) in per_pass {
+            out!("  {:<8} {:>9.3} ms", pass.name(), median(&mut v));
         }
         let total = median(&mut totals);
         out!("  {:<8} {:>9.3} ms  ({:.1} frames/s)", "total", total, 1000.0 / total);

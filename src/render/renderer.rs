@@ -50,10 +50,56 @@ pub enum RenderError {
         /// The format given.
         format: vk::Format,
     },
-    /// A call that does not fit the renderer's target (own images or the host's), or names an
-    /// object that cannot take it.
-    #[error("{0}")]
-    Target(&'static str),
+    /// The pixel gather was asked of a renderer drawing into a host's target.
+    #[error("the pixel gather needs the renderer's own HDR image: use vertex or sparse")]
+    PixelGatherOnHostTarget,
+    /// `resize` of a renderer drawing into a host's target.
+    #[error("resize: a host target's size comes with each frame's HostTarget")]
+    ResizeHostTarget,
+    /// A `HostTarget` given to a renderer that draws into its own images.
+    #[error("this renderer draws into its own images: record it without a HostTarget")]
+    UnexpectedHostTarget,
+    /// A host-target renderer recorded without a `HostTarget`.
+    #[error("a host-target renderer needs a HostTarget for every frame")]
+    MissingHostTarget,
+    /// `image` or `hdr_image` of a renderer drawing into a host's target.
+    #[error("a host target has no image of the renderer's own: the host reads its own")]
+    NoOwnImage,
+    /// A scene object index past the scene's objects.
+    #[error("object {object} does not exist: the scene has {objects} objects")]
+    NoSuchObject {
+        /// The index given.
+        object: usize,
+        /// How many objects the scene has.
+        objects: usize,
+    },
+    /// A translucent-only call (`set_material`) on an opaque object.
+    #[error("object {0} is opaque: it has no translucent material to replace")]
+    OpaqueObject(usize),
+    /// `set_material` with coefficients the dipole model refuses.
+    #[error("object {object}: invalid material: {reason}")]
+    InvalidMaterial {
+        /// The object.
+        object: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// `set_exitance` with another number of values than the object has vertices.
+    #[error("object {object} has {vertices} vertices, but {given} exitance values were given")]
+    ExitanceCount {
+        /// The object.
+        object: usize,
+        /// Its vertex count.
+        vertices: usize,
+        /// Values given.
+        given: usize,
+    },
+    /// `exitance` after a gather that ran at a coarser level of detail than the whole mesh.
+    #[error(
+        "exitance at every vertex of object {0}: its last gather ran at a coarser level of detail \
+         (render.level_of_detail = false, or --full-detail, keeps every vertex current)"
+    )]
+    ExitanceAtCoarserLevel(usize),
     /// A scene change could not be prepared (the message names the object and step).
     #[error("{0}")]
     Scene(String),
@@ -69,8 +115,8 @@ pub enum RenderError {
 /// Non-finite values one pass left on one object.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct NonFinite {
-    /// "splat" or "gather".
-    pub pass: &'static str,
+    /// `Pass::Splat` (at the samples) or `Pass::Gather` (at the vertices).
+    pub pass: Pass,
     /// Index of the object in the scene.
     pub object: usize,
     /// Samples (splat) or vertices (gather) with a NaN or infinite value.
@@ -80,8 +126,8 @@ pub struct NonFinite {
 /// Per-pass GPU milliseconds of one frame, in recording order.
 #[derive(Clone, Debug, Default)]
 pub struct FrameTimings {
-    /// (pass name, GPU milliseconds) per recorded pass.
-    pub passes: Vec<(String, f64)>,
+    /// (pass, GPU milliseconds) per recorded pass.
+    pub passes: Vec<(Pass, f64)>,
 }
 
 impl FrameTimings {
@@ -89,9 +135,9 @@ impl FrameTimings {
     pub fn total(&self) -> f64 {
         self.passes.iter().map(|(_, ms)| ms).sum()
     }
-    /// Milliseconds of the pass named `name` (`Pass::name`), if it was recorded.
-    pub fn get(&self, name: &str) -> Option<f64> {
-        self.passes.iter().find(|(n, _)| n == name).map(|(_, ms)| *ms)
+    /// Milliseconds of `pass`, if it was recorded.
+    pub fn get(&self, pass: Pass) -> Option<f64> {
+        self.passes.iter().find(|(p, _)| *p == pass).map(|(_, ms)| *ms)
     }
 }
 
@@ -205,9 +251,7 @@ impl Renderer {
         }
         let needs = Self::needs_of(&scene, target);
         if needs.host_target && needs.pixel_gather {
-            return Err(RenderError::Target(
-                "the pixel gather needs the renderer's own HDR image: use vertex or sparse",
-            ));
+            return Err(RenderError::PixelGatherOnHostTarget);
         }
         let buffers = GpuScene::new(gpu, &scene)?;
         let settings = &scene.scene.file.render;
@@ -371,7 +415,7 @@ impl Renderer {
     /// its extent from each frame's `HostTarget` instead.
     pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
         if self.target != TargetDesc::Own {
-            return Err(RenderError::Target("resize: a host target's size comes with each frame's HostTarget"));
+            return Err(RenderError::ResizeHostTarget);
         }
         self.scene.scene.file.camera.resolution = [width, height];
         check_fits(&self.gpu, &self.scene)?;
@@ -422,9 +466,9 @@ impl Renderer {
         target: Option<&HostTarget>,
     ) -> Result<RecordedFrame, RenderError> {
         match (self.target, target) {
-            (TargetDesc::Own, Some(_)) => return Err(RenderError::Target("this renderer draws into its own images")),
+            (TargetDesc::Own, Some(_)) => return Err(RenderError::UnexpectedHostTarget),
             (TargetDesc::Host { .. }, None) => {
-                return Err(RenderError::Target("a host-target renderer needs a HostTarget"));
+                return Err(RenderError::MissingHostTarget);
             }
             _ => {}
         }
@@ -454,7 +498,7 @@ impl Renderer {
         if let Some(t) = timer.as_deref_mut() {
             t.reset(cmd);
         }
-        self.record(cmd, plan, timer, target);
+        let recorded = self.record(cmd, plan, timer, target);
         self.timers = timers;
         self.pending = None;
         // Only the vertex gather works at a level's vertices; the others reach every vertex.
@@ -465,28 +509,30 @@ impl Renderer {
                 self.gathered[o.object] = if by_level { o.level } else { 0 };
             }
         }
-        Ok(RecordedFrame { passes: plan.passes.iter().map(|(p, _)| *p).collect(), slot })
+        Ok(RecordedFrame { passes: recorded, slot })
     }
 
     /// GPU milliseconds of each pass of `frame`, from its timestamps: call after the host's
     /// fence for the submission holding it, and before `FRAMES_IN_FLIGHT` more frames were
     /// recorded (they reuse its queries). Empty on a queue without timestamps.
     pub fn read_timings(&self, frame: &RecordedFrame) -> Result<FrameTimings, RenderError> {
-        let passes = match frame.slot {
+        let marks = match frame.slot {
             Some(slot) => self.timers[slot].results()?,
             None => Vec::new(),
         };
-        Ok(FrameTimings { passes })
+        // One mark per recorded pass, in order (`record`).
+        Ok(FrameTimings { passes: frame.passes.iter().zip(marks).map(|(&p, (_, ms))| (p, ms)).collect() })
     }
 
-    /// Record the passes of `plan` into `cmd`, each between the timer's marks when given.
+    /// Record the passes of `plan` into `cmd`, each after the barrier its declaration needs and
+    /// between the timer's marks when given; returns the passes recorded.
     fn record(
         &self,
         cmd: vk::CommandBuffer,
         plan: &Plan,
         mut timer: Option<&mut GpuTimer>,
         target: Option<&HostTarget>,
-    ) {
+    ) -> Vec<Pass> {
         let layers = plan.shadow_light.map(|source| self.scene.shadow_layers_of(source));
         if target.is_some() {
             // The host's contract: it drew into its attachments before this frame.
@@ -507,8 +553,10 @@ impl Renderer {
             target,
             hazards: &self.hazards,
         };
+        let mut recorded = Vec::new();
         for &(pass, _) in &plan.passes {
             let Some(recorder) = self.pass(pass) else { continue };
+            recorded.push(pass);
             if let Some(t) = timer.as_deref_mut() {
                 t.begin(cmd, pass.name());
             }
@@ -524,6 +572,7 @@ impl Renderer {
             .flat_map(|&r| [read(r, Access::HostRead), read(r, Access::TransferRead)])
             .collect();
         frame.before(cmd, &host);
+        recorded
     }
 
     /// Render one frame: record the passes of `plan` in one submission of its own, wait, and
@@ -548,7 +597,7 @@ impl Renderer {
             let alone = Plan { passes: vec![(*pass, why.clone())], skipped: Vec::new(), ..plan.clone() };
             let start = std::time::Instant::now();
             gpu.one_shot(pass.name(), |cmd| self.record_plan(cmd, &alone, None))??;
-            passes.push((pass.name().to_string(), start.elapsed().as_secs_f64() * 1e3));
+            passes.push((*pass, start.elapsed().as_secs_f64() * 1e3));
         }
         self.bake_after(plan)?;
         Ok(FrameTimings { passes })
@@ -557,13 +606,13 @@ impl Renderer {
     /// The last tone-mapped image (RGBA8, rows top to bottom) and how many of its HDR pixels
     /// were non-finite (they are drawn black).
     pub fn image(&self) -> Result<(Vec<u8>, u32), RenderError> {
-        let tonemap = self.tonemap.as_ref().ok_or(RenderError::Target("a host target has no tone-mapped image"))?;
+        let tonemap = self.tonemap.as_ref().ok_or(RenderError::NoOwnImage)?;
         Ok(tonemap.read()?)
     }
 
     /// The last linear HDR image, RGBA f32, rows top to bottom.
     pub fn hdr_image(&self) -> Result<Vec<f32>, RenderError> {
-        let hdr = self.targets.hdr().ok_or(RenderError::Target("a host target's image is the host's"))?;
+        let hdr = self.targets.hdr().ok_or(RenderError::NoOwnImage)?;
         let mut hazards = self.hazards.borrow_mut();
         let bytes = hdr.read(hazards.last_access(Resource::Hdr))?;
         // The copy waited for the fence and left the image in TRANSFER_SRC.
@@ -574,11 +623,9 @@ impl Renderer {
     /// Radiant exitance (RGB, W/m^2 for the scene's light units) at every vertex of object
     /// `object`, from the last vertex gather (zero in pixel-gather mode).
     pub fn exitance(&self, object: usize) -> Result<Vec<[f32; 3]>, RenderError> {
+        self.check_object(object)?;
         if self.gathered.get(object).is_some_and(|&g| g > 0 && g != usize::MAX) {
-            return Err(RenderError::Target(
-                "exitance at every vertex: the last gather of this object ran at a coarser level of detail \
-                 (render.level_of_detail = false, or --full-detail, keeps every vertex current)",
-            ));
+            return Err(RenderError::ExitanceAtCoarserLevel(object));
         }
         let all: Vec<[f32; 4]> = self.buffers.exitance.read()?;
         let first = self.buffers.object_range(object).first_vertex as usize;
@@ -591,9 +638,10 @@ impl Renderer {
     /// draws the image of the exact exitance. The next gather overwrites it. Call with no
     /// frame in flight.
     pub fn set_exitance(&mut self, object: usize, exitance: &[[f32; 3]]) -> Result<(), RenderError> {
-        let count = self.scene.objects.get(object).map(|o| o.mesh.positions().len());
-        if count != Some(exitance.len()) {
-            return Err(RenderError::Target("set_exitance: not one value per vertex of that object"));
+        self.check_object(object)?;
+        let vertices = self.scene.objects[object].mesh.positions().len();
+        if vertices != exitance.len() {
+            return Err(RenderError::ExitanceCount { object, vertices, given: exitance.len() });
         }
         let first = u64::from(self.buffers.object_range(object).first_vertex);
         let values: Vec<[f32; 4]> = exitance.iter().map(|e| [e[0], e[1], e[2], 1.0]).collect();
@@ -631,15 +679,14 @@ impl Renderer {
     /// record is re-packed and uploaded by the next frame, which reruns its splat and gather
     /// (`Change::Material`). Errors when the object is opaque or the index is out of range.
     pub fn set_material(&mut self, object: usize, material: crate::optics::Material) -> Result<(), RenderError> {
-        let Some(o) = self.scene.objects.get_mut(object) else {
-            return Err(RenderError::Target("set_material: no such object"));
-        };
+        self.check_object(object)?;
+        let o = &mut self.scene.objects[object];
         let crate::scene::build::ResolvedMaterial::Translucent { material: m, dipoles, mm_per_unit, .. } =
             &mut o.material
         else {
-            return Err(RenderError::Target("set_material: the object is opaque"));
+            return Err(RenderError::OpaqueObject(object));
         };
-        *dipoles = material.dipoles(*mm_per_unit).map_err(|_| RenderError::Target("set_material: invalid material"))?;
+        *dipoles = material.dipoles(*mm_per_unit)            .map_err(|e| RenderError::InvalidMaterial { object, reason: e.to_string() })?;
         // The scene file says so too, so that a later resampling (`set_transform`) keeps it.
         if let crate::scene::MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, eta, .. } =
             &mut self.scene.scene.file.objects[object].material
@@ -663,7 +710,7 @@ impl Renderer {
     pub fn set_transform(&mut self, object: usize, transform: crate::scene::Transform) -> Result<(), RenderError> {
         let mut file_scene = self.scene.scene.clone();
         let Some(o) = file_scene.file.objects.get_mut(object) else {
-            return Err(RenderError::Target("set_transform: no such object"));
+            return Err(RenderError::NoSuchObject { object, objects: self.scene.objects.len() });
         };
         o.transform = transform;
         let prepared = PreparedScene::new(&file_scene, &crate::scene::build::Overrides::default())
@@ -696,16 +743,22 @@ impl Renderer {
             first_sample += o.samples.len();
             let bad = samples.iter().filter(|(e, a)| !(e.iter().all(|v| v.is_finite()) && a.is_finite())).count();
             if bad > 0 {
-                found.push(NonFinite { pass: "splat", object, count: bad });
+                found.push(NonFinite { pass: Pass::Splat, object, count: bad });
             }
             let first = self.buffers.object_range(object).first_vertex as usize;
             let vertices = &exitance[first..first + o.mesh.positions().len()];
             let bad = vertices.iter().filter(|e| !e.iter().all(|v| v.is_finite())).count();
             if bad > 0 {
-                found.push(NonFinite { pass: "gather", object, count: bad });
+                found.push(NonFinite { pass: Pass::Gather, object, count: bad });
             }
         }
         Ok(found)
+    }
+
+    /// An error unless `object` is an index of the scene's objects.
+    fn check_object(&self, object: usize) -> Result<(), RenderError> {
+        let objects = self.scene.objects.len();
+        if object < objects { Ok(()) } else { Err(RenderError::NoSuchObject { object, objects }) }
     }
 
     /// Bytes of device memory in use by the allocator.

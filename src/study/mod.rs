@@ -349,7 +349,7 @@ pub fn run(
                     for _ in 0..config.frames.max(1) {
                         timings.push(renderer.frame_isolated(&plan)?);
                     }
-                    let pass = |name: &str| median(timings.iter().map(|t| t.get(name).unwrap_or(0.0)).collect());
+                    let pass = |p: crate::render::plan::Pass| median(timings.iter().map(|t| t.get(p).unwrap_or(0.0)).collect());
                     let error = exitance.as_ref().map(|e| vertex_error(&truth.exitance, e));
                     let nan = [f64::NAN; 3];
                     rows.push(Row {
@@ -360,9 +360,9 @@ pub fn run(
                         epsilon: gather.1.map(f64::from),
                         seed,
                         sampling_ms,
-                        splat_ms: pass("splat"),
-                        gather_ms: pass("gather"),
-                        shade_ms: pass("shade"),
+                        splat_ms: pass(crate::render::plan::Pass::Splat),
+                        gather_ms: pass(crate::render::plan::Pass::Gather),
+                        shade_ms: pass(crate::render::plan::Pass::Shade),
                         frame_ms: median(timings.iter().map(|t| t.total()).collect()),
                         device_mib: renderer.device_memory() as f64 / (1024.0 * 1024.0),
                         rel_rms: error.map_or(nan, |e| e.rel_rms),
