@@ -33,7 +33,7 @@ void main() {
     ObjectRecord o = objects[uint(s.normal_object.w)];
     vec3 p = s.position_area.xyz;
     vec3 n = s.normal_object.xyz;
-    float eta = o.eta_norm_kind.x;
+    float eta = o.eta;
     vec3 e = vec3(0.0);
     for (uint l = 0u; l < push.light_count; ++l) {
         vec3 wi, irradiance;

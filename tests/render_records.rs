@@ -18,8 +18,9 @@ use translucent::render::tonemap::TonemapPush;
 use translucent::render::vertex_light::VertexLightPush;
 
 /// (field name, std430 offset) of `struct NAME { ... };` in `source`, for the member types used
-/// here: 4-byte scalars and arrays of them, and 16-byte vec4, uvec4, mat4, DipoleChannel and
-/// arrays of them, in an order that needs no padding.
+/// here: 4-byte scalars and arrays of them, a 12-byte vec3, and 16-byte vec4, uvec4, mat4,
+/// DipoleChannel and arrays of them, in an order that needs no padding (checked: every vector
+/// starts on a 16-byte boundary).
 fn glsl_layout(source: &str, name: &str) -> (Vec<(String, usize)>, usize) {
     let start = source.find(&format!("struct {name} {{")).unwrap_or_else(|| panic!("struct {name} not found"));
     let body = &source[start..source[start..].find("};").unwrap() + start];
@@ -40,10 +41,14 @@ fn glsl_layout(source: &str, name: &str) -> (Vec<(String, usize)>, usize) {
         };
         let size = match ty {
             "float" | "uint" => 4,
+            "vec3" => 12,
             "vec4" | "uvec4" | "DipoleChannel" => 16,
             "mat4" => 64,
             other => panic!("type {other} of {name}.{field} is not handled here"),
         };
+        if size >= 12 {
+            assert_eq!(offset % 16, 0, "{name}.{field} would need padding before it");
+        }
         fields.push((field, offset));
         offset += size * count;
     }
@@ -57,7 +62,10 @@ fn scene_records_match_glsl() {
     assert_eq!(size, size_of::<ObjectRecord>());
     let rust = [
         ("albedo_roughness", offset_of!(ObjectRecord, albedo_roughness)),
-        ("eta_norm_kind", offset_of!(ObjectRecord, eta_norm_kind)),
+        ("eta", offset_of!(ObjectRecord, eta)),
+        ("norm", offset_of!(ObjectRecord, norm)),
+        ("kind", offset_of!(ObjectRecord, kind)),
+        ("local_channels", offset_of!(ObjectRecord, local_channels)),
         ("dipole", offset_of!(ObjectRecord, dipole)),
         ("ranges", offset_of!(ObjectRecord, ranges)),
         ("near_blend", offset_of!(ObjectRecord, near_blend)),
@@ -78,7 +86,8 @@ fn light_record_matches_glsl() {
     let (fields, size) = glsl_layout(include_str!("../glsl/common/lights.glsl"), "Light");
     assert_eq!(size, size_of::<LightGpu>());
     let rust = [
-        ("position_kind", offset_of!(LightGpu, position_kind)),
+        ("position", offset_of!(LightGpu, position)),
+        ("kind", offset_of!(LightGpu, kind)),
         ("direction_cos", offset_of!(LightGpu, direction_cos)),
         ("power_layer", offset_of!(LightGpu, power_layer)),
         ("spot_texel", offset_of!(LightGpu, spot_texel)),

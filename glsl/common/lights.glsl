@@ -8,7 +8,8 @@ const uint LIGHT_POINT = 1u;
 const uint LIGHT_SPOT = 2u;
 
 struct Light {
-    vec4 position_kind;    // xyz: position (point, spot); w: kind (LIGHT_*)
+    vec3 position;         // point, spot
+    uint kind;             // LIGHT_*
     vec4 direction_cos;    // xyz: unit vector towards the light (directional) or the spot axis
                            //      pointing away from the light; w: cos of the spot's outer angle
     vec4 power_layer;      // rgb: irradiance W/m^2 (directional) or intensity W/sr (point, spot);
@@ -28,13 +29,13 @@ bool light_is_environment(Light l) {
 // Unit direction towards the light from `p`, and the irradiance it delivers to a surface facing
 // it (inverse-square falloff and spot cone for local lights), before visibility and cosine.
 void light_incidence(Light l, vec3 p, out vec3 wi, out vec3 irradiance) {
-    uint kind = uint(l.position_kind.w);
+    uint kind = l.kind;
     if (kind == LIGHT_DIRECTIONAL) {
         wi = l.direction_cos.xyz;
         irradiance = l.power_layer.rgb;
         return;
     }
-    vec3 d = l.position_kind.xyz - p;
+    vec3 d = l.position - p;
     float dist2 = max(dot(d, d), 1e-12);
     wi = d * inversesqrt(dist2);
     irradiance = l.power_layer.rgb / dist2;

@@ -10,10 +10,11 @@ const uint MATERIAL_TRANSLUCENT = 1u;
 struct ObjectRecord {
     vec4 albedo_roughness;  // rgb: albedo: opaque, Lambert's; translucent, R_d,total per channel
                             // (dipole_r_d_total, taken once in f64); w: GGX roughness (both kinds)
-    vec4 eta_norm_kind;     // x: relative index of refraction eta; y: BSSRDF normalization
-                            // 1 / (pi T(eta)), T(eta) = 1 - 2 FM1(eta) (optics::Dipole::s_d);
-                            // z: kind (MATERIAL_*); w: channels computed locally, a bit
-                            // mask as float (bit c: channel c; render::plan)
+    float eta;              // relative index of refraction
+    float norm;             // BSSRDF normalization 1 / (pi T(eta)), T(eta) = 1 - 2 FM1(eta)
+                            // (optics::Dipole::s_d); 0 for opaque
+    uint kind;              // MATERIAL_*
+    uint local_channels;    // channels computed locally, bit c: channel c (render::plan)
     DipoleChannel dipole[3]; // per channel: alpha', sigma_tr, z_r, z_v in scene units
     uvec4 ranges;           // x: first vertex, y: vertex count, z: first sample, w: sample count
     vec4 near_blend;        // rgb: per channel, 1 / k^2 for the near blend's radius k sqrt(dA)
@@ -23,7 +24,7 @@ struct ObjectRecord {
 // 1 in each channel whose exitance is gathered, 0 in each the planner computes locally
 // (M = R_d,total E_t at the receiver itself; GpuScene::set_local_channels).
 vec3 object_gathered_channels(ObjectRecord o) {
-    uint local = uint(o.eta_norm_kind.w);
+    uint local = o.local_channels;
     return vec3((local & 1u) == 0u ? 1.0 : 0.0, (local & 2u) == 0u ? 1.0 : 0.0, (local & 4u) == 0u ? 1.0 : 0.0);
 }
 

@@ -58,13 +58,13 @@ void main() {
     // Seen from behind (open meshes, the far side of a thin plane): shade the visible side.
     if (dot(n, wo) < 0.0) n = -n;
     float cos_o = max(dot(n, wo), 0.0);
-    bool translucent = uint(o.eta_norm_kind.z) == MATERIAL_TRANSLUCENT;
-    float eta = translucent ? o.eta_norm_kind.x : 1.5;
+    bool translucent = o.kind == MATERIAL_TRANSLUCENT;
+    float eta = translucent ? o.eta : 1.5;
     float roughness = o.albedo_roughness.w;
     float alpha = max(roughness * roughness, 1e-3);
     vec3 radiance = vec3(0.0);
     float exitance_to_radiance = !translucent ? 0.0
-        : (shade_skips(SHADE_SKIP_FRESNEL) ? 1.0 : dipole_fresnel_transmittance(cos_o, eta)) * o.eta_norm_kind.y;
+        : (shade_skips(SHADE_SKIP_FRESNEL) ? 1.0 : dipole_fresnel_transmittance(cos_o, eta)) * o.norm;
     // Irradiance transmitted into a translucent surface here, for the channels the planner
     // computes locally: the environment's part arrives per vertex (vertex_light.comp weighs it
     // by F_t for translucent objects), the key lights' is added below.

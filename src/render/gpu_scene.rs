@@ -381,9 +381,9 @@ impl GpuScene {
     /// its record.
     pub fn object_ranges(&self) -> impl Iterator<Item = ObjectRange> + '_ {
         self.object_records.iter().map(|r| {
-            let translucent = r.eta_norm_kind[2] == super::records::MATERIAL_TRANSLUCENT;
+            let translucent = r.kind == super::records::MATERIAL_TRANSLUCENT;
             let [first_vertex, vertex_count, first_sample, sample_count] = r.ranges;
-            let eta = if translucent { r.eta_norm_kind[0] } else { 0.0 };
+            let eta = if translucent { r.eta } else { 0.0 };
             ObjectRange { first_vertex, vertex_count, first_sample, sample_count, eta }
         })
     }
@@ -412,11 +412,11 @@ impl GpuScene {
     }
 
     /// Which channels of object `object` the planner computes locally (bit c: channel c), in
-    /// its record's `eta_norm_kind.w`; uploaded by the next recorded frame when it changed.
+    /// its record's `local_channels`; uploaded by the next recorded frame when it changed.
     pub fn set_local_channels(&mut self, object: usize, mask: u32) {
         let record = &mut self.object_records[object];
-        if record.eta_norm_kind[3] != mask as f32 {
-            record.eta_norm_kind[3] = mask as f32;
+        if record.local_channels != mask {
+            record.local_channels = mask;
             self.pending_objects = true;
         }
     }
@@ -426,7 +426,7 @@ impl GpuScene {
     pub fn set_material(&mut self, scene: &PreparedScene, object: usize) {
         let old = self.object_records[object];
         let mut record = ObjectRecord::new(&scene.objects[object], old.ranges);
-        record.eta_norm_kind[3] = old.eta_norm_kind[3];
+        record.local_channels = old.local_channels;
         self.object_records[object] = record;
         self.pending_objects = true;
     }

@@ -11,20 +11,19 @@ use crate::scene::build::{PreparedObject, ResolvedMaterial};
 use crate::scene::lights::{LightKind, PreparedLight};
 use ash::vk;
 
-/// Kind of an opaque (Lambertian) object in `ObjectRecord::eta_norm_kind` z; `MATERIAL_OPAQUE` in
+/// Kind of an opaque (Lambertian) object in `ObjectRecord::kind`; `MATERIAL_OPAQUE` in
 /// glsl/common/scene.glsl.
-pub const MATERIAL_OPAQUE: f32 = 0.0;
-/// Kind of a translucent (dipole BSSRDF) object in `ObjectRecord::eta_norm_kind` z;
+pub const MATERIAL_OPAQUE: u32 = 0;
+/// Kind of a translucent (dipole BSSRDF) object in `ObjectRecord::kind`;
 /// `MATERIAL_TRANSLUCENT` in glsl/common/scene.glsl.
-pub const MATERIAL_TRANSLUCENT: f32 = 1.0;
+pub const MATERIAL_TRANSLUCENT: u32 = 1;
 
-/// Kind of a directional light in `LightGpu::position_kind` w; `LIGHT_DIRECTIONAL` in
-/// glsl/common/lights.glsl.
-pub const LIGHT_DIRECTIONAL: f32 = 0.0;
-/// Kind of a point light in `LightGpu::position_kind` w; `LIGHT_POINT` in glsl/common/lights.glsl.
-pub const LIGHT_POINT: f32 = 1.0;
-/// Kind of a spot light in `LightGpu::position_kind` w; `LIGHT_SPOT` in glsl/common/lights.glsl.
-pub const LIGHT_SPOT: f32 = 2.0;
+/// Kind of a directional light in `LightGpu::kind`; `LIGHT_DIRECTIONAL` in glsl/common/lights.glsl.
+pub const LIGHT_DIRECTIONAL: u32 = 0;
+/// Kind of a point light in `LightGpu::kind`; `LIGHT_POINT` in glsl/common/lights.glsl.
+pub const LIGHT_POINT: u32 = 1;
+/// Kind of a spot light in `LightGpu::kind`; `LIGHT_SPOT` in glsl/common/lights.glsl.
+pub const LIGHT_SPOT: u32 = 2;
 
 /// `ObjectRecord` in glsl/common/scene.glsl.
 #[repr(C)]
@@ -36,10 +35,15 @@ pub struct ObjectRecord {
     /// than per pixel in f32 (it was a quarter of the shading pass on lavapipe). w: GGX
     /// roughness (both kinds).
     pub albedo_roughness: [f32; 4],
-    /// x: relative index of refraction eta; y: the BSSRDF normalization 1 / (pi T(eta)) (0 for
-    /// opaque); z: kind (`MATERIAL_*`); w: the channels computed locally, a bit mask as a
-    /// float (bit c: channel c; set per frame from the plan, `GpuScene::set_local_channels`).
-    pub eta_norm_kind: [f32; 4],
+    /// Relative index of refraction eta (1.5 for opaque, for its specular lobe).
+    pub eta: f32,
+    /// The BSSRDF normalization 1 / (pi T(eta)) (0 for opaque).
+    pub norm: f32,
+    /// `MATERIAL_*`.
+    pub kind: u32,
+    /// The channels computed locally, bit c: channel c (set per frame from the plan,
+    /// `GpuScene::set_local_channels`).
+    pub local_channels: u32,
     /// Per channel: alpha', sigma_tr, z_r, z_v, with lengths in scene units.
     pub dipole: [DipoleChannelGpu; 3],
     /// First vertex, vertex count, first sample, sample count.
@@ -63,13 +67,11 @@ impl ObjectRecord {
                         dipoles[2].r_d_total() as f32,
                         *roughness,
                     ],
-                    eta_norm_kind: [
-                        material.eta as f32,
-                        // The BSSRDF's normalization 1 / (pi T(eta)) (optics::Dipole::s_d).
-                        (1.0 / (std::f64::consts::PI * t_eta)) as f32,
-                        MATERIAL_TRANSLUCENT,
-                        0.0,
-                    ],
+                    eta: material.eta as f32,
+                    // The BSSRDF's normalization 1 / (pi T(eta)) (optics::Dipole::s_d).
+                    norm: (1.0 / (std::f64::consts::PI * t_eta)) as f32,
+                    kind: MATERIAL_TRANSLUCENT,
+                    local_channels: 0,
                     dipole: dipoles.each_ref().map(DipoleChannelGpu::from),
                     ranges,
                     near_blend: {
@@ -80,7 +82,10 @@ impl ObjectRecord {
             }
             ResolvedMaterial::Opaque { albedo, roughness } => ObjectRecord {
                 albedo_roughness: [albedo[0], albedo[1], albedo[2], *roughness],
-                eta_norm_kind: [1.5, 0.0, MATERIAL_OPAQUE, 0.0],
+                eta: 1.5,
+                norm: 0.0,
+                kind: MATERIAL_OPAQUE,
+                local_channels: 0,
                 dipole: [DipoleChannelGpu::default(); 3],
                 ranges,
                 near_blend: [0.0; 4],
@@ -190,8 +195,10 @@ pub struct ReceiverGroupRecord {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct LightGpu {
-    /// xyz: position (point, spot); w: kind (`LIGHT_*`).
-    pub position_kind: [f32; 4],
+    /// Position (point, spot).
+    pub position: [f32; 3],
+    /// `LIGHT_*`.
+    pub kind: u32,
     /// xyz: unit vector towards the light (directional) or the spot axis pointing away from the
     /// light; w: cosine of the spot's outer angle.
     pub direction_cos: [f32; 4],
@@ -208,19 +215,20 @@ pub struct LightGpu {
 impl LightGpu {
     /// Pack one prepared light.
     pub fn new(light: &PreparedLight) -> LightGpu {
-        let (position_kind, direction_cos, power, cos_inner) = match light.kind {
+        let ((position, kind), direction_cos, power, cos_inner) = match light.kind {
             LightKind::Directional { direction: d, irradiance } => {
-                ([0.0, 0.0, 0.0, LIGHT_DIRECTIONAL], [d.x, d.y, d.z, 0.0], irradiance, 0.0)
+                (([0.0; 3], LIGHT_DIRECTIONAL), [d.x, d.y, d.z, 0.0], irradiance, 0.0)
             }
-            LightKind::Point { position: p, intensity } => ([p.x, p.y, p.z, LIGHT_POINT], [0.0; 4], intensity, 0.0),
+            LightKind::Point { position: p, intensity } => ((p.to_array(), LIGHT_POINT), [0.0; 4], intensity, 0.0),
             LightKind::Spot { position: p, axis: a, intensity, cos_outer, cos_inner } => {
-                ([p.x, p.y, p.z, LIGHT_SPOT], [a.x, a.y, a.z, cos_outer], intensity, cos_inner)
+                ((p.to_array(), LIGHT_SPOT), [a.x, a.y, a.z, cos_outer], intensity, cos_inner)
             }
         };
         // A negative layer tells the shaders the light casts no shadow.
         let layer = light.shadow_layer.map_or(-1.0, |l| l as f32);
         LightGpu {
-            position_kind,
+            position,
+            kind,
             direction_cos,
             power_layer: [power.x, power.y, power.z, layer],
             spot_texel: [cos_inner, light.shadow_texel, light.normal_offset, if light.environment { 1.0 } else { 0.0 }],
