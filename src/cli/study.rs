@@ -3,7 +3,7 @@
 
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use translucent::gpu::Gpu;
 use translucent::output::OutputSet;
@@ -138,6 +138,36 @@ fn config(args: &Args) -> Result<StudyConfig> {
 pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let chosen = args.error_image.as_deref().map(parse_error_image).transpose()?;
     let config = config(args)?;
+    check_error_image(chosen, &config)?;
+    if args.output.exists() && !args.output.is_dir() {
+        bail!("{} exists and is not a folder", args.output.display());
+    }
+    let scene = match &args.scene {
+        Some(path) => Scene::load(path)?,
+        None => Scene::builtin(),
+    };
+    let gpu: Arc<Gpu> = Gpu::new(&gpu_args.options())?;
+    let device = gpu.info().name.clone();
+    let cache = args.truth_cache.clone().unwrap_or_else(truth::default_cache_dir);
+    let study = run_with_progress(&gpu, &scene, &config, &cache)?;
+
+    let preamble = preamble(&study, &scene, &config, &device) + &reference_timing(&study);
+    let summaries = report::summarise(&study.rows);
+    let md = report::markdown(&format!("Accuracy study: {}", scene.name), &preamble, &summaries);
+    let plot = report_plot(&summaries, &scene.name)?;
+    write_outputs(&args.output, &study, chosen, md, &plot)?;
+    for target in report::TARGETS {
+        match report::fastest_meeting(&summaries, target) {
+            Some(s) => out!("error <= {:>4}%: {} at {:.1} ms", target * 100.0, s.label(), s.frame_ms),
+            None => out!("error <= {:>4}%: no configuration in the sweep", target * 100.0),
+        }
+    }
+    Ok(())
+}
+
+/// `--error-image`'s configuration must be one the sweep renders, against a truth at every
+/// vertex.
+fn check_error_image(chosen: Option<(Method, usize, GatherMode)>, config: &StudyConfig) -> Result<()> {
     if chosen.is_some() && config.truth.receivers.is_some() {
         // The picture colours every vertex by its error; a subset truth knows only some.
         bail!("--error-image needs the truth at every vertex: leave out --truth-receivers");
@@ -154,25 +184,17 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
             );
         }
     }
-    if args.output.exists() && !args.output.is_dir() {
-        bail!("{} exists and is not a folder", args.output.display());
-    }
-    let names = ["study.csv", "study.md", "study.png", "truth.png", "error.png"];
-    let outputs: Vec<PathBuf> = names.iter().map(|n| args.output.join(n)).collect();
-    let scene = match &args.scene {
-        Some(path) => Scene::load(path)?,
-        None => Scene::builtin(),
-    };
-    let gpu: Arc<Gpu> = Gpu::new(&gpu_args.options())?;
-    let device = gpu.info().name.clone();
-    let cache = args.truth_cache.clone().unwrap_or_else(truth::default_cache_dir);
+    Ok(())
+}
 
+/// `study::run` behind a progress bar (cleared when done).
+fn run_with_progress(gpu: &Arc<Gpu>, scene: &Scene, config: &StudyConfig, cache: &Path) -> Result<study::Study> {
     let bar = ProgressBar::new(config.runs() as u64);
     bar.set_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} eta {eta} {msg}")
             .expect("a valid template"),
     );
-    let study = study::run(&gpu, &scene, &config, &cache, &|e| match e {
+    let study = study::run(gpu, scene, config, cache, &|e| match e {
         Event::Truth(level, done, of) => {
             bar.set_message(format!("exact integral, level {level}: {done}/{of} receivers"))
         }
@@ -183,7 +205,12 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         }
     })?;
     bar.finish_and_clear();
+    Ok(study)
+}
 
+/// study.md's text above the results: the scene, device and timing method, then the truth
+/// and its refinement level by level.
+fn preamble(study: &study::Study, scene: &Scene, config: &StudyConfig, device: &str) -> String {
     let t = &study.truth;
     let mut levels = String::new();
     for l in &t.levels {
@@ -202,7 +229,7 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     } else {
         "each pass in a submission of its own, submission to fence"
     };
-    let preamble = format!(
+    format!(
         "Scene `{}`, device {device}, {} configurations x seeds. Times: median of {} frames after one warm-up, \
          a moving light's frame (splat, gather, shade), {timing}.\n\n\
          Truth: the exact dipole integral at {} (`reference::truth`), {} (last change between levels \
@@ -220,8 +247,12 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         t.tolerance,
         if study.truth_cached { ", read from the cache" } else { "" },
         100.0 * truth::LIT_FLOOR,
-    );
-    let reference = study.reference.as_ref().map_or(String::new(), |t| {
+    )
+}
+
+/// study.md's paragraph on the GPU against the f64 CPU reference, where it was timed.
+fn reference_timing(study: &study::Study) -> String {
+    study.reference.as_ref().map_or(String::new(), |t| {
         let r = &study.rows[t.row];
         format!(
             "\n\nGPU against the f64 CPU reference (`reference::splat` + `reference::gather`, the same sum in f64, \
@@ -236,14 +267,22 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
             t.cpu_ms,
             t.cpu_ms / (r.splat_ms + r.gather_ms)
         )
-    });
-    let preamble = preamble + &reference;
-    let summaries = report::summarise(&study.rows);
-    let md = report::markdown(&format!("Accuracy study: {}", scene.name), &preamble, &summaries);
-    let [w, h] = study.prepared.scene.file.camera.resolution;
-    let plot = report_plot(&summaries, &scene.name)?;
+    })
+}
 
-    std::fs::create_dir_all(&args.output).with_context(|| format!("cannot make {}", args.output.display()))?;
+/// Write study.csv, study.md, study.png, truth.png (where the truth has an image) and
+/// error.png (for `chosen`) into `output`, all or none (`OutputSet`).
+fn write_outputs(
+    output: &Path,
+    study: &study::Study,
+    chosen: Option<(Method, usize, GatherMode)>,
+    md: String,
+    plot: &[u8],
+) -> Result<()> {
+    let names = ["study.csv", "study.md", "study.png", "truth.png", "error.png"];
+    let outputs: Vec<PathBuf> = names.iter().map(|n| output.join(n)).collect();
+    let [w, h] = study.prepared.scene.file.camera.resolution;
+    std::fs::create_dir_all(output).with_context(|| format!("cannot make {}", output.display()))?;
     let mut set = OutputSet::new();
     let text = |set: &mut OutputSet, path: &PathBuf, body: String| {
         set.stage(path, |tmp| {
@@ -253,7 +292,7 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     };
     text(&mut set, &outputs[0], report::csv(&study.rows))?;
     text(&mut set, &outputs[1], md)?;
-    set.png(&outputs[2], 960, 640, &plot)?;
+    set.png(&outputs[2], 960, 640, plot)?;
     if let Some(image) = &study.truth_image {
         set.png(&outputs[3], w, h, &image.ldr)?;
     }
@@ -265,17 +304,11 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
             .expect("checked to be in the sweep");
         let estimate = study.exitance[i].as_ref().expect("not the pixel gather");
         let (rgba, width) =
-            study::error_image(&study.prepared, &t.exitance, estimate, 0.1).map_err(anyhow::Error::msg)?;
+            study::error_image(&study.prepared, &study.truth.exitance, estimate, 0.1).map_err(anyhow::Error::msg)?;
         set.png(&outputs[4], width, h, &rgba)?;
     }
     for p in set.commit()? {
         out!("wrote {}", p.display());
-    }
-    for target in report::TARGETS {
-        match report::fastest_meeting(&summaries, target) {
-            Some(s) => out!("error <= {:>4}%: {} at {:.1} ms", target * 100.0, s.label(), s.frame_ms),
-            None => out!("error <= {:>4}%: no configuration in the sweep", target * 100.0),
-        }
     }
     Ok(())
 }

@@ -47,17 +47,7 @@ pub(super) fn compute(positions: &[Vec3], triangles: &[[u32; 3]], topo: &Topolog
         triangle_areas.push(area);
         face_normals.push(normal.as_vec3());
 
-        // Angle and cotangent at each corner. |u x v| is twice the area at every corner, so the
-        // cotangent is dot / twice_area; atan2 keeps small and near-pi angles accurate.
-        let mut angle = [0.0; 3];
-        let mut cot = [0.0; 3];
-        for k in 0..3 {
-            let u = p[(k + 1) % 3] - p[k];
-            let w = p[(k + 2) % 3] - p[k];
-            let d = u.dot(w);
-            angle[k] = twice_area.atan2(d);
-            cot[k] = d / twice_area;
-        }
+        let (angle, cot) = corner_angles(&p, twice_area);
 
         for k in 0..3 {
             let (j, l) = ((k + 1) % 3, (k + 2) % 3);
@@ -82,25 +72,7 @@ pub(super) fn compute(positions: &[Vec3], triangles: &[[u32; 3]], topo: &Topolog
         }
     }
 
-    let mut vertex_normals = vec![Vec3::Z; n];
-    let mut any_face = vec![u32::MAX; n];
-    for (t, tri) in triangles.iter().enumerate() {
-        for &i in tri {
-            if any_face[i as usize] == u32::MAX {
-                any_face[i as usize] = t as u32;
-            }
-        }
-    }
-    for i in 0..n {
-        // Two triangles folded onto each other cancel; fall back to area weighting, then to any
-        // one face, so every vertex normal is a unit vector.
-        let nrm = angle_weighted[i]
-            .try_normalize()
-            .or_else(|| area_weighted[i].try_normalize())
-            .map(|d| d.as_vec3())
-            .unwrap_or_else(|| face_normals.get(any_face[i] as usize).copied().unwrap_or(Vec3::Z));
-        vertex_normals[i] = nrm;
-    }
+    let vertex_normals = vertex_normals(triangles, &face_normals, &angle_weighted, &area_weighted);
 
     let mut mean = vec![0.0; n];
     let mut gauss = vec![0.0; n];
@@ -120,6 +92,53 @@ pub(super) fn compute(positions: &[Vec3], triangles: &[[u32; 3]], topo: &Topolog
         gaussian_curvature: gauss,
         mixed_areas: mixed,
     }
+}
+
+/// Angle and cotangent at each corner of the triangle `p` whose `|(p1 - p0) x (p2 - p0)|` is
+/// `twice_area`. |u x v| is twice the area at every corner, so the cotangent is dot /
+/// twice_area; atan2 keeps small and near-pi angles accurate.
+fn corner_angles(p: &[DVec3; 3], twice_area: f64) -> ([f64; 3], [f64; 3]) {
+    let mut angle = [0.0; 3];
+    let mut cot = [0.0; 3];
+    for k in 0..3 {
+        let u = p[(k + 1) % 3] - p[k];
+        let w = p[(k + 2) % 3] - p[k];
+        let d = u.dot(w);
+        angle[k] = twice_area.atan2(d);
+        cot[k] = d / twice_area;
+    }
+    (angle, cot)
+}
+
+/// Unit vertex normals: the angle-weighted sum of the faces' normals, else the area-weighted
+/// one, else any one face's, else +z for a vertex on no face.
+fn vertex_normals(
+    triangles: &[[u32; 3]],
+    face_normals: &[Vec3],
+    angle_weighted: &[DVec3],
+    area_weighted: &[DVec3],
+) -> Vec<Vec3> {
+    let n = angle_weighted.len();
+    let mut vertex_normals = vec![Vec3::Z; n];
+    let mut any_face = vec![u32::MAX; n];
+    for (t, tri) in triangles.iter().enumerate() {
+        for &i in tri {
+            if any_face[i as usize] == u32::MAX {
+                any_face[i as usize] = t as u32;
+            }
+        }
+    }
+    for i in 0..n {
+        // Two triangles folded onto each other cancel; fall back to area weighting, then to any
+        // one face, so every vertex normal is a unit vector.
+        let nrm = angle_weighted[i]
+            .try_normalize()
+            .or_else(|| area_weighted[i].try_normalize())
+            .map(|d| d.as_vec3())
+            .unwrap_or_else(|| face_normals.get(any_face[i] as usize).copied().unwrap_or(Vec3::Z));
+        vertex_normals[i] = nrm;
+    }
+    vertex_normals
 }
 
 /// At boundary (and non-manifold) vertices half the one-ring is missing, so the cotangent sum

@@ -108,155 +108,162 @@ fn parse_error(source_name: &str, line: usize, message: String, text: &str) -> M
     MeshError::Parse { source_name: source_name.to_string(), line, message, text: shown }
 }
 
+/// What a face vertex's `v/vt/vn` indices refer to, in that order, for messages.
+const KINDS: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+
+/// One line of the file, to quote in its errors.
+#[derive(Clone, Copy)]
+struct Line<'a> {
+    source_name: &'a str,
+    /// Line number, from 1.
+    no: usize,
+    text: &'a str,
+}
+
+impl Line<'_> {
+    fn error(self, message: String) -> MeshError {
+        parse_error(self.source_name, self.no, message, self.text)
+    }
+}
+
+/// A positive face index beyond the elements defined so far: OBJ lets it refer forward, so it
+/// is checked against the final counts.
+struct ForwardRef<'a> {
+    line: Line<'a>,
+    index: i64,
+    /// Index into [`KINDS`].
+    kind: usize,
+}
+
+/// The pre-scan's state: elements of each of [`KINDS`] defined so far, and the forward
+/// references still to check.
+struct Prescan<'a> {
+    counts: [i64; 3],
+    forward: Vec<ForwardRef<'a>>,
+}
+
 /// Check every `v`, `vt`, `vn`, `f` and `l` line: numbers that parse and are finite in f32, faces
 /// of at least three vertices, indices that are non-zero and inside the lists they refer to
 /// (negative indices count back from the last element defined so far, positive ones may refer
 /// forward). Other statements are left to tobj, which ignores what it does not know.
 fn prescan(text: &str, source_name: &str) -> Result<(), MeshError> {
-    struct FaceRef<'a> {
-        line: usize,
-        text: &'a str,
-        index: i64,
-        kind: usize,
-    }
-    const KINDS: [&str; 3] = ["vertex", "texture coordinate", "normal"];
-    let mut counts = [0i64; 3];
-    let mut forward: Vec<FaceRef> = Vec::new();
-
-    for (n, line) in text.lines().enumerate() {
-        let line_no = n + 1;
-        let mut words = line.split_whitespace();
+    let mut scan = Prescan { counts: [0; 3], forward: Vec::new() };
+    for (n, text) in text.lines().enumerate() {
+        let line = Line { source_name, no: n + 1, text };
+        let mut words = text.split_whitespace();
         let Some(keyword) = words.next() else { continue };
         let (kind, needed) = match keyword {
             "v" => (0, 3),
             "vt" => (1, 2),
             "vn" => (2, 3),
             "f" | "l" => {
-                let mut vertices = 0;
-                for word in words {
-                    vertices += 1;
-                    for (kind, part) in word.split('/').enumerate() {
-                        if kind >= 3 {
-                            return Err(parse_error(
-                                source_name,
-                                line_no,
-                                format!("face vertex `{word}` has more than three indices"),
-                                line,
-                            ));
-                        }
-                        if part.is_empty() {
-                            if kind == 0 {
-                                return Err(parse_error(
-                                    source_name,
-                                    line_no,
-                                    format!("face vertex `{word}` has no position index"),
-                                    line,
-                                ));
-                            }
-                            continue;
-                        }
-                        let index: i64 = part.parse().map_err(|_| {
-                            parse_error(source_name, line_no, format!("face index `{part}` is not an integer"), line)
-                        })?;
-                        if index == 0 {
-                            return Err(parse_error(
-                                source_name,
-                                line_no,
-                                "face index 0 is invalid (OBJ indices start at 1)".into(),
-                                line,
-                            ));
-                        }
-                        if index < 0 && -index > counts[kind] {
-                            return Err(parse_error(
-                                source_name,
-                                line_no,
-                                format!(
-                                    "relative {} index {index} reaches before the first of the {} defined so far",
-                                    KINDS[kind], counts[kind]
-                                ),
-                                line,
-                            ));
-                        }
-                        if index > counts[kind] {
-                            forward.push(FaceRef { line: line_no, text: line, index, kind });
-                        }
-                    }
-                }
-                if keyword == "f" && vertices < 3 {
-                    return Err(parse_error(
-                        source_name,
-                        line_no,
-                        format!("a face needs at least 3 vertices, this one has {vertices}"),
-                        line,
-                    ));
-                }
+                scan.face(line, keyword == "f", words)?;
                 continue;
             }
             _ => continue,
         };
-        let mut values = 0;
-        for word in words.by_ref().take(needed) {
-            let value: f32 = word
-                .parse()
-                .map_err(|_| parse_error(source_name, line_no, format!("`{word}` is not a number"), line))?;
-            if !value.is_finite() {
-                return Err(parse_error(
-                    source_name,
-                    line_no,
-                    format!("coordinate `{word}` is not a finite f32 number"),
-                    line,
-                ));
-            }
-            values += 1;
-        }
-        if values < needed {
-            return Err(parse_error(
-                source_name,
-                line_no,
-                format!("`{keyword}` needs {needed} numbers, found {values}"),
-                line,
-            ));
-        }
+        check_numbers(line, keyword, needed, &mut words)?;
         if keyword == "v" {
-            // An optional fourth value is the homogeneous w (positions are divided by it); three
-            // more are a vertex colour.
-            let rest: Vec<&str> = words.collect();
-            match rest.len() {
-                0 | 3 => {}
-                1 => {
-                    let w: f32 = rest[0].parse().map_err(|_| {
-                        parse_error(source_name, line_no, format!("weight `{}` is not a number", rest[0]), line)
-                    })?;
-                    if !w.is_finite() || w == 0.0 {
-                        return Err(parse_error(
-                            source_name,
-                            line_no,
-                            format!("weight w = `{}` must be finite and non-zero", rest[0]),
-                            line,
-                        ));
-                    }
-                }
-                k => {
-                    return Err(parse_error(
-                        source_name,
-                        line_no,
-                        format!("`v` takes 3, 4 or 6 numbers, found {}", 3 + k),
-                        line,
-                    ));
-                }
+            check_vertex_extras(line, words)?;
+        }
+        scan.counts[kind] += 1;
+    }
+    scan.finish()
+}
+
+impl<'a> Prescan<'a> {
+    /// An `f` (`is_face`) or `l` statement's vertices, `words` after the keyword; a face needs
+    /// three.
+    fn face(&mut self, line: Line<'a>, is_face: bool, words: impl Iterator<Item = &'a str>) -> Result<(), MeshError> {
+        let mut vertices = 0;
+        for word in words {
+            vertices += 1;
+            for (kind, part) in word.split('/').enumerate() {
+                self.face_index(line, word, kind, part)?;
             }
         }
-        counts[kind] += 1;
+        if is_face && vertices < 3 {
+            return Err(line.error(format!("a face needs at least 3 vertices, this one has {vertices}")));
+        }
+        Ok(())
     }
 
-    // Positive indices may point forward in the file; check them against the final counts.
-    if let Some(bad) = forward.iter().find(|f| f.index > counts[f.kind]) {
-        return Err(parse_error(
-            source_name,
-            bad.line,
-            format!("{} index {} is out of range: the file defines {}", KINDS[bad.kind], bad.index, counts[bad.kind]),
-            bad.text,
-        ));
+    /// One index `part` (the `kind`th, 0 for the position) of face vertex `word`: present for
+    /// the position, a non-zero integer, a relative one reaching no further back than the
+    /// first element, a positive one beyond those defined so far kept for [`Self::finish`].
+    fn face_index(&mut self, line: Line<'a>, word: &str, kind: usize, part: &str) -> Result<(), MeshError> {
+        if kind >= 3 {
+            return Err(line.error(format!("face vertex `{word}` has more than three indices")));
+        }
+        if part.is_empty() {
+            if kind == 0 {
+                return Err(line.error(format!("face vertex `{word}` has no position index")));
+            }
+            return Ok(());
+        }
+        let index: i64 = part.parse().map_err(|_| line.error(format!("face index `{part}` is not an integer")))?;
+        if index == 0 {
+            return Err(line.error("face index 0 is invalid (OBJ indices start at 1)".into()));
+        }
+        if index < 0 && -index > self.counts[kind] {
+            return Err(line.error(format!(
+                "relative {} index {index} reaches before the first of the {} defined so far",
+                KINDS[kind], self.counts[kind]
+            )));
+        }
+        if index > self.counts[kind] {
+            self.forward.push(ForwardRef { line, index, kind });
+        }
+        Ok(())
+    }
+
+    /// Positive indices may point forward in the file; check them against the final counts.
+    fn finish(self) -> Result<(), MeshError> {
+        if let Some(bad) = self.forward.iter().find(|f| f.index > self.counts[f.kind]) {
+            return Err(bad.line.error(format!(
+                "{} index {} is out of range: the file defines {}",
+                KINDS[bad.kind], bad.index, self.counts[bad.kind]
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The first `needed` numbers after `keyword` (`v`, `vt`, `vn`): present, parsing and finite
+/// in f32. Leaves `words` at what follows them.
+fn check_numbers<'a>(
+    line: Line<'_>,
+    keyword: &str,
+    needed: usize,
+    words: &mut impl Iterator<Item = &'a str>,
+) -> Result<(), MeshError> {
+    let mut values = 0;
+    for word in words.by_ref().take(needed) {
+        let value: f32 = word.parse().map_err(|_| line.error(format!("`{word}` is not a number")))?;
+        if !value.is_finite() {
+            return Err(line.error(format!("coordinate `{word}` is not a finite f32 number")));
+        }
+        values += 1;
+    }
+    if values < needed {
+        return Err(line.error(format!("`{keyword}` needs {needed} numbers, found {values}")));
     }
     Ok(())
+}
+
+/// What follows a `v` line's three coordinates: nothing, a homogeneous w (positions are divided
+/// by it, so finite and non-zero) or three values of a vertex colour.
+fn check_vertex_extras<'a>(line: Line<'_>, words: impl Iterator<Item = &'a str>) -> Result<(), MeshError> {
+    let rest: Vec<&str> = words.collect();
+    match rest.len() {
+        0 | 3 => Ok(()),
+        1 => {
+            let w: f32 = rest[0].parse().map_err(|_| line.error(format!("weight `{}` is not a number", rest[0])))?;
+            if !w.is_finite() || w == 0.0 {
+                return Err(line.error(format!("weight w = `{}` must be finite and non-zero", rest[0])));
+            }
+            Ok(())
+        }
+        k => Err(line.error(format!("`v` takes 3, 4 or 6 numbers, found {}", 3 + k))),
+    }
 }

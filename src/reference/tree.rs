@@ -63,66 +63,80 @@ fn center_of(n: &TreeNode) -> DVec3 {
     glam::Vec3::from(n.center).as_dvec3()
 }
 
-/// Stage 1 at one receiver `x` whose group's cut is `items` (`sampling::SampleTree::cut`): a
-/// sample's far kernel and near exitance as in the flat sum, a node's power times the cluster
-/// kernel (`kernel::r_d_far_cluster`: its centroid, the `b` of its mean area, its spread); the
-/// near field blended over the listed samples with each channel's radius factor `radii` (the
-/// nearest sample of the object where no weight reaches), times the share kept beside open
-/// boundaries `boundary` away (`super::near_kept`).
-#[allow(clippy::too_many_arguments)]
-pub fn gather_items(
-    x: DVec3,
-    items: &[u32],
-    tree: &SampleTree,
-    power: &[NodePower],
-    dipoles: &[Dipole; 3],
-    positions: &[DVec3],
-    areas: &[f64],
-    e: &[[f64; 3]],
-    boundary: [f32; 2],
-    radii: [f64; 3],
-) -> [f64; 3] {
-    let mut far = [0.0f64; 3];
-    let mut near = Vec::new();
-    for &item in items {
-        if item & NODE_ITEM != 0 {
-            let i = (item & !NODE_ITEM) as usize;
-            let n = &tree.nodes[i];
-            // As the GPU packs it: the f32 area over the count.
-            let mean_area = (n.area / n.count as f32) as f64;
-            let b = B_PER_SQRT_AREA * mean_area.sqrt();
-            let u = x - power[i].centroid;
-            let cov = &power[i].covariance;
-            let w = u.normalize_or_zero();
-            let (tr_cov, axial_cov) = (cov.x_axis.x + cov.y_axis.y + cov.z_axis.z, w.dot(*cov * w));
-            for c in 0..3 {
-                far[c] += power[i].power[c] * kernel::r_d_far_cluster(&dipoles[c], u.length(), b, tr_cov, axial_cov);
+/// One object's data for stage 1 (`TreeGather::at`): its hierarchy and node powers
+/// (`node_power`), its channels' dipoles and near-blend radius factors
+/// (`PreparedObject::near_blend_radii`), and its samples' positions, areas and transmitted
+/// irradiance in the object's own sample order.
+#[derive(Clone, Copy)]
+pub struct TreeGather<'a> {
+    /// The hierarchy over the object's samples.
+    pub tree: &'a SampleTree,
+    /// Stage 0's aggregate of each node.
+    pub power: &'a [NodePower],
+    /// The R, G, B dipoles in scene units.
+    pub dipoles: &'a [Dipole; 3],
+    /// Sample positions.
+    pub positions: &'a [DVec3],
+    /// Sample areas.
+    pub areas: &'a [f64],
+    /// Per-sample transmitted irradiance.
+    pub e: &'a [[f64; 3]],
+    /// Each channel's near-blend radius factor.
+    pub radii: [f64; 3],
+}
+
+impl TreeGather<'_> {
+    /// Stage 1 at one receiver `x` whose group's cut is `items` (`sampling::SampleTree::cut`): a
+    /// sample's far kernel and near exitance as in the flat sum, a node's power times the cluster
+    /// kernel (`kernel::r_d_far_cluster`: its centroid, the `b` of its mean area, its spread); the
+    /// near field blended over the listed samples with each channel's radius factor `radii` (the
+    /// nearest sample of the object where no weight reaches), times the share kept beside open
+    /// boundaries `boundary` away (`super::near_kept`).
+    pub fn at(&self, x: DVec3, items: &[u32], boundary: [f32; 2]) -> [f64; 3] {
+        let TreeGather { tree, power, dipoles, positions, areas, e, radii } = *self;
+        let mut far = [0.0f64; 3];
+        let mut near = Vec::new();
+        for &item in items {
+            if item & NODE_ITEM != 0 {
+                let i = (item & !NODE_ITEM) as usize;
+                let n = &tree.nodes[i];
+                // As the GPU packs it: the f32 area over the count.
+                let mean_area = (n.area / n.count as f32) as f64;
+                let b = B_PER_SQRT_AREA * mean_area.sqrt();
+                let u = x - power[i].centroid;
+                let cov = &power[i].covariance;
+                let w = u.normalize_or_zero();
+                let (tr_cov, axial_cov) = (cov.x_axis.x + cov.y_axis.y + cov.z_axis.z, w.dot(*cov * w));
+                for c in 0..3 {
+                    far[c] +=
+                        power[i].power[c] * kernel::r_d_far_cluster(&dipoles[c], u.length(), b, tr_cov, axial_cov);
+                }
+            } else {
+                let s = item as usize;
+                let r = x.distance(positions[s]);
+                for c in 0..3 {
+                    far[c] += e[s][c] * kernel::far_kernel(&dipoles[c], r, areas[s]);
+                }
+                let b = B_PER_SQRT_AREA * areas[s].sqrt();
+                near.push((positions[s], areas[s], [0, 1, 2].map(|c| e[s][c] * kernel::near_energy(&dipoles[c], b))));
             }
-        } else {
-            let s = item as usize;
-            let r = x.distance(positions[s]);
-            for c in 0..3 {
-                far[c] += e[s][c] * kernel::far_kernel(&dipoles[c], r, areas[s]);
-            }
+        }
+        let (blended, mean_area) = near_blend(x, &near, radii);
+        let kept = super::near_kept(dipoles, mean_area, boundary);
+        let mut blended = [0, 1, 2].map(|c| blended[c] * kept[c]);
+        // A channel no weight reached: the nearest sample of the whole object, as the flat sum takes it.
+        let nearest = || {
+            (0..positions.len())
+                .min_by(|&a, &b| x.distance(positions[a]).total_cmp(&x.distance(positions[b])).then(a.cmp(&b)))
+        };
+        if let Some(s) = mean_area.iter().any(Option::is_none).then(nearest).flatten() {
             let b = B_PER_SQRT_AREA * areas[s].sqrt();
-            near.push((positions[s], areas[s], [0, 1, 2].map(|c| e[s][c] * kernel::near_energy(&dipoles[c], b))));
+            for c in (0..3).filter(|&c| mean_area[c].is_none()) {
+                blended[c] = e[s][c] * kernel::near_energy(&dipoles[c], b);
+            }
         }
+        [0, 1, 2].map(|c| (far[c] + blended[c]).max(0.0))
     }
-    let (blended, mean_area) = near_blend(x, &near, radii);
-    let kept = super::near_kept(dipoles, mean_area, boundary);
-    let mut blended = [0, 1, 2].map(|c| blended[c] * kept[c]);
-    // A channel no weight reached: the nearest sample of the whole object, as the flat sum takes it.
-    let nearest = || {
-        (0..positions.len())
-            .min_by(|&a, &b| x.distance(positions[a]).total_cmp(&x.distance(positions[b])).then(a.cmp(&b)))
-    };
-    if let Some(s) = mean_area.iter().any(Option::is_none).then(nearest).flatten() {
-        let b = B_PER_SQRT_AREA * areas[s].sqrt();
-        for c in (0..3).filter(|&c| mean_area[c].is_none()) {
-            blended[c] = e[s][c] * kernel::near_energy(&dipoles[c], b);
-        }
-    }
-    [0, 1, 2].map(|c| (far[c] + blended[c]).max(0.0))
 }
 
 /// Radiant exitance at every vertex of every object (zero for opaque ones) by the hierarchical
@@ -139,7 +153,15 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]], epsilon: f64) -> V
         let cuts = o.gather_cuts(&tree, &groups, epsilon);
         let mesh = o.mesh.positions();
         let boundary = o.mesh.boundary_distances();
-        let radii = o.near_blend_radii();
+        let object = TreeGather {
+            tree: &tree,
+            power: &power,
+            dipoles,
+            positions: &positions,
+            areas: &areas,
+            e,
+            radii: o.near_blend_radii(),
+        };
         let computed: Vec<(usize, [f64; 3])> = groups
             .order
             .par_iter()
@@ -147,10 +169,7 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]], epsilon: f64) -> V
             .map(|(k, &v)| {
                 let x = mesh[v as usize].as_dvec3();
                 let items = &cuts[k / RECEIVER_GROUP_SIZE];
-                (
-                    v as usize,
-                    gather_items(x, items, &tree, &power, dipoles, &positions, &areas, e, boundary[v as usize], radii),
-                )
+                (v as usize, object.at(x, items, boundary[v as usize]))
             })
             .collect();
         let mut exitance = vec![[0.0; 3]; mesh.len()];

@@ -51,9 +51,10 @@
 
 use super::bvh::Bvh;
 use super::{Visibility, occluders, ray_offset, transmitted_irradiance_known};
+use crate::mesh::Mesh;
 use crate::optics::Dipole;
 use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
-use glam::DVec3;
+use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -508,103 +509,138 @@ fn linear_moments(y: &[DVec3; 3], e: &[DVec3; 3], area: f64) -> ([f64; 3], [DVec
 /// where the set of lights reaching it changes inside it.
 fn sources(scene: &PreparedScene, occluders: &Bvh, o: &PreparedObject, eta: f64, level: u32, eps: f64) -> Vec<Source> {
     let mesh = &o.mesh;
-    let normals = mesh.vertex_normals();
+    let caster =
+        Caster { scene, occluders, eta, eps, normals: mesh.vertex_normals(), strong: strong_lights(scene, mesh) };
+    (0..mesh.triangles().len()).into_par_iter().map(|t| caster.source(mesh, t, level)).collect()
+}
+
+/// The lights (by bit, modulo 64) giving at least [`STRONG_LIGHT`] of the total incidence at
+/// the mesh's centre: their shadow edges get [`EDGE_EXTRA_DEPTH`] more levels.
+fn strong_lights(scene: &PreparedScene, mesh: &Mesh) -> u64 {
     let centre = mesh.positions().iter().map(|p| p.as_dvec3()).sum::<DVec3>() / mesh.positions().len().max(1) as f64;
     let peak: Vec<f64> = scene.lights.iter().map(|l| super::light_incidence(l, centre).1.max_element()).collect();
     let total: f64 = peak.iter().sum();
-    let strong = peak
-        .iter()
-        .enumerate()
-        .filter(|&(_, &p)| p >= STRONG_LIGHT * total)
-        .fold(0u64, |m, (i, _)| m | 1u64 << (i % 64));
-    (0..mesh.triangles().len())
-        .into_par_iter()
-        .map(|t| {
-            let corners = mesh.corners(t);
-            let [a, b, c] = mesh.triangles()[t].map(|i| normals[i as usize].as_dvec3());
-            let grid_at = |depth: u32, known: Visibility| -> (Vec<DVec3>, u64, u64) {
-                let n = 1usize << depth;
-                let mut grid = vec![DVec3::ZERO; (n + 1) * (n + 2) / 2];
-                let at = |u: f64, v: f64| {
-                    let p = triangle_point(&corners, u, v);
-                    let normal = a * (1.0 - u - v) + b * u + c * v;
-                    transmitted_irradiance_known(scene, occluders, p, normal, eta, eps, known)
-                };
-                let (mut reached, mut blocked) = (0u64, 0u64);
-                for i in 0..=n {
-                    for j in 0..=n - i {
-                        let (e, r, b) = at(i as f64 / n as f64, j as f64 / n as f64);
-                        grid[grid_index(i, j, n)] = e;
-                        (reached, blocked) = (reached | r, blocked | b);
+    peak.iter().enumerate().filter(|&(_, &p)| p >= STRONG_LIGHT * total).fold(0u64, |m, (i, _)| m | 1u64 << (i % 64))
+}
+
+/// What ray casting `E_t` on one object's triangles needs: the scene, its occluders, the
+/// object's refractive index and ray offset, its vertex normals and its strong lights.
+struct Caster<'a> {
+    scene: &'a PreparedScene,
+    occluders: &'a Bvh,
+    eta: f64,
+    eps: f64,
+    normals: &'a [Vec3],
+    /// [`strong_lights`].
+    strong: u64,
+}
+
+impl Caster<'_> {
+    /// Triangle `t` of `mesh` as a source at `level`, its grid as deep as its normals and shadow
+    /// edges ask.
+    fn source(&self, mesh: &Mesh, t: usize, level: u32) -> Source {
+        let corners = mesh.corners(t);
+        let normals = mesh.triangles()[t].map(|i| self.normals[i as usize].as_dvec3());
+        let [a, b, c] = normals;
+        // E_t follows the shading normal: linear interpolation over a cell whose normals
+        // turn by `delta` radians misses about `delta^2 / 8` of it, so cells start small
+        // enough that `delta` is at most NORMAL_SPREAD.
+        let spread = [a.angle_between(b), b.angle_between(c), c.angle_between(a)].into_iter().fold(0.0, f64::max);
+        let base = (spread / NORMAL_SPREAD).log2().ceil().clamp(0.0, 8.0) as u32;
+        // Every light is ray cast on the base grid. A light that reaches some of its points
+        // and is blocked at others casts a shadow edge across the triangle (the terminator
+        // is no edge: E_t falls to zero there continuously, as cos^2); such lights are ray
+        // cast on the finer grids, and so are those that face none of the base points (the
+        // triangle straddles their terminator, so the base grid says nothing of their
+        // shadows; back-facing points cost no ray). The others keep the base grid's
+        // verdict, so a shadow narrower than the base grid that touches none of its points
+        // is missed at every level.
+        let (base_grid, reached, blocked) = self.grid(&corners, normals, base, Visibility::TRACE_ALL);
+        let edges = reached & blocked;
+        let unknown = !(reached | blocked);
+        let depth = base + level + if edges & self.strong != 0 { EDGE_EXTRA_DEPTH } else { 0 };
+        let grid = if depth == base {
+            base_grid
+        } else {
+            self.grid(&corners, normals, depth, Visibility { trace: edges | unknown, blocked: blocked & !reached }).0
+        };
+        Source::new(corners, depth, grid, mesh.triangle_areas()[t])
+    }
+
+    /// `E_t` at the grid points of a triangle's grid at `depth` (at [`grid_index`]), with the
+    /// lights that reached and that were blocked at any of them or at the centroid. Normals are
+    /// interpolated from the corners'; `known` says which lights need no ray.
+    fn grid(&self, corners: &[DVec3; 3], normals: [DVec3; 3], depth: u32, known: Visibility) -> (Vec<DVec3>, u64, u64) {
+        let [a, b, c] = normals;
+        let n = 1usize << depth;
+        let mut grid = vec![DVec3::ZERO; (n + 1) * (n + 2) / 2];
+        let at = |u: f64, v: f64| {
+            let p = triangle_point(corners, u, v);
+            let normal = a * (1.0 - u - v) + b * u + c * v;
+            transmitted_irradiance_known(self.scene, self.occluders, p, normal, self.eta, self.eps, known)
+        };
+        let (mut reached, mut blocked) = (0u64, 0u64);
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let (e, r, b) = at(i as f64 / n as f64, j as f64 / n as f64);
+                grid[grid_index(i, j, n)] = e;
+                (reached, blocked) = (reached | r, blocked | b);
+            }
+        }
+        let (_, r, b) = at(1.0 / 3.0, 1.0 / 3.0);
+        (grid, reached | r, blocked | b)
+    }
+}
+
+impl Source {
+    /// A triangle's source from its `E_t` grid at `depth`: its moment pyramid, flux, centroid
+    /// and second moments, and its bounding sphere.
+    fn new(corners: [DVec3; 3], depth: u32, grid: Vec<DVec3>, area: f64) -> Source {
+        let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
+        let radius = corners.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
+        let mut s = Source {
+            corners,
+            depth,
+            grid,
+            area,
+            flux: [0.0; 3],
+            centroid: [DVec3::ZERO; 3],
+            quadrupole: [[0.0; 6]; 3],
+            centre,
+            radius,
+            pyramid: vec![Moments::default(); ((1usize << (2 * depth)) - 1) / 3],
+        };
+        let whole = s.build_pyramid(WHOLE, 0, 0);
+        s.centroid = whole.centroid(centre);
+        s.flux = whole.flux;
+        s.quadrupole = s.second_moments();
+        s
+    }
+
+    /// `integral (y - c)(y - c)^T E_t dA` about each channel's centroid, cell by cell: Radon's
+    /// rule is exact for the cubic `(y - c)^2 E_t`.
+    fn second_moments(&self) -> [[f64; 6]; 3] {
+        let n = 1usize << self.depth;
+        let cell_area = self.area / (n * n) as f64;
+        let mut q = [[0.0; 6]; 3];
+        for_each_cell(n, |cell| {
+            let y = cell.map(|(i, j)| self.point(i as f64 / n as f64, j as f64 / n as f64));
+            let e = cell.map(|(i, j)| self.grid[grid_index(i, j, n)]);
+            for (b, w) in RADON {
+                let p = y[0] * b[0] + y[1] * b[1] + y[2] * b[2];
+                let ep = e[0] * b[0] + e[1] * b[1] + e[2] * b[2];
+                for ch in 0..3 {
+                    let r = p - self.centroid[ch];
+                    let we = w * cell_area * ep[ch];
+                    let terms = [r.x * r.x, r.y * r.y, r.z * r.z, r.x * r.y, r.x * r.z, r.y * r.z];
+                    for (qk, t) in q[ch].iter_mut().zip(terms) {
+                        *qk += we * t;
                     }
                 }
-                let (_, r, b) = at(1.0 / 3.0, 1.0 / 3.0);
-                (grid, reached | r, blocked | b)
-            };
-            // E_t follows the shading normal: linear interpolation over a cell whose normals
-            // turn by `delta` radians misses about `delta^2 / 8` of it, so cells start small
-            // enough that `delta` is at most NORMAL_SPREAD.
-            let spread = [a.angle_between(b), b.angle_between(c), c.angle_between(a)].into_iter().fold(0.0, f64::max);
-            let base = (spread / NORMAL_SPREAD).log2().ceil().clamp(0.0, 8.0) as u32;
-            // Every light is ray cast on the base grid. A light that reaches some of its points
-            // and is blocked at others casts a shadow edge across the triangle (the terminator
-            // is no edge: E_t falls to zero there continuously, as cos^2); such lights are ray
-            // cast on the finer grids, and so are those that face none of the base points (the
-            // triangle straddles their terminator, so the base grid says nothing of their
-            // shadows; back-facing points cost no ray). The others keep the base grid's
-            // verdict, so a shadow narrower than the base grid that touches none of its points
-            // is missed at every level.
-            let (base_grid, reached, blocked) = grid_at(base, Visibility::TRACE_ALL);
-            let edges = reached & blocked;
-            let unknown = !(reached | blocked);
-            let depth = base + level + if edges & strong != 0 { EDGE_EXTRA_DEPTH } else { 0 };
-            let grid = if depth == base {
-                base_grid
-            } else {
-                grid_at(depth, Visibility { trace: edges | unknown, blocked: blocked & !reached }).0
-            };
-            let area = mesh.triangle_areas()[t];
-            let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
-            let radius = corners.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
-            let mut s = Source {
-                corners,
-                depth,
-                grid,
-                area,
-                flux: [0.0; 3],
-                centroid: [DVec3::ZERO; 3],
-                quadrupole: [[0.0; 6]; 3],
-                centre,
-                radius,
-                pyramid: vec![Moments::default(); ((1usize << (2 * depth)) - 1) / 3],
-            };
-            let whole = s.build_pyramid(WHOLE, 0, 0);
-            s.centroid = whole.centroid(centre);
-            s.flux = whole.flux;
-            let n = 1usize << depth;
-            let cell_area = area / (n * n) as f64;
-            // Second moments cell by cell: Radon's rule is exact for the cubic (y - c)^2 E_t.
-            let mut q = [[0.0; 6]; 3];
-            for_each_cell(n, |cell| {
-                let y = cell.map(|(i, j)| s.point(i as f64 / n as f64, j as f64 / n as f64));
-                let e = cell.map(|(i, j)| s.grid[grid_index(i, j, n)]);
-                for (b, w) in RADON {
-                    let p = y[0] * b[0] + y[1] * b[1] + y[2] * b[2];
-                    let ep = e[0] * b[0] + e[1] * b[1] + e[2] * b[2];
-                    for ch in 0..3 {
-                        let r = p - s.centroid[ch];
-                        let we = w * cell_area * ep[ch];
-                        let terms = [r.x * r.x, r.y * r.y, r.z * r.z, r.x * r.y, r.x * r.z, r.y * r.z];
-                        for (qk, t) in q[ch].iter_mut().zip(terms) {
-                            *qk += we * t;
-                        }
-                    }
-                }
-            });
-            s.quadrupole = q;
-            s
-        })
-        .collect()
+            }
+        });
+        q
+    }
 }
 
 /// Radon's 7-point degree-5 rule on a triangle: barycentric coordinates and weights (summing

@@ -177,102 +177,11 @@ impl PreparedScene {
     /// or light and which step.
     pub fn new(scene: &Scene, overrides: &Overrides) -> Result<PreparedScene, SceneError> {
         let mut scene = scene.clone();
-        if let Some(n) = overrides.samples {
-            if n > crate::scene::MAX_SAMPLE_COUNT {
-                return Err(SceneError::TooManySamples(n));
-            }
-            if n == 0 {
-                return Err(SceneError::ZeroSamples);
-            }
-            scene.file.sampling.count = n;
-        }
-        if let Some(m) = overrides.sampler {
-            scene.file.sampling.method = m;
-        }
-        if let Some(g) = overrides.gather {
-            scene.file.render.gather = g;
-        }
-        if let Some(e) = overrides.gather_epsilon {
-            if !(0.0..=crate::scene::MAX_GATHER_EPSILON).contains(&e) {
-                return Err(SceneError::GatherEpsilon(e));
-            }
-            scene.file.render.gather_epsilon = e;
-        }
-        if let Some(t) = overrides.transport {
-            scene.file.render.transport = t;
-        }
-        if let Some(l) = overrides.level_of_detail {
-            scene.file.render.level_of_detail = l;
-        }
-        if let Some(r) = overrides.resolution {
-            scene.file.camera.resolution = r;
-        }
-        let method = scene.file.sampling.method;
+        apply_overrides(&mut scene, overrides)?;
         let environment_lit = scene.file.lights.iter().any(|l| matches!(l, Light::Environment { .. }));
-
-        let mut objects = Vec::new();
-        for (i, o) in scene.file.objects.iter().enumerate() {
-            let (name, mesh) = load_shape(&scene, &o.shape).with_context(|| format!("{}: object[{i}]", scene.name))?;
-            let mesh = transform_mesh(mesh, &o.transform)
-                .with_context(|| format!("{}: object[{i}] ({name}): transform", scene.name))?;
-            let (lo, hi) = mesh.bounds();
-            let reach = lo.abs().max(hi.abs()).max_element();
-            if reach > super::MAX_SCENE_COORDINATE {
-                return Err(SceneError::Invalid {
-                    file: scene.name.clone(),
-                    message: format!(
-                        "`object[{i}]` ({name}): placed by its shape and transform it reaches {reach:e} scene units \
-                         from the origin, beyond the limit of {:e}",
-                        super::MAX_SCENE_COORDINATE
-                    ),
-                });
-            }
-            let material = match &o.material {
-                MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, eta, mm_per_unit, roughness } => {
-                    let key = format!("{}: object[{i}].material", scene.name);
-                    let mut material = match preset {
-                        Some(p) => Material::preset(p).with_context(|| key.clone())?,
-                        None => Material::new(
-                            "custom",
-                            sigma_a.expect("checked when parsed"),
-                            sigma_s_prime.expect("checked when parsed"),
-                            eta.unwrap_or(1.3),
-                        )
-                        .with_context(|| key.clone())?,
-                    };
-                    if let (Some(e), Some(_)) = (eta, preset) {
-                        material = material.with_eta(*e).with_context(|| key.clone())?;
-                    }
-                    let dipoles = material.dipoles(*mm_per_unit).with_context(|| key.clone())?;
-                    ResolvedMaterial::Translucent {
-                        material,
-                        dipoles,
-                        mm_per_unit: *mm_per_unit,
-                        roughness: *roughness,
-                    }
-                }
-                MaterialSpec::Opaque { albedo, roughness } => {
-                    ResolvedMaterial::Opaque { albedo: *albedo, roughness: *roughness }
-                }
-            };
-            let samples = match material {
-                ResolvedMaterial::Translucent { .. } => {
-                    let options = SampleOptions::new(method, scene.file.sampling.count)
-                        .with_seed(scene.file.sampling.seed.wrapping_add(i as u64));
-                    sampling::sample(&mesh, &options)
-                        .with_context(|| format!("{}: object[{i}] ({name}): sampling", scene.name))?
-                        .points
-                }
-                ResolvedMaterial::Opaque { .. } => Vec::new(),
-            };
-            let levels = if scene.file.render.level_of_detail && lod_allowed(&material, environment_lit) {
-                mesh.levels_of_detail()
-            } else {
-                vec![mesh.full_level()]
-            };
-            objects.push(PreparedObject { name, mesh, material, casts_shadow: o.casts_shadow, samples, levels });
-        }
-
+        let objects = (0..scene.file.objects.len())
+            .map(|i| prepare_object(&scene, i, environment_lit))
+            .collect::<Result<Vec<_>, _>>()?;
         for (i, o) in objects.iter().enumerate() {
             if let Some(warning) = precision_warning(&o.mesh) {
                 log::warn!("{}: object[{i}] ({}): {warning}", scene.name, o.name);
@@ -282,23 +191,7 @@ impl PreparedScene {
         let casters: Vec<&Mesh> = objects.iter().filter(|o| o.casts_shadow).map(|o| &o.mesh).collect();
         let caster_bounds = if casters.is_empty() { bounds } else { bounding_sphere(casters.iter().copied()) };
         let any_caster = !casters.is_empty();
-        let environment = scene
-            .file
-            .lights
-            .iter()
-            .find_map(|l| match l {
-                Light::Environment { map, .. } => Some(map.clone()),
-                _ => None,
-            })
-            .map(|map| match map {
-                None => Ok(Environment::procedural_sky(128, 64)),
-                Some(path) => match scene.resolve(&path)? {
-                    AssetSource::File(p) => Ok(Environment::load(&p)?),
-                    AssetSource::Embedded(_) => Err(SceneError::EmbeddedEnvironment),
-                },
-            })
-            .transpose()
-            .with_context(|| format!("{}: environment light", scene.name))?;
+        let environment = load_environment(&scene)?;
         let mut prepared = PreparedScene {
             scene,
             objects,
@@ -310,23 +203,29 @@ impl PreparedScene {
             any_caster,
         };
         prepared.reprepare_lights();
-        // Each value was checked finite, but products can overflow (an environment's `scale`
-        // times the irradiance of one of its directions).
-        if let Some(light) = prepared.lights.iter().find(|l| !light_is_finite(l)) {
-            let key = match &prepared.scene.file.lights[light.source] {
-                Light::Environment { .. } => "scale",
-                Light::Directional { .. } => "irradiance",
-                _ => "intensity",
-            };
-            return Err(SceneError::Invalid {
-                file: prepared.scene.name.clone(),
-                message: format!(
-                    "`light[{}].{key}`: the light is not finite once prepared ({:?}); lower it",
-                    light.source, light.kind
-                ),
-            });
-        }
+        prepared.check_lights_finite()?;
         Ok(prepared)
+    }
+
+    /// Each light's values were checked finite when parsed, but products can overflow (an
+    /// environment's `scale` times the irradiance of one of its directions): the first light
+    /// that is not finite once prepared, as an error naming the key to lower.
+    fn check_lights_finite(&self) -> Result<(), SceneError> {
+        let Some(light) = self.lights.iter().find(|l| !light_is_finite(l)) else {
+            return Ok(());
+        };
+        let key = match &self.scene.file.lights[light.source] {
+            Light::Environment { .. } => "scale",
+            Light::Directional { .. } => "irradiance",
+            _ => "intensity",
+        };
+        Err(SceneError::Invalid {
+            file: self.scene.name.clone(),
+            message: format!(
+                "`light[{}].{key}`: the light is not finite once prepared ({:?}); lower it",
+                light.source, light.kind
+            ),
+        })
     }
 
     /// Recompute the GPU light records from `scene.file.lights` (after a light moved). The
@@ -351,6 +250,140 @@ impl PreparedScene {
     pub fn has_translucent(&self) -> bool {
         self.objects.iter().any(|o| matches!(o.material, ResolvedMaterial::Translucent { .. }))
     }
+}
+
+/// Apply the command-line `overrides` to `scene`, checking the two whose ranges the scene
+/// file's parser would otherwise have checked (sample count, gather epsilon).
+fn apply_overrides(scene: &mut Scene, overrides: &Overrides) -> Result<(), SceneError> {
+    if let Some(n) = overrides.samples {
+        if n > crate::scene::MAX_SAMPLE_COUNT {
+            return Err(SceneError::TooManySamples(n));
+        }
+        if n == 0 {
+            return Err(SceneError::ZeroSamples);
+        }
+        scene.file.sampling.count = n;
+    }
+    if let Some(m) = overrides.sampler {
+        scene.file.sampling.method = m;
+    }
+    if let Some(g) = overrides.gather {
+        scene.file.render.gather = g;
+    }
+    if let Some(e) = overrides.gather_epsilon {
+        if !(0.0..=crate::scene::MAX_GATHER_EPSILON).contains(&e) {
+            return Err(SceneError::GatherEpsilon(e));
+        }
+        scene.file.render.gather_epsilon = e;
+    }
+    if let Some(t) = overrides.transport {
+        scene.file.render.transport = t;
+    }
+    if let Some(l) = overrides.level_of_detail {
+        scene.file.render.level_of_detail = l;
+    }
+    if let Some(r) = overrides.resolution {
+        scene.file.camera.resolution = r;
+    }
+    Ok(())
+}
+
+/// Object `i` of `scene` loaded, placed, checked against [`super::MAX_SCENE_COORDINATE`], its
+/// material resolved, sampled (translucent only, seed `sampling.seed + i`) and its levels of
+/// detail built (where [`lod_allowed`]).
+fn prepare_object(scene: &Scene, i: usize, environment_lit: bool) -> Result<PreparedObject, SceneError> {
+    let o = &scene.file.objects[i];
+    let (name, mesh) = load_shape(scene, &o.shape).with_context(|| format!("{}: object[{i}]", scene.name))?;
+    let mesh = transform_mesh(mesh, &o.transform)
+        .with_context(|| format!("{}: object[{i}] ({name}): transform", scene.name))?;
+    check_reach(scene, i, &name, &mesh)?;
+    let material = resolve_material(&o.material, &format!("{}: object[{i}].material", scene.name))?;
+    let samples = match material {
+        ResolvedMaterial::Translucent { .. } => {
+            let options = SampleOptions::new(scene.file.sampling.method, scene.file.sampling.count)
+                .with_seed(scene.file.sampling.seed.wrapping_add(i as u64));
+            sampling::sample(&mesh, &options)
+                .with_context(|| format!("{}: object[{i}] ({name}): sampling", scene.name))?
+                .points
+        }
+        ResolvedMaterial::Opaque { .. } => Vec::new(),
+    };
+    let levels = if scene.file.render.level_of_detail && lod_allowed(&material, environment_lit) {
+        mesh.levels_of_detail()
+    } else {
+        vec![mesh.full_level()]
+    };
+    Ok(PreparedObject { name, mesh, material, casts_shadow: o.casts_shadow, samples, levels })
+}
+
+/// Object `i` (`name`), as placed, must stay within [`super::MAX_SCENE_COORDINATE`] of the
+/// origin on every axis.
+fn check_reach(scene: &Scene, i: usize, name: &str, mesh: &Mesh) -> Result<(), SceneError> {
+    let (lo, hi) = mesh.bounds();
+    let reach = lo.abs().max(hi.abs()).max_element();
+    if reach > super::MAX_SCENE_COORDINATE {
+        return Err(SceneError::Invalid {
+            file: scene.name.clone(),
+            message: format!(
+                "`object[{i}]` ({name}): placed by its shape and transform it reaches {reach:e} scene units \
+                 from the origin, beyond the limit of {:e}",
+                super::MAX_SCENE_COORDINATE
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// A material as the scene gives it, resolved: a preset or custom coefficients (`eta` 1.3 unless
+/// given, a preset's own overridden where given) and its dipoles in scene units. Errors carry
+/// `key`, the material's place in the scene.
+fn resolve_material(spec: &MaterialSpec, key: &str) -> Result<ResolvedMaterial, SceneError> {
+    let (preset, sigma_a, sigma_s_prime, eta, mm_per_unit, roughness) = match spec {
+        MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, eta, mm_per_unit, roughness } => {
+            (preset, sigma_a, sigma_s_prime, eta, mm_per_unit, roughness)
+        }
+        MaterialSpec::Opaque { albedo, roughness } => {
+            return Ok(ResolvedMaterial::Opaque { albedo: *albedo, roughness: *roughness });
+        }
+    };
+    let key = || key.to_owned();
+    let mut material = match preset {
+        Some(p) => Material::preset(p).with_context(key)?,
+        None => Material::new(
+            "custom",
+            sigma_a.expect("checked when parsed"),
+            sigma_s_prime.expect("checked when parsed"),
+            eta.unwrap_or(1.3),
+        )
+        .with_context(key)?,
+    };
+    if let (Some(e), Some(_)) = (eta, preset) {
+        material = material.with_eta(*e).with_context(key)?;
+    }
+    let dipoles = material.dipoles(*mm_per_unit).with_context(key)?;
+    Ok(ResolvedMaterial::Translucent { material, dipoles, mm_per_unit: *mm_per_unit, roughness: *roughness })
+}
+
+/// The environment light's map loaded (or the procedural sky where it names none), if the scene
+/// has an environment light. A map embedded in the scene file is refused.
+fn load_environment(scene: &Scene) -> Result<Option<Environment>, SceneError> {
+    scene
+        .file
+        .lights
+        .iter()
+        .find_map(|l| match l {
+            Light::Environment { map, .. } => Some(map.clone()),
+            _ => None,
+        })
+        .map(|map| match map {
+            None => Ok(Environment::procedural_sky(128, 64)),
+            Some(path) => match scene.resolve(&path)? {
+                AssetSource::File(p) => Ok(Environment::load(&p)?),
+                AssetSource::Embedded(_) => Err(SceneError::EmbeddedEnvironment),
+            },
+        })
+        .transpose()
+        .with_context(|| format!("{}: environment light", scene.name))
 }
 
 fn light_is_finite(l: &PreparedLight) -> bool {

@@ -359,36 +359,117 @@ pub fn prepare(
     bounds: (Vec3, f32),
     shadow_map_size: u32,
 ) -> Vec<PreparedLight> {
-    let (center, radius) = (bounds.0, bounds.1.max(1e-6));
-    let texel = 1.0 / shadow_map_size as f32;
-    // Half a texel's world size: the normal offset of lookups (glsl/common/lights.glsl); for
-    // local lights taken at the casters' centre. Measured on the default scene against ray
-    // casting (tests/render.rs), 2048^2 maps: 0.5 texel leaves no sample off by 2%, 1 texel
-    // 1%, 2 texels 2.25%; 1024^2 maps with 0.5 texel: 1.5%.
-    let offset_ortho = 0.5 * (2.0 * radius) * texel;
+    let frame = ShadowFrame::new(bounds, shadow_map_size);
     let mut out = Vec::new();
-    let shadowed =
-        |kind: LightKind, matrix: Mat4, offset: f32, environment: bool, casts_shadow: bool, source| PreparedLight {
+    for (source, light) in lights.iter().enumerate() {
+        match light {
+            Light::Directional { direction, irradiance, shadows } => {
+                out.push(frame.directional(Vec3::from(*direction), Vec3::from(*irradiance), false, *shadows, source))
+            }
+            Light::Point { position, intensity, shadows } => {
+                let p = Vec3::from(*position);
+                let kind = LightKind::Point { position: p, intensity: Vec3::from(*intensity) };
+                out.push(frame.light(kind, frame.local(p, None), false, *shadows, source))
+            }
+            Light::Spot { position, direction, intensity, angle, softness, shadows } => {
+                let p = Vec3::from(*position);
+                let axis = unit(Vec3::from(*direction));
+                let outer = angle.to_radians();
+                let inner = outer * (1.0 - softness);
+                let shadow = frame.local(p, Some((axis, (outer * 1.05).min(85f32.to_radians()))));
+                let kind = LightKind::Spot {
+                    position: p,
+                    axis,
+                    intensity: Vec3::from(*intensity),
+                    cos_outer: outer.cos(),
+                    cos_inner: inner.cos(),
+                };
+                out.push(frame.light(kind, shadow, false, *shadows, source))
+            }
+            Light::Environment { scale, directions, shadows, .. } => {
+                if let Some(env) = environment {
+                    for (dir, irradiance) in env.median_cut(*directions as usize) {
+                        out.push(frame.directional(dir, irradiance * *scale, true, *shadows, source));
+                    }
+                }
+            }
+        }
+    }
+    // Key lights first, the environment's directions after: shading loops over the key lights
+    // only (`key_light_count`), the environment reaching it through the per-vertex cache.
+    out.sort_by_key(|l| l.environment);
+    out
+}
+
+/// What every light's shadow map is fitted to: the casters' bounding sphere and the map's
+/// resolution.
+struct ShadowFrame {
+    center: Vec3,
+    radius: f32,
+    /// One shadow-map texel in uv.
+    texel: f32,
+    /// A directional light's normal offset (world units).
+    offset_ortho: f32,
+}
+
+impl ShadowFrame {
+    fn new(bounds: (Vec3, f32), shadow_map_size: u32) -> ShadowFrame {
+        let (center, radius) = (bounds.0, bounds.1.max(1e-6));
+        let texel = 1.0 / shadow_map_size as f32;
+        // Half a texel's world size: the normal offset of lookups (glsl/common/lights.glsl); for
+        // local lights taken at the casters' centre. Measured on the default scene against ray
+        // casting (tests/render.rs), 2048^2 maps: 0.5 texel leaves no sample off by 2%, 1 texel
+        // 1%, 2 texels 2.25%; 1024^2 maps with 0.5 texel: 1.5%.
+        let offset_ortho = 0.5 * (2.0 * radius) * texel;
+        ShadowFrame { center, radius, texel, offset_ortho }
+    }
+
+    /// A prepared light of `kind` from scene light `source`, with its shadow `(matrix, normal
+    /// offset)`; no shadow layer yet.
+    fn light(
+        &self,
+        kind: LightKind,
+        (matrix, offset): (Mat4, f32),
+        environment: bool,
+        casts_shadow: bool,
+        source: usize,
+    ) -> PreparedLight {
+        PreparedLight {
             kind,
             environment,
             casts_shadow,
             shadow_layer: None,
             shadow_matrix: matrix,
-            shadow_texel: texel,
+            shadow_texel: self.texel,
             normal_offset: offset,
             source,
-        };
-    let directional = |dir: Vec3, irradiance: Vec3, environment: bool, casts_shadow: bool, source: usize| {
+        }
+    }
+
+    /// A directional light towards `dir` (normalised here), its shadow map an orthographic
+    /// view of the casters' sphere from outside it.
+    fn directional(
+        &self,
+        dir: Vec3,
+        irradiance: Vec3,
+        environment: bool,
+        casts_shadow: bool,
+        source: usize,
+    ) -> PreparedLight {
+        let (center, radius) = (self.center, self.radius);
         let dir = unit(dir);
         let eye = center + dir * (2.0 * radius);
         let view = look_at_mat4(eye, center, any_up(dir));
         let proj = vulkan::orthographic(-radius, radius, -radius, radius, 0.0, 4.0 * radius);
         let kind = LightKind::Directional { direction: dir, irradiance };
-        shadowed(kind, proj * view, offset_ortho, environment, casts_shadow, source)
-    };
-    let local_offset =
-        |position: Vec3, half_angle: f32| 0.5 * (2.0 * (center - position).length() * half_angle.tan()) * texel;
-    let local = |position: Vec3, axis: Option<(Vec3, f32)>| {
+        self.light(kind, (proj * view, self.offset_ortho), environment, casts_shadow, source)
+    }
+
+    /// A local light's shadow `(matrix, normal offset)` at `position`: a perspective view along
+    /// a spot's `axis` (with its half-angle), or for a point light towards the casters' centre,
+    /// wide enough to cover their sphere.
+    fn local(&self, position: Vec3, axis: Option<(Vec3, f32)>) -> (Mat4, f32) {
+        let (center, radius) = (self.center, self.radius);
         let to_center = center - position;
         let dist = to_center.length().max(1e-6);
         let (forward, half_angle) = match axis {
@@ -415,47 +496,9 @@ pub fn prepare(
         let far = (axial + radius).max(near * 2.0);
         let view = look_at_mat4(position, position + forward, any_up(forward));
         let proj = vulkan::perspective(2.0 * half_angle, 1.0, near, far);
-        (proj * view, local_offset(position, half_angle))
-    };
-    for (source, light) in lights.iter().enumerate() {
-        match light {
-            Light::Directional { direction, irradiance, shadows } => {
-                out.push(directional(Vec3::from(*direction), Vec3::from(*irradiance), false, *shadows, source))
-            }
-            Light::Point { position, intensity, shadows } => {
-                let p = Vec3::from(*position);
-                let (matrix, offset) = local(p, None);
-                let kind = LightKind::Point { position: p, intensity: Vec3::from(*intensity) };
-                out.push(shadowed(kind, matrix, offset, false, *shadows, source))
-            }
-            Light::Spot { position, direction, intensity, angle, softness, shadows } => {
-                let p = Vec3::from(*position);
-                let axis = unit(Vec3::from(*direction));
-                let outer = angle.to_radians();
-                let inner = outer * (1.0 - softness);
-                let (matrix, offset) = local(p, Some((axis, (outer * 1.05).min(85f32.to_radians()))));
-                let kind = LightKind::Spot {
-                    position: p,
-                    axis,
-                    intensity: Vec3::from(*intensity),
-                    cos_outer: outer.cos(),
-                    cos_inner: inner.cos(),
-                };
-                out.push(shadowed(kind, matrix, offset, false, *shadows, source))
-            }
-            Light::Environment { scale, directions, shadows, .. } => {
-                if let Some(env) = environment {
-                    for (dir, irradiance) in env.median_cut(*directions as usize) {
-                        out.push(directional(dir, irradiance * *scale, true, *shadows, source));
-                    }
-                }
-            }
-        }
+        let offset = 0.5 * (2.0 * (center - position).length() * half_angle.tan()) * self.texel;
+        (proj * view, offset)
     }
-    // Key lights first, the environment's directions after: shading loops over the key lights
-    // only (`key_light_count`), the environment reaching it through the per-vertex cache.
-    out.sort_by_key(|l| l.environment);
-    out
 }
 
 /// How many of `lights` (as `prepare` orders them) are not environment directions.

@@ -250,8 +250,30 @@ fn unit_interval(key: &str, v: f32) -> Check {
     if (0.0..=1.0).contains(&v) { Ok(()) } else { Err((key.into(), format!("{v} must be between 0 and 1"))) }
 }
 
+/// Every value of a parsed scene in range, section by section; the first that is not, as its
+/// key path and what is wrong.
 fn check(scene: &SceneFile) -> Check {
-    let c = &scene.camera;
+    check_camera(&scene.camera)?;
+    if scene.objects.is_empty() {
+        return Err(("object".into(), "the scene has no [[object]]".into()));
+    }
+    for (i, o) in scene.objects.iter().enumerate() {
+        let key = |k: &str| format!("object[{i}].{k}");
+        check_shape(&key, &o.shape)?;
+        check_transform(&key, &o.transform)?;
+        check_material(&key, &o.material)?;
+    }
+    check_lights(&scene.lights)?;
+    let s = &scene.sampling;
+    if s.count == 0 || s.count > MAX_SAMPLE_COUNT {
+        return Err(("sampling.count".into(), format!("{} must be 1 to {MAX_SAMPLE_COUNT}", s.count)));
+    }
+    check_render(&scene.render)
+}
+
+/// `[camera]`: eye and target apart by a distance f32 can square, an up vector off the view
+/// direction, a field of view a projection can use, 1 to 16384 pixels each way.
+fn check_camera(c: &Camera) -> Check {
     coordinates("camera.eye", &c.eye)?;
     coordinates("camera.target", &c.target)?;
     nonzero("camera.up", c.up)?;
@@ -279,65 +301,76 @@ fn check(scene: &SceneFile) -> Check {
     if c.resolution.iter().any(|r| *r == 0 || *r > 16384) {
         return Err(("camera.resolution".into(), format!("{:?} must be 1 to 16384 pixels each", c.resolution)));
     }
-    if scene.objects.is_empty() {
-        return Err(("object".into(), "the scene has no [[object]]".into()));
+    Ok(())
+}
+
+/// An object's `shape`, `key` making its key paths: a mesh path that names something, a
+/// built-in shape's size positive and within [`crate::mesh::MAX_COORDINATE`], 1 to 2048
+/// divisions.
+fn check_shape(key: &impl Fn(&str) -> String, shape: &Shape) -> Check {
+    match shape {
+        Shape::Mesh { path } if path.trim().is_empty() => Err((key("shape.path"), "is empty".into())),
+        Shape::Plane { size, divisions } | Shape::Sphere { radius: size, divisions } => {
+            if !(size.is_finite() && *size > 0.0) {
+                return Err((key("shape"), format!("size/radius {size} must be positive")));
+            }
+            if *size > crate::mesh::MAX_COORDINATE {
+                return Err((key("shape"), format!("size/radius {size:e} is above {:e}", crate::mesh::MAX_COORDINATE)));
+            }
+            if *divisions == 0 || *divisions > 2048 {
+                return Err((key("shape.divisions"), format!("{divisions} must be 1 to 2048")));
+            }
+            Ok(())
+        }
+        _ => Ok(()),
     }
-    for (i, o) in scene.objects.iter().enumerate() {
-        let key = |k: &str| format!("object[{i}].{k}");
-        match &o.shape {
-            Shape::Mesh { path } if path.trim().is_empty() => {
-                return Err((key("shape.path"), "is empty".into()));
-            }
-            Shape::Plane { size, divisions } | Shape::Sphere { radius: size, divisions } => {
-                if !(size.is_finite() && *size > 0.0) {
-                    return Err((key("shape"), format!("size/radius {size} must be positive")));
-                }
-                if *size > crate::mesh::MAX_COORDINATE {
-                    return Err((
-                        key("shape"),
-                        format!("size/radius {size:e} is above {:e}", crate::mesh::MAX_COORDINATE),
-                    ));
-                }
-                if *divisions == 0 || *divisions > 2048 {
-                    return Err((key("shape.divisions"), format!("{divisions} must be 1 to 2048")));
-                }
-            }
-            _ => {}
-        }
-        let t = &o.transform;
-        for (name, v) in [("transform.fit", t.fit), ("transform.scale", t.scale)] {
-            if let Some(v) = v
-                && !(v.is_finite() && v > 0.0)
-            {
-                return Err((key(name), format!("{v} must be positive")));
-            }
-        }
-        finite(&key("transform.rotate"), &t.rotate.unwrap_or_default())?;
-        coordinates(&key("transform.translate"), &t.translate.unwrap_or_default())?;
-        match &o.material {
-            MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, mm_per_unit, roughness, .. } => {
-                if preset.is_none() && (sigma_a.is_none() || sigma_s_prime.is_none()) {
-                    return Err((key("material"), "needs `preset` or both `sigma_a` and `sigma_s_prime`".into()));
-                }
-                if preset.is_some() && (sigma_a.is_some() || sigma_s_prime.is_some()) {
-                    return Err((key("material"), "give `preset` or coefficients, not both".into()));
-                }
-                if !(mm_per_unit.is_finite() && *mm_per_unit > 0.0) {
-                    return Err((key("material.mm_per_unit"), format!("{mm_per_unit} must be positive")));
-                }
-                unit_interval(&key("material.roughness"), *roughness)?;
-            }
-            MaterialSpec::Opaque { albedo, roughness } => {
-                non_negative(&key("material.albedo"), albedo)?;
-                if albedo.iter().any(|a| *a > 1.0) {
-                    return Err((key("material.albedo"), format!("{albedo:?} must be at most 1 (energy)")));
-                }
-                unit_interval(&key("material.roughness"), *roughness)?;
-            }
+}
+
+/// An object's `transform`: fit and scale positive, rotation finite, translation a coordinate.
+fn check_transform(key: &impl Fn(&str) -> String, t: &Transform) -> Check {
+    for (name, v) in [("transform.fit", t.fit), ("transform.scale", t.scale)] {
+        if let Some(v) = v
+            && !(v.is_finite() && v > 0.0)
+        {
+            return Err((key(name), format!("{v} must be positive")));
         }
     }
+    finite(&key("transform.rotate"), &t.rotate.unwrap_or_default())?;
+    coordinates(&key("transform.translate"), &t.translate.unwrap_or_default())
+}
+
+/// An object's `material`: a translucent one given by a preset or by both coefficients (not
+/// both ways) with a positive scale, an opaque one's albedo at most 1 (it reflects no more
+/// than it receives); roughness 0 to 1 for either.
+fn check_material(key: &impl Fn(&str) -> String, material: &MaterialSpec) -> Check {
+    match material {
+        MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, mm_per_unit, roughness, .. } => {
+            if preset.is_none() && (sigma_a.is_none() || sigma_s_prime.is_none()) {
+                return Err((key("material"), "needs `preset` or both `sigma_a` and `sigma_s_prime`".into()));
+            }
+            if preset.is_some() && (sigma_a.is_some() || sigma_s_prime.is_some()) {
+                return Err((key("material"), "give `preset` or coefficients, not both".into()));
+            }
+            if !(mm_per_unit.is_finite() && *mm_per_unit > 0.0) {
+                return Err((key("material.mm_per_unit"), format!("{mm_per_unit} must be positive")));
+            }
+            unit_interval(&key("material.roughness"), *roughness)
+        }
+        MaterialSpec::Opaque { albedo, roughness } => {
+            non_negative(&key("material.albedo"), albedo)?;
+            if albedo.iter().any(|a| *a > 1.0) {
+                return Err((key("material.albedo"), format!("{albedo:?} must be at most 1 (energy)")));
+            }
+            unit_interval(&key("material.roughness"), *roughness)
+        }
+    }
+}
+
+/// `[[light]]`: each light's values in range, and at most one environment light (there is one
+/// environment map).
+fn check_lights(lights: &[Light]) -> Check {
     let mut environments = 0;
-    for (i, l) in scene.lights.iter().enumerate() {
+    for (i, l) in lights.iter().enumerate() {
         let key = |k: &str| format!("light[{i}].{k}");
         match l {
             Light::Directional { direction, irradiance, .. } => {
@@ -371,11 +404,12 @@ fn check(scene: &SceneFile) -> Check {
     if environments > 1 {
         return Err(("light".into(), "at most one environment light".into()));
     }
-    let s = &scene.sampling;
-    if s.count == 0 || s.count > MAX_SAMPLE_COUNT {
-        return Err(("sampling.count".into(), format!("{} must be 1 to {MAX_SAMPLE_COUNT}", s.count)));
-    }
-    let r = &scene.render;
+    Ok(())
+}
+
+/// `[render]`: exposure positive, gather epsilon 0 to [`format::MAX_GATHER_EPSILON`], a
+/// shadow-map size of 16 to 8192 texels, a background that emits nothing negative.
+fn check_render(r: &RenderSettings) -> Check {
     if !(r.exposure.is_finite() && r.exposure > 0.0) {
         return Err(("render.exposure".into(), format!("{} must be positive", r.exposure)));
     }

@@ -12,7 +12,7 @@ pub mod report;
 
 use crate::gpu::Gpu;
 use crate::reference::truth::{self, LIT_FLOOR, Truth, TruthOptions};
-use crate::render::plan::Change;
+use crate::render::plan::{Change, Pass};
 use crate::render::renderer::{RenderError, Renderer};
 use crate::sampling::{self, Method, SampleOptions};
 use crate::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
@@ -301,81 +301,26 @@ pub fn run(
     if truth_cached {
         progress(Event::TruthCached);
     }
+    let truth_image = truth_image(gpu, &base, &truth)?;
 
-    // The truth's image: a full frame for shadows and sky, then the exact exitance shaded. A
-    // truth at a subset of the vertices has no image (the others are unknown), so no image error.
-    let truth_image = if truth.subset.is_some() {
-        None
-    } else {
-        let mut renderer = Renderer::new(gpu, base.clone())?;
-        renderer.frame(&renderer.plan(Change::Everything))?;
-        for (i, m) in truth.exitance.iter().enumerate() {
-            if matches!(base.objects[i].material, ResolvedMaterial::Translucent { .. }) {
-                let values: Vec<[f32; 3]> = m.iter().map(|v| v.map(|x| x as f32)).collect();
-                renderer.set_exitance(i, &values)?;
-            }
-        }
-        renderer.frame(&renderer.plan(Change::Camera))?;
-        Some(images(&renderer)?)
+    let bench = Bench {
+        gpu,
+        base: &base,
+        frames: config.frames,
+        truth: &truth,
+        truth_image: truth_image.as_ref(),
+        scene: &scene.name,
     };
-
-    let name = scene.name.clone();
     let (mut rows, mut exitances) = (Vec::new(), Vec::new());
     let total = config.runs();
     for &method in &config.samplers {
         for &count in &config.counts {
             for &seed in &config.seeds {
                 for &gather in &config.gathers {
-                    let label = format!(
-                        "{method} {count} {}{} seed {seed}",
-                        gather.0.name(),
-                        gather.1.map_or(String::new(), |e| format!(" eps {e}"))
-                    );
-                    progress(Event::Run(rows.len(), total, label));
-                    let (prepared, sampling_ms) = configure(&base, method, count, seed, gather)?;
-                    let mut renderer = Renderer::new(gpu, prepared)?;
-                    renderer.frame(&renderer.plan(Change::Everything))?;
-                    let exitance = if gather.0 == GatherMode::Pixel {
-                        None
-                    } else {
-                        Some((0..base.objects.len()).map(|i| renderer.exitance(i)).collect::<Result<Vec<_>, _>>()?)
-                    };
-                    let image = images(&renderer)?;
-                    // A moving light's frame: splat, gather and shade (the study's subject),
-                    // each pass in a submission of its own (`frame_isolated`).
-                    let plan = renderer.plan(Change::Lights);
-                    renderer.frame_isolated(&plan)?;
-                    let mut timings = Vec::new();
-                    for _ in 0..config.frames.max(1) {
-                        timings.push(renderer.frame_isolated(&plan)?);
-                    }
-                    let pass = |p: crate::render::plan::Pass| median(timings.iter().map(|t| t.get(p).unwrap_or(0.0)).collect());
-                    let error = exitance.as_ref().map(|e| vertex_error(&truth.exitance, e));
-                    let nan = [f64::NAN; 3];
-                    rows.push(Row {
-                        scene: name.clone(),
-                        sampler: method.name().to_string(),
-                        samples: count,
-                        gather: gather.0.name().to_string(),
-                        epsilon: gather.1.map(f64::from),
-                        seed,
-                        sampling_ms,
-                        splat_ms: pass(crate::render::plan::Pass::Splat),
-                        gather_ms: pass(crate::render::plan::Pass::Gather),
-                        shade_ms: pass(crate::render::plan::Pass::Shade),
-                        frame_ms: median(timings.iter().map(|t| t.total()).collect()),
-                        device_mib: renderer.device_memory() as f64 / (1024.0 * 1024.0),
-                        rel_rms: error.map_or(nan, |e| e.rel_rms),
-                        p99: error.map_or(nan, |e| e.p99),
-                        max: error.map_or(nan, |e| e.max),
-                        bias: error.map_or(nan, |e| e.bias),
-                        image_rel_rmse: truth_image.as_ref().map_or(f64::NAN, |t| image_rel_rmse(&t.hdr, &image.hdr)),
-                        flip_mean: match &truth_image {
-                            Some(t) => flip::flip_mean(&t.ldr, &image.ldr, image.size[0], image.size[1])
-                                .map_err(StudyError::Report)?,
-                            None => f64::NAN,
-                        },
-                    });
+                    let run = Configuration { method, count, seed, gather };
+                    progress(Event::Run(rows.len(), total, run.label()));
+                    let (row, exitance) = bench.measure(run)?;
+                    rows.push(row);
                     exitances.push(exitance);
                 }
             }
@@ -383,6 +328,119 @@ pub fn run(
     }
     let reference = time_reference(&base, config, &rows)?;
     Ok(Study { rows, truth, truth_cached, truth_image, prepared: base, exitance: exitances, reference })
+}
+
+/// The truth's image: a full frame for shadows and sky, then the exact exitance shaded. A
+/// truth at a subset of the vertices has no image (the others are unknown), so no image error.
+fn truth_image(gpu: &Arc<Gpu>, base: &PreparedScene, truth: &Truth) -> Result<Option<Images>, StudyError> {
+    if truth.subset.is_some() {
+        return Ok(None);
+    }
+    let mut renderer = Renderer::new(gpu, base.clone())?;
+    renderer.frame(&renderer.plan(Change::Everything))?;
+    for (i, m) in truth.exitance.iter().enumerate() {
+        if matches!(base.objects[i].material, ResolvedMaterial::Translucent { .. }) {
+            let values: Vec<[f32; 3]> = m.iter().map(|v| v.map(|x| x as f32)).collect();
+            renderer.set_exitance(i, &values)?;
+        }
+    }
+    renderer.frame(&renderer.plan(Change::Camera))?;
+    Ok(Some(images(&renderer)?))
+}
+
+/// Per-vertex exitance of every object, in scene order.
+type Exitance = Vec<Vec<[f32; 3]>>;
+
+/// One configuration of the sweep.
+#[derive(Clone, Copy, Debug)]
+struct Configuration {
+    method: Method,
+    count: usize,
+    seed: u64,
+    /// The gather, with the hierarchical gather's epsilon.
+    gather: (GatherMode, Option<f32>),
+}
+
+impl Configuration {
+    /// For the progress bar: `turk 400 hierarchical eps 0.1 seed 1`.
+    fn label(&self) -> String {
+        format!(
+            "{} {} {}{} seed {}",
+            self.method,
+            self.count,
+            self.gather.0.name(),
+            self.gather.1.map_or(String::new(), |e| format!(" eps {e}")),
+            self.seed
+        )
+    }
+}
+
+/// What every configuration of a study is measured with and against.
+struct Bench<'a> {
+    gpu: &'a Arc<Gpu>,
+    /// The scene prepared once (geometry and lights); each configuration resamples it.
+    base: &'a PreparedScene,
+    /// Timed frames per configuration (`StudyConfig::frames`).
+    frames: usize,
+    truth: &'a Truth,
+    truth_image: Option<&'a Images>,
+    /// The scene's name, for the rows.
+    scene: &'a str,
+}
+
+impl Bench<'_> {
+    /// Render configuration `run`, compare it with the truth (per vertex unless it is the pixel
+    /// gather, and as an image where the truth has one) and time a moving light's frame: its
+    /// row, and its per-vertex exitance for `--error-image`.
+    fn measure(&self, run: Configuration) -> Result<(Row, Option<Exitance>), StudyError> {
+        let Configuration { method, count, seed, gather } = run;
+        let (prepared, sampling_ms) = configure(self.base, method, count, seed, gather)?;
+        let mut renderer = Renderer::new(self.gpu, prepared)?;
+        renderer.frame(&renderer.plan(Change::Everything))?;
+        let exitance = if gather.0 == GatherMode::Pixel {
+            None
+        } else {
+            Some((0..self.base.objects.len()).map(|i| renderer.exitance(i)).collect::<Result<Vec<_>, _>>()?)
+        };
+        let image = images(&renderer)?;
+        // A moving light's frame: splat, gather and shade (the study's subject), each pass in a
+        // submission of its own (`frame_isolated`).
+        let plan = renderer.plan(Change::Lights);
+        renderer.frame_isolated(&plan)?;
+        let mut timings = Vec::new();
+        for _ in 0..self.frames.max(1) {
+            timings.push(renderer.frame_isolated(&plan)?);
+        }
+        let pass = |p: Pass| median(timings.iter().map(|t| t.get(p).unwrap_or(0.0)).collect());
+        let error = exitance.as_ref().map(|e| vertex_error(&self.truth.exitance, e));
+        let nan = [f64::NAN; 3];
+        let row = Row {
+            scene: self.scene.to_string(),
+            sampler: method.name().to_string(),
+            samples: count,
+            gather: gather.0.name().to_string(),
+            epsilon: gather.1.map(f64::from),
+            seed,
+            sampling_ms,
+            splat_ms: pass(Pass::Splat),
+            gather_ms: pass(Pass::Gather),
+            shade_ms: pass(Pass::Shade),
+            frame_ms: median(timings.iter().map(|t| t.total()).collect()),
+            device_mib: renderer.device_memory() as f64 / (1024.0 * 1024.0),
+            rel_rms: error.map_or(nan, |e| e.rel_rms),
+            p99: error.map_or(nan, |e| e.p99),
+            max: error.map_or(nan, |e| e.max),
+            bias: error.map_or(nan, |e| e.bias),
+            image_rel_rmse: self.truth_image.map_or(f64::NAN, |t| image_rel_rmse(&t.hdr, &image.hdr)),
+            flip_mean: match self.truth_image {
+                Some(t) => {
+                    flip::flip_mean(&t.ldr, &image.ldr, image.size[0], image.size[1]).map_err(StudyError::Report)?
+                }
+                None => f64::NAN,
+            },
+        };
+        Ok((row, exitance))
+    }
 }
 
 /// Width of the strip beside the model that holds the error image's legend, pixels.

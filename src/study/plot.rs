@@ -6,6 +6,7 @@
 use std::collections::BTreeMap;
 use std::sync::Once;
 
+use plotters::coord::CoordTranslate;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 
@@ -78,44 +79,81 @@ pub fn error_vs_time(summaries: &[Summary], title: &str, width: u32, height: u32
         return Err(format!("chart size {width}x{height} is too small"));
     }
     ensure_font();
-
-    // Points in plot units: milliseconds and percent, clamped for the log axes.
-    let point = |s: &Summary| (s.frame_ms.max(LOG_FLOOR), (100.0 * s.error).max(100.0 * LOG_FLOOR));
     let drawable: Vec<&Summary> = summaries.iter().filter(|s| s.frame_ms.is_finite() && s.error.is_finite()).collect();
     if drawable.is_empty() {
         return Err("no configuration has a finite frame time and error".into());
     }
+    let (x, y) = axis_ranges(&drawable);
+    let chart = Chart { title, x, y, curves: curves(&drawable), front: pareto_front(&drawable) };
+    let mut rgb = vec![255u8; width as usize * height as usize * 3];
+    chart.draw(&mut rgb, width, height)?;
+    Ok(rgb_to_rgba(&rgb))
+}
+
+/// A summary's point in plot units: milliseconds and percent, clamped for the log axes.
+fn point(s: &Summary) -> (f64, f64) {
+    (s.frame_ms.max(LOG_FLOOR), (100.0 * s.error).max(100.0 * LOG_FLOOR))
+}
+
+/// The time and error axes' ranges: the points' with a margin, the error axis always spanning
+/// the targets (they are the point of the chart).
+fn axis_ranges(drawable: &[&Summary]) -> ((f64, f64), (f64, f64)) {
     let (mut x0, mut x1, mut y0, mut y1) = (f64::INFINITY, 0.0f64, f64::INFINITY, 0.0f64);
-    for &s in &drawable {
+    for &s in drawable {
         let (x, y) = point(s);
         (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
     }
-    // The targets are the point of the chart, so the error axis always spans them.
     for t in TARGETS {
         (y0, y1) = (y0.min(100.0 * t), y1.max(100.0 * t));
     }
-    let (x0, x1, y0, y1) = (x0 / 1.3, x1 * 1.3, y0 / 1.5, y1 * 1.5);
+    ((x0 / 1.3, x1 * 1.3), (y0 / 1.5, y1 * 1.5))
+}
 
+/// The summaries by curve (`Summary::curve`), each in order of sample count.
+fn curves<'a>(drawable: &[&'a Summary]) -> BTreeMap<String, Vec<&'a Summary>> {
     let mut curves: BTreeMap<String, Vec<&Summary>> = BTreeMap::new();
-    for &s in &drawable {
+    for &s in drawable {
         curves.entry(s.curve()).or_default().push(s);
     }
     for points in curves.values_mut() {
         points.sort_by_key(|s| s.samples);
     }
+    curves
+}
 
+/// The points on the Pareto front (`report::pareto`), in order of time.
+fn pareto_front(drawable: &[&Summary]) -> Vec<(f64, f64)> {
     let all: Vec<(f64, f64)> = drawable.iter().map(|s| point(s)).collect();
     let mut front: Vec<(f64, f64)> =
         report::pareto(&all).into_iter().zip(&all).filter(|(on, _)| *on).map(|(_, p)| *p).collect();
     front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    front
+}
 
-    let mut rgb = vec![255u8; width as usize * height as usize * 3];
-    {
-        let e = |e: DrawingAreaErrorKind<_>| e.to_string();
-        let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(e)?;
+/// What the chart shows, in plot units.
+struct Chart<'a> {
+    title: &'a str,
+    /// Time axis range, ms.
+    x: (f64, f64),
+    /// Error axis range, %.
+    y: (f64, f64),
+    curves: BTreeMap<String, Vec<&'a Summary>>,
+    front: Vec<(f64, f64)>,
+}
+
+/// A plotters error as the text this module returns.
+fn message<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> String {
+    e.to_string()
+}
+
+impl Chart<'_> {
+    /// Draw it into `rgb` (RGB8, `width` x `height`): axes and grid, targets, front, curves, legend.
+    fn draw(&self, rgb: &mut [u8], width: u32, height: u32) -> Result<(), String> {
+        let ((x0, x1), (y0, y1)) = (self.x, self.y);
+        let root = BitMapBackend::with_buffer(rgb, (width, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(message)?;
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 20))
+            .caption(self.title, ("sans-serif", 20))
             .margin(12)
             .x_label_area_size(45)
             .y_label_area_size(65)
@@ -123,7 +161,7 @@ pub fn error_vs_time(summaries: &[Summary], title: &str, width: u32, height: u32
                 (x0..x1).log_scale().with_key_points(ticks(x0, x1)).with_light_points(minor_ticks(x0, x1)),
                 (y0..y1).log_scale().with_key_points(ticks(y0, y1)).with_light_points(minor_ticks(y0, y1)),
             )
-            .map_err(e)?;
+            .map_err(message)?;
         chart
             .configure_mesh()
             .x_desc("frame time, ms (median GPU time)")
@@ -134,23 +172,51 @@ pub fn error_vs_time(summaries: &[Summary], title: &str, width: u32, height: u32
             .axis_desc_style(("sans-serif", 14))
             .light_line_style(RGBColor(242, 242, 242))
             .draw()
-            .map_err(e)?;
+            .map_err(message)?;
+        self.draw_targets(&mut chart)?;
+        self.draw_front(&mut chart)?;
+        self.draw_curves(&mut chart)?;
+        chart.draw_series(self.front.iter().map(|&p| Cross::new(p, 6, BLACK.stroke_width(2)))).map_err(message)?;
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font(("sans-serif", 12))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(message)?;
+        root.present().map_err(message)
+    }
 
+    /// Each error target as a dashed line across the chart, labelled at its left end.
+    fn draw_targets<CT: CoordTranslate<From = (f64, f64)>>(
+        &self,
+        chart: &mut ChartContext<'_, BitMapBackend<'_>, CT>,
+    ) -> Result<(), String> {
+        let (x0, x1) = self.x;
         let guide = RGBColor(150, 150, 150);
         for t in TARGETS {
             let y = 100.0 * t;
-            chart.draw_series(DashedLineSeries::new([(x0, y), (x1, y)], 6, 4, guide.stroke_width(1))).map_err(e)?;
+            chart
+                .draw_series(DashedLineSeries::new([(x0, y), (x1, y)], 6, 4, guide.stroke_width(1)))
+                .map_err(message)?;
             let label = Text::new(
                 format!("{} %", tick(y)),
                 (x0 * 1.05, y * 1.04),
                 ("sans-serif", 12).into_font().color(&guide),
             );
-            chart.draw_series(std::iter::once(label)).map_err(e)?;
+            chart.draw_series(std::iter::once(label)).map_err(message)?;
         }
+        Ok(())
+    }
 
-        // Staircase through the front: the best error reachable within each time budget.
+    /// A staircase through the front: the best error reachable within each time budget.
+    fn draw_front<CT: CoordTranslate<From = (f64, f64)>>(
+        &self,
+        chart: &mut ChartContext<'_, BitMapBackend<'_>, CT>,
+    ) -> Result<(), String> {
         let mut steps = Vec::new();
-        for (i, &(x, y)) in front.iter().enumerate() {
+        for (i, &(x, y)) in self.front.iter().enumerate() {
             if i > 0 {
                 steps.push((x, steps.last().map_or(y, |p: &(f64, f64)| p.1)));
             }
@@ -159,16 +225,23 @@ pub fn error_vs_time(summaries: &[Summary], title: &str, width: u32, height: u32
         let grey = RGBColor(120, 120, 120).mix(0.6);
         chart
             .draw_series(LineSeries::new(steps, grey.stroke_width(5)))
-            .map_err(e)?
+            .map_err(message)?
             .label("Pareto front")
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], grey.stroke_width(5)));
+        Ok(())
+    }
 
-        for (i, (name, points)) in curves.iter().enumerate() {
+    /// Each curve as a line with markers, in the legend by name.
+    fn draw_curves<CT: CoordTranslate<From = (f64, f64)>>(
+        &self,
+        chart: &mut ChartContext<'_, BitMapBackend<'_>, CT>,
+    ) -> Result<(), String> {
+        for (i, (name, points)) in self.curves.iter().enumerate() {
             let colour = PALETTE[i % PALETTE.len()];
             let line: Vec<(f64, f64)> = points.iter().map(|s| point(s)).collect();
             chart
                 .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))
-                .map_err(e)?
+                .map_err(message)?
                 .label(name.as_str())
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
             // Past ten curves the colours repeat, so the marker shape tells them apart.
@@ -177,22 +250,10 @@ pub fn error_vs_time(summaries: &[Summary], title: &str, width: u32, height: u32
                 1 => chart.draw_series(line.iter().map(|&p| TriangleMarker::new(p, 5, colour.filled()))),
                 _ => chart.draw_series(line.iter().map(|&p| Circle::new(p, 4, colour.stroke_width(2)))),
             }
-            .map_err(e)?;
+            .map_err(message)?;
         }
-
-        chart.draw_series(front.iter().map(|&p| Cross::new(p, 6, BLACK.stroke_width(2)))).map_err(e)?;
-
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(("sans-serif", 12))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(e)?;
-        root.present().map_err(e)?;
+        Ok(())
     }
-    Ok(rgb_to_rgba(&rgb))
 }
 
 /// Widens tightly packed RGB8 to opaque RGBA8.
