@@ -209,159 +209,179 @@ fn upload<T: bytemuck::Pod>(gpu: &Arc<Gpu>, name: &str, data: &[T], usage: vk::B
     Ok(buffer)
 }
 
+/// Every object's records packed for the shared buffers, in scene order: vertices, samples and
+/// object records, and for each translucent object its sample hierarchy, receiver groups and the
+/// gathers' item lists, made absolute.
+#[derive(Default)]
+struct PackedObjects {
+    vertices: Vec<Vertex>,
+    objects: Vec<ObjectRecord>,
+    samples: Vec<SampleRecord>,
+    vertex_boundary: Vec<[f32; 2]>,
+    receivers: Vec<Receiver>,
+    tree_nodes: Vec<TreeNodeRecord>,
+    tree_order: Vec<u32>,
+    receiver_order: Vec<u32>,
+    receiver_groups: Vec<ReceiverGroupRecord>,
+    group_items: Vec<u32>,
+    blend_items: Vec<u32>,
+}
+
+impl PackedObjects {
+    fn of(scene: &PreparedScene) -> PackedObjects {
+        let mut packed = PackedObjects::default();
+        for (i, o) in scene.objects.iter().enumerate() {
+            let first = [packed.vertices.len() as u32, packed.samples.len() as u32];
+            packed.object(i, o);
+            if matches!(o.material, crate::scene::build::ResolvedMaterial::Translucent { .. }) {
+                packed.receiver(scene, i, o, first);
+            }
+        }
+        packed
+    }
+
+    /// Object `i`'s vertices, boundary distances, samples and record.
+    fn object(&mut self, i: usize, o: &crate::scene::build::PreparedObject) {
+        let (first_vertex, first_sample) = (self.vertices.len() as u32, self.samples.len() as u32);
+        let normals = o.mesh.vertex_normals();
+        let positions = o.mesh.positions();
+        self.vertices
+            .extend(positions.iter().zip(normals).map(|(p, n)| Vertex { position: p.to_array(), normal: n.to_array() }));
+        if matches!(o.material, crate::scene::build::ResolvedMaterial::Translucent { .. }) {
+            self.vertex_boundary.extend(o.mesh.boundary_distances());
+        } else {
+            self.vertex_boundary.extend(std::iter::repeat_n([crate::mesh::NO_BOUNDARY; 2], positions.len()));
+        }
+        self.samples.extend(o.samples.iter().map(|s| SampleRecord::new(s, i)));
+        let ranges = [first_vertex, positions.len() as u32, first_sample, o.samples.len() as u32];
+        self.objects.push(ObjectRecord::new(o, ranges));
+    }
+
+    /// Translucent object `i`'s hierarchy, receiver groups and their item lists; `first` is its
+    /// first vertex and first sample.
+    fn receiver(&mut self, scene: &PreparedScene, i: usize, o: &crate::scene::build::PreparedObject, first: [u32; 2]) {
+        let [first_vertex, first_sample] = first;
+        let render = &scene.scene.file.render;
+        let tree = o.sample_tree();
+        let (first_node, first_entry) = (self.tree_nodes.len() as u32, self.tree_order.len() as u32);
+        self.tree_nodes.extend(tree.nodes.iter().map(|n| TreeNodeRecord::new(n, first_node, first_entry)));
+        self.tree_order.extend(tree.order.iter().map(|k| first_sample + k));
+        let groups = o.receiver_groups();
+        let (first_receiver, first_group) = (self.receiver_order.len() as u32, self.receiver_groups.len() as u32);
+        self.receiver_order.extend(groups.order.iter().map(|v| first_vertex + v));
+        let cuts = if render.gather == crate::scene::GatherMode::Hierarchical {
+            o.gather_cuts(&tree, &groups, render.gather_epsilon as f64)
+        } else {
+            vec![Vec::new(); groups.bounds.len()]
+        };
+        let sparse = render.gather == crate::scene::GatherMode::Sparse;
+        let positions: Vec<glam::DVec3> = o.samples.iter().map(|s| s.position.as_dvec3()).collect();
+        let areas: Vec<f64> = o.samples.iter().map(|s| s.area).collect();
+        for (&group, items) in groups.bounds.iter().zip(&cuts) {
+            let blend = sparse.then(|| tree.within_reach(group, &positions, &areas, NEAR_BLEND_RADIUS));
+            self.group(group, items, blend.as_deref(), [first_node, first_sample]);
+        }
+        self.receivers.push(Receiver {
+            object: i as u32,
+            vertex_count: o.mesh.positions().len() as u32,
+            sample_count: o.samples.len() as u32,
+            first_node,
+            node_count: tree.nodes.len() as u32,
+            first_receiver,
+            first_group,
+        });
+    }
+
+    /// One receiver group: its hierarchical items (nodes first, then samples: the shader sums
+    /// each kind in its own loop) and its sparse blend list, made absolute with `first` (the
+    /// object's first node and first sample).
+    fn group(&mut self, ([x, y, z], r): ([f32; 3], f32), items: &[u32], blend: Option<&[u32]>, first: [u32; 2]) {
+        let [first_node, first_sample] = first;
+        let start = self.group_items.len() as u32;
+        self.group_items.extend(items.iter().filter(|&&it| it & NODE_ITEM != 0).map(|&it| it + first_node));
+        let node_count = self.group_items.len() as u32 - start;
+        self.group_items.extend(items.iter().filter(|&&it| it & NODE_ITEM == 0).map(|&it| it + first_sample));
+        let sample_count = self.group_items.len() as u32 - start - node_count;
+        let first_blend = self.blend_items.len() as u32;
+        self.blend_items.extend(blend.unwrap_or_default().iter().map(|s| s + first_sample));
+        self.receiver_groups.push(ReceiverGroupRecord {
+            center_radius: [x, y, z, r],
+            items: [start, node_count, sample_count, 0],
+            blend: [first_blend, self.blend_items.len() as u32 - first_blend, 0, 0],
+        });
+    }
+
+    /// The hierarchical gather's lists must fit one storage-buffer range.
+    fn check_lists(&self, gpu: &Gpu, epsilon: f32) -> GpuResult<()> {
+        let range = gpu.properties().limits.max_storage_buffer_range as u64;
+        let list_bytes = 4 * self.group_items.len() as u64;
+        if list_bytes <= range {
+            return Ok(());
+        }
+        Err(crate::gpu::GpuError::Limit {
+            what: format!("bytes of the hierarchical gather's item lists at render.gather_epsilon {epsilon} (raise it)"),
+            value: list_bytes,
+            limit: range,
+            name: "maxStorageBufferRange",
+        })
+    }
+}
+
 impl GpuScene {
     /// Pack the scene's records (`records`) and upload them before any frame: vertices, indices,
     /// objects, samples and lights. Exitance and environment irradiance start at zero; the splat
     /// buffer is left for the splat pass. Every buffer has at least 16 bytes, so an empty part of
     /// the scene still binds.
     pub fn new(gpu: &Arc<Gpu>, scene: &PreparedScene) -> GpuResult<GpuScene> {
-        let (mut vertices, mut objects, mut samples) = (Vec::new(), Vec::new(), Vec::new());
-        let PackedLevels { indices, levels, casters, level_vertices } = pack_levels(scene);
-        let mut vertex_boundary: Vec<[f32; 2]> = Vec::new();
-        let mut receivers = Vec::new();
-        let (mut tree_nodes, mut tree_order) = (Vec::new(), Vec::<u32>::new());
-        let (mut receiver_order, mut receiver_groups) = (Vec::<u32>::new(), Vec::<ReceiverGroupRecord>::new());
-        let (mut group_items, mut blend_items) = (Vec::<u32>::new(), Vec::<u32>::new());
-        let render = &scene.scene.file.render;
-        let hierarchical = render.gather == crate::scene::GatherMode::Hierarchical;
-        let sparse = render.gather == crate::scene::GatherMode::Sparse;
-        for (i, o) in scene.objects.iter().enumerate() {
-            let first_vertex = vertices.len() as u32;
-            let first_sample = samples.len() as u32;
-            let normals = o.mesh.vertex_normals();
-            vertices.extend(
-                o.mesh
-                    .positions()
-                    .iter()
-                    .zip(normals)
-                    .map(|(p, n)| Vertex { position: p.to_array(), normal: n.to_array() }),
-            );
-            if matches!(o.material, crate::scene::build::ResolvedMaterial::Translucent { .. }) {
-                vertex_boundary.extend(o.mesh.boundary_distances());
-            } else {
-                vertex_boundary.extend(std::iter::repeat_n([crate::mesh::NO_BOUNDARY; 2], o.mesh.positions().len()));
-            }
-            samples.extend(o.samples.iter().map(|s| SampleRecord::new(s, i)));
-            let vertex_count = o.mesh.positions().len() as u32;
-            let sample_count = o.samples.len() as u32;
-            objects.push(ObjectRecord::new(o, [first_vertex, vertex_count, first_sample, sample_count]));
-            if matches!(o.material, crate::scene::build::ResolvedMaterial::Translucent { .. }) {
-                let tree = o.sample_tree();
-                let (first_node, first_entry) = (tree_nodes.len() as u32, tree_order.len() as u32);
-                tree_nodes.extend(tree.nodes.iter().map(|n| TreeNodeRecord::new(n, first_node, first_entry)));
-                tree_order.extend(tree.order.iter().map(|k| first_sample + k));
-                let node_count = tree.nodes.len() as u32;
-                let groups = o.receiver_groups();
-                let (first_receiver, first_group) = (receiver_order.len() as u32, receiver_groups.len() as u32);
-                receiver_order.extend(groups.order.iter().map(|v| first_vertex + v));
-                let cuts = if hierarchical {
-                    o.gather_cuts(&tree, &groups, render.gather_epsilon as f64)
-                } else {
-                    vec![Vec::new(); groups.bounds.len()]
-                };
-                let positions: Vec<glam::DVec3> = o.samples.iter().map(|s| s.position.as_dvec3()).collect();
-                let areas: Vec<f64> = o.samples.iter().map(|s| s.area).collect();
-                for (&group, items) in groups.bounds.iter().zip(&cuts) {
-                    // Nodes first, then samples: the shader sums each kind in its own loop.
-                    let first = group_items.len() as u32;
-                    let nodes = items.iter().filter(|&&it| it & NODE_ITEM != 0);
-                    group_items.extend(nodes.clone().map(|&it| it + first_node));
-                    let node_count = group_items.len() as u32 - first;
-                    group_items.extend(items.iter().filter(|&&it| it & NODE_ITEM == 0).map(|&it| it + first_sample));
-                    let sample_count = group_items.len() as u32 - first - node_count;
-                    let first_blend = blend_items.len() as u32;
-                    if sparse {
-                        blend_items.extend(
-                            tree.within_reach(group, &positions, &areas, NEAR_BLEND_RADIUS)
-                                .iter()
-                                .map(|s| s + first_sample),
-                        );
-                    }
-                    let ([x, y, z], r) = group;
-                    receiver_groups.push(ReceiverGroupRecord {
-                        center_radius: [x, y, z, r],
-                        items: [first, node_count, sample_count, 0],
-                        blend: [first_blend, blend_items.len() as u32 - first_blend, 0, 0],
-                    });
-                }
-                receivers.push(Receiver {
-                    object: i as u32,
-                    vertex_count,
-                    sample_count,
-                    first_node,
-                    node_count,
-                    first_receiver,
-                    first_group,
-                });
-            }
-        }
-        let range = gpu.properties().limits.max_storage_buffer_range as u64;
-        let list_bytes = 4 * group_items.len() as u64;
-        if list_bytes > range {
-            return Err(crate::gpu::GpuError::Limit {
-                what: format!(
-                    "bytes of the hierarchical gather's item lists at render.gather_epsilon {} (raise it)",
-                    render.gather_epsilon
-                ),
-                value: list_bytes,
-                limit: range,
-                name: "maxStorageBufferRange",
-            });
-        }
-        let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER;
-        let zeros = vec![[0f32; 4]; vertices.len()];
-        let mut gpu_scene = GpuScene {
-            vertices: upload(gpu, "vertices", &vertices, vertex_usage)?,
-            indices: upload(gpu, "indices", &indices, vk::BufferUsageFlags::INDEX_BUFFER)?,
-            // Opaque vertices keep zero exitance; translucent ones are written by the gather.
-            exitance: upload(gpu, "exitance", &zeros, vertex_usage)?,
-            environment_irradiance: upload(gpu, "environment irradiance", &zeros, vertex_usage)?,
-            vertex_boundary: upload(gpu, "vertex boundary", &vertex_boundary, vk::BufferUsageFlags::empty())?,
-            objects: upload(gpu, "objects", &objects, vk::BufferUsageFlags::empty())?,
-            samples: upload(gpu, "samples", &samples, vk::BufferUsageFlags::empty())?,
-            splat: storage(
-                gpu,
-                "splat",
-                (std::mem::size_of::<SplatRecord>() * samples.len()) as u64,
-                vk::BufferUsageFlags::empty(),
-            )?,
-            tree_nodes: upload(gpu, "tree nodes", &tree_nodes, vk::BufferUsageFlags::empty())?,
-            tree_order: upload(gpu, "tree order", &tree_order, vk::BufferUsageFlags::empty())?,
-            receiver_order: upload(gpu, "receiver order", &receiver_order, vk::BufferUsageFlags::empty())?,
-            receiver_groups: upload(gpu, "receiver groups", &receiver_groups, vk::BufferUsageFlags::empty())?,
-            group_items: upload(gpu, "group items", &group_items, vk::BufferUsageFlags::empty())?,
-            blend_items: upload(gpu, "blend items", &blend_items, vk::BufferUsageFlags::empty())?,
-            node_power: storage(
-                gpu,
-                "node power",
-                (std::mem::size_of::<NodePowerRecord>() * tree_nodes.len()) as u64,
-                vk::BufferUsageFlags::empty(),
-            )?,
-            lights: storage(
-                gpu,
-                "lights",
-                (std::mem::size_of::<LightGpu>() * scene.lights.len()) as u64,
-                vk::BufferUsageFlags::empty(),
-            )?,
-            level_vertices: upload(gpu, "level vertices", &level_vertices, vk::BufferUsageFlags::empty())?,
-            levels,
-            casters,
-            light_matrices: Vec::new(),
-            receivers,
-            vertex_count: vertices.len() as u32,
-            sample_count: samples.len() as u32,
-            light_count: scene.lights.len() as u32,
-            key_light_count: crate::scene::lights::key_light_count(&scene.lights) as u32,
-            pending_lights: None,
-            object_records: objects,
-            pending_objects: false,
-        };
+        let levels = pack_levels(scene);
+        let packed = PackedObjects::of(scene);
+        packed.check_lists(gpu, scene.scene.file.render.gather_epsilon)?;
+        let mut gpu_scene = Self::upload(gpu, scene, packed, levels)?;
         gpu_scene.set_lights(scene);
         // Before any frame the buffer is idle: written from the host directly.
         if let Some(records) = gpu_scene.pending_lights.take().filter(|r| !r.is_empty()) {
             gpu_scene.lights.write(0, &records)?;
         }
         Ok(gpu_scene)
+    }
+
+    /// Every buffer made and filled from the packed records; lights still to be packed.
+    fn upload(gpu: &Arc<Gpu>, scene: &PreparedScene, p: PackedObjects, l: PackedLevels) -> GpuResult<GpuScene> {
+        let none = vk::BufferUsageFlags::empty();
+        let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER;
+        let zeros = vec![[0f32; 4]; p.vertices.len()];
+        let sized = |name, item: usize, count: usize| storage(gpu, name, (item * count) as u64, none);
+        Ok(GpuScene {
+            vertices: upload(gpu, "vertices", &p.vertices, vertex_usage)?,
+            indices: upload(gpu, "indices", &l.indices, vk::BufferUsageFlags::INDEX_BUFFER)?,
+            // Opaque vertices keep zero exitance; translucent ones are written by the gather.
+            exitance: upload(gpu, "exitance", &zeros, vertex_usage)?,
+            environment_irradiance: upload(gpu, "environment irradiance", &zeros, vertex_usage)?,
+            vertex_boundary: upload(gpu, "vertex boundary", &p.vertex_boundary, none)?,
+            objects: upload(gpu, "objects", &p.objects, none)?,
+            samples: upload(gpu, "samples", &p.samples, none)?,
+            splat: sized("splat", std::mem::size_of::<SplatRecord>(), p.samples.len())?,
+            tree_nodes: upload(gpu, "tree nodes", &p.tree_nodes, none)?,
+            tree_order: upload(gpu, "tree order", &p.tree_order, none)?,
+            receiver_order: upload(gpu, "receiver order", &p.receiver_order, none)?,
+            receiver_groups: upload(gpu, "receiver groups", &p.receiver_groups, none)?,
+            group_items: upload(gpu, "group items", &p.group_items, none)?,
+            blend_items: upload(gpu, "blend items", &p.blend_items, none)?,
+            node_power: sized("node power", std::mem::size_of::<NodePowerRecord>(), p.tree_nodes.len())?,
+            lights: sized("lights", std::mem::size_of::<LightGpu>(), scene.lights.len())?,
+            level_vertices: upload(gpu, "level vertices", &l.level_vertices, none)?,
+            levels: l.levels,
+            casters: l.casters,
+            light_matrices: Vec::new(),
+            receivers: p.receivers,
+            vertex_count: p.vertices.len() as u32,
+            sample_count: p.samples.len() as u32,
+            light_count: scene.lights.len() as u32,
+            key_light_count: crate::scene::lights::key_light_count(&scene.lights) as u32,
+            pending_lights: None,
+            object_records: p.objects,
+            pending_objects: false,
+        })
     }
 
     /// Pack the scene's lights and their shadow matrices (after a light moved; the number of
