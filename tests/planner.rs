@@ -9,7 +9,7 @@ use glam::Vec3;
 use std::sync::Arc;
 use translucent::gpu::{Gpu, RecordCounts};
 use translucent::optics::Material;
-use translucent::render::plan::{Change, Transport};
+use translucent::render::plan::{BakedLevels, Change, LevelReason, Transport};
 use translucent::render::renderer::Renderer;
 use translucent::scene::build::{Overrides, PreparedScene};
 use translucent::scene::{Scene, Transform, TransportMode, lights};
@@ -177,7 +177,8 @@ fn marble_at_five_centimetres_is_gathered_in_every_channel() {
     let prepared = prepare(&text, &Overrides { samples: Some(400), ..Overrides::default() });
     let camera = translucent::render::renderer::CameraView::of_scene(&prepared);
     let view = translucent::render::plan::View::of_camera(&camera, 256);
-    let plan = translucent::render::plan::plan(&prepared.needs(), &view, &[true], &[usize::MAX], Change::Everything);
+    let needs = translucent::render::plan::needs(&prepared, false, Default::default());
+    let plan = translucent::render::plan::Planner::new(1, Change::Everything).plan(&needs, &view);
     assert!(plan.objects[0].channels.iter().all(|c| c.transport == Transport::Gather), "{plan}");
 }
 
@@ -268,4 +269,34 @@ fn plan_prints_every_change_and_its_json_has_the_documented_fields() {
     }
     assert_eq!(bunny["channels"][0]["transport"], "gather");
     assert!(json["objects"][0]["channels"][0]["profile_radius"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn levels_baked_from_sky_light_are_withdrawn_when_it_is_recomputed_and_offered_once_baked_again() {
+    let overrides = Overrides { samples: Some(64), resolution: Some([64, 64]), ..Overrides::default() };
+    let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();
+    with_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, prepared).unwrap();
+        // `frame` bakes after a frame that ran the vertex-light pass.
+        frame(gpu, &mut renderer);
+        assert_eq!(renderer.planner().baked_levels(), BakedLevels::Current);
+        let baked = |r: &Renderer| r.needs().objects.iter().position(|o| o.levels.iter().any(|l| l.locked));
+        let floor = baked(&renderer).expect("the floor's levels baked from the sky light");
+        let count = renderer.needs().objects[floor].levels.len();
+        // The sky light moves: the frame recomputing it draws the floor whole, and (recorded as a
+        // host would, without baking) its baked levels are offered no more.
+        let sky = renderer.needs().environment.expect("an environment light");
+        let light = renderer.scene().scene.file.lights[sky].clone();
+        renderer.set_light(sky, light).unwrap();
+        let plan = renderer.plan(renderer.pending_change().unwrap());
+        assert_eq!(plan.objects[floor].level_why, LevelReason::SkyLightRecomputed, "{plan}");
+        gpu.one_shot("frame", |cmd| renderer.record_frame(cmd, None)).unwrap().unwrap();
+        assert_eq!(renderer.planner().baked_levels(), BakedLevels::Withdrawn);
+        assert_eq!(renderer.needs().objects[floor].levels.len(), 1);
+        assert_eq!(renderer.plan(Change::Camera).objects[floor].level, 0);
+        // Baked again: offered again.
+        assert!(renderer.bake_static_levels().unwrap());
+        assert_eq!(renderer.planner().baked_levels(), BakedLevels::Current);
+        assert_eq!(renderer.needs().objects[floor].levels.len(), count);
+    });
 }

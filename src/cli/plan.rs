@@ -4,7 +4,7 @@
 
 use anyhow::Result;
 use std::path::PathBuf;
-use translucent::render::plan::{self, Change};
+use translucent::render::plan::{self, Change, Planner};
 use translucent::render::renderer::CameraView;
 use translucent::scene::build::{Overrides, PreparedScene};
 use translucent::scene::{GatherMode, Scene, TransportMode};
@@ -36,20 +36,18 @@ pub fn run(args: &Args) -> Result<()> {
     let overrides =
         Overrides { samples: args.samples, gather: args.gather, transport: args.transport, ..Overrides::default() };
     let prepared = PreparedScene::new(&scene, &overrides)?;
-    let needs = prepared.needs();
-    let view = plan::View::of_camera(&CameraView::of_scene(&prepared), prepared.scene.file.camera.resolution[1]);
     let objects = prepared.objects.len();
+    let mut planner = Planner::new(objects, Change::Everything);
+    let needs = plan::needs(&prepared, false, planner.baked_levels());
+    let view = plan::View::of_camera(&CameraView::of_scene(&prepared), prepared.scene.file.camera.resolution[1]);
     // The first frame computes everything; every other change follows a frame that did, at the
-    // levels of detail it chose.
-    let none = vec![usize::MAX; objects];
-    let first = plan::plan(&needs, &view, &vec![true; objects], &none, Change::Everything);
-    let levels: Vec<usize> = first.objects.iter().map(|o| o.level).collect();
+    // levels of detail it chose (a fresh scene has no levels baked from sky light to withdraw).
+    let first = planner.plan(&needs, &view);
+    planner.recorded(&first, prepared.scene.file.render.gather == GatherMode::Vertex);
     let frames: Vec<(Change, plan::Plan)> = Change::all(prepared.scene.file.lights.len(), objects)
         .into_iter()
         .map(|change| {
-            let everything = change == Change::Everything;
-            let stale = vec![everything; objects];
-            (change, plan::plan(&needs, &view, &stale, if everything { &none } else { &levels }, change))
+            (change, if change == Change::Everything { first.clone() } else { planner.plan_for(&needs, &view, change) })
         })
         .collect();
     if args.json {

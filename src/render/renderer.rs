@@ -9,7 +9,7 @@ use super::gather_tree::GatherTreePass;
 use super::gpu_scene::GpuScene;
 use super::graph::{HOST_READ, Resource, Resources, read, write};
 use super::pass::{FrameInputs, RenderPass};
-use super::plan::{self, Change, Pass, Plan};
+use super::plan::{self, Change, Pass, Plan, Planner};
 use super::shade::{HostTarget, ShadePass, TargetDesc};
 use super::shadow::ShadowPass;
 use super::splat::SplatPass;
@@ -213,14 +213,8 @@ pub struct Renderer {
     background: [f32; 3],
     target: TargetDesc,
     camera: CameraView,
-    /// What changed since the last recorded frame; `None` when nothing did.
-    pending: Option<Change>,
-    /// Per object: its gathered exitance is out of date (lights or its material changed while
-    /// it was out of view or local), so the next frame that gathers it must splat it first.
-    stale: Vec<bool>,
-    /// Per object: the finest level of detail whose vertices hold its current exitance
-    /// (`usize::MAX`: none yet); a finer level coming into view is gathered again.
-    gathered: Vec<usize>,
+    /// The frames' history: pending change, stale objects, gathered levels, baked levels.
+    planner: Planner,
 }
 
 /// The scene buffers a test or host may write between frames (`Renderer::buffers_mut`).
@@ -249,7 +243,8 @@ impl Renderer {
         if let TargetDesc::Host { color_format, depth_format } = target {
             check_host_formats(gpu, color_format, depth_format)?;
         }
-        let needs = Self::needs_of(&scene, target);
+        let planner = Planner::new(scene.objects.len(), Change::Everything);
+        let needs = Self::needs_of(&scene, target, &planner);
         if needs.host_target && needs.pixel_gather {
             return Err(RenderError::PixelGatherOnHostTarget);
         }
@@ -285,9 +280,7 @@ impl Renderer {
             needs,
             target,
             camera: CameraView::of_scene(&scene),
-            pending: Some(Change::Everything),
-            stale: vec![true; scene.objects.len()],
-            gathered: vec![usize::MAX; scene.objects.len()],
+            planner,
             scene,
         })
     }
@@ -331,7 +324,7 @@ impl Renderer {
     /// The passes a frame with this change would run, seen from the current camera, and what
     /// each object gets.
     pub fn plan(&self, change: Change) -> Plan {
-        plan::plan(&self.needs, &self.view(), &self.stale, &self.gathered, change)
+        self.planner.plan_for(&self.needs, &self.view(), change)
     }
 
     /// Bake the levels of detail of opaque objects under an environment light from their
@@ -342,7 +335,7 @@ impl Renderer {
     /// after each frame that ran the vertex-light pass; a host recording its own frames calls
     /// it after the fence of such a frame, with no frame in flight (the index buffer is
     /// replaced). From the frame that recomputes the sky light until then, those objects are
-    /// drawn whole (the planner, and `record_plan` withdrawing their baked levels). Returns
+    /// drawn whole (the planner withdraws their baked levels, `plan::BakedLevels`). Returns
     /// whether anything was baked.
     pub fn bake_static_levels(&mut self) -> Result<bool, RenderError> {
         if !self.scene.scene.file.render.level_of_detail || self.needs.environment.is_none() {
@@ -363,7 +356,8 @@ impl Renderer {
         }
         if baked {
             self.buffers.set_levels(&self.gpu, &self.scene)?;
-            self.needs = Self::needs_of(&self.scene, self.target);
+            self.planner.levels_baked();
+            self.needs = Self::needs_of(&self.scene, self.target, &self.planner);
         }
         Ok(baked)
     }
@@ -388,14 +382,12 @@ impl Renderer {
 
     /// What changed since the last recorded frame (`record_frame` plans from it).
     pub fn pending_change(&self) -> Option<Change> {
-        self.pending
+        self.planner.pending()
     }
 
-    fn mark(&mut self, change: Change) {
-        self.pending = Some(match self.pending {
-            None => change,
-            Some(old) => old.and(change),
-        });
+    /// The frames' history the planner keeps.
+    pub fn planner(&self) -> &Planner {
+        &self.planner
     }
 
     /// The camera the next frames are drawn from.
@@ -407,7 +399,7 @@ impl Renderer {
     /// at the vertices does not depend on the view.
     pub fn set_camera(&mut self, camera: CameraView) {
         self.camera = camera;
-        self.mark(Change::Camera);
+        self.planner.mark(Change::Camera);
     }
 
     /// Change the own target's size (the CLI's image): its images are made anew. The camera's
@@ -428,7 +420,7 @@ impl Renderer {
         }
         self.tonemap = Some(TonemapPass::new(&gpu, &resources)?);
         self.targets.track(self.hazards.get_mut());
-        self.mark(Change::Camera);
+        self.planner.mark(Change::Camera);
         Ok(())
     }
 
@@ -452,8 +444,7 @@ impl Renderer {
         cmd: vk::CommandBuffer,
         target: Option<&HostTarget>,
     ) -> Result<RecordedFrame, RenderError> {
-        let change = self.pending.unwrap_or(Change::Camera);
-        let plan = self.plan(change);
+        let plan = self.planner.plan(&self.needs, &self.view());
         self.record_plan(cmd, &plan, target)
     }
 
@@ -480,13 +471,6 @@ impl Renderer {
         for o in &plan.objects {
             self.buffers.set_local_channels(o.object, o.local_mask());
         }
-        if plan.runs(Pass::VertexLight) {
-            // Levels baked from the old sky light are offered no more until baked again (the
-            // index buffer keeps them: frames in flight may draw them).
-            for facts in self.needs.objects.iter_mut().filter(|f| f.levels.iter().any(|l| l.locked)) {
-                facts.levels.truncate(1);
-            }
-        }
         let device = self.gpu.device();
         let uploads: Vec<_> =
             self.buffers.pending_uploads().into_iter().map(|r| write(r, Access::TransferWrite)).collect();
@@ -500,14 +484,12 @@ impl Renderer {
         }
         let recorded = self.record(cmd, plan, timer, target);
         self.timers = timers;
-        self.pending = None;
+        let baked = self.planner.baked_levels();
         // Only the vertex gather works at a level's vertices; the others reach every vertex.
-        let by_level = self.scene.scene.file.render.gather == GatherMode::Vertex;
-        for o in &plan.objects {
-            self.stale[o.object] = o.stale_after;
-            if o.gather && plan.runs(Pass::Gather) {
-                self.gathered[o.object] = if by_level { o.level } else { 0 };
-            }
+        self.planner.recorded(plan, self.scene.scene.file.render.gather == GatherMode::Vertex);
+        // A frame that recomputed the sky light withdraws the levels baked from it.
+        if self.planner.baked_levels() != baked {
+            self.needs = Self::needs_of(&self.scene, self.target, &self.planner);
         }
         Ok(RecordedFrame { passes: recorded, slot })
     }
@@ -624,7 +606,7 @@ impl Renderer {
     /// `object`, from the last vertex gather (zero in pixel-gather mode).
     pub fn exitance(&self, object: usize) -> Result<Vec<[f32; 3]>, RenderError> {
         self.check_object(object)?;
-        if self.gathered.get(object).is_some_and(|&g| g > 0 && g != usize::MAX) {
+        if self.planner.gathered_coarser(object) {
             return Err(RenderError::ExitanceAtCoarserLevel(object));
         }
         let all: Vec<[f32; 4]> = self.buffers.exitance.read()?;
@@ -647,7 +629,7 @@ impl Renderer {
         let values: Vec<[f32; 4]> = exitance.iter().map(|e| [e[0], e[1], e[2], 1.0]).collect();
         self.buffers.exitance.write(first * 16, &values)?;
         self.hazards.get_mut().written_outside(Resource::Exitance);
-        self.gathered[object] = 0;
+        self.planner.exitance_written(object);
         Ok(())
     }
 
@@ -671,7 +653,7 @@ impl Renderer {
         }
         self.scene.reprepare_lights();
         self.buffers.set_lights(&self.scene);
-        self.mark(Change::Light(index));
+        self.planner.mark(Change::Light(index));
         Ok(())
     }
 
@@ -696,9 +678,8 @@ impl Renderer {
         }
         *m = material;
         self.buffers.set_material(&self.scene, object);
-        self.needs = Self::needs_of(&self.scene, self.target);
-        self.stale[object] = true;
-        self.mark(Change::Material(object));
+        self.needs = Self::needs_of(&self.scene, self.target, &self.planner);
+        self.planner.mark(Change::Material(object));
         Ok(())
     }
 
@@ -716,17 +697,17 @@ impl Renderer {
         let prepared = PreparedScene::new(&file_scene, &crate::scene::build::Overrides::default())
             .map_err(|e| RenderError::Scene(e.to_string()))?;
         let camera = self.camera;
-        let pending = self.pending.map_or(Change::Geometry(object), |p| p.and(Change::Geometry(object)));
+        let pending = self.planner.pending().map_or(Change::Geometry(object), |p| p.and(Change::Geometry(object)));
         *self = Renderer::with_target(&self.gpu.clone(), prepared, self.target)?;
         self.camera = camera;
-        self.pending = Some(pending);
+        self.planner = Planner::new(self.scene.objects.len(), pending);
         Ok(())
     }
 
-    fn needs_of(scene: &PreparedScene, target: TargetDesc) -> SceneNeeds {
-        let mut needs = scene.needs();
-        needs.host_target = target != TargetDesc::Own;
-        needs
+    /// What the planner weighs for `scene` drawn into `target`, with the baked levels as
+    /// `planner` has them (`plan::needs`).
+    fn needs_of(scene: &PreparedScene, target: TargetDesc, planner: &Planner) -> SceneNeeds {
+        plan::needs(scene, target != TargetDesc::Own, planner.baked_levels())
     }
 
     /// Where the last frame's non-finite values are, pass by pass and object by object (the
