@@ -7,7 +7,9 @@ use ash::vk;
 use common::{plane_scene, validated_options, with_gpu};
 use std::cell::RefCell;
 use std::sync::Arc;
-use translucent::gpu::{Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuError, GpuOptions, Hazards};
+use translucent::gpu::{
+    Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuError, GpuOptions, Hazards,
+};
 use translucent::render::gather::GatherPass;
 use translucent::render::gpu_scene::GpuScene;
 use translucent::render::graph::{Resource, Resources, Use, compute_uses};

@@ -134,17 +134,47 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     if args.frames == 0 {
         bail!("--frames must be at least 1");
     }
+    let outputs = check_outputs(args)?;
+    super::remove_on_interrupt(&outputs)?;
+    let prepared = prepare(args)?;
+    let gpu: Arc<Gpu> = Gpu::new(&gpu_args.options())?;
+    eprintln!(
+        "device: {} | {} vertices, {} samples ({}), {} lights ({} shadow maps)",
+        gpu.info().name,
+        prepared.vertex_count(),
+        prepared.sample_count(),
+        prepared.scene.file.sampling.method,
+        prepared.lights.len(),
+        prepared.shadow_layers
+    );
+    let mut renderer = Renderer::new(&gpu, prepared).context("creating GPU resources")?;
+    check_export(&renderer, args)?;
+    let moving = moving_change(&renderer, args)?;
+    let timed = run_frames(&mut renderer, args, moving)?;
+    write_outputs(&renderer, args)?;
+    if args.timings {
+        print_timings(&renderer, args, &gpu, timed)?;
+    }
+    Ok(())
+}
+
+/// Every output path, distinct and writable, before any work: a render that cannot be written
+/// is not started.
+fn check_outputs(args: &Args) -> Result<Vec<&PathBuf>> {
     let outputs: Vec<&PathBuf> = std::iter::once(&args.output).chain(&args.exr).chain(&args.export_exitance).collect();
     for (i, a) in outputs.iter().enumerate() {
         if outputs[..i].contains(a) {
             bail!("{} is named as two outputs", a.display());
         }
     }
-    // Before any work: a render that cannot be written is not started.
     for path in &outputs {
         translucent::output::check_destination(path)?;
     }
-    super::remove_on_interrupt(&outputs)?;
+    Ok(outputs)
+}
+
+/// The scene (the file, or the built-in one) prepared with the command line's overrides.
+fn prepare(args: &Args) -> Result<PreparedScene> {
     let scene = match &args.scene {
         Some(path) => Scene::load(path)?,
         None => Scene::builtin(),
@@ -176,18 +206,11 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
              visible pixels: use --gather vertex or sparse"
         );
     }
-    let gpu: Arc<Gpu> = Gpu::new(&gpu_args.options())?;
-    eprintln!(
-        "device: {} | {} vertices, {} samples ({}), {} lights ({} shadow maps)",
-        gpu.info().name,
-        prepared.vertex_count(),
-        prepared.sample_count(),
-        prepared.scene.file.sampling.method,
-        prepared.lights.len(),
-        prepared.shadow_layers
-    );
-    let [width, height] = prepared.scene.file.camera.resolution;
-    let mut renderer = Renderer::new(&gpu, prepared).context("creating GPU resources")?;
+    Ok(prepared)
+}
+
+/// `--export-exitance` needs every channel of every object gathered at the vertices.
+fn check_export(renderer: &Renderer, args: &Args) -> Result<()> {
     if let Some(ply) = &args.export_exitance
         && let Some(o) = renderer.plan(Change::Everything).objects.iter().find(|o| o.local_mask() != 0)
     {
@@ -200,7 +223,12 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
             renderer.scene().scene.file.render.transport
         );
     }
-    let moving = match args.moving {
+    Ok(())
+}
+
+/// What `--moving` changes between frames.
+fn moving_change(renderer: &Renderer, args: &Args) -> Result<Change> {
+    Ok(match args.moving {
         Moving::Light => {
             let key = renderer.scene().scene.file.lights.iter().position(|l| !matches!(l, Light::Environment { .. }));
             match key {
@@ -211,21 +239,30 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         }
         Moving::Lights => Change::Lights,
         Moving::Camera => Change::Camera,
-    };
+    })
+}
 
+/// Per pass and in total, the milliseconds of every counted frame.
+struct Timed {
+    per_pass: Vec<(Pass, Vec<f64>)>,
+    totals: Vec<f64>,
+}
+
+/// Render `--frames` frames, the first of everything and each later one after `moving`; the
+/// first is not counted when there are more (it builds everything and warms caches).
+fn run_frames(renderer: &mut Renderer, args: &Args, moving: Change) -> Result<Timed> {
     let progress = if args.frames > 1 {
         ProgressBar::new(args.frames as u64)
             .with_style(ProgressStyle::with_template("frames {bar:30} {pos}/{len} {elapsed}").unwrap())
     } else {
         ProgressBar::hidden()
     };
-    let mut per_pass: Vec<(Pass, Vec<f64>)> = Vec::new();
-    let mut totals = Vec::new();
+    let mut timed = Timed { per_pass: Vec::new(), totals: Vec::new() };
     for frame in 0..args.frames {
         let change = if frame == 0 { Change::Everything } else { moving };
         match change {
-            Change::Light(i) => orbit_light(&mut renderer, i, 3.0)?,
-            Change::Camera => orbit_camera(&mut renderer, 3.0),
+            Change::Light(i) => orbit_light(renderer, i, 3.0)?,
+            Change::Camera => orbit_camera(renderer, 3.0),
             _ => {}
         }
         let plan = renderer.plan(change);
@@ -233,38 +270,48 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
             eprintln!("frame {frame} (change: {change}):\n{}", plan.to_string().trim_end());
         }
         let timings = if args.isolate { renderer.frame_isolated(&plan)? } else { renderer.frame(&plan)? };
-        // The first frame builds everything and warms caches: it is not counted.
         if frame > 0 || args.frames == 1 {
-            totals.push(timings.total());
-            for (name, ms) in timings.passes {
-                match per_pass.iter_mut().find(|(n, _)| *n == name) {
+            timed.totals.push(timings.total());
+            for (pass, ms) in timings.passes {
+                match timed.per_pass.iter_mut().find(|(p, _)| *p == pass) {
                     Some((_, v)) => v.push(ms),
-                    None => per_pass.push((name, vec![ms])),
+                    None => timed.per_pass.push((pass, vec![ms])),
                 }
             }
         }
         progress.inc(1);
     }
     progress.finish_and_clear();
+    Ok(timed)
+}
 
-    let (rgba8, non_finite) = renderer.image()?;
-    // Checked on every render, not only when a pixel shows it: a NaN clamped to black on the
-    // way is still a NaN upstream.
+/// An error naming where non-finite values came from, if the last frame had any. Checked on
+/// every render, not only when a pixel shows it: a NaN clamped to black on the way is still a
+/// NaN upstream.
+fn check_finite(renderer: &Renderer, non_finite: u32) -> Result<()> {
     let upstream = renderer.find_non_finite()?;
-    if non_finite > 0 || !upstream.is_empty() {
-        let causes: Vec<String> = upstream
-            .iter()
-            .map(|n| {
-                let o = &renderer.scene().objects[n.object];
-                let what = if n.pass == Pass::Splat { "samples" } else { "vertices" };
-                let pass = n.pass.name();
-                format!("the {pass} pass left {} {what} of object[{}] ({}) non-finite", n.count, n.object, o.name)
-            })
-            .collect();
-        let cause = if causes.is_empty() { "the shade pass produced them".to_string() } else { causes.join("; ") };
-        bail!("{non_finite} pixels were NaN or infinite before tone mapping ({cause}); no output written");
+    if non_finite == 0 && upstream.is_empty() {
+        return Ok(());
     }
-    // Every output is written to a temporary file first and renamed only once all were written.
+    let causes: Vec<String> = upstream
+        .iter()
+        .map(|n| {
+            let o = &renderer.scene().objects[n.object];
+            let what = if n.pass == Pass::Splat { "samples" } else { "vertices" };
+            let pass = n.pass.name();
+            format!("the {pass} pass left {} {what} of object[{}] ({}) non-finite", n.count, n.object, o.name)
+        })
+        .collect();
+    let cause = if causes.is_empty() { "the shade pass produced them".to_string() } else { causes.join("; ") };
+    bail!("{non_finite} pixels were NaN or infinite before tone mapping ({cause}); no output written");
+}
+
+/// The PNG, and the EXR and exitance PLY when asked for: each written to a temporary file
+/// first and renamed only once all were written.
+fn write_outputs(renderer: &Renderer, args: &Args) -> Result<()> {
+    let (rgba8, non_finite) = renderer.image()?;
+    check_finite(renderer, non_finite)?;
+    let [width, height] = renderer.scene().scene.file.camera.resolution;
     let mut outputs = OutputSet::new();
     outputs.png(&args.output, width, height, &rgba8)?;
     if let Some(exr) = &args.exr {
@@ -291,17 +338,21 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
             eprintln!("wrote {}", path.display());
         }
     }
-    if args.timings {
-        let frames = totals.len();
-        let how = if args.isolate { "submission-to-fence wall time" } else { "GPU time (timestamp queries)" };
-        let after = if args.frames > 1 { " after the first" } else { "" };
-        out!("{how} per pass on {} (median of {frames} frame(s){after}):", gpu.info().name);
-        for (pass, mut v) in per_pass {
-            out!("  {:<8} {:>9.3} ms", pass.name(), median(&mut v));
-        }
-        let total = median(&mut totals);
-        out!("  {:<8} {:>9.3} ms  ({:.1} frames/s)", "total", total, 1000.0 / total);
-        out!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
+    Ok(())
+}
+
+/// `--timings`: the median of each pass and of the frame, and the device memory in use.
+fn print_timings(renderer: &Renderer, args: &Args, gpu: &Gpu, timed: Timed) -> Result<()> {
+    let Timed { per_pass, mut totals } = timed;
+    let frames = totals.len();
+    let how = if args.isolate { "submission-to-fence wall time" } else { "GPU time (timestamp queries)" };
+    let after = if args.frames > 1 { " after the first" } else { "" };
+    out!("{how} per pass on {} (median of {frames} frame(s){after}):", gpu.info().name);
+    for (pass, mut v) in per_pass {
+        out!("  {:<8} {:>9.3} ms", pass.name(), median(&mut v));
     }
+    let total = median(&mut totals);
+    out!("  {:<8} {:>9.3} ms  ({:.1} frames/s)", "total", total, 1000.0 / total);
+    out!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
     Ok(())
 }

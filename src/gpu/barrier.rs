@@ -24,8 +24,6 @@ pub enum Access {
     FragmentSampledRead,
     /// Storage-buffer reads in a fragment shader.
     FragmentRead,
-    /// Anything any earlier or later command does (a frame's start, against the frame before).
-    Everything,
     /// Vertex-buffer reads by the input assembler.
     VertexAttributeRead,
     /// Colour-attachment writes.
@@ -51,7 +49,6 @@ impl Access {
                 | Access::ColorAttachmentWrite
                 | Access::DepthAttachmentReadWrite
                 | Access::TransferWrite
-                | Access::Everything
         )
     }
 
@@ -63,11 +60,8 @@ impl Access {
             | Access::ComputeRead
             | Access::ComputeReadWrite
             | Access::ComputeSampledRead
-            | Access::ComputeImageReadWrite => {
-                S::COMPUTE_SHADER
-            }
+            | Access::ComputeImageReadWrite => S::COMPUTE_SHADER,
             Access::FragmentSampledRead | Access::FragmentRead => S::FRAGMENT_SHADER,
-            Access::Everything => S::ALL_COMMANDS,
             Access::VertexAttributeRead => S::VERTEX_ATTRIBUTE_INPUT,
             Access::ColorAttachmentWrite => S::COLOR_ATTACHMENT_OUTPUT,
             Access::DepthAttachmentReadWrite => S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS,
@@ -84,7 +78,6 @@ impl Access {
             Access::Nothing => A::NONE,
             Access::ComputeWrite => A::SHADER_STORAGE_WRITE,
             Access::ComputeRead | Access::FragmentRead => A::SHADER_STORAGE_READ,
-            Access::Everything => A::MEMORY_READ | A::MEMORY_WRITE,
             Access::ComputeSampledRead | Access::FragmentSampledRead => A::SHADER_SAMPLED_READ,
             Access::ComputeImageReadWrite | Access::ComputeReadWrite => {
                 A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE
@@ -108,7 +101,6 @@ impl Access {
             | Access::ComputeReadWrite
             | Access::ComputeRead
             | Access::FragmentRead
-            | Access::Everything
             | Access::HostRead => L::GENERAL,
             Access::ComputeSampledRead | Access::FragmentSampledRead => L::SHADER_READ_ONLY_OPTIMAL,
             Access::VertexAttributeRead => L::GENERAL,

@@ -126,10 +126,7 @@ impl<K: Copy + Eq + Hash + std::fmt::Debug> Hazards<K> {
 
     /// The last access to `resource`: its last write, or the last read since.
     pub fn last_access(&self, resource: K) -> Access {
-        self.states
-            .get(&resource)
-            .and_then(|s| s.reads.last().copied().or(s.write))
-            .unwrap_or(Access::Nothing)
+        self.states.get(&resource).and_then(|s| s.reads.last().copied().or(s.write)).unwrap_or(Access::Nothing)
     }
 
     /// Barriers recorded so far.

@@ -76,7 +76,8 @@ impl ShaderInterface {
     /// The interface of several stages sharing one layout (vertex + fragment): the union of
     /// their bindings, which must agree where both declare one, and the larger push block.
     pub fn merge(stages: &[ShaderInterface]) -> GpuResult<ShaderInterface> {
-        let mut merged = ShaderInterface { bindings: Vec::new(), names: Vec::new(), push_bytes: 0, local_size: [1, 1, 1] };
+        let mut merged =
+            ShaderInterface { bindings: Vec::new(), names: Vec::new(), push_bytes: 0, local_size: [1, 1, 1] };
         for s in stages {
             if merged.bindings.len() < s.bindings.len() {
                 merged.bindings.resize(s.bindings.len(), None);
@@ -87,7 +88,9 @@ impl ShaderInterface {
             for (i, name) in s.names.iter().enumerate() {
                 match (&merged.names[i], name) {
                     (Some(a), Some(b)) if a != b => {
-                        return Err(GpuError::Invalid(format!("binding {i} is `{a}` in one stage and `{b}` in another")));
+                        return Err(GpuError::Invalid(format!(
+                            "binding {i} is `{a}` in one stage and `{b}` in another"
+                        )));
                     }
                     (None, Some(b)) => merged.names[i] = Some(b.clone()),
                     _ => {}

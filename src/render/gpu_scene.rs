@@ -3,10 +3,10 @@
 //! write and read between frames (splat output, exitance, cached environment irradiance). The
 //! passes get their inputs from here; only lights and object records change after creation.
 
+use super::graph::Resource;
 use super::records::{
     LightGpu, NodePowerRecord, ObjectRecord, ReceiverGroupRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
 };
-use super::graph::Resource;
 use crate::gpu::{Buffer, BufferDesc, Gpu, GpuResult};
 use crate::optics::kernel::NEAR_BLEND_RADIUS;
 use crate::sampling::NODE_ITEM;
@@ -245,8 +245,9 @@ impl PackedObjects {
         let (first_vertex, first_sample) = (self.vertices.len() as u32, self.samples.len() as u32);
         let normals = o.mesh.vertex_normals();
         let positions = o.mesh.positions();
-        self.vertices
-            .extend(positions.iter().zip(normals).map(|(p, n)| Vertex { position: p.to_array(), normal: n.to_array() }));
+        self.vertices.extend(
+            positions.iter().zip(normals).map(|(p, n)| Vertex { position: p.to_array(), normal: n.to_array() }),
+        );
         if matches!(o.material, crate::scene::build::ResolvedMaterial::Translucent { .. }) {
             self.vertex_boundary.extend(o.mesh.boundary_distances());
         } else {
@@ -319,7 +320,9 @@ impl PackedObjects {
             return Ok(());
         }
         Err(crate::gpu::GpuError::Limit {
-            what: format!("bytes of the hierarchical gather's item lists at render.gather_epsilon {epsilon} (raise it)"),
+            what: format!(
+                "bytes of the hierarchical gather's item lists at render.gather_epsilon {epsilon} (raise it)"
+            ),
             value: list_bytes,
             limit: range,
             name: "maxStorageBufferRange",

@@ -112,8 +112,13 @@ impl Resource {
 
 /// What the host reads back after a frame's fence (exitance, splat and sky-light readback, the
 /// tone-mapped image), so every frame makes their last writes visible to the host.
-pub const HOST_READ: [Resource; 5] =
-    [Resource::Splat, Resource::Exitance, Resource::EnvironmentIrradiance, Resource::Tonemapped, Resource::TonemapCounters];
+pub const HOST_READ: [Resource; 5] = [
+    Resource::Splat,
+    Resource::Exitance,
+    Resource::EnvironmentIrradiance,
+    Resource::Tonemapped,
+    Resource::TonemapCounters,
+];
 
 /// One declared access of a pass (`gpu::Use` over `Resource`).
 pub type Use = crate::gpu::Use<Resource>;

@@ -549,10 +549,8 @@ impl Renderer {
             }
         }
         // What the host reads back after the fence: directly, or by a copy of its own.
-        let host: Vec<_> = HOST_READ
-            .iter()
-            .flat_map(|&r| [read(r, Access::HostRead), read(r, Access::TransferRead)])
-            .collect();
+        let host: Vec<_> =
+            HOST_READ.iter().flat_map(|&r| [read(r, Access::HostRead), read(r, Access::TransferRead)]).collect();
         frame.before(cmd, &host);
         recorded
     }
@@ -668,7 +666,9 @@ impl Renderer {
         else {
             return Err(RenderError::OpaqueObject(object));
         };
-        *dipoles = material.dipoles(*mm_per_unit)            .map_err(|e| RenderError::InvalidMaterial { object, reason: e.to_string() })?;
+        *dipoles = material
+            .dipoles(*mm_per_unit)
+            .map_err(|e| RenderError::InvalidMaterial { object, reason: e.to_string() })?;
         // The scene file says so too, so that a later resampling (`set_transform`) keeps it.
         if let crate::scene::MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, eta, .. } =
             &mut self.scene.scene.file.objects[object].material
@@ -753,6 +753,21 @@ impl Renderer {
 /// largest single allocation against `maxMemoryAllocationSize`, the total against the largest
 /// device-local heap).
 fn check_fits(gpu: &Gpu, scene: &PreparedScene) -> Result<(), RenderError> {
+    let mut checks = dispatch_checks(gpu, scene)?;
+    checks.extend(memory_checks(gpu, scene));
+    for (setting, value, limit_name, limit) in checks {
+        if value > limit {
+            return Err(RenderError::DoesNotFit { setting, value, limit_name, limit });
+        }
+    }
+    Ok(())
+}
+
+/// (scene setting, its value, the device limit's name, the limit).
+type Check = (String, u64, &'static str, u64);
+
+/// Dispatch sizes, image sides and layers, and storage ranges against the device's limits.
+fn dispatch_checks(gpu: &Gpu, scene: &PreparedScene) -> Result<Vec<Check>, RenderError> {
     let limits = &gpu.properties().limits;
     // Vertex- and sample-wide passes dispatch along x only.
     let dispatchable = |shader: &str| -> Result<u64, RenderError> {
@@ -760,6 +775,55 @@ fn check_fits(gpu: &Gpu, scene: &PreparedScene) -> Result<(), RenderError> {
     };
     let dispatch = "maxComputeWorkGroupCount x local size";
     let image_side = limits.max_image_dimension2_d as u64;
+    let file = &scene.scene.file;
+    let [width, height] = file.camera.resolution.map(u64::from);
+    let range = limits.max_storage_buffer_range as u64;
+    // With epsilon 0 the hierarchical gather lists every sample for every group of receivers.
+    let flat_lists: u64 = if file.render.gather == GatherMode::Hierarchical && file.render.gather_epsilon == 0.0 {
+        let group = crate::sampling::RECEIVER_GROUP_SIZE as u64;
+        let per_object = |o: &crate::scene::build::PreparedObject| {
+            (o.mesh.positions().len() as u64).div_ceil(group) * o.samples.len() as u64 * 4
+        };
+        scene.objects.iter().map(per_object).sum()
+    } else {
+        0
+    };
+    Ok(vec![
+        (
+            "bytes of the hierarchical gather's item lists at render.gather_epsilon 0 (every sample for every \
+             group of 32 vertices)"
+                .to_string(),
+            flat_lists,
+            "maxStorageBufferRange",
+            range,
+        ),
+        ("the meshes' vertex count".into(), scene.vertex_count() as u64, dispatch, dispatchable("vertex_light.comp")?),
+        (
+            "sampling.count x translucent objects".into(),
+            scene.sample_count() as u64,
+            dispatch,
+            dispatchable("splat.comp")?,
+        ),
+        ("camera.resolution (largest side)".into(), width.max(height), "maxImageDimension2D", image_side),
+        (
+            "camera.resolution (width x height x 4 bytes of tone-mapped output)".into(),
+            4 * width * height,
+            "maxStorageBufferRange",
+            range,
+        ),
+        ("render.shadow_map_size".into(), file.render.shadow_map_size as u64, "maxImageDimension2D", image_side),
+        (
+            "shadow maps (one per shadow-casting light, environment directions included)".into(),
+            scene.shadow_layers as u64,
+            "maxImageArrayLayers",
+            limits.max_image_array_layers as u64,
+        ),
+    ])
+}
+
+/// The large allocations against `maxMemoryAllocationSize`, and the whole scene against the
+/// largest device-local heap.
+fn memory_checks(gpu: &Gpu, scene: &PreparedScene) -> Vec<Check> {
     let file = &scene.scene.file;
     let [width, height] = file.camera.resolution.map(u64::from);
     let pixels = width * height;
@@ -773,52 +837,7 @@ fn check_fits(gpu: &Gpu, scene: &PreparedScene) -> Result<(), RenderError> {
     let surface = if file.render.gather == GatherMode::Pixel { hdr_bytes } else { 0 };
     // HDR, surface, depth (4), tone-mapped output (4) and the EXR readback (16) per pixel.
     let total = hdr_bytes + surface + 24 * pixels + shadow_bytes + vertex_bytes;
-    // With epsilon 0 the hierarchical gather lists every sample for every group of receivers.
-    let flat_lists: u64 = if file.render.gather == GatherMode::Hierarchical && file.render.gather_epsilon == 0.0 {
-        let group = crate::sampling::RECEIVER_GROUP_SIZE as u64;
-        scene
-            .objects
-            .iter()
-            .map(|o| (o.mesh.positions().len() as u64).div_ceil(group) * o.samples.len() as u64 * 4)
-            .sum()
-    } else {
-        0
-    };
-    let checks = [
-        (
-            "bytes of the hierarchical gather's item lists at render.gather_epsilon 0 (every sample for every \
-             group of 32 vertices)"
-                .to_string(),
-            flat_lists,
-            "maxStorageBufferRange",
-            limits.max_storage_buffer_range as u64,
-        ),
-        (
-            "the meshes' vertex count".to_string(),
-            scene.vertex_count() as u64,
-            dispatch,
-            dispatchable("vertex_light.comp")?,
-        ),
-        (
-            "sampling.count x translucent objects".into(),
-            scene.sample_count() as u64,
-            dispatch,
-            dispatchable("splat.comp")?,
-        ),
-        ("camera.resolution (largest side)".into(), width.max(height), "maxImageDimension2D", image_side),
-        (
-            "camera.resolution (width x height x 4 bytes of tone-mapped output)".into(),
-            4 * pixels,
-            "maxStorageBufferRange",
-            limits.max_storage_buffer_range as u64,
-        ),
-        ("render.shadow_map_size".into(), map, "maxImageDimension2D", image_side),
-        (
-            "shadow maps (one per shadow-casting light, environment directions included)".into(),
-            scene.shadow_layers as u64,
-            "maxImageArrayLayers",
-            limits.max_image_array_layers as u64,
-        ),
+    vec![
         (
             format!("bytes of the HDR image at camera.resolution {width}x{height}"),
             hdr_bytes,
@@ -840,13 +859,7 @@ fn check_fits(gpu: &Gpu, scene: &PreparedScene) -> Result<(), RenderError> {
             "largest device-local memory heap",
             heap,
         ),
-    ];
-    for (setting, value, limit_name, limit) in checks {
-        if value > limit {
-            return Err(RenderError::DoesNotFit { setting, value, limit_name, limit });
-        }
-    }
-    Ok(())
+    ]
 }
 
 /// A host target's formats must be renderable: colour attachment (optimal tiling) for the colour

@@ -15,8 +15,8 @@ use crate::gpu::{Access, DescriptorSet, Gpu, GpuResult, GraphicsDesc, GraphicsPi
 use ash::vk;
 use std::sync::Arc;
 
-pub use super::targets::{HDR_FORMAT, SURFACE_FORMAT};
 use super::targets::CAMERA_DEPTH_FORMAT;
+pub use super::targets::{HDR_FORMAT, SURFACE_FORMAT};
 
 /// `Plan::skip_terms` bit: key lights' shadow lookups (every light counts as visible).
 pub const TERM_SHADOW: u32 = 1;

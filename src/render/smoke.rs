@@ -3,7 +3,9 @@
 //!
 //! Bindings: 0 = input f32 (storage, read), 1 = output f32 (storage, write). Push: u32 count.
 
-use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, Gpu, GpuResult, GpuTimer, Named, memory_barrier};
+use crate::gpu::{
+    Access, Binding, Buffer, BufferDesc, ComputePipeline, Gpu, GpuResult, GpuTimer, Named, memory_barrier,
+};
 use ash::vk;
 use std::sync::Arc;
 

@@ -37,9 +37,7 @@ impl CameraTargets {
             // STORAGE: the pixel gather adds its exitance in place.
             hdr: image("hdr radiance", HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED | U::STORAGE)?,
             depth: image("camera depth", CAMERA_DEPTH_FORMAT, U::DEPTH_STENCIL_ATTACHMENT)?,
-            surface: surface
-                .then(|| image("surface", SURFACE_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED))
-                .transpose()?,
+            surface: surface.then(|| image("surface", SURFACE_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED)).transpose()?,
         })
     }
 }
@@ -121,7 +119,11 @@ impl FrameTargets {
 
     /// The HDR image as a storage image (GENERAL), as the pixel gather adds into it.
     pub fn storage_hdr(&self) -> Option<Binding<'_>> {
-        self.hdr().map(|i| Binding::Image { view: i.view(), layout: vk::ImageLayout::GENERAL, sampler: vk::Sampler::null() })
+        self.hdr().map(|i| Binding::Image {
+            view: i.view(),
+            layout: vk::ImageLayout::GENERAL,
+            sampler: vk::Sampler::null(),
+        })
     }
 }
 
@@ -133,11 +135,15 @@ fn clear_to_far(gpu: &Arc<Gpu>, maps: &Image) -> GpuResult<()> {
     let readers = [Access::FragmentSampledRead, Access::ComputeSampledRead];
     gpu.one_shot("shadow map init", |cmd| {
         ImageBarrier::new(maps.raw(), depth, &[Access::Nothing], &[Access::TransferWrite]).record(device, cmd);
-        let range =
-            [vk::ImageSubresourceRange::default().aspect_mask(depth).level_count(1).layer_count(vk::REMAINING_ARRAY_LAYERS)];
+        let range = [vk::ImageSubresourceRange::default()
+            .aspect_mask(depth)
+            .level_count(1)
+            .layer_count(vk::REMAINING_ARRAY_LAYERS)];
         let far = vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 };
         // SAFETY: the image is in TRANSFER_DST_OPTIMAL and has TRANSFER_DST usage.
-        unsafe { device.cmd_clear_depth_stencil_image(cmd, maps.raw(), vk::ImageLayout::TRANSFER_DST_OPTIMAL, &far, &range) };
+        unsafe {
+            device.cmd_clear_depth_stencil_image(cmd, maps.raw(), vk::ImageLayout::TRANSFER_DST_OPTIMAL, &far, &range)
+        };
         ImageBarrier::new(maps.raw(), depth, &[Access::TransferWrite], &readers).record(device, cmd);
     })
 }

@@ -53,7 +53,8 @@ impl TonemapPass {
     /// targets' HDR image and those buffers.
     pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<TonemapPass> {
         let pipeline = ComputePipeline::new(gpu, "tonemap.comp")?;
-        let hdr = resources.targets.hdr().ok_or_else(|| GpuError::Invalid("the tone map needs an own HDR image".into()))?;
+        let hdr =
+            resources.targets.hdr().ok_or_else(|| GpuError::Invalid("the tone map needs an own HDR image".into()))?;
         let extent = hdr.extent();
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let pixels = extent.width as u64 * extent.height as u64;
