@@ -584,23 +584,7 @@ fn main() {
         prepared.scene.file.render.shadow_map_size
     );
     if wanted("frames") {
-        let mut renderer = Renderer::new(&gpu, prepared).expect("renderer");
-        renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
-        print(
-            "key light moves every frame (its shadow map, splat, gather, shade, tone map):",
-            &measure(&mut renderer, Change::Light(0)),
-        );
-        print("only the camera moves (shade, tone map):", &measure(&mut renderer, Change::Camera));
-        println!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
-        let (ours, naive, pairs) = gather_against_naive(&gpu, &mut renderer);
-        println!(
-            "\nFlat vertex gather against a naive point-kernel shader (glsl/bench/gather_naive.comp), same {:.1}M \
-             pairs, isolated submissions, alternating:",
-            pairs / 1e6
-        );
-        println!("  ours  {ours:>8.1} ms = {:>7.1} Mpairs/s", pairs / ours / 1e3);
-        println!("  naive {naive:>8.1} ms = {:>7.1} Mpairs/s", pairs / naive / 1e3);
-        println!("  throughput ratio ours / naive = {:.2}", naive / ours);
+        frames(&gpu, prepared);
     }
     if wanted("savings") {
         savings(&gpu);
@@ -620,7 +604,36 @@ fn main() {
     if !wanted("gathers") {
         return;
     }
+    gathers(&gpu, &scene);
+    fps_against_samples(&gpu, &scene);
+}
 
+/// The "frames" section: per-pass times of the default scene with the key light moving and with
+/// only the camera moving, its device memory, and the flat vertex gather against the naive
+/// shader on the same renderer (so both see the same vertex-sample pairs).
+fn frames(gpu: &Arc<Gpu>, prepared: PreparedScene) {
+    let mut renderer = Renderer::new(gpu, prepared).expect("renderer");
+    renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
+    print(
+        "key light moves every frame (its shadow map, splat, gather, shade, tone map):",
+        &measure(&mut renderer, Change::Light(0)),
+    );
+    print("only the camera moves (shade, tone map):", &measure(&mut renderer, Change::Camera));
+    println!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
+    let (ours, naive, pairs) = gather_against_naive(gpu, &mut renderer);
+    println!(
+        "\nFlat vertex gather against a naive point-kernel shader (glsl/bench/gather_naive.comp), same {:.1}M \
+         pairs, isolated submissions, alternating:",
+        pairs / 1e6
+    );
+    println!("  ours  {ours:>8.1} ms = {:>7.1} Mpairs/s", pairs / ours / 1e3);
+    println!("  naive {naive:>8.1} ms = {:>7.1} Mpairs/s", pairs / naive / 1e3);
+    println!("  throughput ratio ours / naive = {:.2}", naive / ours);
+}
+
+/// The first half of the "gathers" section: each gather's time with the key light moving, and
+/// how far its image is from the vertex gather's (the first, so the reference).
+fn gathers(gpu: &Arc<Gpu>, scene: &Scene) {
     println!("\nWhere the gather runs: time against difference from the vertex gather (key light moving, 512x512):");
     println!(
         "  {:<12} {:>12} {:>12} {:>10} {:>22}",
@@ -629,8 +642,8 @@ fn main() {
     let mut reference_image: Option<Vec<u8>> = None;
     for gather in [GatherMode::Vertex, GatherMode::Hierarchical, GatherMode::Sparse, GatherMode::Pixel] {
         let overrides = Overrides { gather: Some(gather), resolution: Some([512, 512]), ..Default::default() };
-        let prepared = PreparedScene::new(&scene, &overrides).expect("scene");
-        let mut renderer = Renderer::new(&gpu, prepared).expect("renderer");
+        let prepared = PreparedScene::new(scene, &overrides).expect("scene");
+        let mut renderer = Renderer::new(gpu, prepared).expect("renderer");
         renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
         let image = renderer.image().expect("image").0;
         let m = measure(&mut renderer, Change::Light(0));
@@ -650,7 +663,11 @@ fn main() {
             1000.0 / m.frame_wall_ms
         );
     }
+}
 
+/// The second half of the "gathers" section: the seed paper's Figure 7, frames per second
+/// against sample count for each sampler, the key light moving every frame.
+fn fps_against_samples(gpu: &Arc<Gpu>, scene: &Scene) {
     println!("\nFPS against sample count (key light moving every frame, 512x512), seed Figure 7:");
     println!("  {:<8} {:>8} {:>12} {:>12} {:>10}", "sampler", "samples", "gather ms", "frame ms", "frames/s");
     for method in [Method::Turk, Method::Feature] {
@@ -661,8 +678,8 @@ fn main() {
                 resolution: Some([512, 512]),
                 ..Default::default()
             };
-            let prepared = PreparedScene::new(&scene, &overrides).expect("scene");
-            let mut renderer = Renderer::new(&gpu, prepared).expect("renderer");
+            let prepared = PreparedScene::new(scene, &overrides).expect("scene");
+            let mut renderer = Renderer::new(gpu, prepared).expect("renderer");
             renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
             let m = measure(&mut renderer, Change::Light(0));
             let gather = m.passes.iter().find(|(n, _, _)| n == "gather").map(|p| p.2).unwrap_or(0.0);

@@ -165,6 +165,13 @@ fn memory_type(
         .expect("a memory type")
 }
 
+/// A host-visible buffer, mapped for as long as it lives (freeing its memory unmaps it).
+struct Mapped {
+    buffer: vk::Buffer,
+    memory: vk::DeviceMemory,
+    ptr: *mut c_void,
+}
+
 /// The host's engine: its Vulkan objects, created and destroyed by itself.
 struct Host {
     entry: ash::Entry,
@@ -289,7 +296,7 @@ impl Host {
     }
 
     /// A host-visible buffer of `size` bytes, mapped.
-    fn readback(&self, size: u64) -> (vk::Buffer, vk::DeviceMemory, *mut c_void) {
+    fn readback(&self, size: u64) -> Mapped {
         let info = vk::BufferCreateInfo::default()
             .size(size)
             .usage(vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::VERTEX_BUFFER);
@@ -308,7 +315,7 @@ impl Host {
                 .unwrap();
             self.device.bind_buffer_memory(buffer, memory, 0).unwrap();
             let ptr = self.device.map_memory(memory, 0, size, vk::MemoryMapFlags::empty()).unwrap();
-            (buffer, memory, ptr)
+            Mapped { buffer, memory, ptr }
         }
     }
 
@@ -458,11 +465,18 @@ pub fn run(options: &Options) -> Result<Run, String> {
 }
 
 fn run_on(host: &Host, options: &Options) -> Result<Run, String> {
-    let device = &host.device;
-    // translucent on the host's device, drawing into the host's images; it checks the host's
-    // setup before the host has made anything of its own.
+    let gpu = host_gpu(host, options)?;
+    let engine = Engine::new(host, options);
+    let result = render_frames(&engine, gpu, options);
+    engine.destroy();
+    result
+}
+
+/// translucent on the host's device, drawing into the host's images; it checks the host's
+/// setup before the host has made anything of its own.
+fn host_gpu(host: &Host, options: &Options) -> Result<Arc<Gpu>, String> {
     // SAFETY: the host's objects outlive the Gpu (dropped before they are destroyed).
-    let gpu: Arc<Gpu> = unsafe {
+    unsafe {
         Gpu::from_host(
             HostVulkan {
                 entry: host.entry.clone(),
@@ -479,58 +493,128 @@ fn run_on(host: &Host, options: &Options) -> Result<Run, String> {
             &GpuOptions::default(),
         )
     }
-    .map_err(|e| e.to_string())?;
-    let color = host.image(
-        COLOR_FORMAT,
-        vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
-        vk::ImageAspectFlags::COLOR,
-    );
-    let depth = host.image(DEPTH_FORMAT, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT, vk::ImageAspectFlags::DEPTH);
-    let ldr = host.image(
-        vk::Format::R8G8B8A8_UNORM,
-        // SAMPLED only so that it may have a view like the others; the post pass blits.
-        vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::SAMPLED,
-        vk::ImageAspectFlags::COLOR,
-    );
-    let pixels = (SIZE * SIZE) as u64;
-    let (linear_buffer, linear_memory, linear_ptr) = host.readback(16 * pixels);
-    let (ldr_buffer, ldr_memory, ldr_ptr) = host.readback(4 * pixels);
-    let r = 0.05f32;
-    let y = options.ground_y;
-    let quad = [[-r, y, -r], [-r, y, r], [r, y, -r], [r, y, r]];
-    let (quad_buffer, quad_memory, quad_ptr) = host.readback(size_of_val(&quad) as u64);
-    // SAFETY: the mapping is 48 bytes long.
-    unsafe { std::ptr::copy_nonoverlapping(quad.as_ptr().cast::<u8>(), quad_ptr.cast::<u8>(), size_of_val(&quad)) };
-    let ground = Ground::new(device);
-    // SAFETY: valid create infos; destroyed below.
-    let pool = unsafe {
-        device.create_command_pool(
-            &vk::CommandPoolCreateInfo::default()
-                .queue_family_index(host.family)
-                .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
-            None,
-        )
-    }
-    .unwrap();
-    let cmd = unsafe {
-        device.allocate_command_buffers(
-            &vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1),
-        )
-    }
-    .unwrap()[0];
-    let fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }.unwrap();
+    .map_err(|e| e.to_string())
+}
 
-    // One frame of the host: clear, its quad, then whatever `between` records, then its post.
-    let record_and_submit = |view_proj: Mat4, between: &mut dyn FnMut(vk::CommandBuffer)| {
+/// The host's own objects for one run, made once translucent has accepted the device and
+/// destroyed by the host (`destroy`) after translucent is gone.
+struct Engine<'a> {
+    host: &'a Host,
+    /// The linear colour target and the depth target, shared with translucent.
+    color: HostImage,
+    depth: HostImage,
+    /// The post pass's 8-bit image.
+    ldr: HostImage,
+    /// Host copies of `color` and of `ldr`.
+    linear_readback: Mapped,
+    ldr_readback: Mapped,
+    /// The ground quad's vertices.
+    quad: Mapped,
+    ground: Ground,
+    pool: vk::CommandPool,
+    /// The one command buffer every frame is recorded into, and its fence.
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+}
+
+/// Stages and accesses on one side of a barrier.
+type Scope = (vk::PipelineStageFlags2, vk::AccessFlags2);
+
+/// Before a frame, nothing is known of an image's last use: wait on everything.
+fn anything() -> Scope {
+    (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)
+}
+
+/// The colour target drawn to (by the host's quad and by translucent).
+fn color_attachment() -> Scope {
+    (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE)
+}
+
+/// The post pass reading an image (the blit, the copies to host memory).
+fn transfer_read() -> Scope {
+    (vk::PipelineStageFlags2::BLIT | vk::PipelineStageFlags2::COPY, vk::AccessFlags2::TRANSFER_READ)
+}
+
+/// The blit writing the 8-bit image.
+fn blit_write() -> Scope {
+    (vk::PipelineStageFlags2::BLIT, vk::AccessFlags2::TRANSFER_WRITE)
+}
+
+/// The whole of a colour image's one mip level and layer, for blits and copies.
+fn color_layers() -> vk::ImageSubresourceLayers {
+    vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1)
+}
+
+impl<'a> Engine<'a> {
+    fn new(host: &'a Host, options: &Options) -> Engine<'a> {
+        let device = &host.device;
+        let color = host.image(
+            COLOR_FORMAT,
+            vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+            vk::ImageAspectFlags::COLOR,
+        );
+        let depth =
+            host.image(DEPTH_FORMAT, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT, vk::ImageAspectFlags::DEPTH);
+        let ldr = host.image(
+            vk::Format::R8G8B8A8_UNORM,
+            // SAMPLED only so that it may have a view like the others; the post pass blits.
+            vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::SAMPLED,
+            vk::ImageAspectFlags::COLOR,
+        );
+        let pixels = (SIZE * SIZE) as u64;
+        let linear_readback = host.readback(16 * pixels);
+        let ldr_readback = host.readback(4 * pixels);
+        let r = 0.05f32;
+        let y = options.ground_y;
+        let vertices = [[-r, y, -r], [-r, y, r], [r, y, -r], [r, y, r]];
+        let quad = host.readback(size_of_val(&vertices) as u64);
+        // SAFETY: the mapping is 48 bytes long.
+        unsafe {
+            std::ptr::copy_nonoverlapping(vertices.as_ptr().cast::<u8>(), quad.ptr.cast::<u8>(), size_of_val(&vertices))
+        };
+        let ground = Ground::new(device);
+        // SAFETY: valid create infos; destroyed in `destroy`.
+        let pool = unsafe {
+            device.create_command_pool(
+                &vk::CommandPoolCreateInfo::default()
+                    .queue_family_index(host.family)
+                    .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
+                None,
+            )
+        }
+        .unwrap();
+        let cmd = unsafe {
+            device.allocate_command_buffers(
+                &vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1),
+            )
+        }
+        .unwrap()[0];
+        let fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }.unwrap();
+        Engine { host, color, depth, ldr, linear_readback, ldr_readback, quad, ground, pool, cmd, fence }
+    }
+
+    /// One frame of the host: clear, its quad, then whatever `between` records, then its post
+    /// pass, submitted and waited on. Returns the linear image and the 8-bit one.
+    fn frame(&self, view_proj: Mat4, between: &mut dyn FnMut(vk::CommandBuffer)) -> (Vec<f32>, Vec<u8>) {
+        self.begin();
+        self.draw_ground(view_proj);
+        between(self.cmd);
+        // The host's post pass: the linear image to 8 bits by a blit, both copied to host memory.
+        self.blit_to_ldr();
+        self.copy_to_host();
+        self.submit_and_wait();
+        self.read_back()
+    }
+
+    /// Starts the command buffer and moves both targets into their attachment layouts (their
+    /// contents are cleared, so the old layout is left undefined).
+    fn begin(&self) {
+        let (device, cmd) = (&self.host.device, self.cmd);
         // SAFETY: the command buffer is idle (the previous submission was waited on).
         unsafe {
             device.reset_command_buffer(cmd, vk::CommandBufferResetFlags::empty()).unwrap();
             device.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default()).unwrap();
         }
-        let (none, attach) = (
-            (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE),
-            (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
-        );
         let depth_attach = (
             vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
             vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
@@ -538,30 +622,36 @@ fn run_on(host: &Host, options: &Options) -> Result<Run, String> {
         barrier(
             device,
             cmd,
-            color.image,
+            self.color.image,
             vk::ImageAspectFlags::COLOR,
             (vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
-            none,
-            attach,
+            anything(),
+            color_attachment(),
         );
         barrier(
             device,
             cmd,
-            depth.image,
+            self.depth.image,
             vk::ImageAspectFlags::DEPTH,
             (vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL),
-            none,
+            anything(),
             depth_attach,
         );
+    }
+
+    /// The host's own geometry: both targets cleared, then the ground quad, depth-tested and
+    /// depth-written so that translucent's passes test against it.
+    fn draw_ground(&self, view_proj: Mat4) {
+        let (device, cmd) = (&self.host.device, self.cmd);
         let extent = vk::Extent2D { width: SIZE, height: SIZE };
         let colors = [vk::RenderingAttachmentInfo::default()
-            .image_view(color.view)
+            .image_view(self.color.view)
             .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
             .load_op(vk::AttachmentLoadOp::CLEAR)
             .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0, 0.0, 0.0, 1.0] } })];
         let depth_info = vk::RenderingAttachmentInfo::default()
-            .image_view(depth.view)
+            .image_view(self.depth.view)
             .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
             .load_op(vk::AttachmentLoadOp::CLEAR)
             .store_op(vk::AttachmentStoreOp::STORE)
@@ -572,10 +662,10 @@ fn run_on(host: &Host, options: &Options) -> Result<Run, String> {
             .color_attachments(&colors)
             .depth_attachment(&depth_info);
         let push = GroundPush { view_proj: view_proj.to_cols_array_2d(), color: GROUND };
-        // SAFETY: `cmd` is recording; the attachments are in the layouts set above.
+        // SAFETY: `cmd` is recording; the attachments are in the layouts `begin` set.
         unsafe {
             device.cmd_begin_rendering(cmd, &rendering);
-            device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, ground.pipeline);
+            device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.ground.pipeline);
             let viewport = vk::Viewport {
                 x: 0.0,
                 y: 0.0,
@@ -588,77 +678,88 @@ fn run_on(host: &Host, options: &Options) -> Result<Run, String> {
             device.cmd_set_scissor(cmd, 0, &[extent.into()]);
             device.cmd_push_constants(
                 cmd,
-                ground.layout,
+                self.ground.layout,
                 vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
                 0,
                 bytemuck::bytes_of(&push),
             );
-            device.cmd_bind_vertex_buffers(cmd, 0, &[quad_buffer], &[0]);
+            device.cmd_bind_vertex_buffers(cmd, 0, &[self.quad.buffer], &[0]);
             device.cmd_draw(cmd, 4, 1, 0, 0);
             device.cmd_end_rendering(cmd);
         }
-        between(cmd);
-        // The host's post pass: the linear image to 8 bits by a blit, both copied to host memory.
-        let transfer_read =
-            (vk::PipelineStageFlags2::BLIT | vk::PipelineStageFlags2::COPY, vk::AccessFlags2::TRANSFER_READ);
+    }
+
+    /// The post pass's first half: the linear image (after translucent's writes) blitted into
+    /// the 8-bit one, which is made a transfer destination for it.
+    fn blit_to_ldr(&self) {
+        let (device, cmd) = (&self.host.device, self.cmd);
         barrier(
             device,
             cmd,
-            color.image,
+            self.color.image,
             vk::ImageAspectFlags::COLOR,
             (vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
-            attach,
-            transfer_read,
+            color_attachment(),
+            transfer_read(),
         );
-        let transfer_write = (vk::PipelineStageFlags2::BLIT, vk::AccessFlags2::TRANSFER_WRITE);
         barrier(
             device,
             cmd,
-            ldr.image,
+            self.ldr.image,
             vk::ImageAspectFlags::COLOR,
             (vk::ImageLayout::UNDEFINED, vk::ImageLayout::TRANSFER_DST_OPTIMAL),
-            none,
-            transfer_write,
+            anything(),
+            blit_write(),
         );
-        let layers = vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1);
+        let layers = color_layers();
         let corners = [vk::Offset3D::default(), vk::Offset3D { x: SIZE as i32, y: SIZE as i32, z: 1 }];
         let blit = [vk::ImageBlit::default()
             .src_subresource(layers)
             .src_offsets(corners)
             .dst_subresource(layers)
             .dst_offsets(corners)];
-        let region = [vk::BufferImageCopy::default().image_subresource(layers).image_extent(vk::Extent3D {
-            width: SIZE,
-            height: SIZE,
-            depth: 1,
-        })];
-        // SAFETY: layouts as the barriers set; the buffers hold one tightly packed image each.
+        // SAFETY: layouts as the barriers set.
         unsafe {
             device.cmd_blit_image(
                 cmd,
-                color.image,
+                self.color.image,
                 vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                ldr.image,
+                self.ldr.image,
                 vk::ImageLayout::TRANSFER_DST_OPTIMAL,
                 &blit,
                 vk::Filter::NEAREST,
             );
+        }
+    }
+
+    /// The post pass's second half: both images copied into their mapped buffers, and those
+    /// writes made visible to the host's reads after the fence.
+    fn copy_to_host(&self) {
+        let (device, cmd) = (&self.host.device, self.cmd);
+        let region = [vk::BufferImageCopy::default().image_subresource(color_layers()).image_extent(vk::Extent3D {
+            width: SIZE,
+            height: SIZE,
+            depth: 1,
+        })];
+        // SAFETY: the linear image is a transfer source (`blit_to_ldr`); the buffers hold one
+        // tightly packed image each.
+        unsafe {
             device.cmd_copy_image_to_buffer(
                 cmd,
-                color.image,
+                self.color.image,
                 vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                linear_buffer,
+                self.linear_readback.buffer,
                 &region,
             );
         }
         barrier(
             device,
             cmd,
-            ldr.image,
+            self.ldr.image,
             vk::ImageAspectFlags::COLOR,
             (vk::ImageLayout::TRANSFER_DST_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
-            transfer_write,
-            transfer_read,
+            blit_write(),
+            transfer_read(),
         );
         let host_read = [vk::MemoryBarrier2::default()
             .src_stage_mask(vk::PipelineStageFlags2::COPY)
@@ -667,95 +768,131 @@ fn run_on(host: &Host, options: &Options) -> Result<Run, String> {
             .dst_access_mask(vk::AccessFlags2::HOST_READ)];
         // SAFETY: as above.
         unsafe {
-            device.cmd_copy_image_to_buffer(cmd, ldr.image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, ldr_buffer, &region);
+            device.cmd_copy_image_to_buffer(
+                cmd,
+                self.ldr.image,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                self.ldr_readback.buffer,
+                &region,
+            );
             device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&host_read));
+        }
+    }
+
+    /// Ends the frame's recording, submits it and waits on the fence, leaving the command
+    /// buffer idle and the fence unsignalled for the next frame.
+    fn submit_and_wait(&self) {
+        let (device, cmd, fence) = (&self.host.device, self.cmd, self.fence);
+        // SAFETY: `cmd` is recording; the fence is unsignalled.
+        unsafe {
             device.end_command_buffer(cmd).unwrap();
             let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
             let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
-            device.queue_submit2(host.queue, &submit, fence).unwrap();
+            device.queue_submit2(self.host.queue, &submit, fence).unwrap();
             device.wait_for_fences(&[fence], true, u64::MAX).unwrap();
             device.reset_fences(&[fence]).unwrap();
         }
+    }
+
+    /// The linear image and the 8-bit one, from the mapped buffers.
+    fn read_back(&self) -> (Vec<f32>, Vec<u8>) {
+        let pixels = (SIZE * SIZE) as usize;
         // SAFETY: the mappings hold the copies, finished at the fence.
         unsafe {
             (
-                std::slice::from_raw_parts(linear_ptr.cast::<f32>(), 4 * pixels as usize).to_vec(),
-                std::slice::from_raw_parts(ldr_ptr.cast::<u8>(), 4 * pixels as usize).to_vec(),
+                std::slice::from_raw_parts(self.linear_readback.ptr.cast::<f32>(), 4 * pixels).to_vec(),
+                std::slice::from_raw_parts(self.ldr_readback.ptr.cast::<u8>(), 4 * pixels).to_vec(),
             )
         }
+    }
+
+    fn destroy(self) {
+        let device = &self.host.device;
+        // SAFETY: the device is idle (every submission was waited on); the host destroys its own.
+        unsafe {
+            device.device_wait_idle().unwrap();
+            device.destroy_fence(self.fence, None);
+            device.destroy_command_pool(self.pool, None);
+            device.destroy_pipeline(self.ground.pipeline, None);
+            device.destroy_pipeline_layout(self.ground.layout, None);
+            for mapped in [&self.linear_readback, &self.ldr_readback, &self.quad] {
+                device.destroy_buffer(mapped.buffer, None);
+                device.free_memory(mapped.memory, None);
+            }
+        }
+        for image in [&self.color, &self.depth, &self.ldr] {
+            self.host.destroy_image(image);
+        }
+    }
+}
+
+/// translucent's part of the run: its renderers on the host's device, recorded into the host's
+/// frames, then the host's quad drawn once more after translucent is gone. It takes the Gpu so
+/// that it is dropped here, on an error too, before the host destroys its own objects.
+fn render_frames(engine: &Engine, gpu: Arc<Gpu>, options: &Options) -> Result<Run, String> {
+    let target = TargetDesc::Host { color_format: COLOR_FORMAT, depth_format: DEPTH_FORMAT };
+    let prepare = |text: &str| {
+        let scene = Scene::parse(text, "embedded scene", None).map_err(|e| e.to_string())?;
+        PreparedScene::new(&scene, &Overrides::default()).map_err(|e| e.to_string())
     };
-
-    let result = (|| -> Result<Run, String> {
-        let gpu = gpu;
-        let target = TargetDesc::Host { color_format: COLOR_FORMAT, depth_format: DEPTH_FORMAT };
-        let prepare = |text: &str| {
-            let scene = Scene::parse(text, "embedded scene", None).map_err(|e| e.to_string())?;
-            PreparedScene::new(&scene, &Overrides::default()).map_err(|e| e.to_string())
-        };
-        let prepared = prepare(SPHERE_SCENE)?;
-        let mut renderer = Renderer::with_target(&gpu, prepared.clone(), target).map_err(|e| e.to_string())?;
-        let mut second = if options.second_renderer {
-            Some(Renderer::with_target(&gpu, prepare(SECOND_SCENE)?, target).map_err(|e| e.to_string())?)
-        } else {
-            None
-        };
-        let host_target = HostTarget {
-            color: color.view,
-            depth: depth.view,
-            extent: vk::Extent2D { width: SIZE, height: SIZE },
-            load: true,
-        };
-        let mut frames = Vec::new();
-        for i in 0..options.frames {
-            let camera = camera_of(&prepared, i);
-            if i > 0 {
-                renderer.set_camera(camera);
-                if let Some(s) = second.as_mut() {
-                    s.set_camera(camera);
-                }
+    let prepared = prepare(SPHERE_SCENE)?;
+    let mut renderer = Renderer::with_target(&gpu, prepared.clone(), target).map_err(|e| e.to_string())?;
+    let mut second = if options.second_renderer {
+        Some(Renderer::with_target(&gpu, prepare(SECOND_SCENE)?, target).map_err(|e| e.to_string())?)
+    } else {
+        None
+    };
+    let host_target = HostTarget {
+        color: engine.color.view,
+        depth: engine.depth.view,
+        extent: vk::Extent2D { width: SIZE, height: SIZE },
+        load: true,
+    };
+    let mut frames = Vec::new();
+    for i in 0..options.frames {
+        let camera = camera_of(&prepared, i);
+        if i > 0 {
+            renderer.set_camera(camera);
+            if let Some(s) = second.as_mut() {
+                s.set_camera(camera);
             }
-            let mut recorded = Vec::new();
-            let mut error = None;
-            let (linear, rgba8) = record_and_submit(camera.projection * camera.view, &mut |cmd| {
-                for r in std::iter::once(&mut renderer).chain(second.as_mut()) {
-                    match r.record_frame(cmd, Some(&host_target)) {
-                        Ok(frame) => recorded.push(frame),
-                        Err(e) => error = Some(e.to_string()),
-                    }
-                }
-            });
-            if let Some(e) = error {
-                return Err(e);
-            }
-            let timings = renderer.read_timings(&recorded[0]).map_err(|e| e.to_string())?.passes;
-            let timings = timings.into_iter().map(|(p, ms)| (p.name().to_string(), ms)).collect();
-            frames.push(Frame { linear, rgba8, passes: recorded[0].passes.clone(), timings });
         }
-        drop(second);
-        drop(renderer);
-        drop(gpu);
-        // The host's device after translucent is gone: it still draws the quad.
-        let camera = camera_of(&prepared, 0);
-        let (after_drop, _) = record_and_submit(camera.projection * camera.view, &mut |_| {});
-        Ok(Run { frames, after_drop, validation_messages: 0 })
-    })();
+        frames.push(embedded_frame(engine, &mut renderer, second.as_mut(), &host_target, camera)?);
+    }
+    drop(second);
+    drop(renderer);
+    drop(gpu);
+    // The host's device after translucent is gone: it still draws the quad.
+    let camera = camera_of(&prepared, 0);
+    let (after_drop, _) = engine.frame(camera.projection * camera.view, &mut |_| {});
+    Ok(Run { frames, after_drop, validation_messages: 0 })
+}
 
-    // SAFETY: the device is idle (every submission was waited on); the host destroys its own.
-    unsafe {
-        device.device_wait_idle().unwrap();
-        device.destroy_fence(fence, None);
-        device.destroy_command_pool(pool, None);
-        device.destroy_pipeline(ground.pipeline, None);
-        device.destroy_pipeline_layout(ground.layout, None);
-        for (buffer, memory) in [(linear_buffer, linear_memory), (ldr_buffer, ldr_memory), (quad_buffer, quad_memory)] {
-            device.destroy_buffer(buffer, None);
-            device.free_memory(memory, None);
+/// One host frame with every renderer recorded between the host's quad and its post pass, and
+/// the first renderer's timings read after the host's fence.
+fn embedded_frame(
+    engine: &Engine,
+    renderer: &mut Renderer,
+    mut second: Option<&mut Renderer>,
+    host_target: &HostTarget,
+    camera: CameraView,
+) -> Result<Frame, String> {
+    let mut recorded = Vec::new();
+    let mut error = None;
+    let (linear, rgba8) = engine.frame(camera.projection * camera.view, &mut |cmd| {
+        for r in std::iter::once(&mut *renderer).chain(second.as_deref_mut()) {
+            match r.record_frame(cmd, Some(host_target)) {
+                Ok(frame) => recorded.push(frame),
+                Err(e) => error = Some(e.to_string()),
+            }
         }
+    });
+    if let Some(e) = error {
+        return Err(e);
     }
-    for image in [&color, &depth, &ldr] {
-        host.destroy_image(image);
-    }
-    result
+    let timings = renderer.read_timings(&recorded[0]).map_err(|e| e.to_string())?.passes;
+    let timings = timings.into_iter().map(|(p, ms)| (p.name().to_string(), ms)).collect();
+    Ok(Frame { linear, rgba8, passes: recorded[0].passes.clone(), timings })
 }
 
 /// Write frame `i`'s post-processed image as a PNG.

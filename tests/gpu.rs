@@ -4,8 +4,10 @@ mod common;
 
 use ash::vk;
 use common::with_gpu;
+use std::sync::Arc;
 use translucent::gpu::{
-    Access, Binding, Buffer, Named, GpuTimer, GraphicsDesc, GraphicsPipeline, Image, ImageBarrier, ImageDesc, shaders,
+    Access, Binding, Buffer, DescriptorSet, Gpu, GpuTimer, GraphicsDesc, GraphicsPipeline, Image, ImageBarrier,
+    ImageDesc, Named, shaders,
 };
 use translucent::render::smoke;
 
@@ -60,16 +62,86 @@ fn every_embedded_shader_is_spirv() {
     assert!(shaders::spirv("no-such.comp").is_err());
 }
 
+/// One vertex of the test triangle, laid out as test/triangle.vert reads it.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Vertex {
+    position: [f32; 2],
+    color: [f32; 3],
+}
+
+/// The triangle's pipeline: its own vertex layout (position then colour, one binding) and the
+/// target's formats, so that the draw exercises vertex input, a push constant and a depth
+/// attachment at once.
+fn triangle_pipeline(gpu: &Arc<Gpu>, format: vk::Format, depth_format: vk::Format) -> GraphicsPipeline {
+    let mut desc = GraphicsDesc::new("test/triangle.vert", Some("test/triangle.frag"));
+    desc.vertex_bindings = vec![vk::VertexInputBindingDescription {
+        binding: 0,
+        stride: std::mem::size_of::<Vertex>() as u32,
+        input_rate: vk::VertexInputRate::VERTEX,
+    }];
+    desc.vertex_attributes = vec![
+        vk::VertexInputAttributeDescription { location: 0, binding: 0, format: vk::Format::R32G32_SFLOAT, offset: 0 },
+        vk::VertexInputAttributeDescription {
+            location: 1,
+            binding: 0,
+            format: vk::Format::R32G32B32_SFLOAT,
+            offset: 8,
+        },
+    ];
+    desc.color_formats = vec![format];
+    desc.depth_format = Some(depth_format);
+    GraphicsPipeline::new(gpu, &desc).unwrap()
+}
+
+/// Records the draw into `cmd`: both attachments to their attachment layouts, the colour
+/// cleared to blue (what the corners must keep), then the triangle with a tint of 0.5.
+fn record_triangle(
+    device: &ash::Device,
+    cmd: vk::CommandBuffer,
+    (color, depth): (&Image, &Image),
+    (pipeline, set): (&GraphicsPipeline, &DescriptorSet),
+    vertices: &Buffer,
+) {
+    ImageBarrier::new(color.raw(), vk::ImageAspectFlags::COLOR, &[Access::Nothing], &[Access::ColorAttachmentWrite])
+        .record(device, cmd);
+    ImageBarrier::new(
+        depth.raw(),
+        vk::ImageAspectFlags::DEPTH,
+        &[Access::Nothing],
+        &[Access::DepthAttachmentReadWrite],
+    )
+    .record(device, cmd);
+    let colors = [vk::RenderingAttachmentInfo::default()
+        .image_view(color.view())
+        .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0, 0.0, 1.0, 1.0] } })];
+    let depth_attachment = vk::RenderingAttachmentInfo::default()
+        .image_view(depth.view())
+        .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(vk::AttachmentStoreOp::DONT_CARE)
+        .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
+    let rendering = vk::RenderingInfo::default()
+        .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent: color.extent() })
+        .layer_count(1)
+        .color_attachments(&colors)
+        .depth_attachment(&depth_attachment);
+    unsafe {
+        device.cmd_begin_rendering(cmd, &rendering);
+        pipeline.bind(cmd, Some(set), &0.5f32, color.extent());
+        device.cmd_bind_vertex_buffers(cmd, 0, &[vertices.raw()], &[0]);
+        device.cmd_draw(cmd, 3, 1, 0, 0);
+        device.cmd_end_rendering(cmd);
+    }
+}
+
 #[test]
 fn graphics_pipeline_draws_a_triangle() {
     const SIZE: u32 = 64;
     with_gpu(|gpu| {
-        #[repr(C)]
-        #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
-        struct Vertex {
-            position: [f32; 2],
-            color: [f32; 3],
-        }
         // Counter-clockwise in framebuffer space (y down), covering the centre.
         let vertices = [
             Vertex { position: [-0.8, -0.8], color: [1.0, 1.0, 0.0] },
@@ -89,72 +161,10 @@ fn graphics_pipeline_draws_a_triangle() {
             &ImageDesc::new("depth", SIZE, SIZE, depth_format, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT),
         )
         .unwrap();
-        let mut desc = GraphicsDesc::new("test/triangle.vert", Some("test/triangle.frag"));
-        desc.vertex_bindings = vec![vk::VertexInputBindingDescription {
-            binding: 0,
-            stride: std::mem::size_of::<Vertex>() as u32,
-            input_rate: vk::VertexInputRate::VERTEX,
-        }];
-        desc.vertex_attributes = vec![
-            vk::VertexInputAttributeDescription {
-                location: 0,
-                binding: 0,
-                format: vk::Format::R32G32_SFLOAT,
-                offset: 0,
-            },
-            vk::VertexInputAttributeDescription {
-                location: 1,
-                binding: 0,
-                format: vk::Format::R32G32B32_SFLOAT,
-                offset: 8,
-            },
-        ];
-        desc.color_formats = vec![format];
-        desc.depth_format = Some(depth_format);
-        let pipeline = GraphicsPipeline::new(gpu, &desc).unwrap();
+        let pipeline = triangle_pipeline(gpu, format, depth_format);
         let set = pipeline.descriptor_set(&[Named { name: "Tint", binding: Binding::Buffer(&tint) }]).unwrap();
         let device = gpu.device();
-        gpu.one_shot("draw", |cmd| {
-            ImageBarrier::new(
-                color.raw(),
-                vk::ImageAspectFlags::COLOR,
-                &[Access::Nothing],
-                &[Access::ColorAttachmentWrite],
-            )
-            .record(device, cmd);
-            ImageBarrier::new(
-                depth.raw(),
-                vk::ImageAspectFlags::DEPTH,
-                &[Access::Nothing],
-                &[Access::DepthAttachmentReadWrite],
-            )
-            .record(device, cmd);
-            let colors = [vk::RenderingAttachmentInfo::default()
-                .image_view(color.view())
-                .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0, 0.0, 1.0, 1.0] } })];
-            let depth_attachment = vk::RenderingAttachmentInfo::default()
-                .image_view(depth.view())
-                .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(vk::AttachmentStoreOp::DONT_CARE)
-                .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
-            let rendering = vk::RenderingInfo::default()
-                .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent: color.extent() })
-                .layer_count(1)
-                .color_attachments(&colors)
-                .depth_attachment(&depth_attachment);
-            unsafe {
-                device.cmd_begin_rendering(cmd, &rendering);
-                pipeline.bind(cmd, Some(&set), &0.5f32, color.extent());
-                device.cmd_bind_vertex_buffers(cmd, 0, &[vbuf.raw()], &[0]);
-                device.cmd_draw(cmd, 3, 1, 0, 0);
-                device.cmd_end_rendering(cmd);
-            }
-        })
-        .unwrap();
+        gpu.one_shot("draw", |cmd| record_triangle(device, cmd, (&color, &depth), (&pipeline, &set), &vbuf)).unwrap();
         let pixels = color.read(Access::ColorAttachmentWrite).unwrap();
         let at = |x: u32, y: u32| {
             let i = 4 * (y * SIZE + x) as usize;

@@ -5,21 +5,22 @@
 mod common;
 
 use common::{repo_path, temp_dir, text, translucent};
+use std::path::Path;
 use translucent::reference::truth::{LIT_FLOOR, Truth};
 use translucent::study::report::COLUMNS;
 
-fn csv_rows(csv: &str) -> Vec<std::collections::HashMap<String, String>> {
+/// One CSV row, column name to text.
+type Row = std::collections::HashMap<String, String>;
+
+fn csv_rows(csv: &str) -> Vec<Row> {
     let mut lines = csv.lines();
     let header: Vec<String> = lines.next().unwrap().split(',').map(str::to_string).collect();
     lines.map(|l| header.iter().cloned().zip(l.split(',').map(str::to_string)).collect()).collect()
 }
 
-#[test]
-fn quick_study_writes_every_column_converges_and_turk_error_falls_with_samples_and_matches_exported_exitance() {
-    let dir = temp_dir("study-quick");
-    let scene = repo_path("tests/scenes/study-tiny.toml");
-    let scene = scene.to_str().unwrap();
-    let (out, cache) = (dir.join("out"), dir.join("cache"));
+/// Runs `study --quick` as CI does, with an error image and the truth cached under `cache`, and
+/// checks it succeeded and wrote every output file.
+fn run_quick_study(scene: &str, out: &Path, cache: &Path) {
     let run = translucent(
         &[
             "study",
@@ -38,7 +39,11 @@ fn quick_study_writes_every_column_converges_and_turk_error_falls_with_samples_a
     for f in ["study.csv", "study.md", "study.png", "truth.png", "error.png"] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
+}
 
+/// The study's CSV, checked to have the documented header, the quick sweep's six rows and no
+/// empty cell (but epsilon, which only some gathers have).
+fn study_rows(out: &Path) -> Vec<Row> {
     let csv = std::fs::read_to_string(out.join("study.csv")).unwrap();
     assert_eq!(csv.lines().next().unwrap().split(',').collect::<Vec<_>>(), COLUMNS);
     let rows = csv_rows(&csv);
@@ -48,23 +53,33 @@ fn quick_study_writes_every_column_converges_and_turk_error_falls_with_samples_a
             assert!(!r[*c].is_empty(), "empty {c} in {r:?}");
         }
     }
+    rows
+}
 
-    // The truth converged, and says so.
-    let entry = std::fs::read_dir(&cache).unwrap().next().unwrap().unwrap();
+/// The one cached truth, checked to have converged, and the report to say so.
+fn converged_truth(cache: &Path, out: &Path) -> Truth {
+    let entry = std::fs::read_dir(cache).unwrap().next().unwrap().unwrap();
     let truth: Truth = serde_json::from_slice(&std::fs::read(entry.path()).unwrap()).unwrap();
     assert!(truth.converged && truth.change() < 1e-4, "levels {:?}", truth.levels);
     assert!(std::fs::read_to_string(out.join("study.md")).unwrap().contains("converged"));
+    truth
+}
 
-    // Turk's error falls at every doubling.
-    let error = |r: &std::collections::HashMap<String, String>| {
+/// Turk's rows are 100, 200 and 400 samples, and their mean relative RMS error falls at every
+/// doubling.
+fn assert_turk_error_falls(rows: &[Row]) {
+    let error = |r: &Row| {
         ["rel_rms_r", "rel_rms_g", "rel_rms_b"].iter().map(|c| r[*c].parse::<f64>().unwrap()).sum::<f64>() / 3.0
     };
     let turk: Vec<(usize, f64)> =
         rows.iter().filter(|r| r["sampler"] == "turk").map(|r| (r["samples"].parse().unwrap(), error(r))).collect();
     assert_eq!(turk.iter().map(|t| t.0).collect::<Vec<_>>(), [100, 200, 400]);
     assert!(turk.windows(2).all(|w| w[1].1 < w[0].1), "turk error does not fall: {turk:?}");
+}
 
-    // The same configuration rendered on its own, its exitance exported, its error by hand.
+/// The study's turk:400 configuration rendered on its own, with its per-vertex exitance
+/// exported to a PLY in `dir` and read back.
+fn exported_exitance(scene: &str, dir: &Path) -> Vec<[f64; 3]> {
     let ply = dir.join("exitance.ply");
     let render = translucent(
         &[
@@ -88,14 +103,18 @@ fn quick_study_writes_every_column_converges_and_turk_error_falls_with_samples_a
     assert!(render.status.success(), "{}", text(&render.stderr));
     let ply = std::fs::read_to_string(ply).unwrap();
     let body = ply.split("end_header\n").nth(1).unwrap();
-    let exported: Vec<[f64; 3]> = body
-        .lines()
+    body.lines()
         .map(|l| {
             // The PLY holds f32s, printed shortest: parse them as f32, as written.
             let v: Vec<f64> = l.split_whitespace().map(|x| f64::from(x.parse::<f32>().unwrap())).collect();
             [v[3], v[4], v[5]]
         })
-        .collect();
+        .collect()
+}
+
+/// The study's turk:400 relative RMS error per channel equals one computed by hand from the
+/// exported exitance against the truth, over the vertices the study counts as lit.
+fn assert_error_matches_by_hand(rows: &[Row], truth: &Truth, exported: &[[f64; 3]]) {
     let t = &truth.exitance[0];
     assert_eq!(exported.len(), t.len());
     let row = rows.iter().find(|r| r["sampler"] == "turk" && r["samples"] == "400").unwrap();
@@ -103,7 +122,7 @@ fn quick_study_writes_every_column_converges_and_turk_error_falls_with_samples_a
         let floor = LIT_FLOOR * t.iter().map(|m| m[c]).fold(0.0, f64::max);
         let rel: Vec<f64> = t
             .iter()
-            .zip(&exported)
+            .zip(exported)
             .filter(|(m, _)| m[c] >= floor && m[c] > 0.0)
             .map(|(m, e)| (e[c] - m[c]) / m[c])
             .collect();
@@ -111,6 +130,23 @@ fn quick_study_writes_every_column_converges_and_turk_error_falls_with_samples_a
         let study: f64 = row[*name].parse().unwrap();
         assert!((by_hand - study).abs() <= 1e-9 * study.max(1e-12) + 1e-12, "{name}: study {study}, by hand {by_hand}");
     }
+}
+
+#[test]
+fn quick_study_writes_every_column_converges_and_turk_error_falls_with_samples_and_matches_exported_exitance() {
+    let dir = temp_dir("study-quick");
+    let scene = repo_path("tests/scenes/study-tiny.toml");
+    let scene = scene.to_str().unwrap();
+    let (out, cache) = (dir.join("out"), dir.join("cache"));
+    run_quick_study(scene, &out, &cache);
+    let rows = study_rows(&out);
+    // The truth converged, and says so.
+    let truth = converged_truth(&cache, &out);
+    // Turk's error falls at every doubling.
+    assert_turk_error_falls(&rows);
+    // The same configuration rendered on its own, its exitance exported, its error by hand.
+    let exported = exported_exitance(scene, &dir);
+    assert_error_matches_by_hand(&rows, &truth, &exported);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
