@@ -10,6 +10,7 @@ use std::sync::Arc;
 use translucent::gpu::{
     Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuError, GpuOptions, Hazards,
 };
+use translucent::render::edit::SceneEdit;
 use translucent::render::gather::GatherPass;
 use translucent::render::gpu_scene::GpuScene;
 use translucent::render::graph::{Resource, Resources, Use, compute_uses};
@@ -185,4 +186,31 @@ fn every_gather_and_frame_change_is_clean_under_synchronisation_validation() {
         });
         assert!(messages.is_empty(), "{gather} gather, synchronisation validation:\n{}", messages.join("\n"));
     }
+}
+
+#[test]
+fn a_transform_edit_keeps_the_renderer_and_draws_what_a_fresh_one_draws() {
+    let messages = with_sync_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, plane(CASTER)).unwrap();
+        renderer.frame(&renderer.plan(Change::Everything)).unwrap();
+        let (before, _) = renderer.image().unwrap();
+        let transform: translucent::scene::Transform =
+            toml::from_str("translate = [3.0, 5.0, -2.0]").expect("a transform");
+        renderer.edit(SceneEdit::Transform { object: 1, transform: transform.clone() }).unwrap();
+        let plan = renderer.plan(renderer.pending_change().expect("the edit is pending"));
+        renderer.frame(&plan).unwrap();
+        let (edited, _) = renderer.image().unwrap();
+        // The same scene with the sphere placed there from the start.
+        let mut moved = plane(CASTER);
+        moved.set_transform(1, transform).unwrap();
+        let mut fresh = Renderer::new(gpu, moved).unwrap();
+        fresh.frame(&fresh.plan(Change::Everything)).unwrap();
+        let (expected, _) = fresh.image().unwrap();
+        assert!(edited != before, "moving the sphere changed nothing in the image");
+        assert!(edited == expected, "the edited renderer's image differs from a fresh renderer's");
+        // An index past the objects is an error naming it, and changes nothing.
+        let err = renderer.edit(SceneEdit::Transform { object: 7, transform: Default::default() }).unwrap_err();
+        assert!(err.to_string().contains("object 7"), "{err}");
+    });
+    assert!(messages.is_empty(), "synchronisation validation:\n{}", messages.join("\n"));
 }

@@ -119,6 +119,11 @@ impl<K: Copy + Eq + Hash + std::fmt::Debug> Hazards<K> {
         state.reads.clear();
     }
 
+    /// Forget `resource`: it was replaced by a new, idle one (e.g. a buffer made anew).
+    pub fn forget(&mut self, resource: K) {
+        self.states.remove(&resource);
+    }
+
     /// The layout image `resource` is in now (`None`: not a tracked image).
     pub fn layout(&self, resource: K) -> Option<vk::ImageLayout> {
         self.states.get(&resource).and_then(|s| s.layout)

@@ -120,6 +120,26 @@ pub const HOST_READ: [Resource; 5] = [
     Resource::TonemapCounters,
 ];
 
+/// Every resource that is a `GpuScene` buffer (`Resources::buffer`).
+pub const SCENE_BUFFERS: [Resource; 16] = [
+    Resource::Vertices,
+    Resource::Objects,
+    Resource::Lights,
+    Resource::Samples,
+    Resource::Splat,
+    Resource::Exitance,
+    Resource::EnvironmentIrradiance,
+    Resource::VertexBoundary,
+    Resource::TreeNodes,
+    Resource::TreeOrder,
+    Resource::NodePower,
+    Resource::ReceiverOrder,
+    Resource::ReceiverGroups,
+    Resource::GroupItems,
+    Resource::BlendItems,
+    Resource::LevelVertices,
+];
+
 /// One declared access of a pass (`gpu::Use` over `Resource`).
 pub type Use = crate::gpu::Use<Resource>;
 

@@ -2,6 +2,7 @@
 //! frame loop that records the passes a plan asks for, each timed with the `GpuTimer`. Outputs
 //! stay on the GPU between frames, so a frame that skips a pass reuses its last result.
 
+use super::edit::SceneEdit;
 use super::gather::GatherPass;
 use super::gather_pixel::GatherPixelPass;
 use super::gather_sparse::GatherSparsePass;
@@ -217,10 +218,6 @@ pub struct Renderer {
     planner: Planner,
 }
 
-/// The scene buffers a test or host may write between frames (`Renderer::buffers_mut`).
-const SCENE_BUFFERS: [Resource; 5] =
-    [Resource::Samples, Resource::Splat, Resource::Exitance, Resource::EnvironmentIrradiance, Resource::Objects];
-
 /// Share of an opaque object's brightest per-vertex sky light by which two neighbouring
 /// vertices may differ and still be simplified away (`Renderer::bake_static_levels`): 0.2%,
 /// under what a person sees in a smooth gradient. Measured on the default scene's floor
@@ -314,7 +311,7 @@ impl Renderer {
     /// frame in flight: the next frame's readers of any of it wait for those writes.
     pub fn buffers_mut(&mut self) -> &mut GpuScene {
         let mut hazards = self.hazards.borrow_mut();
-        for r in SCENE_BUFFERS {
+        for r in super::graph::SCENE_BUFFERS {
             hazards.written_outside(r);
         }
         drop(hazards);
@@ -395,6 +392,22 @@ impl Renderer {
         self.camera
     }
 
+    /// Apply one edit of the scene (`SceneEdit`), re-preparing only what it reaches; the next
+    /// frame's plan redoes what it invalidates. `set_camera`, `resize`, `set_light`,
+    /// `set_material` and `set_transform` are its cases.
+    pub fn edit(&mut self, edit: SceneEdit) -> Result<(), RenderError> {
+        match edit {
+            SceneEdit::Camera(camera) => {
+                self.set_camera(camera);
+                Ok(())
+            }
+            SceneEdit::Resize { width, height } => self.resize(width, height),
+            SceneEdit::Light { index, light } => self.set_light(index, light),
+            SceneEdit::Material { object, material } => self.set_material(object, material),
+            SceneEdit::Transform { object, transform } => self.set_transform(object, transform),
+        }
+    }
+
     /// Move the camera: the next frame re-shades (and, in pixel mode, gathers again); exitance
     /// at the vertices does not depend on the view.
     pub fn set_camera(&mut self, camera: CameraView) {
@@ -419,7 +432,7 @@ impl Renderer {
             self.gather = Box::new(GatherPixelPass::new(&gpu, &resources)?);
         }
         self.tonemap = Some(TonemapPass::new(&gpu, &resources)?);
-        self.targets.track(self.hazards.get_mut());
+        self.targets.track_camera(self.hazards.get_mut());
         self.planner.mark(Change::Camera);
         Ok(())
     }
@@ -683,24 +696,47 @@ impl Renderer {
         Ok(())
     }
 
-    /// Move object `object`: `transform` replaces its transform in the scene. Its mesh is placed
-    /// again and resampled (same method, count and seed), and the scene's GPU data and passes
-    /// are rebuilt around it (the hierarchy and its lists depend on the geometry); the next
-    /// frame redraws every shadow and gathers every object (`Change::Geometry`). Call with no
-    /// frame of this renderer in flight: its GPU objects are replaced.
+    /// Move object `object`: `transform` replaces its transform in the scene. That object alone
+    /// is placed again and resampled (same method, count and seed), and the scene's GPU data
+    /// and the passes that bind it are made anew (the hierarchy and its lists depend on the
+    /// geometry); the frame targets, timers, camera and shadow pass stay. The next frame redraws
+    /// every shadow and gathers every object (`Change::Geometry`). Call with no frame of this
+    /// renderer in flight: its scene buffers are replaced. On an error nothing changed.
     pub fn set_transform(&mut self, object: usize, transform: crate::scene::Transform) -> Result<(), RenderError> {
-        let mut file_scene = self.scene.scene.clone();
-        let Some(o) = file_scene.file.objects.get_mut(object) else {
-            return Err(RenderError::NoSuchObject { object, objects: self.scene.objects.len() });
-        };
-        o.transform = transform;
-        let prepared = PreparedScene::new(&file_scene, &crate::scene::build::Overrides::default())
-            .map_err(|e| RenderError::Scene(e.to_string()))?;
-        let camera = self.camera;
+        self.check_object(object)?;
+        let mut scene = self.scene.clone();
+        scene.set_transform(object, transform).map_err(|e| RenderError::Scene(e.to_string()))?;
+        check_fits(&self.gpu, &scene)?;
+        let old = std::mem::replace(&mut self.scene, scene);
+        if let Err(e) = self.rebuild_scene_data() {
+            self.scene = old;
+            return Err(e);
+        }
+        // Every buffer is new: nothing is gathered yet, and the change covers what was pending.
         let pending = self.planner.pending().map_or(Change::Geometry(object), |p| p.and(Change::Geometry(object)));
-        *self = Renderer::with_target(&self.gpu.clone(), prepared, self.target)?;
-        self.camera = camera;
         self.planner = Planner::new(self.scene.objects.len(), pending);
+        self.needs = Self::needs_of(&self.scene, self.target, &self.planner);
+        Ok(())
+    }
+
+    /// The scene's GPU data made anew from `self.scene`, and the passes that bind it; the
+    /// shadow pass, the tone map, the frame targets, timers and camera stay. No frame may be
+    /// in flight (the old buffers go).
+    fn rebuild_scene_data(&mut self) -> Result<(), RenderError> {
+        let gpu = self.gpu.clone();
+        let buffers = GpuScene::new(&gpu, &self.scene)?;
+        let resources = Resources { scene: &buffers, targets: &self.targets };
+        let settings = &self.scene.scene.file.render;
+        // Built first, then swapped in: an error leaves the renderer as it was.
+        let gather = Self::gather_pass(&gpu, &resources, settings.gather, self.needs.pixel_gather)?;
+        let (vertex_light, splat) = (VertexLightPass::new(&gpu, &resources)?, SplatPass::new(&gpu, &resources)?);
+        let shade = ShadePass::new(&gpu, self.target, &resources, self.needs.pixel_gather)?;
+        (self.gather, self.vertex_light, self.splat, self.shade) = (gather, vertex_light, splat, shade);
+        self.buffers = buffers;
+        let hazards = self.hazards.get_mut();
+        for r in super::graph::SCENE_BUFFERS {
+            hazards.forget(r);
+        }
         Ok(())
     }
 

@@ -80,6 +80,12 @@ impl FrameTargets {
     pub fn track(&self, hazards: &mut Hazards<Resource>) {
         let depth = vk::ImageAspectFlags::DEPTH;
         hazards.image(Resource::ShadowMaps, self.shadow_maps.raw(), depth, Access::ComputeSampledRead);
+        self.track_camera(hazards);
+    }
+
+    /// Register the camera images with `hazards`, new (after `CameraTargets::new`).
+    pub fn track_camera(&self, hazards: &mut Hazards<Resource>) {
+        let depth = vk::ImageAspectFlags::DEPTH;
         if let Some(c) = &self.camera {
             let color = vk::ImageAspectFlags::COLOR;
             hazards.image(Resource::Hdr, c.hdr.raw(), color, Access::Nothing);

@@ -228,6 +228,24 @@ impl PreparedScene {
         })
     }
 
+    /// Move object `object` to `transform`: that object alone is placed, sampled and given its
+    /// levels anew (as `new` would: same method, count and seed), then the scene's bounds and
+    /// the lights' shadow frames follow it. Errors as `new` does for that object, leaving the
+    /// scene as it was.
+    pub fn set_transform(&mut self, object: usize, transform: super::Transform) -> Result<(), SceneError> {
+        let mut scene = self.scene.clone();
+        scene.file.objects[object].transform = transform;
+        let environment_lit = scene.file.lights.iter().any(|l| matches!(l, Light::Environment { .. }));
+        let prepared = prepare_object(&scene, object, environment_lit)?;
+        self.scene = scene;
+        self.objects[object] = prepared;
+        self.bounds = bounding_sphere(self.objects.iter().map(|o| &o.mesh));
+        let casters: Vec<&Mesh> = self.objects.iter().filter(|o| o.casts_shadow).map(|o| &o.mesh).collect();
+        self.caster_bounds = if casters.is_empty() { self.bounds } else { bounding_sphere(casters.iter().copied()) };
+        self.reprepare_lights();
+        self.check_lights_finite()
+    }
+
     /// Recompute the GPU light records from `scene.file.lights` (after a light moved). The
     /// environment's directions and every light's shadow layer stay as they were.
     pub fn reprepare_lights(&mut self) {
