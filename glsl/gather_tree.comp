@@ -2,8 +2,8 @@
 // Hierarchical dipole gather, for `render.gather = "hierarchical"` (after Jensen and Buhler
 // 2002): the vertex gather's sum with far clusters of samples standing in for their members.
 // Which clusters stand in for which receivers is decided once on the CPU, per group of 32
-// (RECEIVER_GROUP_SIZE) nearby vertices (sampling::SampleTree::cut, with the solid-angle bound render.gather_epsilon):
-// each group has a list of items, samples and nodes. Two stages, one dispatch each (push
+// (RECEIVER_GROUP_SIZE) nearby vertices (sampling::SampleTree::cut, with the solid-angle bound
+// render.gather_epsilon): each group has a list of items, samples and nodes. Two stages, one dispatch each (push
 // `stage`):
 //   0: per node of the object's hierarchy, its transmitted power sum E_i A_i per channel, its
 //      power-weighted centroid and the power-weighted covariance of its members about it, from
