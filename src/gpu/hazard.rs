@@ -75,13 +75,11 @@ impl Sides {
 #[derive(Clone, Debug)]
 pub struct Hazards<K> {
     states: HashMap<K, State>,
-    /// Barriers recorded so far, each counted once (for tests and `--explain`).
-    recorded: usize,
 }
 
 impl<K: Copy + Eq + Hash + std::fmt::Debug> Default for Hazards<K> {
     fn default() -> Self {
-        Hazards { states: HashMap::new(), recorded: 0 }
+        Hazards { states: HashMap::new() }
     }
 }
 
@@ -124,19 +122,9 @@ impl<K: Copy + Eq + Hash + std::fmt::Debug> Hazards<K> {
         self.states.remove(&resource);
     }
 
-    /// The layout image `resource` is in now (`None`: not a tracked image).
-    pub fn layout(&self, resource: K) -> Option<vk::ImageLayout> {
-        self.states.get(&resource).and_then(|s| s.layout)
-    }
-
     /// The last access to `resource`: its last write, or the last read since.
     pub fn last_access(&self, resource: K) -> Access {
         self.states.get(&resource).and_then(|s| s.reads.last().copied().or(s.write)).unwrap_or(Access::Nothing)
-    }
-
-    /// Barriers recorded so far.
-    pub fn barriers_recorded(&self) -> usize {
-        self.recorded
     }
 
     /// Record into `cmd` the one barrier the `uses` need against what came before, and take them
@@ -149,28 +137,27 @@ impl<K: Copy + Eq + Hash + std::fmt::Debug> Hazards<K> {
             let state = self.states.entry(u.resource).or_default();
             let next_layout = state.layout.map(|_| u.access.layout());
             let relayout = u.discard || next_layout.is_some() && next_layout != state.layout;
+            // A write or a layout change waits for the last write and every read since; a read
+            // waits for the last write unless it already did. The readers that already waited
+            // are in the chain too: their stages let a later reader in another stage wait
+            // behind an earlier layout change.
+            let unseen = state.write.is_some() && !state.reads.contains(&u.access);
             let mut sides = Sides::default();
-            if u.access.writes() || relayout {
-                // After the last write and every read since: none of them may see this write.
-                sides.add(&state.reads, state.write, u.access);
-            } else if state.write.is_some() && !state.reads.contains(&u.access) {
-                // Readers that already waited for the write are in the chain: their stages let a
-                // later reader in another stage wait behind an earlier layout change too.
+            if u.access.writes() || relayout || unseen {
                 sides.add(&state.reads, state.write, u.access);
             }
             match (state.image, relayout) {
                 (Some((image, aspect)), true) => {
                     let old = if u.discard { vk::ImageLayout::UNDEFINED } else { state.layout.unwrap_or_default() };
-                    let src_stage = if sides.is_empty() { vk::PipelineStageFlags2::NONE } else { sides.src_stage };
                     images.push(
                         vk::ImageMemoryBarrier2::default()
                             .image(image)
                             .old_layout(old)
                             .new_layout(u.access.layout())
-                            .src_stage_mask(src_stage)
+                            .src_stage_mask(sides.src_stage)
                             .src_access_mask(sides.src_access)
-                            .dst_stage_mask(sides.dst_stage | u.access.stage())
-                            .dst_access_mask(sides.dst_access | u.access.access())
+                            .dst_stage_mask(sides.dst_stage)
+                            .dst_access_mask(sides.dst_access)
                             .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
                             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
                             .subresource_range(
@@ -213,7 +200,6 @@ impl<K: Copy + Eq + Hash + std::fmt::Debug> Hazards<K> {
         if memory.is_empty() && images.is_empty() {
             return;
         }
-        self.recorded += 1;
         let info = vk::DependencyInfo::default().memory_barriers(memory).image_memory_barriers(&images);
         // SAFETY: `cmd` is recording outside rendering; every image is alive while it is.
         unsafe { device.cmd_pipeline_barrier2(cmd, &info) };
