@@ -33,7 +33,9 @@ fn builtin_scene_is_the_marble_bunny() {
     assert!(matches!(&s.objects[0].material, MaterialSpec::Translucent { preset: Some(p), .. } if p == "marble"));
     assert!(matches!(s.objects[1].material, MaterialSpec::Opaque { .. }));
     assert!(s.lights.iter().any(|l| matches!(l, Light::Environment { .. })));
-    assert_eq!(s.sampling.count, 400);
+    // Accurate by default: no count, the 1% error target chooses it.
+    assert_eq!(s.sampling.count, None);
+    assert_eq!(s.render.max_error, 0.01);
     assert!(scene.resolve("bunny-37k.obj").is_ok());
     assert!(scene.resolve("missing.obj").is_err());
 }
@@ -44,6 +46,8 @@ fn defaults_fill_what_is_left_out() {
     assert_eq!(scene.file.camera.resolution, [512, 512]);
     assert_eq!(scene.file.sampling.method, Method::Turk);
     assert_eq!(scene.file.render.gather, GatherMode::Vertex);
+    assert_eq!(scene.file.render.gather_given, None);
+    assert_eq!(scene.file.sampling.count, None);
 }
 
 #[test]

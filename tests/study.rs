@@ -180,3 +180,43 @@ fn study_rejects_a_bad_sweep_selection_naming_the_flag_and_writes_nothing() {
     assert!(!run.status.success() && err.contains("--error-image") && err.contains("--truth-receivers"), "{err}");
     assert!(!out.exists(), "--error-image with --truth-receivers made the output folder");
 }
+
+/// The sample count `render.max_error = target` chooses for the tiny sphere (its scene's own
+/// count left out), with the error predicted for it.
+fn chosen(scene: &translucent::Scene, target: f64) -> (usize, f64) {
+    use translucent::scene::build::{Overrides, PreparedScene};
+    let overrides = Overrides { max_error: Some(target), ..Overrides::default() };
+    let prepared = PreparedScene::new(scene, &overrides).unwrap();
+    let o = &prepared.objects[0];
+    (o.samples.len(), o.density.as_ref().unwrap().worst())
+}
+
+#[test]
+fn an_error_target_gives_a_measured_error_within_its_bounds() {
+    let path = repo_path("tests/scenes/study-tiny.toml");
+    let mut scene = translucent::Scene::load(&path).unwrap();
+    scene.file.sampling.count = None;
+    let targets = [0.1, 0.03];
+    let counts: Vec<(usize, f64)> = targets.iter().map(|&t| chosen(&scene, t)).collect();
+    assert!(counts[1].0 > counts[0].0, "a tighter target needs more samples: {counts:?}");
+    let cache = temp_dir("study-target-cache");
+    let config = translucent::study::StudyConfig {
+        samplers: vec![translucent::sampling::Method::Turk],
+        counts: counts.iter().map(|c| c.0).collect(),
+        gathers: vec![(translucent::GatherMode::Vertex, None)],
+        seeds: vec![1],
+        frames: 1,
+        ..translucent::study::StudyConfig::quick()
+    };
+    let study = common::with_gpu(|gpu| translucent::study::run(gpu, &scene, &config, &cache, &|_| {}).unwrap());
+    for ((row, &target), (count, predicted)) in study.rows.iter().zip(&targets).zip(&counts) {
+        let measured = row.rel_rms.iter().sum::<f64>() / 3.0;
+        eprintln!("target {target}: {count} samples, predicted {predicted:.4} (worst channel), measured {measured:.4}");
+        assert!(
+            (target / 3.0..=1.5 * target).contains(&measured),
+            "target {target}: measured {measured} outside [{}, {}]",
+            target / 3.0,
+            1.5 * target
+        );
+    }
+}

@@ -22,9 +22,13 @@ pub struct Args {
     /// Also write the linear HDR image as OpenEXR
     #[arg(long)]
     pub exr: Option<PathBuf>,
-    /// Sample points per translucent object (overrides the scene)
+    /// Sample points per translucent object (overrides the scene and the error target)
     #[arg(long)]
     pub samples: Option<usize>,
+    /// Relative per-vertex error against the exact dipole integral that each object's sample
+    /// count is chosen for, e.g. 0.01 for 1% (overrides render.max_error)
+    #[arg(long)]
+    pub max_error: Option<f64>,
     /// Sampler (overrides the scene)
     #[arg(long, value_parser = super::one_of::<Method>(&Method::ALL.map(Method::name)))]
     pub sampler: Option<Method>,
@@ -91,6 +95,7 @@ impl Default for Args {
             output: PathBuf::from("translucent.png"),
             exr: None,
             samples: None,
+            max_error: None,
             sampler: None,
             gather: None,
             gather_epsilon: None,
@@ -181,6 +186,7 @@ fn prepare(args: &Args) -> Result<PreparedScene> {
     };
     let overrides = Overrides {
         samples: args.samples,
+        max_error: args.max_error,
         sampler: args.sampler,
         gather: args.gather,
         gather_epsilon: args.gather_epsilon,

@@ -11,6 +11,7 @@
 //! Every point then gets the area of the surface nearer to it than to any other sample
 //! ([`weights`]), so the weights sum to the mesh area and follow the local density.
 
+pub mod density;
 pub mod feature;
 pub mod hash;
 pub mod poisson;

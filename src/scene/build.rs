@@ -57,6 +57,8 @@ pub struct PreparedObject {
     pub casts_shadow: bool,
     /// World-space sample points with area weights (translucent objects only).
     pub samples: Vec<SamplePoint>,
+    /// How many samples it got and the error predicted for them (translucent objects only).
+    pub density: Option<super::accuracy::Density>,
     /// Its levels of detail, finest (the mesh itself) first; only the mesh itself when
     /// `render.level_of_detail` is off or the object's shading rests on per-vertex data the
     /// simplifier cannot see (`lod_allowed`).
@@ -162,6 +164,9 @@ pub struct Overrides {
     pub transport: Option<crate::scene::TransportMode>,
     /// `--full-detail` (false): replaces `render.level_of_detail`.
     pub level_of_detail: Option<bool>,
+    /// `--max-error`: replaces `render.max_error` ([`crate::scene::MIN_MAX_ERROR`] to
+    /// [`crate::scene::MAX_MAX_ERROR`]).
+    pub max_error: Option<f64>,
 }
 
 impl PreparedScene {
@@ -179,9 +184,11 @@ impl PreparedScene {
         let mut scene = scene.clone();
         apply_overrides(&mut scene, overrides)?;
         let environment_lit = scene.file.lights.iter().any(|l| matches!(l, Light::Environment { .. }));
-        let objects = (0..scene.file.objects.len())
+        let mut objects = (0..scene.file.objects.len())
             .map(|i| prepare_object(&scene, i, environment_lit))
             .collect::<Result<Vec<_>, _>>()?;
+        sample_objects(&scene, &mut objects, None)?;
+        choose_gather(&mut scene, &objects, overrides);
         for (i, o) in objects.iter().enumerate() {
             if let Some(warning) = precision_warning(&o.mesh) {
                 log::warn!("{}: object[{i}] ({}): {warning}", scene.name, o.name);
@@ -236,9 +243,11 @@ impl PreparedScene {
         let mut scene = self.scene.clone();
         scene.file.objects[object].transform = transform;
         let environment_lit = scene.file.lights.iter().any(|l| matches!(l, Light::Environment { .. }));
-        let prepared = prepare_object(&scene, object, environment_lit)?;
+        let mut objects = self.objects.clone();
+        objects[object] = prepare_object(&scene, object, environment_lit)?;
+        sample_objects(&scene, &mut objects, Some(object))?;
         self.scene = scene;
-        self.objects[object] = prepared;
+        self.objects = objects;
         self.bounds = bounding_sphere(self.objects.iter().map(|o| &o.mesh));
         let casters: Vec<&Mesh> = self.objects.iter().filter(|o| o.casts_shadow).map(|o| &o.mesh).collect();
         self.caster_bounds = if casters.is_empty() { self.bounds } else { bounding_sphere(casters.iter().copied()) };
@@ -280,7 +289,13 @@ fn apply_overrides(scene: &mut Scene, overrides: &Overrides) -> Result<(), Scene
         if n == 0 {
             return Err(SceneError::ZeroSamples);
         }
-        scene.file.sampling.count = n;
+        scene.file.sampling.count = Some(n);
+    }
+    if let Some(e) = overrides.max_error {
+        if crate::scene::check_max_error("--max-error", e).is_err() {
+            return Err(SceneError::MaxError(e));
+        }
+        scene.file.render.max_error = e;
     }
     if let Some(m) = overrides.sampler {
         scene.file.sampling.method = m;
@@ -307,8 +322,8 @@ fn apply_overrides(scene: &mut Scene, overrides: &Overrides) -> Result<(), Scene
 }
 
 /// Object `i` of `scene` loaded, placed, checked against [`super::MAX_SCENE_COORDINATE`], its
-/// material resolved, sampled (translucent only, seed `sampling.seed + i`) and its levels of
-/// detail built (where [`lod_allowed`]).
+/// material resolved and its levels of detail built (where [`lod_allowed`]); [`sample_objects`]
+/// places its samples once every object is placed.
 fn prepare_object(scene: &Scene, i: usize, environment_lit: bool) -> Result<PreparedObject, SceneError> {
     let o = &scene.file.objects[i];
     let (name, mesh) = load_shape(scene, &o.shape).with_context(|| format!("{}: object[{i}]", scene.name))?;
@@ -316,22 +331,67 @@ fn prepare_object(scene: &Scene, i: usize, environment_lit: bool) -> Result<Prep
         .with_context(|| format!("{}: object[{i}] ({name}): transform", scene.name))?;
     check_reach(scene, i, &name, &mesh)?;
     let material = resolve_material(&o.material, &format!("{}: object[{i}].material", scene.name))?;
-    let samples = match material {
-        ResolvedMaterial::Translucent { .. } => {
-            let options = SampleOptions::new(scene.file.sampling.method, scene.file.sampling.count)
-                .with_seed(scene.file.sampling.seed.wrapping_add(i as u64));
-            sampling::sample(&mesh, &options)
-                .with_context(|| format!("{}: object[{i}] ({name}): sampling", scene.name))?
-                .points
-        }
-        ResolvedMaterial::Opaque { .. } => Vec::new(),
-    };
     let levels = if scene.file.render.level_of_detail && lod_allowed(&material, environment_lit) {
         mesh.levels_of_detail()
     } else {
         vec![mesh.full_level()]
     };
-    Ok(PreparedObject { name, mesh, material, casts_shadow: o.casts_shadow, samples, levels })
+    Ok(PreparedObject {
+        name,
+        mesh,
+        material,
+        casts_shadow: o.casts_shadow,
+        samples: Vec::new(),
+        density: None,
+        levels,
+    })
+}
+
+/// Place the samples of every translucent object of `objects` (only object `only`, when given),
+/// object `i` with seed `sampling.seed + i`: `sampling.count` of them when the scene sets it,
+/// else as many as `render.max_error` needs (`super::accuracy`), judged with every shadow
+/// caster of `objects` in place.
+fn sample_objects(scene: &Scene, objects: &mut [PreparedObject], only: Option<usize>) -> Result<(), SceneError> {
+    let casters: Vec<[glam::DVec3; 3]> = objects
+        .iter()
+        .filter(|o| o.casts_shadow)
+        .flat_map(|o| (0..o.mesh.triangles().len()).map(|t| o.mesh.corners(t)))
+        .collect();
+    let occluders = crate::reference::bvh::Bvh::new(casters);
+    let bounds = bounding_sphere(objects.iter().map(|o| &o.mesh));
+    let eps = 1e-5 * f64::from(bounds.1);
+    let file = &scene.file;
+    for (i, o) in objects.iter_mut().enumerate().filter(|(i, _)| only.is_none_or(|j| j == *i)) {
+        let facts = super::accuracy::surface_facts(o, &occluders, eps);
+        let Some((count, density)) =
+            super::accuracy::choose_count(o, facts, file.sampling.count, file.render.max_error)
+        else {
+            continue;
+        };
+        let options =
+            SampleOptions::new(file.sampling.method, count).with_seed(file.sampling.seed.wrapping_add(i as u64));
+        o.samples = sampling::sample(&o.mesh, &options)
+            .with_context(|| format!("{}: object[{i}] ({}): sampling", scene.name, o.name))?
+            .points;
+        o.density = Some(density);
+    }
+    Ok(())
+}
+
+/// The gather a scene leaves to the sample count: the hierarchical one, at
+/// [`super::ACCURATE_GATHER_EPSILON`] unless the scene or the command line gives an epsilon,
+/// when an object has more than [`super::AUTO_HIERARCHICAL_COUNT`] samples.
+fn choose_gather(scene: &mut Scene, objects: &[PreparedObject], overrides: &Overrides) {
+    let render = &mut scene.file.render;
+    if render.gather_given.is_some() || overrides.gather.is_some() {
+        return;
+    }
+    if objects.iter().any(|o| o.samples.len() > super::AUTO_HIERARCHICAL_COUNT) {
+        render.gather = GatherMode::Hierarchical;
+        if render.gather_epsilon_given.is_none() && overrides.gather_epsilon.is_none() {
+            render.gather_epsilon = super::ACCURATE_GATHER_EPSILON;
+        }
+    }
 }
 
 /// Object `i` (`name`), as placed, must stay within [`super::MAX_SCENE_COORDINATE`] of the

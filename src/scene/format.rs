@@ -249,10 +249,11 @@ pub struct Sampling {
     /// Placement: `"random"`, `"turk"`, `"feature"` or `"poisson"` (default `"turk"`).
     #[serde(default = "method")]
     pub method: Method,
-    /// Sample points per translucent object (default 400; 1 to
-    /// [`crate::scene::MAX_SAMPLE_COUNT`]).
-    #[serde(default = "count")]
-    pub count: usize,
+    /// Sample points per translucent object (1 to [`crate::scene::MAX_SAMPLE_COUNT`]). Unset
+    /// (the default), each object gets as many as `render.max_error` needs
+    /// (`sampling::density`); set, it overrides the error target's count.
+    #[serde(default)]
+    pub count: Option<usize>,
     /// Random seed (default 1); object `i` uses `seed + i`, so the same scene gives the same
     /// points.
     #[serde(default = "seed")]
@@ -261,15 +262,12 @@ pub struct Sampling {
 
 impl Default for Sampling {
     fn default() -> Self {
-        Self { method: method(), count: count(), seed: seed() }
+        Self { method: method(), count: None, seed: seed() }
     }
 }
 
 fn method() -> Method {
     Method::Turk
-}
-fn count() -> usize {
-    400
 }
 fn seed() -> u64 {
     1
@@ -279,15 +277,25 @@ fn seed() -> u64 {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RenderSettings {
-    /// Where exitance is gathered (default `"vertex"`).
-    #[serde(default)]
+    /// Where exitance is gathered, as the scene gives it (`None`: chosen with the sample count,
+    /// [`RenderSettings::gather`]).
+    #[serde(default, rename = "gather")]
+    pub gather_given: Option<GatherMode>,
+    /// Where exitance is gathered: `render.gather` when given, else `"vertex"` until the sample
+    /// count is known, then `"hierarchical"` for an object of more than
+    /// [`AUTO_HIERARCHICAL_COUNT`] samples (`PreparedScene::new`).
+    #[serde(skip)]
     pub gather: GatherMode,
     /// The hierarchical gather's accuracy knob (default [`DEFAULT_GATHER_EPSILON`]; 0 to
     /// [`MAX_GATHER_EPSILON`]): a cluster of samples of area `A` whose nearest member is `r`
     /// away stands in for its members when `A < epsilon r^2`. 0 is the flat sum; other gather
     /// modes ignore it.
-    #[serde(default = "gather_epsilon")]
+    #[serde(skip, default = "gather_epsilon")]
     pub gather_epsilon: f32,
+    /// `render.gather_epsilon` as the scene gives it (`None`: [`DEFAULT_GATHER_EPSILON`], or
+    /// [`ACCURATE_GATHER_EPSILON`] when the gather is chosen with the sample count).
+    #[serde(default, rename = "gather_epsilon")]
+    pub gather_epsilon_given: Option<f32>,
     /// How each translucent object's channels get their exitance (default `"auto"`: the
     /// planner chooses per object and channel, `render::plan`).
     #[serde(default)]
@@ -306,6 +314,13 @@ pub struct RenderSettings {
     /// every mesh whole, and every vertex's exitance current (what per-vertex studies need).
     #[serde(default = "yes")]
     pub level_of_detail: bool,
+    /// The relative per-vertex error of the exitance against the exact dipole integral that
+    /// the sample density is chosen for (default [`DEFAULT_MAX_ERROR`], 1%; [`MIN_MAX_ERROR`] to
+    /// [`MAX_MAX_ERROR`]): `sampling::density` predicts each object's error per channel and
+    /// places as many samples as the worst channel needs. `sampling.count` or `--samples`
+    /// overrides it.
+    #[serde(default = "max_error")]
+    pub max_error: f64,
 }
 
 /// Where exitance is gathered: `render.gather` in a scene, `--gather` on the command line.
@@ -404,13 +419,16 @@ impl std::fmt::Display for TransportMode {
 impl Default for RenderSettings {
     fn default() -> Self {
         Self {
+            gather_given: None,
             gather: GatherMode::default(),
             gather_epsilon: gather_epsilon(),
+            gather_epsilon_given: None,
             transport: TransportMode::default(),
             exposure: 1.0,
             shadow_map_size: shadow_size(),
             background: None,
             level_of_detail: true,
+            max_error: DEFAULT_MAX_ERROR,
         }
     }
 }
@@ -418,12 +436,29 @@ impl Default for RenderSettings {
 /// `render.gather_epsilon` when a scene names none: chosen from the benchmark's sweep (README,
 /// "Performance").
 pub const DEFAULT_GATHER_EPSILON: f32 = 4.0;
+/// `render.gather_epsilon` when the gather is chosen with the sample count: the study's rows at
+/// 0.3 match the flat sum's error at every count (docs/STUDY.md), where 4 adds about 0.5%.
+pub const ACCURATE_GATHER_EPSILON: f32 = 0.3;
+/// Above this many samples on an object, a gather the scene does not name is the hierarchical
+/// one: the flat sum's cost grows with samples times receivers.
+pub const AUTO_HIERARCHICAL_COUNT: usize = 1600;
 /// The largest `render.gather_epsilon`: a node seen under more than this solid angle is never
 /// a good stand-in.
 pub const MAX_GATHER_EPSILON: f32 = 10.0;
 
 fn gather_epsilon() -> f32 {
     DEFAULT_GATHER_EPSILON
+}
+
+/// `render.max_error` when a scene names none: 1% per vertex against the exact integral.
+pub const DEFAULT_MAX_ERROR: f64 = 0.01;
+/// The smallest `render.max_error`: below it the model's fit has no data (docs/STUDY.md).
+pub const MIN_MAX_ERROR: f64 = 0.001;
+/// The largest `render.max_error`: 50% is already a different picture.
+pub const MAX_MAX_ERROR: f64 = 0.5;
+
+fn max_error() -> f64 {
+    DEFAULT_MAX_ERROR
 }
 
 fn shadow_size() -> u32 {

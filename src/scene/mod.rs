@@ -1,6 +1,7 @@
 //! Scenes: the TOML format (`format`), loading with errors that name the file, key path and
 //! line, value checks, and the built-in default scene.
 
+pub mod accuracy;
 pub mod build;
 mod camera;
 pub mod format;
@@ -48,6 +49,9 @@ pub enum SceneError {
     /// `--gather-epsilon` outside its range.
     #[error("--gather-epsilon {0} must be 0 to {MAX_GATHER_EPSILON} (as for render.gather_epsilon)")]
     GatherEpsilon(f32),
+    /// `--max-error` outside its range.
+    #[error("--max-error {0} must be {MIN_MAX_ERROR} to {MAX_MAX_ERROR} (as for render.max_error; 0.01 is 1%)")]
+    MaxError(f64),
     /// `transform.fit` on a mesh whose bounding box has no extent.
     #[error("cannot fit a mesh with an empty bounding box")]
     EmptyBounds,
@@ -119,7 +123,7 @@ impl Scene {
     pub fn parse(text: &str, name: &str, base: Option<PathBuf>) -> Result<Scene, SceneError> {
         let invalid = |message: String| SceneError::Invalid { file: name.to_string(), message };
         let deserializer = toml::Deserializer::parse(text).map_err(|e| invalid(e.to_string()))?;
-        let file: SceneFile = serde_path_to_error::deserialize(deserializer).map_err(|e| {
+        let mut file: SceneFile = serde_path_to_error::deserialize(deserializer).map_err(|e| {
             let path = e.path().to_string();
             let inner = e.into_inner().to_string();
             // Inside internally tagged tables toml can only point at the table header; find
@@ -150,6 +154,8 @@ impl Scene {
                 invalid(format!("{line}at key `{path}`: {inner}"))
             }
         })?;
+        file.render.gather = file.render.gather_given.unwrap_or_default();
+        file.render.gather_epsilon = file.render.gather_epsilon_given.unwrap_or(DEFAULT_GATHER_EPSILON);
         check(&file).map_err(|(key, message)| {
             let line = line_of(text, &key).map(|l| format!("line {l}: ")).unwrap_or_default();
             invalid(format!("{line}`{key}`: {message}"))
@@ -265,8 +271,10 @@ fn check(scene: &SceneFile) -> Check {
     }
     check_lights(&scene.lights)?;
     let s = &scene.sampling;
-    if s.count == 0 || s.count > MAX_SAMPLE_COUNT {
-        return Err(("sampling.count".into(), format!("{} must be 1 to {MAX_SAMPLE_COUNT}", s.count)));
+    if let Some(count) = s.count
+        && (count == 0 || count > MAX_SAMPLE_COUNT)
+    {
+        return Err(("sampling.count".into(), format!("{count} must be 1 to {MAX_SAMPLE_COUNT}")));
     }
     check_render(&scene.render)
 }
@@ -423,5 +431,21 @@ fn check_render(r: &RenderSettings) -> Check {
         return Err(("render.shadow_map_size".into(), format!("{} must be 16 to 8192", r.shadow_map_size)));
     }
     non_negative("render.background", &r.background.unwrap_or_default())?;
+    check_max_error("render.max_error", r.max_error)
+}
+
+/// A relative error target (`render.max_error`, `--max-error`) within
+/// [`format::MIN_MAX_ERROR`] to [`format::MAX_MAX_ERROR`].
+pub fn check_max_error(key: &str, e: f64) -> Check {
+    if !(format::MIN_MAX_ERROR..=format::MAX_MAX_ERROR).contains(&e) {
+        return Err((
+            key.into(),
+            format!(
+                "{e} must be {} to {} (a relative error: 0.01 is 1%)",
+                format::MIN_MAX_ERROR,
+                format::MAX_MAX_ERROR
+            ),
+        ));
+    }
     Ok(())
 }

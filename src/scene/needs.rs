@@ -48,6 +48,9 @@ pub struct ObjectFacts {
     pub channels: Option<[ChannelFacts; 3]>,
     /// Its levels of detail, finest (the mesh itself) first (`PreparedObject::levels`).
     pub levels: Vec<LevelFacts>,
+    /// How its sample count was chosen and the per-vertex error predicted for it
+    /// (`scene::accuracy`); `None` for an opaque object.
+    pub density: Option<super::accuracy::Density>,
 }
 
 /// One level of detail as the planner weighs it (`mesh::LodLevel`). Lengths in scene units.
@@ -115,6 +118,7 @@ impl ObjectFacts {
                     locked: l.locked,
                 })
                 .collect(),
+            density: object.density.clone(),
         }
     }
 }

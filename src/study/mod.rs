@@ -216,9 +216,10 @@ fn time_reference(
     rows: &[Row],
 ) -> Result<Option<ReferenceTiming>, StudyError> {
     let own = &base.scene.file.sampling;
+    let own_count = base.objects.iter().find(|o| !o.samples.is_empty()).map(|o| o.samples.len());
     let vertex_rows = || rows.iter().enumerate().filter(|(_, r)| r.gather == GatherMode::Vertex.name());
     let pick = vertex_rows()
-        .find(|(_, r)| r.sampler == own.method.name() && r.samples == own.count)
+        .find(|(_, r)| r.sampler == own.method.name() && Some(r.samples) == own_count)
         .or_else(|| vertex_rows().next());
     let Some((row, r)) = pick else { return Ok(None) };
     let method = *config.samplers.iter().find(|m| m.name() == r.sampler).expect("a swept sampler");
@@ -246,7 +247,7 @@ fn configure(
     let mut scene = base.clone();
     let file = &mut scene.scene.file;
     file.sampling.method = method;
-    file.sampling.count = count;
+    file.sampling.count = Some(count);
     file.sampling.seed = seed;
     file.render.gather = gather.0;
     if let Some(e) = gather.1 {
@@ -255,7 +256,8 @@ fn configure(
     file.render.transport = TransportMode::Gather;
     let start = std::time::Instant::now();
     for (i, o) in scene.objects.iter_mut().enumerate() {
-        if let ResolvedMaterial::Translucent { .. } = o.material {
+        if let ResolvedMaterial::Translucent { dipoles, .. } = &o.material {
+            o.density = o.density.as_ref().map(|d| d.given(dipoles, count));
             // The seed of object i is sampling.seed + i, as `PreparedScene::new` places them.
             let options = SampleOptions::new(method, count).with_seed(seed.wrapping_add(i as u64));
             o.samples = sampling::sample(&o.mesh, &options)

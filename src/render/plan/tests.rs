@@ -18,6 +18,7 @@ fn object(radius: f32, spacing: f64, profile: f64) -> ObjectFacts {
             error: 0.0,
             locked: false,
         }],
+        density: None,
     }
 }
 

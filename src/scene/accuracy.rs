@@ -1,0 +1,104 @@
+//! From `render.max_error` to each translucent object's sample count: the surface facts the
+//! error model weighs (`sampling::density`), measured on the placed meshes.
+
+use super::build::{PreparedObject, ResolvedMaterial};
+use crate::reference::bvh::Bvh;
+use crate::sampling::density::{self, ChannelError, SurfaceFacts};
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Most vertices at which occlusion is ray cast (spread evenly over the vertex order).
+const OCCLUSION_VERTICES: usize = 512;
+/// Directions per vertex, over the hemisphere about its normal.
+const OCCLUSION_DIRECTIONS: usize = 64;
+
+/// How an object's sample count was chosen, with the prediction behind it.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Density {
+    /// `render.max_error` it was chosen for (`None`: the count was given, `sampling.count` or
+    /// `--samples`).
+    pub target: Option<f64>,
+    /// The facts the model weighed.
+    pub facts: SurfaceFacts,
+    /// Per channel (R, G, B), the predicted error at the count placed.
+    pub predicted: [ChannelError; 3],
+}
+
+impl Density {
+    /// The same facts with `count` samples given rather than chosen (a study's configuration).
+    pub fn given(&self, dipoles: &[crate::optics::Dipole; 3], count: usize) -> Density {
+        let radii = dipoles.each_ref().map(|d| d.profile_radius());
+        Density { target: None, facts: self.facts, predicted: density::predict(&self.facts, radii, count) }
+    }
+
+    /// The worst channel's predicted error.
+    pub fn worst(&self) -> f64 {
+        self.predicted.iter().map(|c| c.error).fold(0.0, f64::max)
+    }
+}
+
+/// `object`'s surface facts, with `occluders` the scene's shadow casters.
+pub fn surface_facts(object: &PreparedObject, occluders: &Bvh, ray_offset: f64) -> SurfaceFacts {
+    let mesh = &object.mesh;
+    let (h, a) = (mesh.mean_curvature(), mesh.mixed_areas());
+    let area: f64 = a.iter().sum();
+    let h2 = h.iter().zip(a).map(|(h, a)| h * h * a).sum::<f64>() / area.max(f64::MIN_POSITIVE);
+    let curvature_radius = if h2 > 0.0 { 1.0 / h2.sqrt() } else { f64::INFINITY };
+    SurfaceFacts { area: mesh.total_area(), curvature_radius, occlusion: occlusion(object, occluders, ray_offset) }
+}
+
+/// The area-weighted share of the hemisphere above `object`'s surface that `occluders` block,
+/// ray cast at up to [`OCCLUSION_VERTICES`] vertices in [`OCCLUSION_DIRECTIONS`] fixed
+/// directions each (a spherical Fibonacci set, so the answer is the same on every run).
+fn occlusion(object: &PreparedObject, occluders: &Bvh, eps: f64) -> f64 {
+    let mesh = &object.mesh;
+    let picks = crate::reference::truth::receiver_subset(mesh.positions().len(), Some(OCCLUSION_VERTICES));
+    let directions = fibonacci_sphere(2 * OCCLUSION_DIRECTIONS);
+    let (blocked, weight) = picks
+        .par_iter()
+        .map(|&v| {
+            let p = mesh.positions()[v].as_dvec3();
+            let n = mesh.vertex_normals()[v].as_dvec3();
+            let (mut hits, mut seen) = (0usize, 0usize);
+            for d in directions.iter().filter(|d| d.dot(n) > 0.0) {
+                seen += 1;
+                if occluders.occluded(p + n * eps, *d, eps, f64::INFINITY) {
+                    hits += 1;
+                }
+            }
+            let share = if seen > 0 { hits as f64 / seen as f64 } else { 0.0 };
+            let area = mesh.mixed_areas()[v];
+            (share * area, area)
+        })
+        .reduce(|| (0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+    if weight > 0.0 { blocked / weight } else { 0.0 }
+}
+
+/// `n` unit directions spread evenly over the sphere (spherical Fibonacci lattice).
+fn fibonacci_sphere(n: usize) -> Vec<DVec3> {
+    let golden = std::f64::consts::PI * (3.0 - 5.0f64.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - (2 * i + 1) as f64 / n as f64;
+            let ring = (1.0 - z * z).sqrt();
+            let phi = golden * i as f64;
+            DVec3::new(ring * phi.cos(), ring * phi.sin(), z)
+        })
+        .collect()
+}
+
+/// The sample count for `object` and the prediction behind it: `given` (`sampling.count`) when
+/// set, else the fewest samples `sampling::density::count_for` finds for `max_error`. `None`
+/// for an opaque object.
+pub fn choose_count(
+    object: &PreparedObject,
+    facts: SurfaceFacts,
+    given: Option<usize>,
+    max_error: f64,
+) -> Option<(usize, Density)> {
+    let ResolvedMaterial::Translucent { dipoles, .. } = &object.material else { return None };
+    let radii = dipoles.each_ref().map(|d| d.profile_radius());
+    let count = given.unwrap_or_else(|| density::count_for(&facts, radii, max_error));
+    let predicted = density::predict(&facts, radii, count);
+    Some((count, Density { target: given.is_none().then_some(max_error), facts, predicted }))
+}
