@@ -46,6 +46,7 @@ struct GatherSparsePush {
     uint node_count;        // its node count
     uint first_receiver;    // its first entry in receiver_order
     uint first_group;       // its first group in receiver_groups
+    uint receiver_count;    // receivers at the level of detail gathered (stage 1's threads)
 };
 layout(push_constant) uniform GatherSparsePushBlock { GatherSparsePush push; };
 
@@ -74,7 +75,7 @@ void main() {
         sample_exitance[j] = vec4(max(g.far, vec3(0.0)), 0.0);
         return;
     }
-    uint count = o.ranges.y;
+    uint count = push.receiver_count;
     bool is_receiver = k < count;
     uint v = receiver_order[push.first_receiver + min(k, max(count, 1u) - 1u)];
     vec3 x = vertex_position(vertices[v]);

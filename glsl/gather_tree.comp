@@ -48,6 +48,7 @@ struct GatherTreePush {
     uint node_count;        // its node count
     uint first_receiver;    // its first entry in receiver_order
     uint first_group;       // its first group in receiver_groups
+    uint receiver_count;    // receivers at the level of detail gathered (stage 1's threads)
 };
 layout(push_constant) uniform GatherTreePushBlock { GatherTreePush push; };
 
@@ -92,7 +93,7 @@ void main() {
         return;
     }
     ObjectRecord o = objects[push.object];
-    uint count = o.ranges.y;
+    uint count = push.receiver_count;
     bool is_receiver = k < count;
     uint v = receiver_order[push.first_receiver + min(k, max(count, 1u) - 1u)];
     vec3 x = vertex_position(vertices[v]);

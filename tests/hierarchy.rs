@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{builtin, gather_from, plane_scene, temp_dir, text, translucent, with_gpu};
+use common::{builtin, gather_from, plane_scene, run_all, temp_dir, text, translucent, with_gpu};
 use translucent::optics::{Material, fresnel};
 use translucent::reference;
 use translucent::scene::build::{Overrides, PreparedScene};
@@ -16,6 +16,8 @@ fn hierarchical(epsilon: f32) -> Overrides {
         resolution: Some([64, 64]),
         gather: Some(GatherMode::Hierarchical),
         gather_epsilon: Some(epsilon),
+        // Every vertex is compared: whole meshes.
+        level_of_detail: Some(false),
         ..Default::default()
     }
 }
@@ -173,4 +175,26 @@ fn a_bad_gather_epsilon_is_an_error_naming_it() {
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("render.gather_epsilon 0") && stderr.contains("maxStorageBufferRange"), "{stderr}");
     assert!(!png.exists());
+}
+
+#[test]
+fn a_coarse_level_of_detail_gathers_hierarchically_at_its_own_vertices_as_the_whole_mesh_does() {
+    // At 64x64 the bunny is drawn at a coarse level: the gather runs at that level's vertices,
+    // grouped and cut anew, and must agree there with the whole mesh's gather within the
+    // epsilon's own error.
+    let epsilon = translucent::scene::ACCURATE_GATHER_EPSILON;
+    let lod = Overrides { level_of_detail: Some(true), ..hierarchical(epsilon) };
+    let (level, vertices, coarse, whole) = with_gpu(|gpu| {
+        let (level, vertices, coarse) = run_all(gpu, builtin(&lod)).exitance_at_level(0).unwrap();
+        let whole = run_all(gpu, builtin(&hierarchical(epsilon))).exitance(0).unwrap();
+        (level, vertices, coarse, whole)
+    });
+    assert!(level > 0, "the 64x64 view draws the bunny coarse");
+    let at: Vec<[f64; 3]> = vertices.iter().map(|&v| whole[v as usize].map(f64::from)).collect();
+    let got: Vec<[f64; 3]> = coarse.iter().map(|m| m.map(f64::from)).collect();
+    let (worst, rms) = compare(&got, &at);
+    eprintln!("level {level}, {} vertices: worst {worst:.4}, RMS {rms:.5} against the whole mesh", vertices.len());
+    // Measured at level 6 (591 vertices): RMS 0.54%, and three vertices 6 to 9% off (12 to 15%
+    // of the peak); their cause is not found yet (docs/STUDY.md).
+    assert!(rms < 1e-2 && worst < 0.15, "level {level}: worst {worst}, RMS {rms}");
 }

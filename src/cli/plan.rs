@@ -43,7 +43,8 @@ pub fn run(args: &Args) -> Result<()> {
     // The first frame computes everything; every other change follows a frame that did, at the
     // levels of detail it chose (a fresh scene has no levels baked from sky light to withdraw).
     let first = planner.plan(&needs, &view);
-    planner.recorded(&first, prepared.scene.file.render.gather == GatherMode::Vertex);
+    planner
+        .recorded(&first, matches!(prepared.scene.file.render.gather, GatherMode::Vertex | GatherMode::Hierarchical));
     let frames: Vec<(Change, plan::Plan)> = Change::all(prepared.scene.file.lights.len(), objects)
         .into_iter()
         .map(|change| {

@@ -9,7 +9,7 @@ use super::records::{
 };
 use crate::gpu::{Buffer, BufferDesc, Gpu, GpuResult};
 use crate::optics::kernel::NEAR_BLEND_RADIUS;
-use crate::sampling::NODE_ITEM;
+use crate::sampling::{NODE_ITEM, SampleTree};
 use crate::scene::build::PreparedScene;
 use ash::vk;
 use std::sync::Arc;
@@ -138,6 +138,10 @@ pub struct GpuScene {
     pub light_matrices: Vec<[[f32; 4]; 4]>,
     /// The translucent objects, in scene order: what the gathers dispatch over.
     pub receivers: Vec<Receiver>,
+    /// Per entry of `receivers`, the hierarchical gather's receivers at each coarser level of
+    /// detail (level 1 first): the level's vertices grouped and cut anew, so that a frame
+    /// drawing a coarse level gathers at its vertices only. Empty for other gathers.
+    pub coarser_receivers: Vec<Vec<Receiver>>,
     /// Vertices of all objects together.
     pub vertex_count: u32,
     /// Sample points of all objects together.
@@ -209,6 +213,20 @@ fn upload<T: bytemuck::Pod>(gpu: &Arc<Gpu>, name: &str, data: &[T], usage: vk::B
     Ok(buffer)
 }
 
+/// What `PackedObjects::receivers_at` groups: an object's receivers at one level of detail.
+#[derive(Clone, Copy)]
+struct ReceiversAt<'a> {
+    tree: &'a SampleTree,
+    /// Object-relative vertex indices.
+    vertices: &'a [u32],
+    /// The hierarchical gather's epsilon, when the scene gathers hierarchically.
+    epsilon: Option<f64>,
+    /// Whether the scene gathers sparsely (blend lists wanted).
+    sparse: bool,
+    /// The object's first vertex, first sample and first node.
+    first: [u32; 3],
+}
+
 /// Every object's records packed for the shared buffers, in scene order: vertices, samples and
 /// object records, and for each translucent object its sample hierarchy, receiver groups and the
 /// gathers' item lists, made absolute.
@@ -219,6 +237,7 @@ struct PackedObjects {
     samples: Vec<SampleRecord>,
     vertex_boundary: Vec<[f32; 2]>,
     receivers: Vec<Receiver>,
+    coarser_receivers: Vec<Vec<Receiver>>,
     tree_nodes: Vec<TreeNodeRecord>,
     tree_order: Vec<u32>,
     receiver_order: Vec<u32>,
@@ -259,7 +278,8 @@ impl PackedObjects {
     }
 
     /// Translucent object `i`'s hierarchy, receiver groups and their item lists; `first` is its
-    /// first vertex and first sample.
+    /// first vertex and first sample. A hierarchical gather gets receivers at every coarser
+    /// level of detail too.
     fn receiver(&mut self, scene: &PreparedScene, i: usize, o: &crate::scene::build::PreparedObject, first: [u32; 2]) {
         let [first_vertex, first_sample] = first;
         let render = &scene.scene.file.render;
@@ -267,30 +287,58 @@ impl PackedObjects {
         let (first_node, first_entry) = (self.tree_nodes.len() as u32, self.tree_order.len() as u32);
         self.tree_nodes.extend(tree.nodes.iter().map(|n| TreeNodeRecord::new(n, first_node, first_entry)));
         self.tree_order.extend(tree.order.iter().map(|k| first_sample + k));
-        let groups = o.receiver_groups();
-        let (first_receiver, first_group) = (self.receiver_order.len() as u32, self.receiver_groups.len() as u32);
-        self.receiver_order.extend(groups.order.iter().map(|v| first_vertex + v));
-        let cuts = if render.gather == crate::scene::GatherMode::Hierarchical {
-            o.gather_cuts(&tree, &groups, render.gather_epsilon as f64)
-        } else {
-            vec![Vec::new(); groups.bounds.len()]
-        };
+        let hierarchical = render.gather == crate::scene::GatherMode::Hierarchical;
+        let epsilon = hierarchical.then_some(render.gather_epsilon as f64);
         let sparse = render.gather == crate::scene::GatherMode::Sparse;
-        let positions: Vec<glam::DVec3> = o.samples.iter().map(|s| s.position.as_dvec3()).collect();
+        let whole: Vec<u32> = (0..o.mesh.positions().len() as u32).collect();
+        fn at<'a>(tree: &'a SampleTree, vertices: &'a [u32], like: &ReceiversAt) -> ReceiversAt<'a> {
+            ReceiversAt { tree, vertices, ..*like }
+        }
+        let like = ReceiversAt {
+            tree: &tree,
+            vertices: &whole,
+            epsilon,
+            sparse,
+            first: [first_vertex, first_sample, first_node],
+        };
+        let receiver = self.receivers_at(i, o, at(&tree, &whole, &like));
+        self.receivers.push(receiver);
+        let coarser = if hierarchical {
+            o.levels.iter().skip(1).map(|l| self.receivers_at(i, o, at(&tree, &l.vertices, &like))).collect()
+        } else {
+            Vec::new()
+        };
+        self.coarser_receivers.push(coarser);
+    }
+
+    /// Object `i`'s receivers `at.vertices` (object-relative indices) grouped, with each group's
+    /// hierarchical cut (when `at.epsilon` is given) and sparse blend list.
+    fn receivers_at(&mut self, i: usize, o: &crate::scene::build::PreparedObject, at: ReceiversAt) -> Receiver {
+        let [first_vertex, first_sample, first_node] = at.first;
+        let positions: Vec<glam::DVec3> =
+            at.vertices.iter().map(|&v| o.mesh.positions()[v as usize].as_dvec3()).collect();
+        let groups = crate::sampling::ReceiverGroups::new(&positions);
+        let (first_receiver, first_group) = (self.receiver_order.len() as u32, self.receiver_groups.len() as u32);
+        self.receiver_order.extend(groups.order.iter().map(|&k| first_vertex + at.vertices[k as usize]));
+        let cuts = match at.epsilon {
+            Some(epsilon) => o.gather_cuts(at.tree, &groups, epsilon),
+            None => vec![Vec::new(); groups.bounds.len()],
+        };
+        let samples: Vec<glam::DVec3> = o.samples.iter().map(|s| s.position.as_dvec3()).collect();
         let areas: Vec<f64> = o.samples.iter().map(|s| s.area).collect();
         for (&group, items) in groups.bounds.iter().zip(&cuts) {
-            let blend = sparse.then(|| tree.within_reach(group, &positions, &areas, NEAR_BLEND_RADIUS));
+            let blend = at.sparse.then(|| at.tree.within_reach(group, &samples, &areas, NEAR_BLEND_RADIUS));
             self.group(group, items, blend.as_deref(), [first_node, first_sample]);
         }
-        self.receivers.push(Receiver {
+        Receiver {
             object: i as u32,
-            vertex_count: o.mesh.positions().len() as u32,
+            vertex_count: at.vertices.len() as u32,
             sample_count: o.samples.len() as u32,
             first_node,
-            node_count: tree.nodes.len() as u32,
+            node_count: at.tree.nodes.len() as u32,
             first_receiver,
             first_group,
-        });
+        }
     }
 
     /// One receiver group: its hierarchical items (nodes first, then samples: the shader sums
@@ -377,6 +425,7 @@ impl GpuScene {
             casters: l.casters,
             light_matrices: Vec::new(),
             receivers: p.receivers,
+            coarser_receivers: p.coarser_receivers,
             vertex_count: p.vertices.len() as u32,
             sample_count: p.samples.len() as u32,
             light_count: scene.lights.len() as u32,
@@ -427,6 +476,15 @@ impl GpuScene {
     pub fn level(&self, object: usize, level: usize) -> LevelRange {
         let levels = &self.levels[object];
         levels[level.min(levels.len() - 1)]
+    }
+
+    /// Entry `j` of `receivers` at level of detail `level`: its `coarser_receivers` entry, or
+    /// the whole mesh's where there is none (level 0, or a gather without coarser receivers).
+    pub fn receiver_at(&self, j: usize, level: usize) -> &Receiver {
+        match level.checked_sub(1).and_then(|l| self.coarser_receivers[j].get(l)) {
+            Some(r) => r,
+            None => &self.receivers[j],
+        }
     }
 
     /// Object `object`'s range (`object_ranges`).

@@ -28,6 +28,8 @@ pub struct GroupGatherPush {
     pub first_receiver: u32,
     /// Its first group in `GpuScene::receiver_groups`.
     pub first_group: u32,
+    /// Receivers at the level of detail gathered: stage 1's threads.
+    pub receiver_count: u32,
 }
 
 impl GroupGatherPush {
@@ -40,6 +42,7 @@ impl GroupGatherPush {
             node_count: receiver.node_count,
             first_receiver: receiver.first_receiver,
             first_group: receiver.first_group,
+            receiver_count: receiver.vertex_count,
         }
     }
 }
@@ -72,16 +75,20 @@ impl GroupGather {
         GroupGather { pipeline, set, handoff, stage0_threads }
     }
 
-    /// Stage 0 over the plan's receivers, the hand-off barrier, stage 1 over the same receivers.
+    /// Stage 0 over the plan's receivers, the hand-off barrier, stage 1 over the same receivers
+    /// at the level of detail the plan draws each at (`GpuScene::receiver_at`: the whole mesh
+    /// where the scene built no coarser receivers).
     pub fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        let planned = || frame.scene.receivers.iter().filter(|r| frame.plan.gathers(r.object as usize));
-        for r in planned() {
+        let planned =
+            || frame.scene.receivers.iter().enumerate().filter(|(_, r)| frame.plan.gathers(r.object as usize));
+        for (_, r) in planned() {
             let threads = (self.stage0_threads)(r);
             self.pipeline.dispatch(cmd, &self.set, &GroupGatherPush::new(r, 0), [threads, 1, 1]);
         }
         frame.before(cmd, &[read(self.handoff, Access::ComputeRead)]);
-        for r in planned() {
-            self.pipeline.dispatch(cmd, &self.set, &GroupGatherPush::new(r, 1), [r.vertex_count, 1, 1]);
+        for (j, r) in planned() {
+            let at = frame.scene.receiver_at(j, frame.plan.level(r.object as usize));
+            self.pipeline.dispatch(cmd, &self.set, &GroupGatherPush::new(at, 1), [at.vertex_count, 1, 1]);
         }
     }
 }

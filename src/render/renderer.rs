@@ -499,7 +499,10 @@ impl Renderer {
         self.timers = timers;
         let baked = self.planner.baked_levels();
         // Only the vertex gather works at a level's vertices; the others reach every vertex.
-        self.planner.recorded(plan, self.scene.scene.file.render.gather == GatherMode::Vertex);
+        self.planner.recorded(
+            plan,
+            matches!(self.scene.scene.file.render.gather, GatherMode::Vertex | GatherMode::Hierarchical),
+        );
         // A frame that recomputed the sky light withdraws the levels baked from it.
         if self.planner.baked_levels() != baked {
             self.needs = Self::needs_of(&self.scene, self.target, &self.planner);
@@ -620,6 +623,26 @@ impl Renderer {
         if self.planner.gathered_coarser(object) {
             return Err(RenderError::ExitanceAtCoarserLevel(object));
         }
+        self.exitance_all(object)
+    }
+
+    /// Object `object`'s exitance where the last gather computed it: the level of detail it
+    /// gathered at, that level's vertices (object-relative, ascending) and their RGB exitance.
+    /// Unlike [`Renderer::exitance`], it answers after a gather at a coarser level too.
+    pub fn exitance_at_level(&self, object: usize) -> Result<(usize, Vec<u32>, Vec<[f32; 3]>), RenderError> {
+        self.check_object(object)?;
+        let level = self.planner.gathered_level(object).unwrap_or(0);
+        let all = self.exitance_all(object)?;
+        let vertices = match self.scene.objects[object].levels.get(level) {
+            Some(l) if level > 0 => l.vertices.clone(),
+            _ => (0..all.len() as u32).collect(),
+        };
+        let values = vertices.iter().map(|&v| all[v as usize]).collect();
+        Ok((level, vertices, values))
+    }
+
+    /// Object `object`'s exitance buffer as it stands, every vertex.
+    fn exitance_all(&self, object: usize) -> Result<Vec<[f32; 3]>, RenderError> {
         let all: Vec<[f32; 4]> = self.buffers.exitance.read()?;
         let first = self.buffers.object_range(object).first_vertex as usize;
         let count = self.scene.objects[object].mesh.positions().len();

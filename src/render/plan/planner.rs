@@ -154,8 +154,8 @@ impl Planner {
 
     /// A frame of `plan` was recorded: nothing is pending, each object's exitance is as stale as
     /// the plan leaves it, gathered objects hold exitance at the level they were gathered at (at
-    /// every vertex unless `gather_by_level`, the vertex gather, which works at a level's
-    /// vertices), and a frame that recomputed the sky light withdraws the levels baked from it.
+    /// every vertex unless `gather_by_level`: the vertex and hierarchical gathers work at a
+    /// level's vertices), and a frame that recomputed the sky light withdraws the levels baked from it.
     pub fn recorded(&mut self, plan: &Plan, gather_by_level: bool) {
         self.pending = None;
         if plan.runs(Pass::VertexLight) {
@@ -177,7 +177,12 @@ impl Planner {
     /// Whether object `object`'s last gather ran at a coarser level of detail than the whole
     /// mesh, so that some of its vertices hold older exitance (`Renderer::exitance` refuses it).
     pub fn gathered_coarser(&self, object: usize) -> bool {
-        self.gathered.get(object).is_some_and(|&g| g > 0 && g != usize::MAX)
+        self.gathered_level(object).is_some_and(|g| g > 0)
+    }
+
+    /// The level of detail object `object` was last gathered at (0: the whole mesh), if it was.
+    pub fn gathered_level(&self, object: usize) -> Option<usize> {
+        self.gathered.get(object).copied().filter(|&g| g != usize::MAX)
     }
 
     /// Object `object`'s exitance was written at every vertex from outside the frame
