@@ -41,13 +41,19 @@ fn run_quick_study(scene: &str, out: &Path, cache: &Path) {
     }
 }
 
-/// The study's CSV, checked to have the documented header, the quick sweep's six rows and no
-/// empty cell (but epsilon, which only some gathers have).
+/// The study's CSV, checked to have the documented header, the scene's own row (labelled
+/// `default`, first) then the quick sweep's six rows, and no empty cell (but epsilon, which
+/// only some gathers have).
 fn study_rows(out: &Path) -> Vec<Row> {
     let csv = std::fs::read_to_string(out.join("study.csv")).unwrap();
     assert_eq!(csv.lines().next().unwrap().split(',').collect::<Vec<_>>(), COLUMNS);
     let rows = csv_rows(&csv);
-    assert_eq!(rows.len(), 6, "{csv}");
+    assert_eq!(rows.len(), 7, "{csv}");
+    assert_eq!(rows[0]["configuration"], "default", "{csv}");
+    assert!(rows[1..].iter().all(|r| r["configuration"] == "sweep"), "{csv}");
+    // The tiny scene fixes 400 Turk samples; its own row is that, with the model's prediction.
+    assert_eq!((rows[0]["sampler"].as_str(), rows[0]["samples"].as_str()), ("turk", "400"));
+    assert!(rows[0]["predicted"].parse::<f64>().unwrap() > 0.0, "{csv}");
     for r in &rows {
         for c in COLUMNS.iter().filter(|c| **c != "epsilon") {
             assert!(!r[*c].is_empty(), "empty {c} in {r:?}");
@@ -71,8 +77,11 @@ fn assert_turk_error_falls(rows: &[Row]) {
     let error = |r: &Row| {
         ["rel_rms_r", "rel_rms_g", "rel_rms_b"].iter().map(|c| r[*c].parse::<f64>().unwrap()).sum::<f64>() / 3.0
     };
-    let turk: Vec<(usize, f64)> =
-        rows.iter().filter(|r| r["sampler"] == "turk").map(|r| (r["samples"].parse().unwrap(), error(r))).collect();
+    let turk: Vec<(usize, f64)> = rows
+        .iter()
+        .filter(|r| r["sampler"] == "turk" && r["configuration"] == "sweep")
+        .map(|r| (r["samples"].parse().unwrap(), error(r)))
+        .collect();
     assert_eq!(turk.iter().map(|t| t.0).collect::<Vec<_>>(), [100, 200, 400]);
     assert!(turk.windows(2).all(|w| w[1].1 < w[0].1), "turk error does not fall: {turk:?}");
 }
@@ -117,7 +126,8 @@ fn exported_exitance(scene: &str, dir: &Path) -> Vec<[f64; 3]> {
 fn assert_error_matches_by_hand(rows: &[Row], truth: &Truth, exported: &[[f64; 3]]) {
     let t = &truth.exitance[0];
     assert_eq!(exported.len(), t.len());
-    let row = rows.iter().find(|r| r["sampler"] == "turk" && r["samples"] == "400").unwrap();
+    let row =
+        rows.iter().find(|r| r["sampler"] == "turk" && r["samples"] == "400" && r["configuration"] == "sweep").unwrap();
     for (c, name) in ["rel_rms_r", "rel_rms_g", "rel_rms_b"].iter().enumerate() {
         let floor = LIT_FLOOR * t.iter().map(|m| m[c]).fold(0.0, f64::max);
         let rel: Vec<f64> = t
@@ -165,6 +175,12 @@ fn study_rejects_a_bad_sweep_selection_naming_the_flag_and_writes_nothing() {
         ("--samplers", "sobol", "sobol"),
         ("--truth-levels", "0", "1 to"),
         ("--truth-receivers", "10", "at least 100"),
+        // --error-image names its gather as --gathers does: the hierarchical one with its epsilon.
+        ("--error-image", "turk:400:hierarchical", "name the hierarchical gather's epsilon"),
+        ("--error-image", "turk:400:hierarchical:99", "epsilon must be"),
+        ("--error-image", "turk:401:hierarchical:0.1", "not in this sweep"),
+        ("--configurations", "best", "expected default or sweep"),
+        ("--max-error", "0", "must be 0.001 to 0.5"),
     ] {
         let run = translucent(&["study", "-o", out.to_str().unwrap(), flag, value], &[]);
         let err = text(&run.stderr);
@@ -181,42 +197,34 @@ fn study_rejects_a_bad_sweep_selection_naming_the_flag_and_writes_nothing() {
     assert!(!out.exists(), "--error-image with --truth-receivers made the output folder");
 }
 
-/// The sample count `render.max_error = target` chooses for the tiny sphere (its scene's own
-/// count left out), with the error predicted for it.
-fn chosen(scene: &translucent::Scene, target: f64) -> (usize, f64) {
-    use translucent::scene::build::{Overrides, PreparedScene};
-    let overrides = Overrides { max_error: Some(target), ..Overrides::default() };
-    let prepared = PreparedScene::new(scene, &overrides).unwrap();
-    let o = &prepared.objects[0];
-    (o.samples.len(), o.density.as_ref().unwrap().worst())
-}
-
 #[test]
 fn an_error_target_gives_a_measured_error_within_its_bounds() {
-    let path = repo_path("tests/scenes/study-tiny.toml");
-    let mut scene = translucent::Scene::load(&path).unwrap();
+    // The study's `default` row of the tiny sphere, its count left to `render.max_error`, at
+    // two targets: the planner's prediction verified against the exact integral.
+    let mut scene = translucent::Scene::load(&repo_path("tests/scenes/study-tiny.toml")).unwrap();
     scene.file.sampling.count = None;
-    let targets = [0.1, 0.03];
-    let counts: Vec<(usize, f64)> = targets.iter().map(|&t| chosen(&scene, t)).collect();
-    assert!(counts[1].0 > counts[0].0, "a tighter target needs more samples: {counts:?}");
     let cache = temp_dir("study-target-cache");
     let config = translucent::study::StudyConfig {
-        samplers: vec![translucent::sampling::Method::Turk],
-        counts: counts.iter().map(|c| c.0).collect(),
-        gathers: vec![(translucent::GatherMode::Vertex, None)],
-        seeds: vec![1],
         frames: 1,
+        own: true,
+        sweep: false,
         ..translucent::study::StudyConfig::quick()
     };
-    let study = common::with_gpu(|gpu| translucent::study::run(gpu, &scene, &config, &cache, &|_| {}).unwrap());
-    for ((row, &target), (count, predicted)) in study.rows.iter().zip(&targets).zip(&counts) {
+    let mut counts = Vec::new();
+    for target in [0.1, 0.03] {
+        scene.file.render.max_error = target;
+        let study = common::with_gpu(|gpu| translucent::study::run(gpu, &scene, &config, &cache, &|_| {}).unwrap());
+        let [row] = &study.rows[..] else { panic!("one row: {:?}", study.rows) };
+        assert!(row.default);
         let measured = row.rel_rms.iter().sum::<f64>() / 3.0;
-        eprintln!("target {target}: {count} samples, predicted {predicted:.4} (worst channel), measured {measured:.4}");
+        eprintln!("target {target}: {} samples, predicted {:.4}, measured {measured:.4}", row.samples, row.predicted);
         assert!(
             (target / 3.0..=1.5 * target).contains(&measured),
             "target {target}: measured {measured} outside [{}, {}]",
             target / 3.0,
             1.5 * target
         );
+        counts.push(row.samples);
     }
+    assert!(counts[1] > counts[0], "a tighter target needs more samples: {counts:?}");
 }

@@ -52,28 +52,45 @@ pub struct Args {
     /// folder, translucent/truth)
     #[arg(long)]
     pub truth_cache: Option<PathBuf>,
+    /// Which configurations, comma-separated: `default` (the scene's own: the counts its error
+    /// target chooses and its gather, a row labelled default), `sweep` (default: both)
+    #[arg(long, value_delimiter = ',', value_name = "default|sweep")]
+    pub configurations: Vec<String>,
+    /// The error target the `default` row's counts are chosen for, e.g. 0.01 (overrides
+    /// render.max_error)
+    #[arg(long)]
+    pub max_error: Option<f64>,
 }
 
-fn parse_error_image(spec: &str) -> Result<(Method, usize, GatherMode)> {
-    let parts: Vec<&str> = spec.split(':').collect();
-    let bad = || format!("--error-image {spec:?}: expected SAMPLER:COUNT[:GATHER], e.g. turk:400:vertex");
-    if !(2..=3).contains(&parts.len()) {
+/// `--error-image SAMPLER:COUNT[:GATHER]`, the gather written as `--gathers` writes it
+/// (`hierarchical:EPSILON` included; vertex by default).
+fn parse_error_image(spec: &str) -> Result<(Method, usize, Gather)> {
+    let parts: Vec<&str> = spec.splitn(3, ':').collect();
+    let bad = || {
+        format!(
+            "--error-image {spec:?}: expected SAMPLER:COUNT[:GATHER], e.g. turk:400:vertex or turk:400:hierarchical:0.1"
+        )
+    };
+    if parts.len() < 2 {
         bail!(bad());
     }
     let method: Method = parts[0].parse().map_err(|e: String| anyhow::anyhow!("{}: {e}", bad()))?;
     let count: usize = parts[1].parse().with_context(bad)?;
-    let gather: GatherMode = parts
-        .get(2)
-        .map_or(Ok(GatherMode::Vertex), |g| g.parse())
-        .map_err(|e: String| anyhow::anyhow!("{}: {e}", bad()))?;
-    if gather == GatherMode::Pixel {
+    let gather = match parts.get(2) {
+        Some(g) => parse_gather(g).with_context(bad)?,
+        None => (GatherMode::Vertex, None),
+    };
+    if gather.0 == GatherMode::Pixel {
         bail!("--error-image {spec:?}: the pixel gather has no per-vertex exitance to draw");
     }
     Ok((method, count, gather))
 }
 
+/// A gather with the hierarchical gather's epsilon.
+type Gather = (GatherMode, Option<f32>);
+
 /// One `--gathers` entry: a gather's name, the hierarchical one with its epsilon.
-fn parse_gather(spec: &str) -> Result<(GatherMode, Option<f32>)> {
+fn parse_gather(spec: &str) -> Result<Gather> {
     let (name, epsilon) = match spec.split_once(':') {
         Some((n, e)) => (n, Some(e)),
         None => (spec, None),
@@ -126,6 +143,17 @@ fn config(args: &Args) -> Result<StudyConfig> {
         }
         config.truth.receivers = Some(n);
     }
+    if !args.configurations.is_empty() {
+        config.own = false;
+        config.sweep = false;
+        for c in &args.configurations {
+            match c.as_str() {
+                "default" => config.own = true,
+                "sweep" => config.sweep = true,
+                other => bail!("--configurations {other:?}: expected default or sweep"),
+            }
+        }
+    }
     if let Some(n) = args.seeds {
         if n == 0 {
             bail!("--seeds must be at least 1");
@@ -142,10 +170,15 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     if args.output.exists() && !args.output.is_dir() {
         bail!("{} exists and is not a folder", args.output.display());
     }
-    let scene = match &args.scene {
+    let mut scene = match &args.scene {
         Some(path) => Scene::load(path)?,
         None => Scene::builtin(),
     };
+    if let Some(e) = args.max_error {
+        translucent::scene::check_max_error("--max-error", e)
+            .map_err(|(key, message)| anyhow::anyhow!("{key} {message}"))?;
+        scene.file.render.max_error = e;
+    }
     let gpu: Arc<Gpu> = Gpu::new(&gpu_args.options())?;
     let device = gpu.info().name.clone();
     let cache = args.truth_cache.clone().unwrap_or_else(truth::default_cache_dir);
@@ -167,18 +200,18 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
 
 /// `--error-image`'s configuration must be one the sweep renders, against a truth at every
 /// vertex.
-fn check_error_image(chosen: Option<(Method, usize, GatherMode)>, config: &StudyConfig) -> Result<()> {
+fn check_error_image(chosen: Option<(Method, usize, Gather)>, config: &StudyConfig) -> Result<()> {
     if chosen.is_some() && config.truth.receivers.is_some() {
         // The picture colours every vertex by its error; a subset truth knows only some.
         bail!("--error-image needs the truth at every vertex: leave out --truth-receivers");
     }
     if let Some((m, n, g)) = chosen {
         let swept =
-            config.samplers.contains(&m) && config.counts.contains(&n) && config.gathers.iter().any(|x| x.0 == g);
+            config.sweep && config.samplers.contains(&m) && config.counts.contains(&n) && config.gathers.contains(&g);
         if !swept {
             bail!(
                 "--error-image: {m} with {n} samples and the {} gather is not in this sweep (samplers {:?}, counts {:?})",
-                g.name(),
+                g.0.name(),
                 config.samplers.iter().map(|m| m.name()).collect::<Vec<_>>(),
                 config.counts
             );
@@ -275,7 +308,7 @@ fn reference_timing(study: &study::Study) -> String {
 fn write_outputs(
     output: &Path,
     study: &study::Study,
-    chosen: Option<(Method, usize, GatherMode)>,
+    chosen: Option<(Method, usize, Gather)>,
     md: String,
     plot: &[u8],
 ) -> Result<()> {
@@ -300,7 +333,13 @@ fn write_outputs(
         let i = study
             .rows
             .iter()
-            .position(|r| r.sampler == m.name() && r.samples == n && r.gather == g.name())
+            .position(|r| {
+                !r.default
+                    && r.sampler == m.name()
+                    && r.samples == n
+                    && r.gather == g.0.name()
+                    && r.epsilon == g.1.map(f64::from)
+            })
             .expect("checked to be in the sweep");
         let estimate = study.exitance[i].as_ref().expect("not the pixel gather");
         let (rgba, width) =

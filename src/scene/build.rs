@@ -383,15 +383,24 @@ fn sample_objects(scene: &Scene, objects: &mut [PreparedObject], only: Option<us
 /// when an object has more than [`super::AUTO_HIERARCHICAL_COUNT`] samples.
 fn choose_gather(scene: &mut Scene, objects: &[PreparedObject], overrides: &Overrides) {
     let render = &mut scene.file.render;
-    if render.gather_given.is_some() || overrides.gather.is_some() {
+    if overrides.gather.is_some() {
         return;
     }
-    if objects.iter().any(|o| o.samples.len() > super::AUTO_HIERARCHICAL_COUNT) {
-        render.gather = GatherMode::Hierarchical;
-        if render.gather_epsilon_given.is_none() && overrides.gather_epsilon.is_none() {
-            render.gather_epsilon = super::ACCURATE_GATHER_EPSILON;
-        }
+    let (gather, epsilon) = own_gather(render, objects);
+    render.gather = gather;
+    if overrides.gather_epsilon.is_none() {
+        render.gather_epsilon = epsilon;
     }
+}
+
+/// The gather and epsilon a scene's own `render` settings give `objects` as sampled: what it
+/// names, else by [`choose_gather`]'s rule (the study's `default` row).
+pub fn own_gather(render: &super::RenderSettings, objects: &[PreparedObject]) -> (GatherMode, f32) {
+    let many = objects.iter().any(|o| o.samples.len() > super::AUTO_HIERARCHICAL_COUNT);
+    let gather = render.gather_given.unwrap_or(if many { GatherMode::Hierarchical } else { GatherMode::Vertex });
+    let chosen = render.gather_given.is_none() && gather == GatherMode::Hierarchical;
+    let fallback = if chosen { super::ACCURATE_GATHER_EPSILON } else { super::DEFAULT_GATHER_EPSILON };
+    (gather, render.gather_epsilon_given.unwrap_or(fallback))
 }
 
 /// Object `i` (`name`), as placed, must stay within [`super::MAX_SCENE_COORDINATE`] of the

@@ -36,6 +36,11 @@ pub struct StudyConfig {
     pub frames: usize,
     /// How far the truth is refined (its tolerance and deepest level).
     pub truth: TruthOptions,
+    /// Measure the scene's own configuration (its error target's counts and gather) as a row
+    /// labelled `default`.
+    pub own: bool,
+    /// Measure the sweep (samplers x counts x gathers x seeds).
+    pub sweep: bool,
 }
 
 impl StudyConfig {
@@ -56,6 +61,8 @@ impl StudyConfig {
             seeds: vec![1, 2, 3],
             frames: 5,
             truth: TruthOptions::default(),
+            own: true,
+            sweep: true,
         }
     }
 
@@ -69,12 +76,37 @@ impl StudyConfig {
             seeds: vec![1],
             frames: 3,
             truth: TruthOptions::default(),
+            own: true,
+            sweep: true,
         }
     }
 
-    /// Configurations times seeds.
+    /// Configurations times seeds, and the scene's own row.
     pub fn runs(&self) -> usize {
-        self.samplers.len() * self.counts.len() * self.gathers.len() * self.seeds.len()
+        let sweep = if self.sweep {
+            self.samplers.len() * self.counts.len() * self.gathers.len() * self.seeds.len()
+        } else {
+            0
+        };
+        sweep + usize::from(self.own)
+    }
+
+    /// The sweep's configurations, in order.
+    fn configurations(&self) -> Vec<Configuration> {
+        let mut out = Vec::new();
+        if !self.sweep {
+            return out;
+        }
+        for &method in &self.samplers {
+            for &count in &self.counts {
+                for &seed in &self.seeds {
+                    for &gather in &self.gathers {
+                        out.push(Configuration { method, count, seed, gather, own: false });
+                    }
+                }
+            }
+        }
+        out
     }
 }
 
@@ -223,7 +255,9 @@ fn time_reference(
         .or_else(|| vertex_rows().next());
     let Some((row, r)) = pick else { return Ok(None) };
     let method = *config.samplers.iter().find(|m| m.name() == r.sampler).expect("a swept sampler");
-    let (scene, _) = configure(base, method, r.samples, r.seed, (GatherMode::Vertex, None))?;
+    let run =
+        Configuration { method, count: r.samples, seed: r.seed, gather: (GatherMode::Vertex, None), own: r.default };
+    let (scene, _) = configure(base, run)?;
     let occluders = crate::reference::occluders(&scene);
     let mut times = Vec::new();
     for _ in 0..3 {
@@ -237,23 +271,22 @@ fn time_reference(
 
 /// The scene for one configuration: `base` (prepared once, geometry and lights) with new
 /// samples, the gather set, every channel gathered. Returns it and the sampling time (ms).
-fn configure(
-    base: &PreparedScene,
-    method: Method,
-    count: usize,
-    seed: u64,
-    gather: (GatherMode, Option<f32>),
-) -> Result<(PreparedScene, f64), StudyError> {
+fn configure(base: &PreparedScene, run: Configuration) -> Result<(PreparedScene, f64), StudyError> {
+    let Configuration { method, count, seed, gather, own } = run;
     let mut scene = base.clone();
     let file = &mut scene.scene.file;
-    file.sampling.method = method;
-    file.sampling.count = Some(count);
-    file.sampling.seed = seed;
     file.render.gather = gather.0;
     if let Some(e) = gather.1 {
         file.render.gather_epsilon = e;
     }
     file.render.transport = TransportMode::Gather;
+    if own {
+        // The samples as the scene's error target placed them (their time is the scene's).
+        return Ok((scene, f64::NAN));
+    }
+    file.sampling.method = method;
+    file.sampling.count = Some(count);
+    file.sampling.seed = seed;
     let start = std::time::Instant::now();
     for (i, o) in scene.objects.iter_mut().enumerate() {
         if let ResolvedMaterial::Translucent { dipoles, .. } = &o.material {
@@ -266,6 +299,20 @@ fn configure(
         }
     }
     Ok((scene, start.elapsed().as_secs_f64() * 1e3))
+}
+
+/// The error model's prediction for `scene` as configured (mean of r, g, b, worst object):
+/// NaN where it makes none (it was fitted to Turk's samples at the vertices).
+fn predicted(scene: &PreparedScene, method: Method, gather: GatherMode) -> f64 {
+    if method != Method::Turk || gather == GatherMode::Pixel {
+        return f64::NAN;
+    }
+    scene
+        .objects
+        .iter()
+        .filter_map(|o| o.density.as_ref())
+        .map(|d| d.predicted.iter().map(|c| c.error).sum::<f64>() / 3.0)
+        .fold(f64::NAN, f64::max)
 }
 
 fn images(renderer: &Renderer) -> Result<Images, StudyError> {
@@ -315,18 +362,12 @@ pub fn run(
     };
     let (mut rows, mut exitances) = (Vec::new(), Vec::new());
     let total = config.runs();
-    for &method in &config.samplers {
-        for &count in &config.counts {
-            for &seed in &config.seeds {
-                for &gather in &config.gathers {
-                    let run = Configuration { method, count, seed, gather };
-                    progress(Event::Run(rows.len(), total, run.label()));
-                    let (row, exitance) = bench.measure(run)?;
-                    rows.push(row);
-                    exitances.push(exitance);
-                }
-            }
-        }
+    let own = config.own.then(|| own_configuration(&base));
+    for run in own.into_iter().chain(config.configurations()) {
+        progress(Event::Run(rows.len(), total, run.label()));
+        let (row, exitance) = bench.measure(run)?;
+        rows.push(row);
+        exitances.push(exitance);
     }
     let reference = time_reference(&base, config, &rows)?;
     Ok(Study { rows, truth, truth_cached, truth_image, prepared: base, exitance: exitances, reference })
@@ -353,21 +394,40 @@ fn truth_image(gpu: &Arc<Gpu>, base: &PreparedScene, truth: &Truth) -> Result<Op
 /// Per-vertex exitance of every object, in scene order.
 type Exitance = Vec<Vec<[f32; 3]>>;
 
-/// One configuration of the sweep.
+/// One configuration of the sweep, or the scene's own.
 #[derive(Clone, Copy, Debug)]
 struct Configuration {
     method: Method,
+    /// Samples per object (the scene's own row keeps each object's own count).
     count: usize,
     seed: u64,
     /// The gather, with the hierarchical gather's epsilon.
     gather: (GatherMode, Option<f32>),
+    /// The scene's own configuration: its samples as placed, its own gather.
+    own: bool,
+}
+
+/// The scene's own configuration: `base`'s samples as its error target placed them, and the
+/// gather its own settings give them (`scene::build::own_gather`).
+fn own_configuration(base: &PreparedScene) -> Configuration {
+    let file = &base.scene.file;
+    let (gather, epsilon) = crate::scene::build::own_gather(&file.render, &base.objects);
+    let count = base.objects.iter().map(|o| o.samples.len()).max().unwrap_or(0);
+    Configuration {
+        method: file.sampling.method,
+        count,
+        seed: file.sampling.seed,
+        gather: (gather, (gather == GatherMode::Hierarchical).then_some(epsilon)),
+        own: true,
+    }
 }
 
 impl Configuration {
     /// For the progress bar: `turk 400 hierarchical eps 0.1 seed 1`.
     fn label(&self) -> String {
         format!(
-            "{} {} {}{} seed {}",
+            "{}{} {} {}{} seed {}",
+            if self.own { "default: " } else { "" },
             self.method,
             self.count,
             self.gather.0.name(),
@@ -395,8 +455,9 @@ impl Bench<'_> {
     /// gather, and as an image where the truth has one) and time a moving light's frame: its
     /// row, and its per-vertex exitance for `--error-image`.
     fn measure(&self, run: Configuration) -> Result<(Row, Option<Exitance>), StudyError> {
-        let Configuration { method, count, seed, gather } = run;
-        let (prepared, sampling_ms) = configure(self.base, method, count, seed, gather)?;
+        let Configuration { method, count, seed, gather, own } = run;
+        let (prepared, sampling_ms) = configure(self.base, run)?;
+        let predicted = predicted(&prepared, method, gather.0);
         let mut renderer = Renderer::new(self.gpu, prepared)?;
         renderer.frame(&renderer.plan(Change::Everything))?;
         let exitance = if gather.0 == GatherMode::Pixel {
@@ -418,6 +479,8 @@ impl Bench<'_> {
         let nan = [f64::NAN; 3];
         let row = Row {
             scene: self.scene.to_string(),
+            default: own,
+            predicted,
             sampler: method.name().to_string(),
             samples: count,
             gather: gather.0.name().to_string(),

@@ -11,6 +11,8 @@ use std::fmt::Write as _;
 pub struct Row {
     /// Scene name (commas are replaced in the CSV so the file needs no quoting).
     pub scene: String,
+    /// The scene's own configuration (its error target's count and gather), not the sweep's.
+    pub default: bool,
     /// Sample placement: `random`, `turk`, `feature` or `poisson`.
     pub sampler: String,
     /// Requested sample count (the placed count may differ slightly).
@@ -45,11 +47,15 @@ pub struct Row {
     pub image_rel_rmse: f64,
     /// Mean of the FLIP error map of the rendered image against the reference image.
     pub flip_mean: f64,
+    /// The error model's prediction for this row (`sampling::density`, mean of r, g, b; NaN
+    /// where it makes none: samplers other than Turk's, the pixel gather).
+    pub predicted: f64,
 }
 
 /// CSV header, in column order; the single source for it, so the writer and any reader agree.
 pub const COLUMNS: &[&str] = &[
     "scene",
+    "configuration",
     "sampler",
     "samples",
     "gather",
@@ -75,6 +81,7 @@ pub const COLUMNS: &[&str] = &[
     "bias_b",
     "image_rel_rmse",
     "flip_mean",
+    "predicted",
 ];
 
 /// Error targets (as fractions) the report finds the fastest configuration for.
@@ -94,6 +101,7 @@ pub fn csv(rows: &[Row]) -> String {
     for row in rows {
         let mut fields = vec![
             csv_text(&row.scene),
+            (if row.default { "default" } else { "sweep" }).to_string(),
             csv_text(&row.sampler),
             row.samples.to_string(),
             csv_text(&row.gather),
@@ -110,6 +118,7 @@ pub fn csv(rows: &[Row]) -> String {
         }
         fields.push(row.image_rel_rmse.to_string());
         fields.push(row.flip_mean.to_string());
+        fields.push(row.predicted.to_string());
         debug_assert_eq!(fields.len(), COLUMNS.len());
         out.push_str(&fields.join(","));
         out.push('\n');
@@ -168,6 +177,8 @@ pub struct Summary {
     pub image_rel_rmse: f64,
     /// Mean over seeds of the CPU sample placement time, in milliseconds.
     pub sampling_ms: f64,
+    /// Mean over seeds of the error model's prediction (NaN where it makes none).
+    pub predicted: f64,
 }
 
 impl Summary {
@@ -213,7 +224,7 @@ pub fn summarise(rows: &[Row]) -> Vec<Summary> {
     let mut groups: BTreeMap<Key, Vec<&Row>> = BTreeMap::new();
     for row in rows {
         // Sort epsilon numerically: the bits of a non-negative float order like the float.
-        let key = (row.gather.clone(), row.sampler.clone(), row.samples, row.epsilon.map(|e| e.max(0.0).to_bits()));
+        let key = (row.gather.clone(), sampler_label(row), row.samples, row.epsilon.map(|e| e.max(0.0).to_bits()));
         groups.entry(key).or_default().push(row);
     }
     groups
@@ -224,7 +235,7 @@ pub fn summarise(rows: &[Row]) -> Vec<Summary> {
             let lo = errors.iter().copied().fold(f64::INFINITY, f64::min);
             let hi = errors.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             Summary {
-                sampler: first.sampler.clone(),
+                sampler: sampler_label(first),
                 samples: first.samples,
                 gather: first.gather.clone(),
                 epsilon: first.epsilon,
@@ -235,9 +246,43 @@ pub fn summarise(rows: &[Row]) -> Vec<Summary> {
                 flip_mean: mean(group.iter().map(|r| r.flip_mean)),
                 image_rel_rmse: mean(group.iter().map(|r| r.image_rel_rmse)),
                 sampling_ms: mean(group.iter().map(|r| r.sampling_ms)),
+                predicted: mean(group.iter().map(|r| r.predicted)),
             }
         })
         .collect()
+}
+
+/// The table of the error model's predictions against the measured errors, for every
+/// configuration it predicts (none: no table).
+fn predicted_against_measured(out: &mut String, summaries: &[Summary]) {
+    let predicted: Vec<&Summary> = summaries.iter().filter(|s| s.predicted.is_finite()).collect();
+    if predicted.is_empty() {
+        return;
+    }
+    let _ = writeln!(out, "\n## The error model against the measurement\n");
+    let _ = writeln!(
+        out,
+        "`sampling::density`'s prediction (mean of r, g, b) beside the measured error; the scene's own \
+         configuration is `default: ...` (docs/STUDY.md, \"The error model\").\n"
+    );
+    let _ = writeln!(out, "| configuration | predicted % | measured % | measured / predicted |");
+    let _ = writeln!(out, "|---|---:|---:|---:|");
+    for s in predicted {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} |",
+            md_cell(&s.label()),
+            percent(s.predicted),
+            percent(s.error),
+            sig3(s.error / s.predicted)
+        );
+    }
+}
+
+/// A row's sampler as tables and curves name it: `default: turk` for the scene's own row, so it
+/// stands apart from the sweep's.
+fn sampler_label(row: &Row) -> String {
+    if row.default { format!("default: {}", row.sampler) } else { row.sampler.clone() }
 }
 
 /// The configuration with the smallest frame time whose error is at most `target`, if any.
@@ -320,6 +365,7 @@ pub fn markdown(title: &str, preamble: &str, summaries: &[Summary]) -> String {
             }
         }
     }
+    predicted_against_measured(&mut out, summaries);
 
     let front = pareto(&summaries.iter().map(|s| (s.frame_ms, s.error)).collect::<Vec<_>>());
     let _ = writeln!(out, "\n## Every configuration\n");
@@ -471,6 +517,8 @@ mod tests {
             bias: [-0.001; 3],
             image_rel_rmse: err / 2.0,
             flip_mean: 0.01,
+            default: false,
+            predicted: f64::NAN,
         }
     }
 
