@@ -51,6 +51,6 @@ pub use optics::Material;
 pub use output::{OutputError, OutputSet};
 pub use render::plan::{Change, Pass, Plan};
 pub use render::renderer::{CameraView, FrameTimings, NonFinite, RecordedFrame, RenderError, Renderer};
-pub use render::shade::{HostTarget, TargetDesc};
+pub use render::shade::{HostAttachment, HostTarget, TargetDesc};
 pub use scene::build::{Overrides, PreparedScene};
 pub use scene::{GatherMode, Scene, SceneError};
