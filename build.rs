@@ -7,6 +7,9 @@
 //! from `src/optics/kernel_constants.rs`, the file `optics::kernel` includes too.
 //! A shader error fails the build with glslang's `file:line: message`.
 
+// Links the static glslang and SPIRV-Tools archives under shaderc (shaderc-link/build.rs says why).
+use translucent_shaderc_link as _;
+
 use std::fmt::Write as _;
 use std::fs;
 use std::path::{Path, PathBuf};

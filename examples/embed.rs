@@ -18,7 +18,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use translucent::gpu::{EnabledFeatures, Gpu, GpuOptions, HostVulkan, required_features};
 use translucent::render::plan::Pass;
 use translucent::render::renderer::{CameraView, Renderer};
-use translucent::render::shade::{HostTarget, TargetDesc};
+use translucent::render::shade::{HostAttachment, HostTarget, TargetDesc};
 use translucent::scene::Scene;
 use translucent::scene::build::{Overrides, PreparedScene};
 
@@ -842,10 +842,12 @@ fn render_frames(engine: &Engine, gpu: Arc<Gpu>, options: &Options) -> Result<Ru
     } else {
         None
     };
+    let extent = vk::Extent2D { width: SIZE, height: SIZE };
+    // Each image with its format and size, which translucent checks against its pipelines.
     let host_target = HostTarget {
-        color: engine.color.view,
-        depth: engine.depth.view,
-        extent: vk::Extent2D { width: SIZE, height: SIZE },
+        color: HostAttachment { view: engine.color.view, format: COLOR_FORMAT, extent },
+        depth: HostAttachment { view: engine.depth.view, format: DEPTH_FORMAT, extent },
+        extent,
         load: true,
     };
     let mut frames = Vec::new();

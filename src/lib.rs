@@ -20,6 +20,11 @@
 //!
 //! An engine with its own device wraps it with `Gpu::from_host` and draws into its own images
 //! with `Renderer::with_target` and `Renderer::record_frame` (docs/GPU.md, examples/embed.rs).
+//!
+//! Features: `cli` (the `translucent` binary's dependencies) and `study` (`translucent::study`,
+//! its charts and FLIP), both on by default. An engine can depend on it with
+//! `default-features = false` for the renderer alone; `shaderc-from-source` builds glslang from
+//! source instead of linking the distribution's static archives.
 
 #![warn(missing_docs)]
 
@@ -31,13 +36,21 @@ pub mod reference;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+#[cfg(feature = "study")]
 pub mod study;
+
+/// The `ash` this crate was built with: a host can name `translucent::ash::vk` and need not
+/// match the version by hand (`HostVulkan` takes ash's handles and function tables).
+pub use ash;
+/// The `glam` this crate was built with: `CameraView` and the lights take its vectors and
+/// matrices.
+pub use glam;
 
 pub use gpu::{EnabledFeatures, Gpu, GpuError, GpuOptions, HostVulkan, RequiredFeatures, required_features};
 pub use optics::Material;
 pub use output::{OutputError, OutputSet};
 pub use render::plan::{Change, Pass, Plan};
 pub use render::renderer::{CameraView, FrameTimings, NonFinite, RecordedFrame, RenderError, Renderer};
-pub use render::shade::{HostTarget, TargetDesc};
+pub use render::shade::{HostAttachment, HostTarget, TargetDesc};
 pub use scene::build::{Overrides, PreparedScene};
 pub use scene::{GatherMode, Scene, SceneError};

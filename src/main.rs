@@ -29,6 +29,7 @@ enum Command {
     Plan(cli::plan::Args),
     /// Measure what accuracy costs in time: every sampler, sample count and gather against the
     /// exact dipole integral (CSV, Markdown, a plot)
+    #[cfg(feature = "study")]
     Study(cli::study::Args),
 }
 
@@ -42,6 +43,7 @@ fn main() -> ExitCode {
         Some(Command::Material(args)) => cli::material::run(&args),
         Some(Command::Sample(args)) => cli::sample::run(&args),
         Some(Command::Plan(args)) => cli::plan::run(&args),
+        #[cfg(feature = "study")]
         Some(Command::Study(args)) => cli::study::run(&cli.gpu, &args),
     };
     match result {

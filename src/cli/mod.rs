@@ -14,6 +14,7 @@ pub mod material;
 pub mod plan;
 pub mod render;
 pub mod sample;
+#[cfg(feature = "study")]
 pub mod study;
 
 use translucent::gpu::GpuOptions;

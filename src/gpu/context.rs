@@ -6,7 +6,7 @@
 use super::GpuOptions;
 use super::debug::ValidationCounters;
 use super::device::{self, DeviceInfo};
-use super::error::{GpuError, GpuResult};
+use super::error::{GpuError, GpuResult, VkContext};
 use super::instance::{self, OwnedInstance};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
@@ -20,7 +20,8 @@ use std::time::Duration;
 /// it destroys neither).
 ///
 /// Shared as `Arc<Gpu>`: every object made from it holds a clone, so the `Gpu` drops last. Its Drop
-/// waits for the device to go idle, frees the allocator's memory, then destroys the device and the
+/// waits for the device to go idle (`vkDeviceWaitIdle`: on a host's device that is the host's
+/// work on every queue too, once, when the last `Arc` goes), frees the allocator's memory, then destroys the device and the
 /// instance when it owns them.
 pub struct Gpu {
     entry: ash::Entry,
@@ -162,17 +163,22 @@ impl Gpu {
         }
         device::check_features(&host.instance, &info)?;
         let f = host.enabled_features;
-        for (enabled, name) in [
+        // Every missing feature in one error: a host fixes its device creation once.
+        let missing: Vec<&str> = [
             (f.dynamic_rendering, "dynamicRendering"),
             (f.synchronization2, "synchronization2"),
             (f.shader_output_layer, "shaderOutputLayer"),
-        ] {
-            if !enabled {
-                return Err(unsuitable(format!(
-                    " with the {name} feature enabled at device creation; the host's device was created \
-                     without it (chain translucent::gpu::required_features() into VkDeviceCreateInfo)"
-                )));
-            }
+        ]
+        .into_iter()
+        .filter_map(|(enabled, name)| (!enabled).then_some(name))
+        .collect();
+        if !missing.is_empty() {
+            let (features, them) = if missing.len() == 1 { ("feature", "it") } else { ("features", "them") };
+            return Err(unsuitable(format!(
+                " with the {} {features} enabled at device creation; the host's device was created without \
+                 {them} (chain translucent::gpu::required_features() into VkDeviceCreateInfo)",
+                missing.join(", ")
+            )));
         }
         // A device of an instance created for Vulkan 1.2 has no 1.3 commands, whatever the
         // hardware supports; ash would abort on the first call.
@@ -288,9 +294,18 @@ impl Gpu {
     pub fn queue_family(&self) -> u32 {
         self.queue_family
     }
-    /// The queue, locked: Vulkan requires external synchronisation of vkQueueSubmit.
-    pub(crate) fn queue(&self) -> MutexGuard<'_, vk::Queue> {
+    /// The queue, locked: Vulkan requires external synchronisation of vkQueueSubmit. A caller
+    /// of `Gpu::new` that records frames into its own command buffers submits them here; a host
+    /// (`from_host`) may too, and must hold this lock whenever it submits to the same queue
+    /// from another thread while translucent may submit (docs/GPU.md, "queue use").
+    pub fn queue(&self) -> MutexGuard<'_, vk::Queue> {
         self.queue.lock().unwrap_or_else(|p| p.into_inner())
+    }
+    /// Block until the queue has finished everything submitted to it (`vkQueueWaitIdle`).
+    pub(crate) fn wait_queue_idle(&self) -> GpuResult<()> {
+        let queue = self.queue();
+        // SAFETY: the queue is externally synchronised by the guard.
+        unsafe { self.device.queue_wait_idle(*queue) }.vk("vkQueueWaitIdle")
     }
     pub(crate) fn allocator(&self) -> MutexGuard<'_, Allocator> {
         self.allocator.lock().unwrap_or_else(|p| p.into_inner())

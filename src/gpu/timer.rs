@@ -84,36 +84,48 @@ impl GpuTimer {
         };
     }
 
-    /// (name, milliseconds) of each pass of the finished submission, in recording order.
+    /// (name, milliseconds) of each pass of the finished submission, in recording order;
+    /// waits for the submission (it must have been submitted).
     pub fn results(&self) -> GpuResult<Vec<(String, f64)>> {
+        Ok(self.read(true)?.unwrap_or_default())
+    }
+
+    /// As `results`, without waiting: `None` while a query is not yet written (the submission
+    /// has not finished, or was never made).
+    pub fn results_if_done(&self) -> GpuResult<Option<Vec<(String, f64)>>> {
+        self.read(false)
+    }
+
+    fn read(&self, wait: bool) -> GpuResult<Option<Vec<(String, f64)>>> {
         if self.names.is_empty() {
-            return Ok(Vec::new());
+            return Ok(Some(Vec::new()));
         }
         let mut ticks = vec![0u64; 2 * self.names.len()];
-        // SAFETY: the submission that wrote these queries has completed (WAIT makes sure).
-        unsafe {
-            self.gpu.device().get_query_pool_results(
-                self.pool,
-                0,
-                &mut ticks,
-                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
-            )
+        let flags = if wait { vk::QueryResultFlags::WAIT } else { vk::QueryResultFlags::empty() };
+        // SAFETY: the queries were reset in a recorded command buffer; without WAIT, Vulkan
+        // answers NOT_READY until every one of them is written.
+        let read = unsafe {
+            self.gpu.device().get_query_pool_results(self.pool, 0, &mut ticks, vk::QueryResultFlags::TYPE_64 | flags)
+        };
+        match read {
+            Err(vk::Result::NOT_READY) if !wait => return Ok(None),
+            other => other.vk("vkGetQueryPoolResults")?,
         }
-        .vk("vkGetQueryPoolResults")?;
         let (period_ns, valid_bits) = self.gpu.timestamp_info();
         let mask = if valid_bits >= 64 { u64::MAX } else { (1u64 << valid_bits) - 1 };
-        Ok(self
-            .names
-            .iter()
-            .enumerate()
-            .map(|(i, name)| {
-                let start = ticks[2 * i] & mask;
-                let end = ticks[2 * i + 1] & mask;
-                // Wrapping difference within the valid bits handles a counter that rolled over.
-                let delta = end.wrapping_sub(start) & mask;
-                (name.clone(), delta as f64 * period_ns / 1.0e6)
-            })
-            .collect())
+        Ok(Some(
+            self.names
+                .iter()
+                .enumerate()
+                .map(|(i, name)| {
+                    let start = ticks[2 * i] & mask;
+                    let end = ticks[2 * i + 1] & mask;
+                    // Wrapping difference within the valid bits handles a counter that rolled over.
+                    let delta = end.wrapping_sub(start) & mask;
+                    (name.clone(), delta as f64 * period_ns / 1.0e6)
+                })
+                .collect(),
+        ))
     }
 }
 

@@ -63,6 +63,56 @@ pub enum RenderError {
     /// A host-target renderer recorded without a `HostTarget`.
     #[error("a host-target renderer needs a HostTarget for every frame")]
     MissingHostTarget,
+    /// A `HostTarget` whose render area has no pixel.
+    #[error("HostTarget extent {}x{}: the render area needs at least one pixel each way", extent[0], extent[1])]
+    HostTargetEmpty {
+        /// The extent given.
+        extent: [u32; 2],
+    },
+    /// A `HostTarget` whose render area is larger than one of its images, or than the device
+    /// allows.
+    #[error("HostTarget extent {}x{} is larger than {what} ({}x{})", extent[0], extent[1], limit[0], limit[1])]
+    HostTargetTooLarge {
+        /// The render area given.
+        extent: [u32; 2],
+        /// What it exceeds: "the colour image", "the depth image" or the device limit.
+        what: &'static str,
+        /// Its size.
+        limit: [u32; 2],
+    },
+    /// A `HostTarget` attachment of another format than the `TargetDesc` the pipelines were
+    /// made for.
+    #[error(
+        "the HostTarget's {which} image is {given:?}, but the renderer was made for {declared:?} (TargetDesc::Host)"
+    )]
+    HostTargetFormat {
+        /// "colour" or "depth".
+        which: &'static str,
+        /// The attachment's format.
+        given: vk::Format,
+        /// The `TargetDesc::Host` format.
+        declared: vk::Format,
+    },
+    /// `read_timings` of a frame whose submission has not finished (or was not made): reading
+    /// would block until it does.
+    #[error("frame {0}'s timings are not written yet: read them after the fence of its submission")]
+    FrameNotDone(u64),
+    /// `read_timings` of a frame whose timestamp queries a later frame has reused.
+    #[error(
+        "frame {frame}'s timings were overwritten by frame {by}: read them before {in_flight} more frames are \
+         recorded (Renderer::FRAMES_IN_FLIGHT)"
+    )]
+    TimingsOverwritten {
+        /// The frame asked for (`RecordedFrame::generation`).
+        frame: u64,
+        /// The later frame that reused its queries.
+        by: u64,
+        /// How many frames may be in flight.
+        in_flight: usize,
+    },
+    /// `read_timings` of a frame another renderer recorded.
+    #[error("this frame was recorded by another renderer")]
+    ForeignFrame,
     /// `image` or `hdr_image` of a renderer drawing into a host's target.
     #[error("a host target has no image of the renderer's own: the host reads its own")]
     NoOwnImage,
@@ -186,10 +236,32 @@ pub struct RecordedFrame {
     pub passes: Vec<Pass>,
     /// Slot of the timer ring that holds its timestamps.
     slot: Option<usize>,
+    /// Its number among the frames its renderer recorded, from 1.
+    generation: u64,
+    /// The renderer that recorded it (`Renderer::id`).
+    renderer: usize,
+}
+
+impl RecordedFrame {
+    /// Its number among the frames its renderer recorded, from 1: `read_timings` refuses a
+    /// frame whose timer slot a later generation reused.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
 }
 
 /// Renders one prepared scene: its passes over its GPU data, recording the passes each frame
 /// needs into a command buffer (the host's, or its own for `frame`).
+///
+/// **Lifetime.** Frames recorded with `record_frame` into a host's command buffer use the
+/// renderer's pipelines, buffers and images until their submission finishes. Dropping the
+/// renderer (and `set_transform`, `bake_static_levels`, `resize`, which replace some of them)
+/// therefore first waits for the `Gpu`'s queue to go idle (`vkQueueWaitIdle`) unless every
+/// frame it recorded was seen finished: by `read_timings` succeeding on the last one, or by
+/// `frame`. So no order of safe calls destroys what a frame in flight uses; a host that does
+/// not want the wait reads the last frame's timings after its fence first. A host must submit
+/// the command buffers it recorded into before dropping the renderer, or never (a buffer
+/// recorded against a dropped renderer is invalid, as after any destroyed object).
 pub struct Renderer {
     gpu: Arc<Gpu>,
     scene: PreparedScene,
@@ -205,7 +277,16 @@ pub struct Renderer {
     tonemap: Option<TonemapPass>,
     /// One timer per frame that may be in flight (empty without timestamps).
     timers: Vec<GpuTimer>,
-    next_slot: usize,
+    /// The generation of the frame each timer holds.
+    slot_frames: Vec<u64>,
+    /// Frames recorded so far (the last one's generation).
+    generation: u64,
+    /// The last generation seen finished (`read_timings`, `frame`); what Drop need not wait for.
+    finished: std::cell::Cell<u64>,
+    /// The extent of the last `HostTarget`: the planner's levels of detail follow it.
+    host_extent: Option<vk::Extent2D>,
+    /// Tells its `RecordedFrame`s from another renderer's (`NEXT_RENDERER`).
+    id: usize,
     /// The shadow maps and camera images the passes' descriptor sets point into.
     targets: FrameTargets,
     buffers: GpuScene,
@@ -223,6 +304,10 @@ pub struct Renderer {
 /// under what a person sees in a smooth gradient. Measured on the default scene's floor
 /// (README, "Performance").
 pub const SKY_LOCK_SHARE: f32 = 0.002;
+
+/// The next renderer's `id`: a frame handed to another renderer's `read_timings` would read
+/// that renderer's queries.
+static NEXT_RENDERER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 impl Renderer {
     /// Frames a host may have in flight at once: each has its own timestamp queries.
@@ -268,8 +353,12 @@ impl Renderer {
             shadow: ShadowPass::new(gpu, scene.shadow_layers)?,
             gather,
             shade,
+            slot_frames: vec![0; timers.len()],
             timers,
-            next_slot: 0,
+            generation: 0,
+            finished: std::cell::Cell::new(0),
+            host_extent: None,
+            id: NEXT_RENDERER.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
             targets,
             buffers,
             hazards: RefCell::new(hazards),
@@ -338,6 +427,7 @@ impl Renderer {
         if !self.scene.scene.file.render.level_of_detail || self.needs.environment.is_none() {
             return Ok(false);
         }
+        self.wait_for_recorded()?;
         let sky: Vec<[f32; 4]> = self.buffers.environment_irradiance.read()?;
         let mut baked = false;
         let mut first = 0;
@@ -368,8 +458,11 @@ impl Renderer {
     }
 
     /// The current camera as the planner sees it.
+    /// Its height in pixels is the host target's (the last `HostTarget` given) or the own
+    /// image's: levels of detail follow the pixels really drawn, not `camera.resolution`.
     pub fn view(&self) -> plan::View {
-        plan::View::of_camera(&self.camera, self.scene.scene.file.camera.resolution[1])
+        let height = self.host_extent.map_or(self.scene.scene.file.camera.resolution[1], |e| e.height);
+        plan::View::of_camera(&self.camera, height)
     }
 
     /// What the planner knows of the scene (per-object facts included).
@@ -424,6 +517,7 @@ impl Renderer {
         }
         self.scene.scene.file.camera.resolution = [width, height];
         check_fits(&self.gpu, &self.scene)?;
+        self.wait_for_recorded()?;
         let gpu = self.gpu.clone();
         // The old images' last frame must be done before they go (the caller's contract).
         self.targets.camera = Some(CameraTargets::new(&gpu, [width, height], self.needs.pixel_gather)?);
@@ -457,6 +551,14 @@ impl Renderer {
         cmd: vk::CommandBuffer,
         target: Option<&HostTarget>,
     ) -> Result<RecordedFrame, RenderError> {
+        if let Some(t) = target {
+            super::host::check_target(&self.gpu, self.target, t)?;
+            if self.host_extent.is_some_and(|e| e != t.extent) {
+                // As for the own image's `resize`: the levels of detail follow the new size.
+                self.planner.mark(Change::Camera);
+            }
+            self.host_extent = Some(t.extent);
+        }
         let plan = self.planner.plan(&self.needs, &self.view());
         self.record_plan(cmd, &plan, target)
     }
@@ -474,11 +576,13 @@ impl Renderer {
             (TargetDesc::Host { .. }, None) => {
                 return Err(RenderError::MissingHostTarget);
             }
+            (_, Some(t)) => super::host::check_target(&self.gpu, self.target, t)?,
             _ => {}
         }
+        self.generation += 1;
         let slot = (!self.timers.is_empty()).then(|| {
-            let slot = self.next_slot % self.timers.len();
-            self.next_slot += 1;
+            let slot = (self.generation - 1) as usize % self.timers.len();
+            self.slot_frames[slot] = self.generation;
             slot
         });
         for o in &plan.objects {
@@ -507,17 +611,41 @@ impl Renderer {
         if self.planner.baked_levels() != baked {
             self.needs = Self::needs_of(&self.scene, self.target, &self.planner);
         }
-        Ok(RecordedFrame { passes: recorded, slot })
+        Ok(RecordedFrame { passes: recorded, slot, generation: self.generation, renderer: self.id() })
+    }
+
+    /// Identifies this renderer's frames: a number no other renderer of this process has.
+    fn id(&self) -> usize {
+        self.id
     }
 
     /// GPU milliseconds of each pass of `frame`, from its timestamps: call after the host's
     /// fence for the submission holding it, and before `FRAMES_IN_FLIGHT` more frames were
-    /// recorded (they reuse its queries). Empty on a queue without timestamps.
+    /// recorded (they reuse its queries). Never blocks: before the submission has finished it
+    /// answers `FrameNotDone`, after its queries were reused `TimingsOverwritten`. Empty on a
+    /// queue without timestamps (then nothing tells whether the frame finished). Before the
+    /// fence, `FrameNotDone` is certain only for a slot's first frame: until the GPU begins a
+    /// later one, the slot's queries still hold the results of the frame `FRAMES_IN_FLIGHT`
+    /// before it (docs/GPU.md, "Timestamps").
     pub fn read_timings(&self, frame: &RecordedFrame) -> Result<FrameTimings, RenderError> {
+        if frame.renderer != self.id() {
+            return Err(RenderError::ForeignFrame);
+        }
         let marks = match frame.slot {
-            Some(slot) => self.timers[slot].results()?,
+            Some(slot) if self.slot_frames[slot] != frame.generation => {
+                return Err(RenderError::TimingsOverwritten {
+                    frame: frame.generation,
+                    by: self.slot_frames[slot],
+                    in_flight: self.timers.len(),
+                });
+            }
+            Some(slot) => self.timers[slot].results_if_done()?.ok_or(RenderError::FrameNotDone(frame.generation))?,
             None => Vec::new(),
         };
+        if frame.slot.is_some() {
+            // Frames finish in the order they were recorded (the host's contract).
+            self.finished.set(self.finished.get().max(frame.generation));
+        }
         // One mark per recorded pass, in order (`record`).
         Ok(FrameTimings { passes: frame.passes.iter().zip(marks).map(|(&p, (_, ms))| (p, ms)).collect() })
     }
@@ -577,6 +705,7 @@ impl Renderer {
     pub fn frame(&mut self, plan: &Plan) -> Result<FrameTimings, RenderError> {
         let gpu = self.gpu.clone();
         let recorded = gpu.one_shot("frame", |cmd| self.record_plan(cmd, plan, None))??;
+        self.finished.set(recorded.generation);
         let timings = self.read_timings(&recorded)?;
         self.bake_after(plan)?;
         Ok(timings)
@@ -592,7 +721,8 @@ impl Renderer {
         for (pass, why) in &plan.passes {
             let alone = Plan { passes: vec![(*pass, why.clone())], skipped: Vec::new(), ..plan.clone() };
             let start = std::time::Instant::now();
-            gpu.one_shot(pass.name(), |cmd| self.record_plan(cmd, &alone, None))??;
+            let recorded = gpu.one_shot(pass.name(), |cmd| self.record_plan(cmd, &alone, None))??;
+            self.finished.set(recorded.generation);
             passes.push((*pass, start.elapsed().as_secs_f64() * 1e3));
         }
         self.bake_after(plan)?;
@@ -727,6 +857,7 @@ impl Renderer {
     /// renderer in flight: its scene buffers are replaced. On an error nothing changed.
     pub fn set_transform(&mut self, object: usize, transform: crate::scene::Transform) -> Result<(), RenderError> {
         self.check_object(object)?;
+        self.wait_for_recorded()?;
         let mut scene = self.scene.clone();
         scene.set_transform(object, transform).map_err(|e| RenderError::Scene(e.to_string()))?;
         check_fits(&self.gpu, &scene)?;
@@ -804,6 +935,25 @@ impl Renderer {
     /// Bytes of device memory in use by the allocator.
     pub fn device_memory(&self) -> u64 {
         self.gpu.memory_usage().0
+    }
+
+    /// Before destroying what recorded frames use: wait for the queue unless every frame
+    /// recorded was seen finished (the lifetime rule on `Renderer`).
+    fn wait_for_recorded(&self) -> Result<(), RenderError> {
+        if self.finished.get() < self.generation {
+            self.gpu.wait_queue_idle()?;
+            self.finished.set(self.generation);
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        if let Err(e) = self.wait_for_recorded() {
+            // A lost device: nothing will run again, so destroying is safe.
+            log::error!("dropping a renderer: {e}");
+        }
     }
 }
 

@@ -60,17 +60,34 @@ pub enum TargetDesc {
 /// image is in COLOR_ATTACHMENT_OPTIMAL and the depth image in DEPTH_ATTACHMENT_OPTIMAL; the
 /// pass waits for earlier attachment writes, and its own writes are done at the colour-output
 /// and late-fragment-test stages, where the host's next barrier picks them up.
+///
+/// Each attachment carries its image's format and size, because a view does not say them and
+/// Vulkan cannot be asked: `record_frame` checks them against the `TargetDesc` the pipelines
+/// were made for and the render area against both images and the device's framebuffer limits
+/// (an area past an image is `VUID-VkRenderingInfo-pNext-06079`, and a crash on some drivers).
 #[derive(Clone, Copy, Debug)]
 pub struct HostTarget {
-    /// View of the host's colour image.
-    pub color: vk::ImageView,
-    /// View of the host's depth image.
-    pub depth: vk::ImageView,
-    /// Size of both images: the render area, viewport and scissor.
+    /// The host's colour image.
+    pub color: HostAttachment,
+    /// The host's depth image.
+    pub depth: HostAttachment,
+    /// The render area (from the images' origin), viewport and scissor: at least 1x1, and
+    /// within both images.
     pub extent: vk::Extent2D,
     /// Keep the host's colour and depth (`true`), or clear them to the scene's background and
     /// the far plane (`false`).
     pub load: bool,
+}
+
+/// One of the host's images, as `HostTarget` gives it: a 2D view of mip level 0, one layer.
+#[derive(Clone, Copy, Debug)]
+pub struct HostAttachment {
+    /// The view drawn through.
+    pub view: vk::ImageView,
+    /// The image's (and view's) format: must be the `TargetDesc::Host` format.
+    pub format: vk::Format,
+    /// The image's width and height at mip level 0.
+    pub extent: vk::Extent2D,
 }
 
 /// glsl/common/shade.glsl's bindings, in binding order.
@@ -121,7 +138,7 @@ impl ShadePass {
     /// host's attachments.
     fn attachments(&self, frame: &FrameInputs) -> (Vec<vk::ImageView>, vk::ImageView, vk::Extent2D, bool) {
         match (frame.target, &frame.targets.camera) {
-            (Some(t), _) => (vec![t.color], t.depth, t.extent, t.load),
+            (Some(t), _) => (vec![t.color.view], t.depth.view, t.extent, t.load),
             (None, Some(c)) => {
                 let colors = std::iter::once(&c.hdr).chain(c.surface.as_ref().filter(|_| self.pixel_gather));
                 (colors.map(|i| i.view()).collect(), c.depth.view(), c.hdr.extent(), false)

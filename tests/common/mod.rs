@@ -4,6 +4,8 @@
 //! destruction included.
 #![allow(dead_code)]
 
+pub mod host;
+
 use glam::{Mat4, Vec3};
 use std::path::PathBuf;
 use std::process::{Command, Output};
