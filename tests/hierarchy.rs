@@ -185,7 +185,8 @@ fn a_coarse_level_of_detail_gathers_hierarchically_at_its_own_vertices_as_the_wh
     let epsilon = translucent::scene::ACCURATE_GATHER_EPSILON;
     let lod = Overrides { level_of_detail: Some(true), ..hierarchical(epsilon) };
     let (level, vertices, coarse, whole) = with_gpu(|gpu| {
-        let (level, vertices, coarse) = run_all(gpu, builtin(&lod)).exitance_at_level(0).unwrap();
+        let at = run_all(gpu, builtin(&lod)).exitance_at_level(0).unwrap();
+        let (level, vertices, coarse) = (at.level, at.vertices, at.values);
         let whole = run_all(gpu, builtin(&hierarchical(epsilon))).exitance(0).unwrap();
         (level, vertices, coarse, whole)
     });

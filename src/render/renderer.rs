@@ -250,6 +250,17 @@ impl RecordedFrame {
     }
 }
 
+/// An object's exitance where its last gather computed it (`Renderer::exitance_at_level`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LevelExitance {
+    /// The level of detail gathered at (0: the whole mesh).
+    pub level: usize,
+    /// That level's vertices, object-relative, ascending.
+    pub vertices: Vec<u32>,
+    /// Their RGB exitance, in the same order.
+    pub values: Vec<[f32; 3]>,
+}
+
 /// Renders one prepared scene: its passes over its GPU data, recording the passes each frame
 /// needs into a command buffer (the host's, or its own for `frame`).
 ///
@@ -759,7 +770,7 @@ impl Renderer {
     /// Object `object`'s exitance where the last gather computed it: the level of detail it
     /// gathered at, that level's vertices (object-relative, ascending) and their RGB exitance.
     /// Unlike [`Renderer::exitance`], it answers after a gather at a coarser level too.
-    pub fn exitance_at_level(&self, object: usize) -> Result<(usize, Vec<u32>, Vec<[f32; 3]>), RenderError> {
+    pub fn exitance_at_level(&self, object: usize) -> Result<LevelExitance, RenderError> {
         self.check_object(object)?;
         let level = self.planner.gathered_level(object).unwrap_or(0);
         let all = self.exitance_all(object)?;
@@ -768,7 +779,7 @@ impl Renderer {
             _ => (0..all.len() as u32).collect(),
         };
         let values = vertices.iter().map(|&v| all[v as usize]).collect();
-        Ok((level, vertices, values))
+        Ok(LevelExitance { level, vertices, values })
     }
 
     /// Object `object`'s exitance buffer as it stands, every vertex.

@@ -15,6 +15,8 @@ const OCCLUSION_DIRECTIONS: usize = 64;
 /// How an object's sample count was chosen, with the prediction behind it.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Density {
+    /// Samples placed.
+    pub count: usize,
     /// `render.max_error` it was chosen for (`None`: the count was given, `sampling.count` or
     /// `--samples`).
     pub target: Option<f64>,
@@ -28,12 +30,33 @@ impl Density {
     /// The same facts with `count` samples given rather than chosen (a study's configuration).
     pub fn given(&self, dipoles: &[crate::optics::Dipole; 3], count: usize) -> Density {
         let radii = dipoles.each_ref().map(|d| d.profile_radius());
-        Density { target: None, facts: self.facts, predicted: density::predict(&self.facts, radii, count) }
+        Density { count, target: None, facts: self.facts, predicted: density::predict(&self.facts, radii, count) }
     }
 
     /// The worst channel's predicted error.
     pub fn worst(&self) -> f64 {
         self.predicted.iter().map(|c| c.error).fold(0.0, f64::max)
+    }
+}
+
+impl std::fmt::Display for Density {
+    /// `30505 samples for render.max_error 1%: predicted R 0.52%, G 0.74%, B 1% (spacing / radius
+    /// 0.087, 0.12, 0.155; thin part 1.15, 0.78, 0.626; shadow edges 2.47)`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let pct = |x: f64| format!("{:.3}%", 100.0 * x);
+        match self.target {
+            Some(t) => write!(f, "{} samples for render.max_error {}", self.count, pct(t))?,
+            None => write!(f, "{} samples given (sampling.count or --samples)", self.count)?,
+        }
+        let [r, g, b] = self.predicted.map(|c| pct(c.error));
+        let three = |v: [f64; 3]| format!("{:.3}, {:.3}, {:.3}", v[0], v[1], v[2]);
+        write!(
+            f,
+            ": predicted R {r}, G {g}, B {b} (spacing / radius {}; thin part {}; shadow edges {:.3})",
+            three(self.predicted.map(|c| c.spacing_over_radius)),
+            three(self.predicted.map(|c| c.thin_term)),
+            self.predicted[0].shadow_term
+        )
     }
 }
 
@@ -100,5 +123,5 @@ pub fn choose_count(
     let radii = dipoles.each_ref().map(|d| d.profile_radius());
     let count = given.unwrap_or_else(|| density::count_for(&facts, radii, max_error));
     let predicted = density::predict(&facts, radii, count);
-    Some((count, Density { target: given.is_none().then_some(max_error), facts, predicted }))
+    Some((count, Density { count, target: given.is_none().then_some(max_error), facts, predicted }))
 }

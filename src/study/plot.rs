@@ -278,6 +278,7 @@ mod tests {
             flip_mean: 0.01,
             image_rel_rmse: error / 2.0,
             sampling_ms: 1.0,
+            predicted: f64::NAN,
         }
     }
 

@@ -194,6 +194,9 @@ pub struct ObjectPlan {
     pub level: usize,
     /// Why that level, with the figures.
     pub level_why: LevelReason,
+    /// Its sample count and the per-vertex error predicted for it (`scene::accuracy`;
+    /// translucent objects only).
+    pub density: Option<crate::scene::accuracy::Density>,
 }
 
 impl ObjectPlan {
@@ -283,6 +286,9 @@ impl fmt::Display for Plan {
         for o in self.objects.iter().filter(|o| !o.channels.is_empty() || o.level > 0) {
             writeln!(f, "  object {} ({}): {}", o.object, o.name, o.why)?;
             writeln!(f, "    level {}: {}", o.level, o.level_why)?;
+            if let Some(d) = &o.density {
+                writeln!(f, "    {d}")?;
+            }
             for (c, ch) in ["R", "G", "B"].iter().zip(&o.channels) {
                 let t = match ch.transport {
                     Transport::Local => "local ",

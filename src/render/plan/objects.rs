@@ -114,6 +114,7 @@ impl Frame<'_> {
             why,
             level,
             level_why,
+            density: facts.density.clone(),
         }
     }
 
