@@ -174,14 +174,14 @@ fn push_blocks_match_glsl_and_spirv() {
             include_str!("../glsl/gather_sparse.comp"),
             "GatherSparsePush",
             size_of::<GatherSparsePush>(),
-            &["object", "stage", "first_node", "node_count", "first_receiver", "first_group"],
+            &["object", "stage", "first_node", "node_count", "first_receiver", "first_group", "receiver_count"],
         ),
         (
             "gather_tree.comp",
             include_str!("../glsl/gather_tree.comp"),
             "GatherTreePush",
             size_of::<GatherTreePush>(),
-            &["object", "stage", "first_node", "node_count", "first_receiver", "first_group"],
+            &["object", "stage", "first_node", "node_count", "first_receiver", "first_group", "receiver_count"],
         ),
         (
             "gather_pixel.comp",

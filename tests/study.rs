@@ -255,3 +255,32 @@ fn the_built_in_scene_at_its_defaults_stays_within_its_error_targets_bound() {
     assert!(study.truth.converged, "the truth did not converge: {:?}", study.truth.levels);
     assert!(measured <= 1.5 * target, "measured {measured} above 1.5 x the target {target}");
 }
+
+#[test]
+fn a_scene_no_light_reaches_is_refused_not_ranked() {
+    // Defect 3 of the study's probe: a truth that is zero everywhere read as "converged" with
+    // every configuration at 0% error.
+    let dir = temp_dir("study-unlit");
+    let tiny = std::fs::read_to_string(repo_path("tests/scenes/study-tiny.toml")).unwrap();
+    let dark = tiny.replace("irradiance = [1.0, 1.0, 1.0]", "irradiance = [0.0, 0.0, 0.0]");
+    assert_ne!(dark, tiny, "the tiny scene's light is where this test expects it");
+    let scene = dir.join("dark.toml");
+    std::fs::write(&scene, dark).unwrap();
+    let out = dir.join("out");
+    let run = translucent(
+        &[
+            "study",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--quick",
+            "--truth-cache",
+            dir.join("cache").to_str().unwrap(),
+        ],
+        &[],
+    );
+    let err = text(&run.stderr);
+    assert!(!run.status.success(), "an unlit scene was studied");
+    assert!(err.contains("no light reaches"), "{err}");
+    assert!(!out.exists(), "the refused study made its output folder");
+}

@@ -288,3 +288,46 @@ seed = 1
     assert!(band.iter().all(|b| b.abs() < 0.005), "mean error beside the terminator {band:?}");
     assert!(rms.iter().all(|&r| r < 0.01), "RMS over lit vertices {rms:?}");
 }
+
+/// A cache file edited but still valid JSON is never read as the truth (issue "the study never
+/// reports a wrong number", defects 1 and 2): a changed digit, every value zeroed, negative or
+/// huge, half the vertices left out. Each is detected, recomputed and replaced, and the values
+/// returned are the computed ones.
+#[test]
+fn an_edited_truth_cache_is_recomputed_never_trusted() {
+    let dir = std::env::temp_dir().join(format!("translucent-truth-edited-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let options = truth::TruthOptions { max_level: 1, ..Default::default() };
+    let scene = prepare(&lit_marble_sphere(0.2));
+    let (computed, _) = truth::cached(&scene, &options, &dir, &quiet).unwrap();
+    let file = std::fs::read_dir(&dir).unwrap().next().unwrap().unwrap().path();
+    type Edit = fn(&mut truth::Truth);
+    let edits: [(&str, Edit); 5] = [
+        ("one value changed", |t| t.exitance[0][3][1] *= 1.0 + 1e-9),
+        ("every value zero", |t| t.exitance[0].iter_mut().for_each(|m| *m = [0.0; 3])),
+        ("every value negative", |t| t.exitance[0].iter_mut().for_each(|m| *m = m.map(|x| -x))),
+        ("every value 1e6", |t| t.exitance[0].iter_mut().for_each(|m| *m = [1e6; 3])),
+        ("half the vertices", |t| {
+            let half = t.exitance[0].len() / 2;
+            t.exitance[0].truncate(half);
+        }),
+    ];
+    for (what, edit) in edits {
+        let mut t = computed.clone();
+        edit(&mut t);
+        std::fs::write(&file, serde_json::to_vec(&t).unwrap()).unwrap();
+        let (read, was_cached) = truth::cached(&scene, &options, &dir, &quiet).unwrap();
+        assert!(!was_cached, "{what}: the edited file was trusted");
+        assert_eq!(read.exitance, computed.exitance, "{what}: not the computed truth");
+        // The same edit with its checksum made to match is still refused where values are impossible.
+        let mut forged = computed.clone();
+        edit(&mut forged);
+        forged.checksum = Some(forged.digest());
+        let refused = forged.unusable_for(&scene, &options, &forged.key.clone());
+        let impossible = what != "one value changed" && what != "every value zero" && what != "every value 1e6";
+        assert_eq!(refused.is_some(), impossible, "{what}: {refused:?}");
+    }
+    let (_, was_cached) = truth::cached(&scene, &options, &dir, &quiet).unwrap();
+    assert!(was_cached, "the replaced file is read back");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -122,9 +122,56 @@ pub struct Truth {
     pub tolerance: f64,
     /// Whether the last level changed by less than `tolerance`.
     pub converged: bool,
+    /// [`Truth::digest`] of what it holds, written with the cache file and checked when it is
+    /// read back, so that an edited or damaged file is recomputed, never trusted.
+    #[serde(default)]
+    pub checksum: Option<String>,
 }
 
 impl Truth {
+    /// A hash (FNV-1a, hex) of its key, version, subset, convergence and every exitance value's
+    /// bits.
+    pub fn digest(&self) -> String {
+        let mut h = Fnv(0xcbf2_9ce4_8422_2325);
+        h.bytes(self.key.as_bytes());
+        h.u64(u64::from(self.version));
+        h.u64(self.subset.map_or(u64::MAX, |m| m as u64));
+        h.u64(u64::from(self.converged));
+        for o in &self.exitance {
+            h.u64(o.len() as u64);
+            o.iter().flatten().for_each(|&v| h.f64(v));
+        }
+        format!("{:016x}", h.0)
+    }
+
+    /// Why this truth, read from a cache file, cannot be the truth of `scene` under `options`
+    /// (`None`: it can): a foreign key or version, a checksum that does not match its values, a
+    /// vertex count other than the mesh's, or a value that is negative, infinite, or NaN at a
+    /// vertex the receivers include.
+    pub fn unusable_for(&self, scene: &PreparedScene, options: &TruthOptions, key: &str) -> Option<String> {
+        if self.key != key || self.version != VERSION {
+            return Some(format!("made for other content (key {}, version {})", self.key, self.version));
+        }
+        if self.checksum.as_deref() != Some(self.digest().as_str()) {
+            return Some("its checksum does not match its values (edited or damaged)".into());
+        }
+        if self.exitance.len() != scene.objects.len() {
+            return Some(format!("{} objects, the scene has {}", self.exitance.len(), scene.objects.len()));
+        }
+        for (i, (m, o)) in self.exitance.iter().zip(&scene.objects).enumerate() {
+            let vertices = o.mesh.positions().len();
+            if m.len() != vertices {
+                return Some(format!("object {i} has {} values, its mesh {vertices} vertices", m.len()));
+            }
+            for v in receiver_subset(vertices, options.receivers) {
+                if m[v].iter().any(|x| !x.is_finite() || *x < 0.0) {
+                    return Some(format!("object {i}, vertex {v}: {:?} is not a finite non-negative exitance", m[v]));
+                }
+            }
+        }
+        None
+    }
+
     /// The last level's RMS relative change: the truth's own error estimate (an upper bound of
     /// the kept level's error when each level at least halves the error).
     pub fn change(&self) -> f64 {
@@ -240,7 +287,7 @@ pub fn compute(scene: &PreparedScene, options: &TruthOptions, progress: Progress
             break;
         }
     }
-    Truth {
+    let mut truth = Truth {
         version: VERSION,
         key: content_key(scene, options),
         exitance: previous.unwrap_or_default(),
@@ -248,7 +295,10 @@ pub fn compute(scene: &PreparedScene, options: &TruthOptions, progress: Progress
         levels,
         tolerance: options.tolerance,
         converged,
-    }
+        checksum: None,
+    };
+    truth.checksum = Some(truth.digest());
+    truth
 }
 
 /// Why the cached truth could not be read or written.
@@ -272,12 +322,14 @@ pub fn cached(
     let key = content_key(scene, options);
     let path = dir.join(format!("truth-{key}.json"));
     if let Ok(bytes) = std::fs::read(&path) {
-        // An unreadable or foreign file is recomputed and replaced, never trusted.
-        if let Ok(truth) = serde_json::from_slice::<Truth>(&bytes)
-            && truth.key == key
-            && truth.version == VERSION
-        {
-            return Ok((truth, true));
+        // An unreadable, foreign, edited or damaged file is recomputed and replaced, never
+        // trusted.
+        match serde_json::from_slice::<Truth>(&bytes) {
+            Ok(truth) => match truth.unusable_for(scene, options, &key) {
+                None => return Ok((truth, true)),
+                Some(why) => log::warn!("truth cache {}: {why}; computing it anew", path.display()),
+            },
+            Err(e) => log::warn!("truth cache {}: unreadable ({e}); computing it anew", path.display()),
         }
     }
     let truth = compute(scene, options, progress);

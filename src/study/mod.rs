@@ -126,6 +126,11 @@ pub enum StudyError {
     Report(String),
     #[error("the scene has no translucent object: there is nothing to study")]
     NothingTranslucent,
+    #[error(
+        "no light reaches a translucent object: the exact exitance is zero at every receiver, so every \
+         configuration would read 0% error and none can be ranked; light the scene"
+    )]
+    NothingLit,
 }
 
 /// What a running study reports, for a progress bar.
@@ -349,6 +354,9 @@ pub fn run(
         truth::cached(&base, &config.truth, truth_dir, &|l, d, n| progress(Event::Truth(l, d, n)))?;
     if truth_cached {
         progress(Event::TruthCached);
+    }
+    if !truth.exitance.iter().flatten().flatten().any(|&m| m > 0.0) {
+        return Err(StudyError::NothingLit);
     }
     let truth_image = truth_image(gpu, &base, &truth)?;
 
