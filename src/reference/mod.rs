@@ -16,8 +16,13 @@ use rayon::prelude::*;
 
 /// Occluders of a prepared scene: every triangle of every shadow-casting object.
 pub fn occluders(scene: &PreparedScene) -> Bvh {
+    occluders_of(&scene.objects)
+}
+
+/// [`occluders`] of `objects` alone (before the scene around them is complete).
+pub fn occluders_of(objects: &[PreparedObject]) -> Bvh {
     let mut triangles = Vec::new();
-    for o in scene.objects.iter().filter(|o| o.casts_shadow) {
+    for o in objects.iter().filter(|o| o.casts_shadow) {
         for t in 0..o.mesh.triangles().len() {
             triangles.push(o.mesh.corners(t));
         }
@@ -73,7 +78,12 @@ pub fn splat(scene: &PreparedScene, occluders: &Bvh) -> Vec<[f64; 3]> {
 
 /// How far a visibility ray starts off the surface: the scale of f32 positions in the scene.
 pub fn ray_offset(scene: &PreparedScene) -> f64 {
-    1e-5 * scene.bounds.1 as f64
+    ray_offset_within(scene.bounds.1)
+}
+
+/// [`ray_offset`] for a scene whose bounding sphere has radius `radius`.
+pub fn ray_offset_within(radius: f32) -> f64 {
+    1e-5 * f64::from(radius)
 }
 
 /// Fresnel-transmitted irradiance `E_t(p) = sum_l E_l cos_i F_t(cos_i, eta) V_l(p)` at a surface

@@ -291,20 +291,21 @@ impl PackedObjects {
         let epsilon = hierarchical.then_some(render.gather_epsilon as f64);
         let sparse = render.gather == crate::scene::GatherMode::Sparse;
         let whole: Vec<u32> = (0..o.mesh.positions().len() as u32).collect();
-        fn at<'a>(tree: &'a SampleTree, vertices: &'a [u32], like: &ReceiversAt) -> ReceiversAt<'a> {
-            ReceiversAt { tree, vertices, ..*like }
-        }
-        let like = ReceiversAt {
+        let whole_mesh = ReceiversAt {
             tree: &tree,
             vertices: &whole,
             epsilon,
             sparse,
             first: [first_vertex, first_sample, first_node],
         };
-        let receiver = self.receivers_at(i, o, at(&tree, &whole, &like));
+        let receiver = self.receivers_at(i, o, whole_mesh);
         self.receivers.push(receiver);
         let coarser = if hierarchical {
-            o.levels.iter().skip(1).map(|l| self.receivers_at(i, o, at(&tree, &l.vertices, &like))).collect()
+            o.levels
+                .iter()
+                .skip(1)
+                .map(|l| self.receivers_at(i, o, ReceiversAt { vertices: &l.vertices, ..whole_mesh }))
+                .collect()
         } else {
             Vec::new()
         };

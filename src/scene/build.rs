@@ -352,14 +352,8 @@ fn prepare_object(scene: &Scene, i: usize, environment_lit: bool) -> Result<Prep
 /// else as many as `render.max_error` needs (`super::accuracy`), judged with every shadow
 /// caster of `objects` in place.
 fn sample_objects(scene: &Scene, objects: &mut [PreparedObject], only: Option<usize>) -> Result<(), SceneError> {
-    let casters: Vec<[glam::DVec3; 3]> = objects
-        .iter()
-        .filter(|o| o.casts_shadow)
-        .flat_map(|o| (0..o.mesh.triangles().len()).map(|t| o.mesh.corners(t)))
-        .collect();
-    let occluders = crate::reference::bvh::Bvh::new(casters);
-    let bounds = bounding_sphere(objects.iter().map(|o| &o.mesh));
-    let eps = 1e-5 * f64::from(bounds.1);
+    let occluders = crate::reference::occluders_of(objects);
+    let eps = crate::reference::ray_offset_within(bounding_sphere(objects.iter().map(|o| &o.mesh)).1);
     let file = &scene.file;
     for (i, o) in objects.iter_mut().enumerate().filter(|(i, _)| only.is_none_or(|j| j == *i)) {
         let facts = super::accuracy::surface_facts(o, &occluders, eps);
