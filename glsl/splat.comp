@@ -1,13 +1,19 @@
 #version 450
 // Irradiance splat: for every sample point, the irradiance transmitted into the medium from
 // every light: sum over lights of E_light cos(theta_i) F_t(cos theta_i, eta) V, with V from the
-// light's shadow map (one bilinear compare tap: the sharpest, closest to ray casting). Also the sample's near-field energy per channel
-// (dipole_near_energy), which depends only on its area and material, so that the gather pays
-// for it once per sample instead of once per pair.
+// light's shadow map (one bilinear compare tap: the sharpest, closest to ray casting). Also the
+// sample's near-field energy per channel (dipole_near_energy), which depends only on its area and
+// material, so that the gather pays for it once per sample instead of once per pair.
+//
+// The environment's directions (lights key_light_count..light_count) rarely change while a key
+// light moves every frame, so their part is kept per sample (SplatEnvironment): a frame after a
+// key light moved reads it back and loops over the key lights alone. The sum is taken in the same
+// order either way (key lights + environment), so the kept splat equals a full one bit for bit.
 //
 // Bindings: 0 = samples (SampleRecord[], read), 1 = objects (ObjectRecord[], read),
 // 2 = lights (Light[], read), 3 = shadow maps (sampler2DArrayShadow),
-// 4 = splat output (SplatRecord[]), write.
+// 4 = splat output (SplatRecord[]), write, 5 = the environment's part (vec4 per sample), read
+// when kept, else written.
 // Push: SplatPush.
 #include "dipole.glsl"
 #include "lights.glsl"
@@ -19,12 +25,29 @@ layout(std430, set = 0, binding = 1) readonly buffer Objects { ObjectRecord obje
 layout(std430, set = 0, binding = 2) readonly buffer Lights { Light lights[]; };
 layout(set = 0, binding = 3) uniform sampler2DArrayShadow shadow_maps;
 layout(std430, set = 0, binding = 4) writeonly buffer Splat { SplatRecord splat[]; };
+layout(std430, set = 0, binding = 5) buffer SplatEnvironment { vec4 kept_environment[]; };
 struct SplatPush {
     uint first_sample;      // one dispatch per object: its samples
     uint sample_count;
-    uint light_count;
+    uint light_count;       // all lights: key lights first, then the environment's directions
+    uint key_light_count;
+    uint environment_kept;  // 1: read the environment's part; 0: compute and keep it
 };
 layout(push_constant) uniform SplatPushBlock { SplatPush push; };
+
+// Irradiance transmitted at `p` (normal `n`, index ratio `eta`) from lights [first, end).
+vec3 transmitted(uint first, uint end, vec3 p, vec3 n, float eta) {
+    vec3 e = vec3(0.0);
+    for (uint l = first; l < end; ++l) {
+        vec3 wi, irradiance;
+        light_incidence(lights[l], p, wi, irradiance);
+        float cos_i = dot(n, wi);
+        if (cos_i <= 0.0) continue;
+        float v = light_visibility(lights[l], shadow_maps, p, n, 0);
+        e += irradiance * (cos_i * dipole_fresnel_transmittance(cos_i, eta) * v);
+    }
+    return e;
+}
 
 void main() {
     if (gl_GlobalInvocationID.x >= push.sample_count) return;
@@ -33,16 +56,14 @@ void main() {
     ObjectRecord o = objects[uint(s.normal_object.w)];
     vec3 p = s.position_area.xyz;
     vec3 n = s.normal_object.xyz;
-    float eta = o.eta;
-    vec3 e = vec3(0.0);
-    for (uint l = 0u; l < push.light_count; ++l) {
-        vec3 wi, irradiance;
-        light_incidence(lights[l], p, wi, irradiance);
-        float cos_i = dot(n, wi);
-        if (cos_i <= 0.0) continue;
-        float v = light_visibility(lights[l], shadow_maps, p, n, 0);
-        e += irradiance * (cos_i * dipole_fresnel_transmittance(cos_i, eta) * v);
+    vec3 environment;
+    if (push.environment_kept != 0u) {
+        environment = kept_environment[i].xyz;
+    } else {
+        environment = transmitted(push.key_light_count, push.light_count, p, n, o.eta);
+        kept_environment[i] = vec4(environment, 0.0);
     }
+    vec3 e = transmitted(0u, push.key_light_count, p, n, o.eta) + environment;
     float area = s.position_area.w;
     float b = DIPOLE_B_PER_SQRT_AREA * sqrt(area);
     vec3 near_energy;

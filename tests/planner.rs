@@ -9,7 +9,7 @@ use glam::Vec3;
 use std::sync::Arc;
 use translucent::gpu::{Gpu, RecordCounts};
 use translucent::optics::Material;
-use translucent::render::plan::{BakedLevels, Change, LevelReason, Transport};
+use translucent::render::plan::{BakedLevels, Change, LevelReason, SplatLights, Transport};
 use translucent::render::renderer::Renderer;
 use translucent::scene::build::{Overrides, PreparedScene};
 use translucent::scene::{Scene, Transform, TransportMode, lights};
@@ -298,5 +298,52 @@ fn levels_baked_from_sky_light_are_withdrawn_when_it_is_recomputed_and_offered_o
         assert!(renderer.bake_static_levels().unwrap());
         assert_eq!(renderer.planner().baked_levels(), BakedLevels::Current);
         assert_eq!(renderer.needs().objects[floor].levels.len(), count);
+    });
+}
+
+#[test]
+fn a_moved_key_light_resplats_only_its_own_part_and_matches_a_full_splat() {
+    // A sphere over a floor, lit by a key light and the sky (16 shadowed directions).
+    let mut text = format!(
+        "{}{}{}",
+        stage([0.0, 0.02, 0.06], 32),
+        sphere(0.01, [0.0; 3], "marble", 1000.0, true),
+        sphere(0.004, [0.012, -0.004, 0.0], "skin1", 1000.0, true)
+    );
+    text.push_str("\n[[light]]\ntype = \"environment\"\nscale = 0.3\ndirections = 16\n");
+    with_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, prepare(&text, &Overrides::default())).unwrap();
+        frame(gpu, &mut renderer);
+        let light = lights::orbit(&renderer.scene().scene.file.lights[0], Vec3::ZERO, 40.0).unwrap();
+        renderer.set_light(0, light).unwrap();
+        let plan = renderer.plan(renderer.pending_change().unwrap());
+        for o in &plan.objects {
+            assert!(o.splat, "{plan}");
+            assert_eq!(o.splat_lights, SplatLights::KeyLights, "{plan}");
+        }
+        assert!(plan.to_string().contains("key lights only"), "{plan}");
+        frame(gpu, &mut renderer);
+        let kept = renderer.splat_irradiance().unwrap();
+        // The same moved scene splatted whole by a new renderer.
+        let mut fresh = Renderer::new(gpu, renderer.scene().clone()).unwrap();
+        let first = fresh.plan(fresh.pending_change().unwrap());
+        assert!(first.objects.iter().all(|o| o.splat_lights == SplatLights::All), "{first}");
+        frame(gpu, &mut fresh);
+        let full = fresh.splat_irradiance().unwrap();
+        assert_eq!(kept.len(), full.len());
+        let lit = full.iter().filter(|(e, _)| e.iter().any(|&v| v > 0.0)).count();
+        assert!(lit > full.len() / 3, "most samples are lit: {lit} of {}", full.len());
+        let mut worst = 0.0f32;
+        for ((a, _), (b, _)) in kept.iter().zip(&full) {
+            for c in 0..3 {
+                worst = worst.max((a[c] - b[c]).abs() / b[c].abs().max(1e-12));
+            }
+        }
+        eprintln!("kept against full splat: worst relative difference {worst:.2e}");
+        assert!(worst <= 1e-6, "worst relative difference {worst:e}");
+        // A material change re-splats that object whole.
+        renderer.set_material(1, Material::preset("marble").unwrap()).unwrap();
+        let plan = renderer.plan(renderer.pending_change().unwrap());
+        assert_eq!(plan.objects[1].splat_lights, SplatLights::All, "{plan}");
     });
 }

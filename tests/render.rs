@@ -469,3 +469,62 @@ fn a_level_of_detail_holds_the_whole_mesh_exitance_at_its_vertices_bit_for_bit()
         assert!(flip < 0.02, "FLIP mean {flip} against the whole mesh");
     });
 }
+
+#[test]
+fn exitance_drawn_in_local_channels_is_total_diffuse_reflectance_times_transmitted_irradiance() {
+    // A ketchup sphere, every channel local, under two unshadowed directional lights: E_t at a
+    // vertex is sum_l E_l max(cos, 0) F_t(cos, eta), exactly.
+    let toml = r#"
+[camera]
+eye = [0.0, 0.01, 0.05]
+target = [0.0, 0.0, 0.0]
+resolution = [32, 32]
+
+[[object]]
+shape = { type = "sphere", radius = 0.01, divisions = 12 }
+material = { type = "translucent", preset = "ketchup", mm_per_unit = 1000.0 }
+casts_shadow = false
+
+[[light]]
+type = "directional"
+direction = [0.3, 0.8, 0.5]
+irradiance = [1.0, 0.5, 0.25]
+
+[[light]]
+type = "directional"
+direction = [-0.6, -0.2, 0.4]
+irradiance = [0.2, 0.4, 0.8]
+
+[sampling]
+count = 64
+"#;
+    let overrides = Overrides { transport: Some(TransportMode::Local), ..Default::default() };
+    let prepared = prepare(toml, &overrides);
+    let material = Material::preset("ketchup").unwrap();
+    let rd: Vec<f64> = material.dipoles(1000.0).unwrap().iter().map(Dipole::r_d_total).collect();
+    let lights: Vec<([f64; 3], [f64; 3])> = vec![([0.3, 0.8, 0.5], [1.0, 0.5, 0.25]), ([-0.6, -0.2, 0.4], [0.2, 0.4, 0.8])];
+    let mesh = prepared.objects[0].mesh.clone();
+    with_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, prepared).unwrap();
+        renderer.frame(&renderer.plan(Change::Everything)).unwrap();
+        assert_eq!(renderer.buffers().local_channels(0), 0b111, "every channel local");
+        let drawn = renderer.exitance_drawn(0).unwrap();
+        let mut worst = 0.0f64;
+        for (n, got) in mesh.vertex_normals().iter().zip(&drawn) {
+            let n = n.as_dvec3().normalize();
+            for c in 0..3 {
+                let mut e_t = 0.0;
+                for (d, irradiance) in &lights {
+                    let cos = n.dot(glam::DVec3::from(*d).normalize());
+                    if cos > 0.0 {
+                        e_t += irradiance[c] * cos * fresnel::fresnel_transmittance(cos, material.eta);
+                    }
+                }
+                let expected = rd[c] * e_t;
+                worst = worst.max((f64::from(got[c]) - expected).abs() / expected.max(1e-3 * rd[c]));
+            }
+        }
+        eprintln!("local exitance drawn against R_d,total E_t: worst relative difference {worst:.2e}");
+        assert!(worst < 1e-4, "worst relative difference {worst:e}");
+    });
+}

@@ -66,7 +66,8 @@ pub struct Args {
     /// (overrides render.transport)
     #[arg(long, value_parser = super::one_of::<TransportMode>(&TransportMode::ALL.map(TransportMode::name)))]
     pub transport: Option<TransportMode>,
-    /// Write each translucent vertex's world position and RGB radiant exitance to a PLY
+    /// Write each translucent vertex's world position and the RGB radiant exitance drawn there
+    /// to a PLY: gathered channels as gathered, local ones as R_d,total E_t at the vertex
     /// (implies --full-detail: every vertex gathered)
     #[arg(long)]
     pub export_exitance: Option<PathBuf>,
@@ -153,7 +154,6 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         prepared.shadow_layers
     );
     let mut renderer = Renderer::new(&gpu, prepared).context("creating GPU resources")?;
-    check_export(&renderer, args)?;
     let moving = moving_change(&renderer, args)?;
     let timed = run_frames(&mut renderer, args, moving)?;
     write_outputs(&renderer, args)?;
@@ -191,13 +191,7 @@ fn prepare(args: &Args) -> Result<PreparedScene> {
         gather: args.gather,
         gather_epsilon: args.gather_epsilon,
         resolution: args.resolution,
-        transport: args.transport.or_else(|| {
-            // Local channels have no exitance at the vertices to export.
-            args.export_exitance.is_some().then(|| {
-                eprintln!("--export-exitance: every channel gathered (--transport gather) so each has vertex exitance");
-                TransportMode::Gather
-            })
-        }),
+        transport: args.transport,
         // Exported exitance is every vertex's.
         level_of_detail: (args.full_detail || args.export_exitance.is_some()).then_some(false),
     };
@@ -213,23 +207,6 @@ fn prepare(args: &Args) -> Result<PreparedScene> {
         );
     }
     Ok(prepared)
-}
-
-/// `--export-exitance` needs every channel of every object gathered at the vertices.
-fn check_export(renderer: &Renderer, args: &Args) -> Result<()> {
-    if let Some(ply) = &args.export_exitance
-        && let Some(o) = renderer.plan(Change::Everything).objects.iter().find(|o| o.local_mask() != 0)
-    {
-        bail!(
-            "--export-exitance {}: object[{}] ({}) has channels computed locally (render.transport = \"{}\"), which \
-             have no exitance at the vertices: use --transport gather",
-            ply.display(),
-            o.object,
-            o.name,
-            renderer.scene().scene.file.render.transport
-        );
-    }
-    Ok(())
 }
 
 /// What `--moving` changes between frames.
@@ -330,7 +307,7 @@ fn write_outputs(renderer: &Renderer, args: &Args) -> Result<()> {
             if o.samples.is_empty() {
                 continue;
             }
-            for (p, e) in o.mesh.positions().iter().zip(renderer.exitance(i)?) {
+            for (p, e) in o.mesh.positions().iter().zip(renderer.exitance_drawn(i)?) {
                 points.push((p.to_array(), e));
             }
         }

@@ -91,6 +91,9 @@ pub struct GpuScene {
     pub vertex_boundary: Buffer,
     /// Irradiance from the environment's directions per vertex (vec4), from the vertex-light pass.
     pub environment_irradiance: Buffer,
+    /// The locally computed channels' exitance per vertex (vec4), written on demand by the
+    /// local-exitance pass (`Renderer::exitance_drawn`).
+    pub local_exitance: Buffer,
     /// `ObjectRecord` per object, in scene order.
     pub objects: Buffer,
     /// `SampleRecord` per sample point, objects one after another (`ObjectRecord::ranges` says
@@ -98,6 +101,10 @@ pub struct GpuScene {
     pub samples: Buffer,
     /// `SplatRecord` per sample, from the splat pass.
     pub splat: Buffer,
+    /// Per sample (vec4), the irradiance transmitted from the environment's directions alone,
+    /// kept by the splat pass so that a frame after a key light moved adds only the key lights
+    /// (`plan::SplatLights::KeyLights`).
+    pub splat_environment: Buffer,
     /// `TreeNodeRecord` per node of every translucent object's sample hierarchy
     /// (`sampling::SampleTree`), objects one after another (`Receiver::first_node`).
     pub tree_nodes: Buffer,
@@ -409,10 +416,12 @@ impl GpuScene {
             // Opaque vertices keep zero exitance; translucent ones are written by the gather.
             exitance: upload(gpu, "exitance", &zeros, vertex_usage)?,
             environment_irradiance: upload(gpu, "environment irradiance", &zeros, vertex_usage)?,
+            local_exitance: sized("local exitance", std::mem::size_of::<[f32; 4]>(), p.vertices.len())?,
             vertex_boundary: upload(gpu, "vertex boundary", &p.vertex_boundary, none)?,
             objects: upload(gpu, "objects", &p.objects, none)?,
             samples: upload(gpu, "samples", &p.samples, none)?,
             splat: sized("splat", std::mem::size_of::<SplatRecord>(), p.samples.len())?,
+            splat_environment: sized("splat environment", std::mem::size_of::<[f32; 4]>(), p.samples.len())?,
             tree_nodes: upload(gpu, "tree nodes", &p.tree_nodes, none)?,
             tree_order: upload(gpu, "tree order", &p.tree_order, none)?,
             receiver_order: upload(gpu, "receiver order", &p.receiver_order, none)?,
@@ -493,8 +502,14 @@ impl GpuScene {
         self.object_ranges().nth(object).expect("an object of the scene")
     }
 
-    /// Which channels of object `object` the planner computes locally (bit c: channel c), in
-    /// its record's `local_channels`; uploaded by the next recorded frame when it changed.
+    /// Which channels of object `object` the last recorded plan computes locally (bit c:
+    /// channel c), its record's `local_channels`.
+    pub fn local_channels(&self, object: usize) -> u32 {
+        self.object_records[object].local_channels
+    }
+
+    /// Set object `object`'s locally computed channels (bit c: channel c), uploaded by the next
+    /// recorded frame when they changed.
     pub fn set_local_channels(&mut self, object: usize, mask: u32) {
         let record = &mut self.object_records[object];
         if record.local_channels != mask {

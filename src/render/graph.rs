@@ -27,12 +27,17 @@ pub enum Resource {
     Samples,
     /// `SplatRecord` per sample, the splat's output (`GpuScene::splat`).
     Splat,
+    /// The environment's transmitted irradiance per sample, kept by the splat between frames
+    /// (`GpuScene::splat_environment`).
+    SplatEnvironment,
     /// Exitance per vertex, the vertex-wide gathers' output (`GpuScene::exitance`); also a
     /// vertex stream of shading.
     Exitance,
     /// Environment irradiance per vertex (`GpuScene::environment_irradiance`); also a vertex
     /// stream of shading.
     EnvironmentIrradiance,
+    /// The locally computed channels' exitance per vertex (`GpuScene::local_exitance`).
+    LocalExitance,
     /// Distances to open boundaries per vertex (`GpuScene::vertex_boundary`).
     VertexBoundary,
     /// The sample hierarchies' nodes (`GpuScene::tree_nodes`).
@@ -81,8 +86,10 @@ impl Resource {
             Lights => "Lights",
             Samples => "Samples",
             Splat => "Splat",
+            SplatEnvironment => "SplatEnvironment",
             Exitance => "Exitance",
             EnvironmentIrradiance => "EnvironmentIrradiance",
+            LocalExitance => "LocalExitance",
             VertexBoundary => "VertexBoundary",
             TreeNodes => "TreeNodes",
             TreeOrder => "TreeOrder",
@@ -121,14 +128,16 @@ pub const HOST_READ: [Resource; 5] = [
 ];
 
 /// Every resource that is a `GpuScene` buffer (`Resources::buffer`).
-pub const SCENE_BUFFERS: [Resource; 16] = [
+pub const SCENE_BUFFERS: [Resource; 18] = [
     Resource::Vertices,
     Resource::Objects,
     Resource::Lights,
     Resource::Samples,
     Resource::Splat,
+    Resource::SplatEnvironment,
     Resource::Exitance,
     Resource::EnvironmentIrradiance,
+    Resource::LocalExitance,
     Resource::VertexBoundary,
     Resource::TreeNodes,
     Resource::TreeOrder,
@@ -193,8 +202,10 @@ impl<'a> Resources<'a> {
             Lights => &s.lights,
             Samples => &s.samples,
             Splat => &s.splat,
+            SplatEnvironment => &s.splat_environment,
             Exitance => &s.exitance,
             EnvironmentIrradiance => &s.environment_irradiance,
+            LocalExitance => &s.local_exitance,
             VertexBoundary => &s.vertex_boundary,
             TreeNodes => &s.tree_nodes,
             TreeOrder => &s.tree_order,

@@ -12,6 +12,7 @@ pub mod gpu_scene;
 pub mod graph;
 pub mod group_gather;
 mod host;
+pub mod local_exitance;
 pub mod pass;
 pub mod plan;
 pub mod records;

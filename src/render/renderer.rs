@@ -8,6 +8,7 @@ use super::gather_pixel::GatherPixelPass;
 use super::gather_sparse::GatherSparsePass;
 use super::gather_tree::GatherTreePass;
 use super::gpu_scene::GpuScene;
+use super::local_exitance::LocalExitancePass;
 use super::graph::{HOST_READ, Resource, Resources, read, write};
 use super::pass::{FrameInputs, RenderPass};
 use super::plan::{self, Change, Pass, Plan, Planner};
@@ -677,19 +678,7 @@ impl Renderer {
             hazards.external(Resource::HostColor, Access::ColorAttachmentWrite);
             hazards.external(Resource::HostDepth, Access::DepthAttachmentReadWrite);
         }
-        let frame = FrameInputs {
-            gpu: &self.gpu,
-            scene: &self.buffers,
-            targets: &self.targets,
-            plan,
-            shadow_layers: layers.as_deref(),
-            view_proj: self.camera.projection * self.camera.view,
-            eye: self.camera.eye,
-            background: self.background,
-            exposure: self.scene.scene.file.render.exposure,
-            target,
-            hazards: &self.hazards,
-        };
+        let frame = self.inputs(plan, layers.as_deref(), target);
         let mut recorded = Vec::new();
         for &(pass, _) in &plan.passes {
             let Some(recorder) = self.pass(pass) else { continue };
@@ -708,6 +697,29 @@ impl Renderer {
             HOST_READ.iter().flat_map(|&r| [read(r, Access::HostRead), read(r, Access::TransferRead)]).collect();
         frame.before(cmd, &host);
         recorded
+    }
+
+    /// What the passes of `plan` record from: this renderer's data, camera and hazards, the
+    /// shadow-map layers to redraw and the host's target.
+    fn inputs<'a>(
+        &'a self,
+        plan: &'a Plan,
+        shadow_layers: Option<&'a [u32]>,
+        target: Option<&'a HostTarget>,
+    ) -> FrameInputs<'a> {
+        FrameInputs {
+            gpu: &self.gpu,
+            scene: &self.buffers,
+            targets: &self.targets,
+            plan,
+            shadow_layers,
+            view_proj: self.camera.projection * self.camera.view,
+            eye: self.camera.eye,
+            background: self.background,
+            exposure: self.scene.scene.file.render.exposure,
+            target,
+            hazards: &self.hazards,
+        }
     }
 
     /// Render one frame: record the passes of `plan` in one submission of its own, wait, and
@@ -765,6 +777,36 @@ impl Renderer {
             return Err(RenderError::ExitanceAtCoarserLevel(object));
         }
         self.exitance_all(object)
+    }
+
+    /// Object `object`'s exitance as shading draws it, at every vertex: the gathered channels as
+    /// [`Renderer::exitance`] reads them, and the channels the last recorded frame computed
+    /// locally as `M = R_d,total E_t` at the vertex, with that frame's shadow maps and filter
+    /// (`local_exitance` pass, recorded in a submission of its own and waited for). Call after a
+    /// frame, with none in flight.
+    pub fn exitance_drawn(&self, object: usize) -> Result<Vec<[f32; 3]>, RenderError> {
+        let mut exitance = self.exitance(object)?;
+        let mask = self.buffers.local_channels(object);
+        if mask == 0 {
+            return Ok(exitance);
+        }
+        let pass = LocalExitancePass::new(&self.gpu, &Resources { scene: &self.buffers, targets: &self.targets })?;
+        let plan = self.planner.plan_for(&self.needs, &self.view(), Change::Camera);
+        self.gpu.one_shot("local exitance", |cmd| {
+            let frame = self.inputs(&plan, None, None);
+            frame.before(cmd, &pass.uses(&frame));
+            pass.record(cmd, &frame);
+            let r = Resource::LocalExitance;
+            frame.before(cmd, &[read(r, Access::HostRead), read(r, Access::TransferRead)]);
+        })?;
+        let local: Vec<[f32; 4]> = self.buffers.local_exitance.read()?;
+        let first = self.buffers.object_range(object).first_vertex as usize;
+        for (e, l) in exitance.iter_mut().zip(&local[first..]) {
+            for c in (0..3).filter(|c| mask & (1 << c) != 0) {
+                e[c] = l[c];
+            }
+        }
+        Ok(exitance)
     }
 
     /// Object `object`'s exitance where the last gather computed it: the level of detail it

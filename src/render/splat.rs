@@ -3,11 +3,17 @@
 //! visibility) and its area; together the flux `E_i A_i` each sample injects. Also each sample's
 //! near-field energy per channel, which the gather's kernel needs once per sample.
 //!
+//! The environment's directions' part is kept per sample (`GpuScene::splat_environment`): when
+//! the plan says only key lights changed for an object (`SplatLights::KeyLights`), the dispatch
+//! reads it back and evaluates the key lights alone.
+//!
 //! Reads samples, objects, lights and the shadow maps; writes the splat output (`SplatRecord`
-//! per sample), bound in that order (`BINDINGS`). Push: `SplatPush`.
+//! per sample) and the kept environment part, bound in that order (`BINDINGS`). Push:
+//! `SplatPush`.
 
 use super::graph::{Resource, Resources, Use, compute_uses};
 use super::pass::{FrameInputs, RenderPass};
+use super::plan::SplatLights;
 use crate::gpu::{ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use ash::vk;
 use std::sync::Arc;
@@ -22,11 +28,21 @@ pub struct SplatPush {
     pub sample_count: u32,
     /// Lights in the light buffer; each adds its transmitted irradiance at every sample.
     pub light_count: u32,
+    /// The first `key_light_count` lights are key lights, the rest the environment's directions.
+    pub key_light_count: u32,
+    /// 1: the environment's part is read from `SplatEnvironment`; 0: computed and kept there.
+    pub environment_kept: u32,
 }
 
 /// glsl/splat.comp's bindings, in binding order.
-const BINDINGS: [Resource; 5] =
-    [Resource::Samples, Resource::Objects, Resource::Lights, Resource::ShadowMaps, Resource::Splat];
+const BINDINGS: [Resource; 6] = [
+    Resource::Samples,
+    Resource::Objects,
+    Resource::Lights,
+    Resource::ShadowMaps,
+    Resource::Splat,
+    Resource::SplatEnvironment,
+];
 
 /// The irradiance splat: one dispatch of glsl/splat.comp per object the plan splats, writing
 /// `SplatRecord`s into `GpuScene::splat`.
@@ -34,6 +50,7 @@ pub struct SplatPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
     light_count: u32,
+    key_light_count: u32,
 }
 
 impl SplatPass {
@@ -41,13 +58,16 @@ impl SplatPass {
     pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<SplatPass> {
         let pipeline = ComputePipeline::new(gpu, "splat.comp")?;
         let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
-        Ok(SplatPass { pipeline, set, light_count: resources.scene.light_count })
+        let (light_count, key_light_count) = (resources.scene.light_count, resources.scene.key_light_count);
+        Ok(SplatPass { pipeline, set, light_count, key_light_count })
     }
 }
 
 impl RenderPass for SplatPass {
     fn uses(&self, _: &FrameInputs) -> Vec<Use> {
-        compute_uses(&BINDINGS, &[Resource::Splat])
+        // The kept environment part counts as written even on frames that only read it: one
+        // declaration, and a barrier the splat's own cost dwarfs.
+        compute_uses(&BINDINGS, &[Resource::Splat, Resource::SplatEnvironment])
     }
 
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
@@ -56,8 +76,13 @@ impl RenderPass for SplatPass {
             if r.sample_count == 0 || !frame.plan.splats(i) {
                 continue;
             }
-            let push =
-                SplatPush { first_sample: r.first_sample, sample_count: r.sample_count, light_count: self.light_count };
+            let push = SplatPush {
+                first_sample: r.first_sample,
+                sample_count: r.sample_count,
+                light_count: self.light_count,
+                key_light_count: self.key_light_count,
+                environment_kept: u32::from(frame.plan.splat_lights(i) == SplatLights::KeyLights),
+            };
             self.pipeline.dispatch(cmd, &self.set, &push, [r.sample_count, 1, 1]);
         }
     }

@@ -158,6 +158,18 @@ pub enum Transport {
     Gather,
 }
 
+/// Which lights an object's splat evaluates this frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SplatLights {
+    /// Every light, the environment's directions included; their part is kept for later frames.
+    #[default]
+    All,
+    /// The key lights alone, added to the environment's part a earlier splat kept: only key
+    /// lights changed since (`GpuScene::splat_environment`).
+    KeyLights,
+}
+
 /// The planner's choice for one channel, with the numbers that decided it (scene units).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct ChannelPlan {
@@ -182,6 +194,11 @@ pub struct ObjectPlan {
     pub channels: Vec<ChannelPlan>,
     /// Its samples' irradiance is computed this frame.
     pub splat: bool,
+    /// From which lights, when it is splatted.
+    pub splat_lights: SplatLights,
+    /// Whether the environment's part kept for its samples is current after this frame.
+    #[serde(skip)]
+    pub environment_kept_after: bool,
     /// Its exitance is gathered this frame.
     pub gather: bool,
     /// Why it is (or is not) splatted and gathered (`splat` and `gather` follow from it).
@@ -243,6 +260,11 @@ impl Plan {
         self.objects.get(object).is_none_or(|o| o.splat)
     }
 
+    /// Which lights object `object`'s splat evaluates (all of them in a plan made by hand).
+    pub fn splat_lights(&self, object: usize) -> SplatLights {
+        self.objects.get(object).map_or(SplatLights::All, |o| o.splat_lights)
+    }
+
     /// Whether object `object` is gathered (when the gather runs).
     pub fn gathers(&self, object: usize) -> bool {
         self.objects.get(object).is_none_or(|o| o.gather)
@@ -285,6 +307,9 @@ impl fmt::Display for Plan {
         }
         for o in self.objects.iter().filter(|o| !o.channels.is_empty() || o.level > 0) {
             writeln!(f, "  object {} ({}): {}", o.object, o.name, o.why)?;
+            if o.splat && o.splat_lights == SplatLights::KeyLights {
+                writeln!(f, "    splat: key lights only, the environment's part kept from an earlier frame")?;
+            }
             writeln!(f, "    level {}: {}", o.level, o.level_why)?;
             if let Some(d) = &o.density {
                 writeln!(f, "    {d}")?;

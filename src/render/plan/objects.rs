@@ -4,7 +4,7 @@
 use super::planner::Frame;
 use super::{
     Change, ChannelFigures, ChannelPlan, ChannelReason, LOCAL_PIXELS, LOCAL_SPACING, LOD_EDGE_PIXELS, LOD_ERROR_PIXELS,
-    LevelReason, ObjectPlan, ObjectReason, Transport,
+    LevelReason, ObjectPlan, ObjectReason, SplatLights, Transport,
 };
 use crate::scene::TransportMode;
 use crate::scene::needs::{LevelFacts, ObjectFacts};
@@ -86,6 +86,8 @@ pub(super) struct ObjectHistory {
     /// The finest level of detail whose vertices hold its current exitance (`usize::MAX`: none;
     /// `None`: not known, as none).
     pub gathered: Option<usize>,
+    /// The environment's part of its samples' irradiance, kept on the GPU, is current.
+    pub environment_kept: bool,
 }
 
 impl Frame<'_> {
@@ -102,6 +104,9 @@ impl Frame<'_> {
         let finer = history.gathered.is_some_and(|g| level < g);
         let why = self.work(i, &channels, in_view, stale_now, finer.then_some(level));
         let (splat, gather) = why.splat_and_gather();
+        let kept = history.environment_kept && !self.environment_stale && change != Change::Material(i);
+        let splat_lights =
+            if splat && kept && self.needs.environment.is_some() { SplatLights::KeyLights } else { SplatLights::All };
         ObjectPlan {
             object: i,
             name: facts.name.clone(),
@@ -110,6 +115,8 @@ impl Frame<'_> {
             stale_after: !channels.is_empty() && stale_now && !gather,
             channels,
             splat,
+            splat_lights,
+            environment_kept_after: splat || kept,
             gather,
             why,
             level,

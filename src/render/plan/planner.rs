@@ -74,6 +74,9 @@ pub struct Planner {
     /// Per object: the finest level of detail whose vertices hold its current exitance
     /// (`usize::MAX`: none yet); a finer level coming into view is gathered again.
     gathered: Vec<usize>,
+    /// Per object: the environment's part of its samples' irradiance, kept by the splat, is
+    /// current (`SplatLights`).
+    environment_kept: Vec<bool>,
     /// Whether levels baked from the sky light are current.
     baked: BakedLevels,
 }
@@ -87,17 +90,20 @@ impl Planner {
             pending: Some(first),
             stale: vec![true; objects],
             gathered: vec![usize::MAX; objects],
+            environment_kept: vec![false; objects],
             baked: BakedLevels::Current,
         }
     }
 
     /// Note `change` for the next frame, folded into what is pending (`Change::and`). A material
-    /// change also marks its object stale, so that folding it into another change loses nothing.
+    /// change also marks its object stale, and its kept environment irradiance (its Fresnel
+    /// transmittance changed), so that folding it into another change loses nothing.
     pub fn mark(&mut self, change: Change) {
         if let Change::Material(i) = change
             && let Some(stale) = self.stale.get_mut(i)
         {
             *stale = true;
+            self.environment_kept[i] = false;
         }
         self.pending = Some(self.pending.map_or(change, |old| old.and(change)));
     }
@@ -131,6 +137,7 @@ impl Planner {
                 let history = ObjectHistory {
                     stale: self.stale.get(i).copied().unwrap_or(true),
                     gathered: self.gathered.get(i).copied(),
+                    environment_kept: self.environment_kept.get(i).copied().unwrap_or(false),
                 };
                 frame.object(i, facts, history)
             })
@@ -163,6 +170,8 @@ impl Planner {
         }
         for o in &plan.objects {
             self.stale[o.object] = o.stale_after;
+            // Only a splat that runs writes the kept part.
+            self.environment_kept[o.object] = o.environment_kept_after && (!o.splat || plan.runs(Pass::Splat));
             if o.gather && plan.runs(Pass::Gather) {
                 self.gathered[o.object] = if gather_by_level { o.level } else { 0 };
             }
@@ -194,6 +203,12 @@ impl Planner {
     /// A history with the given stale flags and gathered levels, nothing pending.
     #[cfg(test)]
     pub(super) fn with_history(stale: &[bool], gathered: &[usize]) -> Planner {
-        Planner { pending: None, stale: stale.to_vec(), gathered: gathered.to_vec(), baked: BakedLevels::Current }
+        Planner {
+            pending: None,
+            stale: stale.to_vec(),
+            gathered: gathered.to_vec(),
+            environment_kept: vec![false; stale.len()],
+            baked: BakedLevels::Current,
+        }
     }
 }
