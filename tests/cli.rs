@@ -143,6 +143,36 @@ fn exr_and_exitance_exports_are_complete_files() {
 }
 
 #[test]
+fn exitance_of_an_all_local_scene_exports_as_drawn_without_forcing_a_gather() {
+    let dir = temp_dir("cli-local-export");
+    let (png, ply) = (dir.join("k.png"), dir.join("k.ply"));
+    let args = ["render", "assets/scenes/ketchup-metre.toml", "--resolution", "64x64", "--explain"];
+    let out = translucent(
+        &[&args[..], &["-o", png.to_str().unwrap(), "--export-exitance", ply.to_str().unwrap()]].concat(),
+        &[],
+    );
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    // The planner's choice stands: every channel local, no splat or gather.
+    assert!(stderr.contains("skip splat") && stderr.contains("skip gather"), "{stderr}");
+    let ply_text = std::fs::read_to_string(&ply).unwrap();
+    let rows: Vec<Vec<f64>> = ply_text
+        .split("end_header\n")
+        .nth(1)
+        .unwrap()
+        .lines()
+        .map(|l| l.split_whitespace().map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert!(!rows.is_empty());
+    assert!(rows.iter().all(|r| r[3..].iter().all(|e| e.is_finite() && *e >= 0.0)));
+    // The lit half of the ball: red, the widest profile, brightest (ketchup's albedo).
+    let lit = rows.iter().filter(|r| r[3] > 0.0).count();
+    assert!(lit > rows.len() / 3, "{lit} of {} vertices lit", rows.len());
+    assert!(rows.iter().all(|r| r[3] >= r[5]), "ketchup reflects more red than blue");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
 fn a_moving_camera_really_moves_and_only_reshades() {
     let dir = temp_dir("moving-camera");
     let (still, moved) = (dir.join("still.png"), dir.join("moved.png"));
