@@ -25,8 +25,8 @@
 #define GATHER_TRACK_NEAREST
 #include "gather.glsl"
 
-#define TILE 32u
-layout(local_size_x = 32) in;
+#define TILE 8u
+layout(local_size_x = 8) in;
 layout(std430, set = 0, binding = 0) readonly buffer Vertices { VertexRecord vertices[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Samples { SampleRecord samples[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Splat { SplatRecord splat[]; };

@@ -1,7 +1,7 @@
 #version 450
 // Hierarchical dipole gather, for `render.gather = "hierarchical"` (after Jensen and Buhler
 // 2002): the vertex gather's sum with far clusters of samples standing in for their members.
-// Which clusters stand in for which receivers is decided once on the CPU, per group of 32
+// Which clusters stand in for which receivers is decided once on the CPU, per group of 8
 // (RECEIVER_GROUP_SIZE) nearby vertices (sampling::SampleTree::cut, with the solid-angle bound
 // render.gather_epsilon): each group has a list of items, samples and nodes. Two stages, one dispatch each (push
 // `stage`):
@@ -27,8 +27,8 @@
 #include "scene.glsl"
 #include "gather.glsl"
 
-#define TILE 32u
-layout(local_size_x = 32) in;
+#define TILE 8u
+layout(local_size_x = 8) in;
 layout(std430, set = 0, binding = 0) readonly buffer Vertices { VertexRecord vertices[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Samples { SampleRecord samples[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Splat { SplatRecord splat[]; };

@@ -53,6 +53,7 @@ fn a_swapped_binding_fails_at_pipeline_creation_naming_both() {
             .bind_all(&[Resource::Objects, Resource::Samples, Resource::Lights, Resource::ShadowMaps])
             .unwrap();
         bindings.push(Resource::Splat.bind(Binding::Buffer(&buffer)));
+        bindings.push(resources.bind(Resource::SplatEnvironment).unwrap());
         match pipeline.descriptor_set(&bindings) {
             Err(e @ GpuError::BindingMismatch { binding: 0, .. }) => {
                 let message = e.to_string();

@@ -13,6 +13,7 @@ use translucent::render::records::{
 };
 use translucent::render::shade::ShadePush;
 use translucent::render::shadow::ShadowPush;
+use translucent::render::local_exitance::LocalExitancePush;
 use translucent::render::splat::SplatPush;
 use translucent::render::tonemap::TonemapPush;
 use translucent::render::vertex_light::VertexLightPush;
@@ -40,7 +41,7 @@ fn glsl_layout(source: &str, name: &str) -> (Vec<(String, usize)>, usize) {
             None => (decl.to_string(), 1),
         };
         let size = match ty {
-            "float" | "uint" => 4,
+            "float" | "uint" | "int" => 4,
             "vec3" => 12,
             "vec4" | "uvec4" | "DipoleChannel" => 16,
             "mat4" => 64,
@@ -147,13 +148,20 @@ fn splat_and_vertex_records_match_glsl() {
 /// offsets, and the compiled shader's reflected push block has its size.
 #[test]
 fn push_blocks_match_glsl_and_spirv() {
-    let cases: [(&str, &str, &str, usize, &[&str]); 9] = [
+    let cases: [(&str, &str, &str, usize, &[&str]); 10] = [
         (
             "splat.comp",
             include_str!("../glsl/splat.comp"),
             "SplatPush",
             size_of::<SplatPush>(),
-            &["first_sample", "sample_count", "light_count"],
+            &["first_sample", "sample_count", "light_count", "key_light_count", "environment_kept"],
+        ),
+        (
+            "local_exitance.comp",
+            include_str!("../glsl/local_exitance.comp"),
+            "LocalExitancePush",
+            size_of::<LocalExitancePush>(),
+            &["first_vertex", "vertex_count", "object", "key_light_count", "shadow_radius"],
         ),
         (
             "vertex_light.comp",
@@ -222,6 +230,8 @@ fn push_blocks_match_glsl_and_spirv() {
     }
     // Offsets of the multi-field structs, against repr(C).
     assert_eq!(offset_of!(SplatPush, light_count), 8);
+    assert_eq!(offset_of!(SplatPush, environment_kept), 16);
+    assert_eq!(offset_of!(LocalExitancePush, shadow_radius), 16);
     assert_eq!(offset_of!(VertexLightPush, eta), 12);
     assert_eq!(offset_of!(TonemapPush, exposure), 8);
     assert_eq!(offset_of!(ShadowPush, layer), 64);

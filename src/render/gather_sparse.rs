@@ -5,7 +5,7 @@
 //! far kernel smooths at that scale anyway. `tests/render.rs` measures the difference.
 //!
 //! Stage 0 writes exitance at the samples of each object the plan gathers into a buffer this
-//! pass owns; stage 1 visits, per group of 32 vertices (`sampling::ReceiverGroups`), only the
+//! pass owns; stage 1 visits, per group of 8 vertices (`sampling::ReceiverGroups`), only the
 //! samples whose blend radius reaches the group (`GpuScene::blend_items`), not every sample.
 //! The two stages' shape is `group_gather`'s.
 //!

@@ -1053,7 +1053,7 @@ fn dispatch_checks(gpu: &Gpu, scene: &PreparedScene) -> Result<Vec<Check>, Rende
     Ok(vec![
         (
             "bytes of the hierarchical gather's item lists at render.gather_epsilon 0 (every sample for every \
-             group of 32 vertices)"
+             group of 8 vertices)"
                 .to_string(),
             flat_lists,
             "maxStorageBufferRange",
