@@ -448,3 +448,24 @@ fn an_environment_map_whose_header_claims_millions_of_texels_is_refused_naming_t
         other => panic!("expected TooLarge, got {:?}", other.map(|e| (e.width, e.height))),
     }
 }
+
+/// A value of the wrong type in `[render]` names its key once, with its line (issue 29, defect
+/// 6: it read `render.level_of_detail.level_of_detail`), as in every other table.
+#[test]
+fn a_type_error_in_render_names_its_key_once() {
+    let dir = temp_dir("render-type");
+    let png = dir.join("out.png");
+    let cases = [
+        ("level_of_detail = \"yes\"", "render.level_of_detail"),
+        ("gather_epsilon = \"small\"", "render.gather_epsilon"),
+        ("exposure = [1.0]", "render.exposure"),
+    ];
+    for (line, key) in cases {
+        let scene = sphere_scene(&dir, "render.toml", &[("exposure = 1.0", line)], "");
+        let stderr = fails(&translucent(&["render", scene.to_str().unwrap(), "-o", png.to_str().unwrap()], &[]));
+        assert!(stderr.contains(&format!("at key `{key}`")) && stderr.contains("line 21"), "{line}: {stderr}");
+        let last = key.rsplit('.').next().unwrap();
+        assert!(!stderr.contains(&format!("{key}.{last}")), "{line}: the key named twice: {stderr}");
+        assert!(!png.exists(), "{line}: an image was written");
+    }
+}
