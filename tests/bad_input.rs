@@ -469,3 +469,43 @@ fn a_type_error_in_render_names_its_key_once() {
         assert!(!png.exists(), "{line}: an image was written");
     }
 }
+
+/// A camera nearer a mesh in view than the near plane (which the scene's depth sets) is warned
+/// about with the figures: the image shows nothing of the mesh there (issue 29: a camera 1e-5
+/// units from a sphere beside a 10-unit floor drew black without a word). From 0.05 units, no
+/// warning.
+#[test]
+fn a_camera_whose_near_plane_clips_an_object_in_view_is_warned_about() {
+    let dir = temp_dir("near-plane");
+    let floor = "\n[[object]]\nshape = { type = \"plane\", size = 10.0 }\ntransform = { translate = [0.0, -0.02, 0.0] }\n\
+                 material = { type = \"opaque\", albedo = [0.5, 0.5, 0.5] }\n";
+    let close = sphere_scene(&dir, "close.toml", &[("eye = [0.0, 0.0, 0.1]", "eye = [0.0, 0.0, 0.01001]")], floor);
+    let out = translucent(&["render", close.to_str().unwrap(), "-o", dir.join("close.png").to_str().unwrap()], &[]);
+    let stderr = succeeds(&out);
+    assert!(stderr.contains("object[0]") && stderr.contains("nearer than the near plane"), "{stderr}");
+    assert!(!stderr.contains("object[1]"), "the floor is not clipped where the camera looks: {stderr}");
+    let far = sphere_scene(&dir, "far.toml", &[("eye = [0.0, 0.0, 0.1]", "eye = [0.0, 0.0, 0.06]")], floor);
+    let out = translucent(&["render", far.to_str().unwrap(), "-o", dir.join("far.png").to_str().unwrap()], &[]);
+    assert!(!succeeds(&out).contains("near plane"));
+}
+
+/// With the camera inside an object, at its centre, the planner's text says so instead of
+/// `inf px` and `NaN px` (issue 29).
+#[test]
+fn the_plan_says_when_the_camera_is_inside_an_object() {
+    let dir = temp_dir("inside");
+    let scene = sphere_scene(
+        &dir,
+        "inside.toml",
+        &[
+            ("eye = [0.0, 0.0, 0.1]", "eye = [0.0, 0.0, 0.0]"),
+            ("target = [0.0, 0.0, 0.0]", "target = [0.0, 0.0, -1.0]"),
+        ],
+        "",
+    );
+    let out = subcommand("plan", &[scene.to_str().unwrap()]);
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(stdout.contains("the camera is inside the object") || stdout.contains("inside them"), "{stdout}");
+    assert!(!stdout.contains("inf px") && !stdout.contains("NaN"), "{stdout}");
+}
