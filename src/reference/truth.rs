@@ -503,10 +503,10 @@ pub fn cached(
 /// removed); otherwise what stands in the way.
 fn writable_folder(dir: &Path) -> Result<(), TruthError> {
     let fail = |why: String| Err(TruthError::Folder { path: dir.to_path_buf(), why });
-    if let Some(existing) = dir.ancestors().find(|a| a.exists()) {
-        if !existing.is_dir() {
-            return fail(format!("{} is a file, not a folder", existing.display()));
-        }
+    if let Some(existing) = dir.ancestors().find(|a| a.exists())
+        && !existing.is_dir()
+    {
+        return fail(format!("{} is a file, not a folder", existing.display()));
     }
     if let Err(e) = std::fs::create_dir_all(dir) {
         return fail(format!("cannot make the folder ({e})"));
