@@ -19,7 +19,7 @@ material = {{ type = \"translucent\", preset = \"marble\", mm_per_unit = 10.0 }}
         )
     };
     let base = PreparedScene::new(&Scene::parse(&text(1), "p", None).unwrap(), &Overrides::default()).unwrap();
-    let t = truth::compute(&base, &truth::TruthOptions { max_level: 2, ..Default::default() }, &|_, _, _| {});
+    let t = truth::compute(&base, &truth::TruthOptions { max_level: 2, ..Default::default() }, &|_, _, _| {}).unwrap();
     let exact = &t.exitance[0];
     for seed in 1..=seeds {
         let scene = PreparedScene::new(&Scene::parse(&text(seed), "p", None).unwrap(), &Overrides::default()).unwrap();

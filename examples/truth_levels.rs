@@ -19,7 +19,7 @@ fn main() {
         Some(dir) => {
             translucent::reference::truth::cached(&prepared, &options, std::path::Path::new(dir), &progress).unwrap().0
         }
-        None => translucent::reference::truth::compute(&prepared, &options, &progress),
+        None => translucent::reference::truth::compute(&prepared, &options, &progress).unwrap(),
     };
     for l in &t.levels {
         println!("{l:?}");

@@ -448,3 +448,64 @@ fn an_environment_map_whose_header_claims_millions_of_texels_is_refused_naming_t
         other => panic!("expected TooLarge, got {:?}", other.map(|e| (e.width, e.height))),
     }
 }
+
+/// A value of the wrong type in `[render]` names its key once, with its line (issue 29, defect
+/// 6: it read `render.level_of_detail.level_of_detail`), as in every other table.
+#[test]
+fn a_type_error_in_render_names_its_key_once() {
+    let dir = temp_dir("render-type");
+    let png = dir.join("out.png");
+    let cases = [
+        ("level_of_detail = \"yes\"", "render.level_of_detail"),
+        ("gather_epsilon = \"small\"", "render.gather_epsilon"),
+        ("exposure = [1.0]", "render.exposure"),
+    ];
+    for (line, key) in cases {
+        let scene = sphere_scene(&dir, "render.toml", &[("exposure = 1.0", line)], "");
+        let stderr = fails(&translucent(&["render", scene.to_str().unwrap(), "-o", png.to_str().unwrap()], &[]));
+        assert!(stderr.contains(&format!("at key `{key}`")) && stderr.contains("line 21"), "{line}: {stderr}");
+        let last = key.rsplit('.').next().unwrap();
+        assert!(!stderr.contains(&format!("{key}.{last}")), "{line}: the key named twice: {stderr}");
+        assert!(!png.exists(), "{line}: an image was written");
+    }
+}
+
+/// A camera nearer a mesh in view than the near plane (which the scene's depth sets) is warned
+/// about with the figures: the image shows nothing of the mesh there (issue 29: a camera 1e-5
+/// units from a sphere beside a 10-unit floor drew black without a word). From 0.05 units, no
+/// warning.
+#[test]
+fn a_camera_whose_near_plane_clips_an_object_in_view_is_warned_about() {
+    let dir = temp_dir("near-plane");
+    let floor = "\n[[object]]\nshape = { type = \"plane\", size = 10.0 }\ntransform = { translate = [0.0, -0.02, 0.0] }\n\
+                 material = { type = \"opaque\", albedo = [0.5, 0.5, 0.5] }\n";
+    let close = sphere_scene(&dir, "close.toml", &[("eye = [0.0, 0.0, 0.1]", "eye = [0.0, 0.0, 0.01001]")], floor);
+    let out = translucent(&["render", close.to_str().unwrap(), "-o", dir.join("close.png").to_str().unwrap()], &[]);
+    let stderr = succeeds(&out);
+    assert!(stderr.contains("object[0]") && stderr.contains("nearer than the near plane"), "{stderr}");
+    assert!(!stderr.contains("object[1]"), "the floor is not clipped where the camera looks: {stderr}");
+    let far = sphere_scene(&dir, "far.toml", &[("eye = [0.0, 0.0, 0.1]", "eye = [0.0, 0.0, 0.06]")], floor);
+    let out = translucent(&["render", far.to_str().unwrap(), "-o", dir.join("far.png").to_str().unwrap()], &[]);
+    assert!(!succeeds(&out).contains("near plane"));
+}
+
+/// With the camera inside an object, at its centre, the planner's text says so instead of
+/// `inf px` and `NaN px` (issue 29).
+#[test]
+fn the_plan_says_when_the_camera_is_inside_an_object() {
+    let dir = temp_dir("inside");
+    let scene = sphere_scene(
+        &dir,
+        "inside.toml",
+        &[
+            ("eye = [0.0, 0.0, 0.1]", "eye = [0.0, 0.0, 0.0]"),
+            ("target = [0.0, 0.0, 0.0]", "target = [0.0, 0.0, -1.0]"),
+        ],
+        "",
+    );
+    let out = subcommand("plan", &[scene.to_str().unwrap()]);
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(stdout.contains("the camera is inside the object") || stdout.contains("inside them"), "{stdout}");
+    assert!(!stdout.contains("inf px") && !stdout.contains("NaN"), "{stdout}");
+}

@@ -284,3 +284,140 @@ fn a_scene_no_light_reaches_is_refused_not_ranked() {
     assert!(err.contains("no light reaches"), "{err}");
     assert!(!out.exists(), "the refused study made its output folder");
 }
+
+/// `study` on `scene` with `args` after `-o out --truth-cache cache` (each made under `dir`);
+/// returns the output.
+fn study_cli(dir: &Path, scene: &str, args: &[&str]) -> std::process::Output {
+    let (out, cache) = (dir.join("out"), dir.join("cache"));
+    let mut all = vec!["study", scene, "-o", out.to_str().unwrap(), "--truth-cache", cache.to_str().unwrap()];
+    all.extend_from_slice(args);
+    translucent(&all, &[])
+}
+
+/// Exit status 1, no panic and no validation message, nothing written; returns stderr.
+fn refused(dir: &Path, run: &std::process::Output) -> String {
+    let stderr = text(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(!stderr.contains("panicked") && !stderr.contains("[vulkan"), "{stderr}");
+    assert!(!dir.join("out").join("study.csv").exists(), "an output was written: {stderr}");
+    stderr
+}
+
+/// Issue 29, defect 4: a truth level whose estimated memory is over `--truth-memory` is refused
+/// before it runs, naming the level, the estimate and the limit; no truth is cached and no
+/// output written. A size that is not one is refused naming the option.
+#[test]
+fn a_truth_level_over_the_memory_limit_is_refused_naming_level_estimate_and_limit() {
+    let dir = temp_dir("study-memory");
+    let scene = repo_path("tests/scenes/study-tiny.toml");
+    let run = study_cli(&dir, scene.to_str().unwrap(), &["--quick", "--truth-memory", "1M"]);
+    let stderr = refused(&dir, &run);
+    assert!(
+        stderr.contains("level 1 would need about") && stderr.contains("more than the 1.0 MiB limit given"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("E_t points") && stderr.contains("--truth-memory"), "{stderr}");
+    let cached = std::fs::read_dir(dir.join("cache")).map_or(0, |d| d.filter(|e| e.is_ok()).count());
+    assert_eq!(cached, 0, "a truth or temporary file was left in the cache");
+    for size in ["lots", "0", "-1G", "4Q"] {
+        let arg = format!("--truth-memory={size}");
+        let stderr = refused(&dir, &study_cli(&dir, scene.to_str().unwrap(), &["--quick", &arg]));
+        assert!(stderr.contains(&format!("--truth-memory {size:?}")), "{size}: {stderr}");
+    }
+}
+
+/// An unusable `--truth-cache` is named, with the real problem, before the truth is computed:
+/// with a memory limit that would refuse the truth's level 1 too, the folder's error is the
+/// one reported. (It read `File exists (os error 17): File exists (os error 17)`, after the
+/// whole truth.)
+#[test]
+fn an_unwritable_truth_cache_is_named_before_the_truth_is_computed() {
+    let dir = temp_dir("study-cache-file");
+    let scene = repo_path("tests/scenes/study-tiny.toml");
+    std::fs::write(dir.join("cache"), "not a folder").unwrap();
+    let run = study_cli(&dir, scene.to_str().unwrap(), &["--quick", "--truth-memory", "1M"]);
+    let stderr = refused(&dir, &run);
+    let cache = dir.join("cache");
+    assert!(stderr.contains(&format!("{} is a file, not a folder", cache.display())), "{stderr}");
+    assert!(!stderr.contains("os error 17") && !stderr.contains("level 1"), "{stderr}");
+    assert_eq!(std::fs::read_to_string(&cache).unwrap(), "not a folder");
+    let out = dir.join("out");
+    let run = translucent(
+        &["study", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--truth-cache", "/proc/translucent/truth"],
+        &[],
+    );
+    let stderr = refused(&dir, &run);
+    assert!(stderr.contains("/proc/translucent/truth") && stderr.contains("cannot make the folder"), "{stderr}");
+}
+
+/// Repeated `--samplers`, `--counts` and `--gathers` entries run once, and `hierarchical:-0` is
+/// the gather at epsilon 0, written as 0.
+#[test]
+fn repeated_configurations_run_once_and_minus_zero_is_zero() {
+    let dir = temp_dir("study-repeats");
+    let scene = repo_path("tests/scenes/study-tiny.toml");
+    let args = [
+        "--quick",
+        "--configurations",
+        "sweep",
+        "--samplers",
+        "turk,turk",
+        "--counts",
+        "100,100",
+        "--gathers",
+        "hierarchical:-0,hierarchical:0",
+    ];
+    let run = study_cli(&dir, scene.to_str().unwrap(), &args);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let rows = csv_rows(&std::fs::read_to_string(dir.join("out").join("study.csv")).unwrap());
+    assert_eq!(rows.len(), 1, "{rows:?}");
+    assert_eq!((rows[0]["sampler"].as_str(), rows[0]["epsilon"].as_str()), ("turk", "0"), "{rows:?}");
+    let md = std::fs::read_to_string(dir.join("out").join("study.md")).unwrap();
+    assert!(!md.contains("-0"), "{md}");
+}
+
+/// `--truth-levels` out of range: the note fits the value given.
+#[test]
+fn truth_levels_out_of_range_are_refused_with_a_fitting_note() {
+    let dir = temp_dir("study-levels");
+    let scene = repo_path("tests/scenes/study-tiny.toml");
+    let stderr = refused(&dir, &study_cli(&dir, scene.to_str().unwrap(), &["--truth-levels", "100"]));
+    assert!(stderr.contains("--truth-levels 100: must be 1 to") && !stderr.contains("level 0"), "{stderr}");
+    let stderr = refused(&dir, &study_cli(&dir, scene.to_str().unwrap(), &["--truth-levels", "0"]));
+    assert!(stderr.contains("level 0 has nothing to compare with"), "{stderr}");
+}
+
+/// SIGINT or SIGTERM while the truth is computed ends the study with status 130 and a message,
+/// as `render`: no output file, no temporary, nothing in the cache.
+#[test]
+fn an_interrupted_study_exits_130_leaving_nothing() {
+    for signal in ["-INT", "-TERM"] {
+        let dir = temp_dir(&format!("study-interrupt{signal}"));
+        let (out, cache) = (dir.join("out"), dir.join("cache"));
+        let scene = repo_path("tests/scenes/study-env-sphere.toml");
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_translucent"))
+            .args(["study", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--quick"])
+            .args(["--truth-cache", cache.to_str().unwrap()])
+            .env("TRANSLUCENT_VALIDATION", "1")
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // The cache folder is made just before the truth is computed.
+        let start = std::time::Instant::now();
+        while !cache.is_dir() {
+            assert!(child.try_wait().unwrap().is_none(), "the study ended before its truth began");
+            assert!(start.elapsed().as_secs() < 120, "the truth never began");
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(300));
+        let pid = child.id().to_string();
+        assert!(std::process::Command::new("kill").args([signal, &pid]).status().unwrap().success());
+        let output = child.wait_with_output().unwrap();
+        let stderr = text(&output.stderr);
+        assert_eq!(output.status.code(), Some(130), "{signal}: {stderr}");
+        assert!(stderr.contains("interrupted"), "{signal}: {stderr}");
+        let left = |d: &Path| std::fs::read_dir(d).map_or(0, |d| d.count());
+        assert_eq!((left(&out), left(&cache)), (0, 0), "{signal}: files left behind");
+    }
+}

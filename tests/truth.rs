@@ -51,7 +51,7 @@ direction = [0.0, 1.0, 0.0]
 irradiance = [1.0, 2.0, 3.0]
 "#,
     );
-    let t = truth::compute(&scene, &truth::TruthOptions::default(), &quiet);
+    let t = truth::compute(&scene, &truth::TruthOptions::default(), &quiet).unwrap();
     assert!(t.converged, "levels: {:?}", t.levels);
     let o = &scene.objects[0];
     let ResolvedMaterial::Translucent { dipoles, material, .. } = &o.material else { panic!() };
@@ -88,7 +88,7 @@ direction = [1.0, 0.3, 0.2]
 irradiance = [1.0, 1.0, 1.0]
 "#,
     );
-    let t = truth::compute(&scene, &truth::TruthOptions::default(), &quiet);
+    let t = truth::compute(&scene, &truth::TruthOptions::default(), &quiet).unwrap();
     assert!(t.converged, "levels: {:?}", t.levels);
     let o = &scene.objects[0];
     let ResolvedMaterial::Translucent { dipoles, material, .. } = &o.material else { panic!() };
@@ -180,7 +180,7 @@ count = {count}
     assert_ne!(a.objects[0].samples.len(), b.objects[0].samples.len());
     let options = truth::TruthOptions { max_level: 1, ..Default::default() };
     assert_eq!(truth::content_key(&a, &options), truth::content_key(&b, &options));
-    let (ta, tb) = (truth::compute(&a, &options, &quiet), truth::compute(&b, &options, &quiet));
+    let (ta, tb) = (truth::compute(&a, &options, &quiet).unwrap(), truth::compute(&b, &options, &quiet).unwrap());
     assert_eq!(ta.exitance, tb.exitance);
     assert!(ta.exitance[0].iter().any(|m| m[0] > 0.0));
 }
@@ -214,7 +214,7 @@ fn truth_at_a_vertex_subset_equals_the_full_truth_there_and_is_cached_apart() {
     let full_options = truth::TruthOptions { max_level: 1, ..Default::default() };
     let n = scene.objects[0].mesh.positions().len();
     let subset_options = truth::TruthOptions { receivers: Some(n / 3), ..full_options };
-    let full = truth::compute(&scene, &full_options, &quiet);
+    let full = truth::compute(&scene, &full_options, &quiet).unwrap();
     let dir = std::env::temp_dir().join(format!("translucent-truth-subset-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let (part, _) = truth::cached(&scene, &subset_options, &dir, &quiet).unwrap();
@@ -265,7 +265,7 @@ count = 1600
 seed = 1
 "#,
     );
-    let t = truth::compute(&scene, &truth::TruthOptions::default(), &quiet);
+    let t = truth::compute(&scene, &truth::TruthOptions::default(), &quiet).unwrap();
     assert!(t.converged, "levels: {:?}", t.levels);
     let occluders = reference::occluders(&scene);
     let gathered = reference::gather(&scene, &reference::splat(&scene, &occluders));
@@ -330,4 +330,40 @@ fn an_edited_truth_cache_is_recomputed_never_trusted() {
     let (_, was_cached) = truth::cached(&scene, &options, &dir, &quiet).unwrap();
     assert!(was_cached, "the replaced file is read back");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Each level's memory is estimated before it runs, from its grids' sizes: the estimate counts
+/// exactly the `E_t` points the level then casts, grows with the level, and a limit under a
+/// level's estimate refuses that level (naming it, the estimate and the limit) while the same
+/// limit lets the levels before it run.
+#[test]
+fn a_truth_level_is_estimated_before_it_runs_and_refused_over_the_memory_limit() {
+    let scene = prepare(&lit_marble_sphere(0.3));
+    let options = truth::TruthOptions { max_level: 2, tolerance: 0.0, ..Default::default() };
+    let t = truth::compute(&scene, &options, &quiet).unwrap();
+    assert_eq!(t.levels.len(), 3);
+    let estimates: Vec<truth::LevelMemory> = (0..3).map(|l| truth::memory_estimate(&scene, l)).collect();
+    for (level, estimate) in t.levels.iter().zip(&estimates) {
+        assert_eq!(estimate.points, level.irradiance_points, "level {}", level.level);
+    }
+    assert!(estimates.windows(2).all(|w| w[1].bytes > w[0].bytes), "{estimates:?}");
+    // At least 24 bytes (an f64 RGB) a point.
+    assert!(estimates.iter().all(|e| e.bytes >= 24 * e.points as u64), "{estimates:?}");
+
+    let limit = estimates[2].bytes - 1;
+    let limited = truth::TruthOptions { memory: Some(limit), ..options };
+    let error = truth::compute(&scene, &limited, &quiet).unwrap_err();
+    match &error {
+        truth::TruthError::Memory { level, bytes, points, limit: l, .. } => {
+            assert_eq!((*level, *bytes, *points, *l), (2, estimates[2].bytes, estimates[2].points, limit));
+        }
+        other => panic!("not a memory refusal: {other}"),
+    }
+    let message = error.to_string();
+    assert!(message.contains("level 2") && message.contains(&truth::human_bytes(limit)), "{message}");
+    // The same limit lets level 1 run; the limit does not change the content key.
+    let fits = truth::TruthOptions { max_level: 1, ..limited };
+    assert!(truth::compute(&scene, &fits, &quiet).is_ok());
+    let unlimited = truth::TruthOptions { max_level: 1, memory: None, ..options };
+    assert_eq!(truth::content_key(&scene, &fits), truth::content_key(&scene, &unlimited));
 }

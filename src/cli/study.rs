@@ -48,6 +48,10 @@ pub struct Args {
     /// truth.png are left out)
     #[arg(long, value_name = "N")]
     pub truth_receivers: Option<usize>,
+    /// The most memory one level of the truth may take, e.g. 4G or 500M (binary units; default:
+    /// the memory available when the level starts); a level estimated over it is refused
+    #[arg(long, value_name = "SIZE")]
+    pub truth_memory: Option<String>,
     /// Where the truth is cached, keyed by the scene's content (default: the user's cache
     /// folder, translucent/truth)
     #[arg(long)]
@@ -86,6 +90,17 @@ fn parse_error_image(spec: &str) -> Result<(Method, usize, Gather)> {
     Ok((method, count, gather))
 }
 
+/// `items` with each repeat after the first left out (a configuration named twice is run once).
+fn distinct<T: PartialEq>(items: Vec<T>) -> Vec<T> {
+    let mut out: Vec<T> = Vec::with_capacity(items.len());
+    for item in items {
+        if !out.contains(&item) {
+            out.push(item);
+        }
+    }
+    out
+}
+
 /// A gather with the hierarchical gather's epsilon.
 type Gather = (GatherMode, Option<f32>);
 
@@ -101,7 +116,9 @@ fn parse_gather(spec: &str) -> Result<Gather> {
             bail!("--gathers {spec:?}: name the hierarchical gather's epsilon, e.g. hierarchical:0.1")
         }
         (GatherMode::Hierarchical, Some(e)) => {
-            let eps: f32 = e.parse().with_context(|| format!("--gathers {spec:?}: {e:?} is not a number"))?;
+            // `+ 0.0` makes -0 plain 0, so it prints and compares as 0.
+            let eps: f32 =
+                e.parse::<f32>().with_context(|| format!("--gathers {spec:?}: {e:?} is not a number"))? + 0.0;
             if !(0.0..=MAX_GATHER_EPSILON).contains(&eps) {
                 bail!("--gathers {spec:?}: epsilon must be 0 to {MAX_GATHER_EPSILON}");
             }
@@ -112,6 +129,32 @@ fn parse_gather(spec: &str) -> Result<Gather> {
     }
 }
 
+/// `--truth-memory SIZE`: a number of bytes with an optional binary unit (K, M, G, T; `B` or
+/// `iB` may follow), e.g. `4G`, `512MiB`, `1.5g`.
+fn parse_size(spec: &str) -> Result<u64> {
+    let bad = || format!("--truth-memory {spec:?}: expected a size such as 4G, 512M or 1.5G");
+    let t = spec.trim();
+    let t = t.strip_suffix("iB").or_else(|| t.strip_suffix('B')).unwrap_or(t);
+    let (number, unit) = match t.char_indices().last() {
+        Some((i, c)) if c.is_ascii_alphabetic() => (&t[..i], c.to_ascii_uppercase()),
+        _ => (t, ' '),
+    };
+    let shift = match unit {
+        ' ' => 0,
+        'K' => 10,
+        'M' => 20,
+        'G' => 30,
+        'T' => 40,
+        _ => bail!(bad()),
+    };
+    let value: f64 = number.trim().parse().with_context(bad)?;
+    let bytes = value * 2f64.powi(shift);
+    if !bytes.is_finite() || bytes < 1.0 || bytes >= u64::MAX as f64 {
+        bail!("--truth-memory {spec:?}: must be at least one byte and finite");
+    }
+    Ok(bytes as u64)
+}
+
 /// The sweep the arguments ask for.
 fn config(args: &Args) -> Result<StudyConfig> {
     let mut config = if args.quick { StudyConfig::quick() } else { StudyConfig::full() };
@@ -120,22 +163,32 @@ fn config(args: &Args) -> Result<StudyConfig> {
             .samplers
             .iter()
             .map(|s| s.parse().map_err(|e: String| anyhow::anyhow!("--samplers {s:?}: {e}")))
-            .collect::<Result<_>>()?;
+            .collect::<Result<Vec<_>>>()
+            .map(distinct)?;
     }
     if !args.counts.is_empty() {
         if let Some(&n) = args.counts.iter().find(|&&n| n == 0 || n > MAX_SAMPLE_COUNT) {
             bail!("--counts {n}: a sample count must be 1 to {MAX_SAMPLE_COUNT}");
         }
-        config.counts = args.counts.clone();
+        config.counts = distinct(args.counts.clone());
     }
     if !args.gathers.is_empty() {
-        config.gathers = args.gathers.iter().map(|g| parse_gather(g)).collect::<Result<_>>()?;
+        config.gathers = args.gathers.iter().map(|g| parse_gather(g)).collect::<Result<Vec<_>>>().map(distinct)?;
     }
     if let Some(level) = args.truth_levels {
-        if level == 0 || level > truth::MAX_LEVEL {
-            bail!("--truth-levels {level}: must be 1 to {} (level 0 has nothing to compare with)", truth::MAX_LEVEL);
+        if level == 0 {
+            bail!("--truth-levels 0: must be 1 to {} (level 0 has nothing to compare with)", truth::MAX_LEVEL);
+        }
+        if level > truth::MAX_LEVEL {
+            bail!(
+                "--truth-levels {level}: must be 1 to {} (each level costs about four times the one before)",
+                truth::MAX_LEVEL
+            );
         }
         config.truth.max_level = level;
+    }
+    if let Some(size) = &args.truth_memory {
+        config.truth.memory = Some(parse_size(size)?);
     }
     if let Some(n) = args.truth_receivers {
         if n < 100 {
@@ -170,6 +223,9 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     if args.output.exists() && !args.output.is_dir() {
         bail!("{} exists and is not a folder", args.output.display());
     }
+    // Interrupted, it leaves no output behind and exits 130, as `render` does.
+    let outputs: Vec<PathBuf> = OUTPUT_NAMES.iter().map(|n| args.output.join(n)).collect();
+    super::remove_on_interrupt(&outputs.iter().collect::<Vec<_>>())?;
     let mut scene = match &args.scene {
         Some(path) => Scene::load(path)?,
         None => Scene::builtin(),
@@ -182,7 +238,7 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let gpu: Arc<Gpu> = Gpu::new(&gpu_args.options())?;
     let device = gpu.info().name.clone();
     let cache = args.truth_cache.clone().unwrap_or_else(truth::default_cache_dir);
-    let study = run_with_progress(&gpu, &scene, &config, &cache)?;
+    let study = run_with_progress(&gpu, &scene, &config, &cache).map_err(with_hint)?;
 
     let preamble = preamble(&study, &scene, &config, &device) + &reference_timing(&study);
     let summaries = report::summarise(&study.rows);
@@ -196,6 +252,21 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// A truth level refused for memory, with the options that change it.
+fn with_hint(e: anyhow::Error) -> anyhow::Error {
+    match e.downcast_ref::<study::StudyError>() {
+        Some(study::StudyError::Truth(truth::TruthError::Memory { level, .. })) => {
+            let stop = if *level > 1 {
+                format!(", or --truth-levels {} to stop before it (the truth then reads not converged)", level - 1)
+            } else {
+                String::new()
+            };
+            anyhow::anyhow!("{e:#}; --truth-memory SIZE sets the limit{stop}")
+        }
+        _ => e,
+    }
 }
 
 /// `--error-image`'s configuration must be one the sweep renders, against a truth at every
@@ -303,6 +374,9 @@ fn reference_timing(study: &study::Study) -> String {
     })
 }
 
+/// What a study writes into its folder, in [`write_outputs`]' order.
+const OUTPUT_NAMES: [&str; 5] = ["study.csv", "study.md", "study.png", "truth.png", "error.png"];
+
 /// Write study.csv, study.md, study.png, truth.png (where the truth has an image) and
 /// error.png (for `chosen`) into `output`, all or none (`OutputSet`).
 fn write_outputs(
@@ -312,8 +386,7 @@ fn write_outputs(
     md: String,
     plot: &[u8],
 ) -> Result<()> {
-    let names = ["study.csv", "study.md", "study.png", "truth.png", "error.png"];
-    let outputs: Vec<PathBuf> = names.iter().map(|n| output.join(n)).collect();
+    let outputs: Vec<PathBuf> = OUTPUT_NAMES.iter().map(|n| output.join(n)).collect();
     let [w, h] = study.prepared.scene.file.camera.resolution;
     std::fs::create_dir_all(output).with_context(|| format!("cannot make {}", output.display()))?;
     let mut set = OutputSet::new();

@@ -189,11 +189,15 @@ pub struct TruthOptions {
     /// At most this many receivers per translucent object, spread evenly over its vertex order
     /// ([`receiver_subset`]); `None`: every vertex. The others hold NaN.
     pub receivers: Option<usize>,
+    /// The most memory (bytes) one level may take ([`LevelMemory`]); `None`: the memory
+    /// available when the level starts ([`available_memory`]). A level over it is refused.
+    /// Not part of the content key: it changes whether a truth is computed, not its values.
+    pub memory: Option<u64>,
 }
 
 impl Default for TruthOptions {
     fn default() -> Self {
-        TruthOptions { tolerance: TOLERANCE, max_level: MAX_LEVEL, receivers: None }
+        TruthOptions { tolerance: TOLERANCE, max_level: MAX_LEVEL, receivers: None, memory: None }
     }
 }
 
@@ -230,42 +234,21 @@ mod nan_as_null {
 pub type Progress<'a> = &'a (dyn Fn(u32, usize, usize) + Sync);
 
 /// Compute the truth for every translucent object of `scene`, level after level until it
-/// converges (or `options.max_level`).
-pub fn compute(scene: &PreparedScene, options: &TruthOptions, progress: Progress) -> Truth {
+/// converges (or `options.max_level`). Before each level its memory is estimated
+/// ([`level_memory`]) and checked against `options.memory` (or the memory available): a level
+/// that would not fit is refused with [`TruthError::Memory`] rather than run out of memory.
+pub fn compute(scene: &PreparedScene, options: &TruthOptions, progress: Progress) -> Result<Truth, TruthError> {
     let occluders = occluders(scene);
     let eps = ray_offset(scene);
+    let plans = plans(scene, &occluders, eps);
     let mut levels: Vec<Level> = Vec::new();
     let mut previous: Option<Vec<Vec<[f64; 3]>>> = None;
     let mut converged = false;
     for level in 0..=options.max_level {
+        check_memory(scene, &plans, level, options, &levels)?;
         let start = std::time::Instant::now();
         let eta = 0.4 * 0.5f64.powf(f64::from(level) / 2.0);
-        let mut points = 0;
-        let receivers: usize =
-            scene.objects.iter().map(|o| receiver_subset(o.mesh.positions().len(), options.receivers).len()).sum();
-        let done = AtomicUsize::new(0);
-        let exitance: Vec<Vec<[f64; 3]>> = scene
-            .objects
-            .iter()
-            .map(|o| match &o.material {
-                ResolvedMaterial::Translucent { material, dipoles, .. } => {
-                    let sources = sources(scene, &occluders, o, material.eta, level, eps);
-                    points += sources.iter().map(|s| s.grid.len()).sum::<usize>();
-                    let subset = receiver_subset(o.mesh.positions().len(), options.receivers);
-                    exitance_at_vertices(o, &subset, dipoles, &sources, eta, &|n| {
-                        let d = done.fetch_add(n, Ordering::Relaxed) + n;
-                        progress(level, d, receivers);
-                    })
-                }
-                ResolvedMaterial::Opaque { .. } => {
-                    done.fetch_add(
-                        receiver_subset(o.mesh.positions().len(), options.receivers).len(),
-                        Ordering::Relaxed,
-                    );
-                    vec![[0.0; 3]; o.mesh.positions().len()]
-                }
-            })
-            .collect();
+        let (exitance, points) = level_exitance(scene, &occluders, eps, &plans, level, options, progress);
         let (change_rms, change_max) = match &previous {
             Some(p) => {
                 let (rms, max) = relative_change(p, &exitance);
@@ -298,17 +281,189 @@ pub fn compute(scene: &PreparedScene, options: &TruthOptions, progress: Progress
         checksum: None,
     };
     truth.checksum = Some(truth.digest());
-    truth
+    Ok(truth)
 }
 
-/// Why the cached truth could not be read or written.
+/// Every object's exitance at `level` (all zero for an opaque one), and the `E_t` points ray
+/// cast for it. One object's sources at a time: they are dropped before the next object's.
+fn level_exitance(
+    scene: &PreparedScene,
+    occluders: &Bvh,
+    eps: f64,
+    plans: &[Option<Vec<TrianglePlan>>],
+    level: u32,
+    options: &TruthOptions,
+    progress: Progress,
+) -> (Vec<Vec<[f64; 3]>>, usize) {
+    let eta = 0.4 * 0.5f64.powf(f64::from(level) / 2.0);
+    let mut points = 0;
+    let receivers: usize =
+        scene.objects.iter().map(|o| receiver_subset(o.mesh.positions().len(), options.receivers).len()).sum();
+    let done = AtomicUsize::new(0);
+    let exitance = scene
+        .objects
+        .iter()
+        .zip(plans)
+        .map(|(o, plan)| match (&o.material, plan) {
+            (ResolvedMaterial::Translucent { material, dipoles, .. }, Some(plan)) => {
+                let caster = Caster::new(scene, occluders, o, material.eta, eps);
+                let sources: Vec<Source> =
+                    plan.par_iter().enumerate().map(|(t, p)| caster.source(&o.mesh, t, p, level)).collect();
+                points += sources.iter().map(|s| s.grid.len()).sum::<usize>();
+                let subset = receiver_subset(o.mesh.positions().len(), options.receivers);
+                exitance_at_vertices(o, &subset, dipoles, &sources, eta, &|n| {
+                    let d = done.fetch_add(n, Ordering::Relaxed) + n;
+                    progress(level, d, receivers);
+                })
+            }
+            _ => {
+                done.fetch_add(receiver_subset(o.mesh.positions().len(), options.receivers).len(), Ordering::Relaxed);
+                vec![[0.0; 3]; o.mesh.positions().len()]
+            }
+        })
+        .collect();
+    (exitance, points)
+}
+
+/// Each translucent object's [`TrianglePlan`]s (`None` for an opaque object): the base grids
+/// ray cast once, for every level.
+fn plans(scene: &PreparedScene, occluders: &Bvh, eps: f64) -> Vec<Option<Vec<TrianglePlan>>> {
+    scene
+        .objects
+        .iter()
+        .map(|o| match &o.material {
+            ResolvedMaterial::Translucent { material, .. } => {
+                let caster = Caster::new(scene, occluders, o, material.eta, eps);
+                Some((0..o.mesh.triangles().len()).into_par_iter().map(|t| caster.plan(&o.mesh, t)).collect())
+            }
+            ResolvedMaterial::Opaque { .. } => None,
+        })
+        .collect()
+}
+
+/// What one level of the truth would hold in memory at its peak: one object's sources (their
+/// `E_t` grids and moment pyramids), its cluster tree and receivers, and every object's
+/// exitance at this level and the one before. Exact for the allocations that grow with the
+/// level; the rest (the BVH, the meshes) is the same at every level and was already resident
+/// when the limit was read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LevelMemory {
+    /// Bytes at the level's peak.
+    pub bytes: u64,
+    /// `E_t` grid points over every object (what [`Level::irradiance_points`] will read).
+    pub points: usize,
+}
+
+/// [`LevelMemory`] of `scene`'s truth at `level`: what [`compute`] checks against the limit
+/// before it starts that level (the triangles' base grids are ray cast to know their depths).
+pub fn memory_estimate(scene: &PreparedScene, level: u32) -> LevelMemory {
+    let occluders = occluders(scene);
+    level_memory(scene, &plans(scene, &occluders, ray_offset(scene)), level)
+}
+
+/// [`LevelMemory`] of `level`, from the triangles' plans (no ray is cast).
+fn level_memory(scene: &PreparedScene, plans: &[Option<Vec<TrianglePlan>>], level: u32) -> LevelMemory {
+    let (mut peak, mut points, mut exitance) = (0u64, 0usize, 0u64);
+    for (o, plan) in scene.objects.iter().zip(plans) {
+        let vertices = o.mesh.positions().len() as u64;
+        exitance += 2 * vertices * std::mem::size_of::<[f64; 3]>() as u64;
+        let Some(plan) = plan else { continue };
+        let (mut bytes, mut grid) = (0u64, 0usize);
+        for p in plan {
+            let depth = p.depth(level);
+            grid += grid_points(depth);
+            bytes += Source::bytes(depth);
+        }
+        // The cluster tree (two nodes a triangle at most) and the receivers' coarse and fine
+        // exitance and positions.
+        bytes += plan.len() as u64 * 2 * std::mem::size_of::<Cluster>() as u64;
+        bytes += vertices * 3 * std::mem::size_of::<[f64; 3]>() as u64;
+        peak = peak.max(bytes);
+        points += grid;
+    }
+    LevelMemory { bytes: peak + exitance, points }
+}
+
+/// Refuse `level` when [`level_memory`] exceeds the limit ([`TruthOptions::memory`], else the
+/// memory available now, [`available_memory`]; no check where neither is known).
+fn check_memory(
+    scene: &PreparedScene,
+    plans: &[Option<Vec<TrianglePlan>>],
+    level: u32,
+    options: &TruthOptions,
+    done: &[Level],
+) -> Result<(), TruthError> {
+    let (limit, kind) = match options.memory {
+        Some(bytes) => (bytes, MemoryLimitKind::Given),
+        None => match available_memory() {
+            Some(bytes) => (bytes, MemoryLimitKind::Available),
+            None => return Ok(()),
+        },
+    };
+    let need = level_memory(scene, plans, level);
+    if need.bytes <= limit {
+        return Ok(());
+    }
+    Err(TruthError::Memory {
+        level,
+        bytes: need.bytes,
+        points: need.points,
+        limit,
+        kind,
+        last_change: done.last().and_then(|l| l.change_rms),
+    })
+}
+
+/// `MemAvailable` of `/proc/meminfo`, in bytes: what can be allocated without swapping or the
+/// kernel killing something. `None` where that file is not there (not Linux) or says nothing.
+pub fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Where a truth's memory limit came from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MemoryLimitKind {
+    /// [`TruthOptions::memory`].
+    Given,
+    /// The memory available when the level was to start ([`available_memory`]).
+    Available,
+}
+
+/// `bytes` for a reader: `4.70 GiB`, `312.0 MiB`, `64.0 KiB`.
+pub fn human_bytes(bytes: u64) -> String {
+    let b = bytes as f64;
+    match b {
+        b if b >= 1024f64.powi(3) => format!("{:.2} GiB", b / 1024f64.powi(3)),
+        b if b >= 1024f64.powi(2) => format!("{:.1} MiB", b / 1024f64.powi(2)),
+        b => format!("{:.1} KiB", b / 1024.0),
+    }
+}
+
+/// Why the truth could not be computed, read or written.
 #[derive(Debug, thiserror::Error)]
-#[allow(missing_docs)] // each variant names the cache file and the underlying error
-pub enum TruthCacheError {
-    #[error("truth cache {}: {source}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
-    #[error("truth cache {}: {source}", path.display())]
-    Json { path: PathBuf, source: serde_json::Error },
+#[allow(missing_docs)] // each variant names the cache file, or the level and its figures
+pub enum TruthError {
+    #[error("truth cache {}: {error}", path.display())]
+    Io { path: PathBuf, error: std::io::Error },
+    #[error("truth cache {}: {why}", path.display())]
+    Folder { path: PathBuf, why: String },
+    #[error("truth cache {}: {error}", path.display())]
+    Json { path: PathBuf, error: serde_json::Error },
+    #[error(
+        "the exact integral's level {level} would need about {} of memory ({points} E_t points), more than \
+         the {} {}{}",
+        human_bytes(*bytes),
+        human_bytes(*limit),
+        match kind { MemoryLimitKind::Given => "limit given", MemoryLimitKind::Available => "available (MemAvailable, /proc/meminfo)" },
+        last_change.map_or(String::new(), |c| format!(
+            "; level {} changed by {c:.2e} RMS from the one before, not yet converged",
+            level - 1
+        ))
+    )]
+    Memory { level: u32, bytes: u64, points: usize, limit: u64, kind: MemoryLimitKind, last_change: Option<f64> },
 }
 
 /// The truth of `scene` from `dir` if an earlier run left it there (same content key and
@@ -318,7 +473,7 @@ pub fn cached(
     options: &TruthOptions,
     dir: &Path,
     progress: Progress,
-) -> Result<(Truth, bool), TruthCacheError> {
+) -> Result<(Truth, bool), TruthError> {
     let key = content_key(scene, options);
     let path = dir.join(format!("truth-{key}.json"));
     if let Ok(bytes) = std::fs::read(&path) {
@@ -332,15 +487,38 @@ pub fn cached(
             Err(e) => log::warn!("truth cache {}: unreadable ({e}); computing it anew", path.display()),
         }
     }
-    let truth = compute(scene, options, progress);
-    let io = |source| TruthCacheError::Io { path: path.clone(), source };
-    std::fs::create_dir_all(dir).map_err(io)?;
-    let json = serde_json::to_vec(&truth).map_err(|source| TruthCacheError::Json { path: path.clone(), source })?;
+    // A folder the truth cannot be written to is found before the truth is computed.
+    writable_folder(dir)?;
+    let truth = compute(scene, options, progress)?;
+    let io = |error| TruthError::Io { path: path.clone(), error };
+    let json = serde_json::to_vec(&truth).map_err(|error| TruthError::Json { path: path.clone(), error })?;
     // Write then rename, so a run cut short never leaves half a truth behind.
     let tmp = dir.join(format!(".truth-{key}.json.tmp"));
     std::fs::write(&tmp, json).map_err(io)?;
     std::fs::rename(&tmp, &path).map_err(io)?;
     Ok((truth, false))
+}
+
+/// `dir`, made if missing, is a folder a file can be written in (a file of its own is made and
+/// removed); otherwise what stands in the way.
+fn writable_folder(dir: &Path) -> Result<(), TruthError> {
+    let fail = |why: String| Err(TruthError::Folder { path: dir.to_path_buf(), why });
+    if let Some(existing) = dir.ancestors().find(|a| a.exists())
+        && !existing.is_dir()
+    {
+        return fail(format!("{} is a file, not a folder", existing.display()));
+    }
+    if let Err(e) = std::fs::create_dir_all(dir) {
+        return fail(format!("cannot make the folder ({e})"));
+    }
+    let probe = dir.join(format!(".truth-probe-{}.tmp", std::process::id()));
+    match std::fs::write(&probe, b"") {
+        Ok(()) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) => fail(format!("cannot write a file in the folder ({e})")),
+    }
 }
 
 /// Where truths are cached unless told otherwise: `$XDG_CACHE_HOME/translucent/truth`, else
@@ -444,10 +622,29 @@ struct Source {
     /// Bounding sphere of the triangle (centre of its corners).
     centre: DVec3,
     radius: f64,
-    /// Exact moments of every piece coarser than a grid cell, in the order [`Quadrature::piece`]
-    /// splits (node `k`'s children are `4k + 1 ..= 4k + 4`, the root is the whole triangle), so
-    /// a piece spanning many cells can stand as one monopole once the kernel is smooth over it.
+    /// Exact moments of every piece coarser than a grid cell by more than [`PYRAMID_SKIP`]
+    /// splits, in the order [`Quadrature::piece`] splits (node `k`'s children are
+    /// `4k + 1 ..= 4k + 4`, the root is the whole triangle), so a piece spanning many cells can
+    /// stand as one monopole once the kernel is smooth over it. The finer pieces' moments are
+    /// summed from their cells when asked ([`Source::moments`]).
     pyramid: Vec<Moments>,
+}
+
+/// The pyramid leaves out the pieces this many splits above a grid cell (4 cells each): its
+/// last level held 3/4 of it, twice the grid's own memory, and a receiver asks for those
+/// pieces only where the kernel is not smooth over them. (Leaving out two levels saved a third
+/// more memory but made each level about 1.5 times slower.)
+const PYRAMID_SKIP: u32 = 1;
+
+/// Points of a triangle's grid at `depth`.
+fn grid_points(depth: u32) -> usize {
+    let n = 1usize << depth;
+    (n + 1) * (n + 2) / 2
+}
+
+/// Nodes of a triangle's moment pyramid whose grid is at `depth`.
+fn pyramid_nodes(depth: u32) -> usize {
+    ((1usize << (2 * depth.saturating_sub(PYRAMID_SKIP))) - 1) / 3
 }
 
 /// Flux `integral E_t dA` and first moment `integral y E_t dA` of a piece of surface, per channel.
@@ -498,13 +695,10 @@ impl Source {
 
     /// Exact moments of the piece `uv` at split depth `depth <= self.depth`: a grid cell's from
     /// its linear `E_t`, a coarser piece's as the sum of its children's (stored in `pyramid`
-    /// at `node`). Returns the piece's moments.
+    /// at `node` where the pyramid keeps it). Returns the piece's moments.
     fn build_pyramid(&mut self, uv: [[f64; 2]; 3], depth: u32, node: usize) -> Moments {
-        if depth == self.depth {
-            let y = uv.map(|[u, v]| self.point(u, v));
-            let e = uv.map(|[u, v]| self.irradiance(u, v));
-            let (flux, moment) = linear_moments(&y, &e, self.area * 0.25f64.powi(depth as i32));
-            return Moments { flux, moment };
+        if node >= self.pyramid.len() {
+            return self.summed_moments(uv, depth);
         }
         let mut sum = Moments::default();
         for (k, child) in split(uv).into_iter().enumerate() {
@@ -512,6 +706,34 @@ impl Source {
         }
         self.pyramid[node] = sum;
         sum
+    }
+
+    /// The moments of the piece `uv` at split depth `depth`, pyramid node `node`: stored, or
+    /// summed from its cells in the order `build_pyramid` sums them (so the same bits).
+    fn moments(&self, uv: [[f64; 2]; 3], depth: u32, node: usize) -> Moments {
+        self.pyramid.get(node).copied().unwrap_or_else(|| self.summed_moments(uv, depth))
+    }
+
+    /// The moments of the piece `uv` at split depth `depth <= self.depth`, summed from its cells.
+    fn summed_moments(&self, uv: [[f64; 2]; 3], depth: u32) -> Moments {
+        if depth == self.depth {
+            let y = uv.map(|[u, v]| self.point(u, v));
+            let e = uv.map(|[u, v]| self.irradiance(u, v));
+            let (flux, moment) = linear_moments(&y, &e, self.area * 0.25f64.powi(depth as i32));
+            return Moments { flux, moment };
+        }
+        let mut sum = Moments::default();
+        for child in split(uv) {
+            sum.add(&self.summed_moments(child, depth + 1));
+        }
+        sum
+    }
+
+    /// Heap and inline bytes of a source whose grid is at `depth`.
+    fn bytes(depth: u32) -> u64 {
+        (grid_points(depth) * std::mem::size_of::<DVec3>()
+            + pyramid_nodes(depth) * std::mem::size_of::<Moments>()
+            + std::mem::size_of::<Source>()) as u64
     }
 
     /// `E_t` at `(u, v)`, linear in each grid cell.
@@ -557,15 +779,6 @@ fn linear_moments(y: &[DVec3; 3], e: &[DVec3; 3], area: f64) -> ([f64; 3], [DVec
     (flux, moment)
 }
 
-/// The object's triangles as sources at `level`: `E_t` ray cast on each triangle's grid, finer
-/// where the set of lights reaching it changes inside it.
-fn sources(scene: &PreparedScene, occluders: &Bvh, o: &PreparedObject, eta: f64, level: u32, eps: f64) -> Vec<Source> {
-    let mesh = &o.mesh;
-    let caster =
-        Caster { scene, occluders, eta, eps, normals: mesh.vertex_normals(), strong: strong_lights(scene, mesh) };
-    (0..mesh.triangles().len()).into_par_iter().map(|t| caster.source(mesh, t, level)).collect()
-}
-
 /// The lights (by bit, modulo 64) giving at least [`STRONG_LIGHT`] of the total incidence at
 /// the mesh's centre: their shadow edges get [`EDGE_EXTRA_DEPTH`] more levels.
 fn strong_lights(scene: &PreparedScene, mesh: &Mesh) -> u64 {
@@ -587,10 +800,33 @@ struct Caster<'a> {
     strong: u64,
 }
 
-impl Caster<'_> {
-    /// Triangle `t` of `mesh` as a source at `level`, its grid as deep as its normals and shadow
-    /// edges ask.
-    fn source(&self, mesh: &Mesh, t: usize, level: u32) -> Source {
+/// How one triangle is refined, from its base grid (ray cast once): its depth at level `l` is
+/// `base + l + extra`, and which lights its finer grids ray cast.
+#[derive(Clone, Copy, Debug)]
+struct TrianglePlan {
+    /// Grid depth at level 0 before shadow edges: set by how far the shading normal turns.
+    base: u32,
+    /// [`EDGE_EXTRA_DEPTH`] where a strong light's shadow edge crosses the triangle, else 0.
+    extra: u32,
+    /// The lights finer grids ray cast, and those known blocked everywhere.
+    finer: Visibility,
+}
+
+impl TrianglePlan {
+    fn depth(&self, level: u32) -> u32 {
+        self.base + level + self.extra
+    }
+}
+
+impl<'a> Caster<'a> {
+    fn new(scene: &'a PreparedScene, occluders: &'a Bvh, o: &'a PreparedObject, eta: f64, eps: f64) -> Caster<'a> {
+        let mesh = &o.mesh;
+        Caster { scene, occluders, eta, eps, normals: mesh.vertex_normals(), strong: strong_lights(scene, mesh) }
+    }
+
+    /// How triangle `t` of `mesh` is refined at every level: its grid as deep as its normals
+    /// and shadow edges ask.
+    fn plan(&self, mesh: &Mesh, t: usize) -> TrianglePlan {
         let corners = mesh.corners(t);
         let normals = mesh.triangles()[t].map(|i| self.normals[i as usize].as_dvec3());
         let [a, b, c] = normals;
@@ -607,15 +843,23 @@ impl Caster<'_> {
         // shadows; back-facing points cost no ray). The others keep the base grid's
         // verdict, so a shadow narrower than the base grid that touches none of its points
         // is missed at every level.
-        let (base_grid, reached, blocked) = self.grid(&corners, normals, base, Visibility::TRACE_ALL);
+        let (_, reached, blocked) = self.grid(&corners, normals, base, Visibility::TRACE_ALL);
         let edges = reached & blocked;
         let unknown = !(reached | blocked);
-        let depth = base + level + if edges & self.strong != 0 { EDGE_EXTRA_DEPTH } else { 0 };
-        let grid = if depth == base {
-            base_grid
-        } else {
-            self.grid(&corners, normals, depth, Visibility { trace: edges | unknown, blocked: blocked & !reached }).0
-        };
+        TrianglePlan {
+            base,
+            extra: if edges & self.strong != 0 { EDGE_EXTRA_DEPTH } else { 0 },
+            finer: Visibility { trace: edges | unknown, blocked: blocked & !reached },
+        }
+    }
+
+    /// Triangle `t` of `mesh` as a source at `level`, refined as `plan` says.
+    fn source(&self, mesh: &Mesh, t: usize, plan: &TrianglePlan, level: u32) -> Source {
+        let corners = mesh.corners(t);
+        let normals = mesh.triangles()[t].map(|i| self.normals[i as usize].as_dvec3());
+        let depth = plan.depth(level);
+        let known = if depth == plan.base { Visibility::TRACE_ALL } else { plan.finer };
+        let grid = self.grid(&corners, normals, depth, known).0;
         Source::new(corners, depth, grid, mesh.triangle_areas()[t])
     }
 
@@ -660,7 +904,7 @@ impl Source {
             quadrupole: [[0.0; 6]; 3],
             centre,
             radius,
-            pyramid: vec![Moments::default(); ((1usize << (2 * depth)) - 1) / 3],
+            pyramid: vec![Moments::default(); pyramid_nodes(depth)],
         };
         let whole = s.build_pyramid(WHOLE, 0, 0);
         s.centroid = whole.centroid(centre);
@@ -968,7 +1212,7 @@ impl Quadrature<'_> {
         let d = (self.x.distance(centre) - radius).max(0.0);
         if depth < s.depth {
             // Coarser than a grid cell: its exact moments are in the pyramid.
-            let moments = &s.pyramid[node];
+            let moments = s.moments(uv, depth, node);
             if self.fine(d, radius, &moments.flux, self.eta / 4.0) {
                 return self.monopole(&moments.flux, &moments.centroid(centre), m);
             }

@@ -3,11 +3,11 @@
 //! prepared with shadow layers. Everything here is CPU work done once per scene.
 
 use super::lights::{self, Environment, PreparedLight};
-use super::{AssetSource, GatherMode, Light, MaterialSpec, Scene, SceneError, Shape};
+use super::{AssetSource, Camera, GatherMode, Light, MaterialSpec, Scene, SceneError, Shape};
 use crate::mesh::{LoadOptions, Mesh, MeshError};
 use crate::optics::{Dipole, Material};
 use crate::sampling::{self, Method, SampleOptions, SamplePoint};
-use glam::{EulerRot, Mat4, Quat, Vec3};
+use glam::{DVec3, EulerRot, Mat4, Quat, Vec3};
 
 /// `.with_context(|| where)`: wrap an error in [`SceneError::Context`].
 trait WithContext<T> {
@@ -195,6 +195,11 @@ impl PreparedScene {
             }
         }
         let bounds = bounding_sphere(objects.iter().map(|o| &o.mesh));
+        for (i, o) in objects.iter().enumerate() {
+            if let Some(warning) = near_plane_warning(&scene.file.camera, &o.mesh, bounds) {
+                log::warn!("{}: object[{i}] ({}): {warning}", scene.name, o.name);
+            }
+        }
         let casters: Vec<&Mesh> = objects.iter().filter(|o| o.casts_shadow).map(|o| &o.mesh).collect();
         let caster_bounds = if casters.is_empty() { bounds } else { bounding_sphere(casters.iter().copied()) };
         let any_caster = !casters.is_empty();
@@ -578,6 +583,66 @@ pub fn sphere(radius: f32, divisions: u32) -> Result<Mesh, MeshError> {
         }
     }
     Mesh::from_triangles(positions, triangles)
+}
+
+/// A warning when the camera's near plane clips `mesh` where the camera looks at it: its
+/// nearest point to the eye lies inside the field of view (the cone through the image's
+/// corners) and nearer than the near plane, which the scene's depth sets (a camera 1e-5 units
+/// from a thin mesh in a large scene sees nothing of it). A grazing part of the mesh that is
+/// not its nearest point is not looked for.
+pub fn near_plane_warning(camera: &Camera, mesh: &Mesh, bounds: (Vec3, f32)) -> Option<String> {
+    let (near, _) = camera.depth_range(bounds.0, bounds.1);
+    let eye = Vec3::from(camera.eye).as_dvec3();
+    let forward = (Vec3::from(camera.target) - Vec3::from(camera.eye)).as_dvec3().normalize_or_zero();
+    let aspect = f64::from(camera.resolution[0]) / f64::from(camera.resolution[1].max(1));
+    let tan_corner = (f64::from(camera.fov_y).to_radians() / 2.0).tan() * (1.0 + aspect * aspect).sqrt();
+    let nearest = (0..mesh.triangles().len())
+        .map(|t| closest_on_triangle(eye, mesh.corners(t)))
+        .min_by(|a, b| a.distance_squared(eye).total_cmp(&b.distance_squared(eye)))?;
+    let (offset, depth) = (nearest - eye, (nearest - eye).dot(forward));
+    let lateral = (offset - forward * depth).length();
+    (depth >= 0.0 && lateral <= depth * tan_corner && offset.length() < f64::from(near)).then(|| {
+        format!(
+            "the camera is {:.3e} units from it, nearer than the near plane ({near:.3e} units, set by the \
+             scene's depth), which clips it from the image: move the camera back",
+            offset.length()
+        )
+    })
+}
+
+/// The point of the triangle `corners` nearest to `p` (Ericson, Real-Time Collision Detection
+/// 5.1.5: by the Voronoi region of `p`).
+fn closest_on_triangle(p: DVec3, corners: [DVec3; 3]) -> DVec3 {
+    let [a, b, c] = corners;
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    a + ab * (vb * denom) + ac * (vc * denom)
 }
 
 /// Positions are f32 in world space: an object far from the origin compared with its size has

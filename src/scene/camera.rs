@@ -15,10 +15,16 @@ impl Camera {
     /// Perspective projection with near and far planes fitted around a scene bounding sphere.
     pub fn projection(&self, scene_center: Vec3, scene_radius: f32) -> Mat4 {
         let aspect = self.resolution[0] as f32 / self.resolution[1] as f32;
-        let distance = (Vec3::from(self.eye) - scene_center).length();
-        let far = (distance + scene_radius) * 1.05;
-        let near = (distance - scene_radius).max(far * 1e-4);
+        let (near, far) = self.depth_range(scene_center, scene_radius);
         // The Vulkan variant outputs y down, as the framebuffer is, so +y is up in the image.
         vulkan::perspective(self.fov_y.to_radians(), aspect, near, far)
+    }
+
+    /// The near and far planes' distances around a scene bounding sphere: the sphere's depth
+    /// seen from `eye`, the near plane at least 1e-4 of the far one (depth precision).
+    pub fn depth_range(&self, scene_center: Vec3, scene_radius: f32) -> (f32, f32) {
+        let distance = (Vec3::from(self.eye) - scene_center).length();
+        let far = (distance + scene_radius) * 1.05;
+        ((distance - scene_radius).max(far * 1e-4), far)
     }
 }

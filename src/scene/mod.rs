@@ -144,6 +144,8 @@ impl Scene {
             let (line, key) = unknown.or(wrong).unzip();
             let line = line.map(|l| format!("line {l}: ")).unwrap_or_default();
             let path = match key.flatten() {
+                // A plain table's path already ends with the key; a tagged table's stops at it.
+                Some(key) if path == key || path.ends_with(&format!(".{key}")) => path,
                 Some(key) if !path.is_empty() && path != "." => format!("{path}.{key}"),
                 Some(key) => key,
                 None => path,

@@ -119,7 +119,7 @@ pub enum StudyError {
     #[error(transparent)]
     Render(#[from] RenderError),
     #[error(transparent)]
-    Truth(#[from] truth::TruthCacheError),
+    Truth(#[from] truth::TruthError),
     #[error("sampling {object}: {message}")]
     Sampling { object: String, message: String },
     #[error("{0}")]

@@ -333,6 +333,12 @@ impl fmt::Display for LevelReason {
             LevelReason::OutOfView => {
                 write!(f, "out of view: its coarsest level (clipped away; shadow maps choose their own)")
             }
+            // A camera at the object's centre (inside it) sees a pixel span no distance there.
+            LevelReason::WithinLimits { triangles, whole_triangles, vertices, pixel, .. } if *pixel <= 0.0 => write!(
+                f,
+                "{triangles} of {whole_triangles} triangles, {vertices} vertices: the camera is inside the object, at \
+                 its centre, where a pixel spans no distance, so no simplification is small enough"
+            ),
             LevelReason::WithinLimits { triangles, whole_triangles, vertices, mean_edge, error, pixel } => write!(
                 f,
                 "{triangles} of {whole_triangles} triangles, {vertices} vertices: edges {:.2} px, error {:.2} px at \
@@ -349,6 +355,10 @@ impl fmt::Display for LevelReason {
 
 impl fmt::Display for ShadowFilter {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if !self.texel_pixels.is_finite() {
+            // The camera at the casters' centre, inside them: a pixel there spans no distance.
+            return write!(f, "four-tap tent: the camera is at the shadow casters' centre, inside them");
+        }
         write!(
             f,
             "{}: a shadow-map texel spans {:.2} px at the casters' centre (one tap up to {SHADOW_ONE_TAP_PIXELS})",
