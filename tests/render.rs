@@ -502,7 +502,8 @@ count = 64
     let prepared = prepare(toml, &overrides);
     let material = Material::preset("ketchup").unwrap();
     let rd: Vec<f64> = material.dipoles(1000.0).unwrap().iter().map(Dipole::r_d_total).collect();
-    let lights: Vec<([f64; 3], [f64; 3])> = vec![([0.3, 0.8, 0.5], [1.0, 0.5, 0.25]), ([-0.6, -0.2, 0.4], [0.2, 0.4, 0.8])];
+    let lights: Vec<([f64; 3], [f64; 3])> =
+        vec![([0.3, 0.8, 0.5], [1.0, 0.5, 0.25]), ([-0.6, -0.2, 0.4], [0.2, 0.4, 0.8])];
     let mesh = prepared.objects[0].mesh.clone();
     with_gpu(|gpu| {
         let mut renderer = Renderer::new(gpu, prepared).unwrap();

@@ -8,12 +8,12 @@ use translucent::render::gather::GatherPush;
 use translucent::render::gather_pixel::GatherPixelPush;
 use translucent::render::gather_sparse::GatherSparsePush;
 use translucent::render::gather_tree::GatherTreePush;
+use translucent::render::local_exitance::LocalExitancePush;
 use translucent::render::records::{
     LightGpu, NodePowerRecord, ObjectRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
 };
 use translucent::render::shade::ShadePush;
 use translucent::render::shadow::ShadowPush;
-use translucent::render::local_exitance::LocalExitancePush;
 use translucent::render::splat::SplatPush;
 use translucent::render::tonemap::TonemapPush;
 use translucent::render::vertex_light::VertexLightPush;
@@ -146,9 +146,12 @@ fn splat_and_vertex_records_match_glsl() {
 
 /// Every pass's push struct: its GLSL declaration has the Rust struct's field names and
 /// offsets, and the compiled shader's reflected push block has its size.
-#[test]
-fn push_blocks_match_glsl_and_spirv() {
-    let cases: [(&str, &str, &str, usize, &[&str]); 10] = [
+/// One pass's push block: shader, GLSL source holding the struct, struct name, Rust size, fields.
+type PushCase = (&'static str, &'static str, &'static str, usize, &'static [&'static str]);
+
+/// Every pass's push block, as `push_blocks_match_glsl_and_spirv` checks them.
+fn push_cases() -> [PushCase; 10] {
+    [
         (
             "splat.comp",
             include_str!("../glsl/splat.comp"),
@@ -219,8 +222,12 @@ fn push_blocks_match_glsl_and_spirv() {
             size_of::<ShadePush>(),
             &["view_proj", "eye_object", "counts"],
         ),
-    ];
-    for (shader, source, name, rust_size, rust_fields) in cases {
+    ]
+}
+
+#[test]
+fn push_blocks_match_glsl_and_spirv() {
+    for (shader, source, name, rust_size, rust_fields) in push_cases() {
         let (fields, size) = glsl_layout(source, name);
         assert_eq!(size, rust_size, "{name}: GLSL and Rust sizes differ");
         let names: Vec<&str> = fields.iter().map(|(n, _)| n.as_str()).collect();
