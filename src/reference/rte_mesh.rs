@@ -44,8 +44,8 @@ use rand_pcg::Pcg64;
 
 /// Photons per chunk (one random stream each).
 const CHUNK: u64 = 256;
-/// Chunks walked in parallel between two looks at the budget.
-const CHUNKS_PER_ROUND: u64 = 32;
+/// The most chunks walked in parallel between two looks at the budget.
+const MAX_CHUNKS_PER_ROUND: u64 = 32;
 
 /// How long to walk and with which random numbers.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -224,7 +224,7 @@ fn object_exitance(
     let photons = run_rounds(
         &options.budget,
         CHUNK,
-        CHUNKS_PER_ROUND,
+        MAX_CHUNKS_PER_ROUND,
         walk_chunk,
         |exits| add_exits(&mut tally.borrow_mut(), exits),
         |n| summarize(&tally.borrow(), &cells, n).2,
