@@ -286,6 +286,10 @@ pub fn half_space_reflectance(
     if sin2_t >= 1.0 {
         return Err(RteError::NothingEnters { cos: cos_incidence, eta });
     }
+    if medium.sigma_s == 0.0 {
+        // Nothing scatters: the beam goes straight in and never turns back.
+        return Ok(Estimate { mean: 0.0, stderr: 0.0, photons: 0 });
+    }
     if medium.sigma_a == 0.0 {
         // Nothing is absorbed and every walk in a half-space comes back to the surface, where
         // it has a chance to leave, so all of it leaves: exactly 1. (Walked, it would take for
@@ -395,7 +399,8 @@ mod tests {
     #[test]
     fn half_space_without_absorption_returns_everything_that_enters() {
         // Conservative scattering: every photon leaves eventually, so the reflectance is 1
-        // whatever the boundary (given, not walked), and nearly so when almost nothing absorbs.
+        // whatever the boundary (given, not walked), and nearly so when almost nothing absorbs;
+        // without scattering none comes back.
         for eta in [1.0, 1.4] {
             let medium = Medium::new(0.0, 1.0, 0.0, eta).unwrap();
             let e = half_space_reflectance(&medium, 0.6, &Budget::photons(500), 1, &quiet).unwrap();
@@ -403,6 +408,9 @@ mod tests {
             let medium = Medium::new(1e-7, 1.0, 0.0, eta).unwrap();
             let e = half_space_reflectance(&medium, 0.6, &Budget::photons(500), 1, &quiet).unwrap();
             assert!(e.mean > 0.99 && e.mean <= 1.0, "eta {eta}: {e:?}");
+            let medium = Medium::new(1.0, 0.0, 0.0, eta).unwrap();
+            let e = half_space_reflectance(&medium, 0.6, &Budget::photons(500), 1, &quiet).unwrap();
+            assert_eq!((e.mean, e.stderr), (0.0, 0.0), "eta {eta}");
         }
     }
 
