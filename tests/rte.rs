@@ -239,13 +239,21 @@ fn dipole_r_d_total_is_close_to_the_rte_at_albedo_0_999() {
         let mc = monte_carlo(w, eta, 1.0, 1e-3);
         let dipole = Dipole::new(1.0 - w, w, eta, 0).unwrap().r_d_total();
         let rel = dipole / mc.mean - 1.0;
-        println!("eta {eta}: dipole {dipole:.6}, RTE {:.6} +- {:.6}, dipole relative {:+.3}%", mc.mean, mc.stderr, 100.0 * rel);
+        println!(
+            "eta {eta}: dipole {dipole:.6}, RTE {:.6} +- {:.6}, dipole relative {:+.3}%",
+            mc.mean,
+            mc.stderr,
+            100.0 * rel
+        );
         assert!(rel.abs() < tolerance + 3.0 * mc.relative_stderr(), "eta {eta}: dipole off by {rel:.4}");
     }
 }
 
 // ---------------------------------------------------------------------------------------------
 // The closed mesh
+
+/// A face of the box: its origin corner, its two edge directions and its squares along each.
+type Face = ([i32; 3], [i32; 3], [i32; 3], i32, i32);
 
 /// A closed box `2 half` wide (x, z) and `depth` deep below y = 0, every face a grid of unit
 /// squares (integer corners, so the loader welds the faces' shared edges exactly), as OBJ text.
@@ -254,13 +262,13 @@ fn box_obj(half: i32, depth: i32) -> String {
     let mut f: Vec<[usize; 3]> = Vec::new();
     // Each face: an origin and two edge directions (counter-clockwise seen from outside).
     let (h, d) = (half, depth);
-    let faces: [([i32; 3], [i32; 3], [i32; 3], i32, i32); 6] = [
-        ([-h, 0, -h], [0, 0, 1], [1, 0, 0], 2 * h, 2 * h), // top, facing +y
+    let faces: [Face; 6] = [
+        ([-h, 0, -h], [0, 0, 1], [1, 0, 0], 2 * h, 2 * h),  // top, facing +y
         ([-h, -d, -h], [1, 0, 0], [0, 0, 1], 2 * h, 2 * h), // bottom, facing -y
-        ([-h, -d, h], [1, 0, 0], [0, 1, 0], 2 * h, d),     // front, facing +z
-        ([h, -d, -h], [-1, 0, 0], [0, 1, 0], 2 * h, d),    // back, facing -z
-        ([h, -d, h], [0, 0, -1], [0, 1, 0], 2 * h, d),     // right, facing +x
-        ([-h, -d, -h], [0, 0, 1], [0, 1, 0], 2 * h, d),    // left, facing -x
+        ([-h, -d, h], [1, 0, 0], [0, 1, 0], 2 * h, d),      // front, facing +z
+        ([h, -d, -h], [-1, 0, 0], [0, 1, 0], 2 * h, d),     // back, facing -z
+        ([h, -d, h], [0, 0, -1], [0, 1, 0], 2 * h, d),      // right, facing +x
+        ([-h, -d, -h], [0, 0, 1], [0, 1, 0], 2 * h, d),     // left, facing -x
     ];
     for (o, a, b, na, nb) in faces {
         let base = v.len();
@@ -336,13 +344,13 @@ fn uniformly_lit_box_exitance_matches_the_half_space_reflectance() {
         .collect();
     assert_eq!(middle.len(), 81);
     let f_t = fresnel::fresnel_transmittance(1.0, eta);
-    for c in 0..3 {
+    for (c, albedo) in albedo.into_iter().enumerate() {
         // The vertices' cells are equal, so their mean is the region's.
         let n = middle.len() as f64;
         let mean = middle.iter().map(|&v| rte.exitance[v][c]).sum::<f64>() / n;
         let se = middle.iter().map(|&v| rte.stderr[v][c].powi(2)).sum::<f64>().sqrt() / n;
-        let exact = (c + 1) as f64 * f_t * fresnel_half_space_reflectance(albedo[c], eta, 1.0);
+        let exact = (c + 1) as f64 * f_t * fresnel_half_space_reflectance(albedo, eta, 1.0);
         let estimate = rte::Estimate { mean, stderr: se, photons: rte.photons };
-        assert_close(&format!("box, channel {c}, albedo {}", albedo[c]), &estimate, exact, 2e-2);
+        assert_close(&format!("box, channel {c}, albedo {albedo}"), &estimate, exact, 2e-2);
     }
 }

@@ -145,10 +145,15 @@ fn rte_table(dipoles: &[Dipole; 3], rte: &[Estimate; 3], args: &Args) -> String 
     row("  standard error", rte.map(|e| fmt(e.stderr)));
     row("  photons", rte.map(|e| e.photons.to_string()));
     row("R_d,total (dipole)", dipoles.map(|d| fmt(d.r_d_total())));
-    let difference = |c: usize| match (dipoles[c].r_d_total(), rte[c].mean) {
-        (d, m) if m > 0.0 => format!("{:+.2}%", 100.0 * (d / m - 1.0)),
-        (d, _) if d == 0.0 => "both 0".into(),
-        _ => "n/a".into(),
+    let difference = |c: usize| {
+        let (d, m) = (dipoles[c].r_d_total(), rte[c].mean);
+        if m > 0.0 {
+            format!("{:+.2}%", 100.0 * (d / m - 1.0))
+        } else if d == 0.0 {
+            "both 0".into()
+        } else {
+            "n/a".into()
+        }
     };
     row("dipole vs RTE", [0, 1, 2].map(difference));
     out

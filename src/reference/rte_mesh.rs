@@ -220,7 +220,8 @@ fn object_exitance(
         exits
     };
     // Adding chunks and measuring the precision both need the tally: a cell between them.
-    let tally = std::cell::RefCell::new(Tally { sum: vec![[0.0; 3]; count], sum2: vec![[0.0; 3]; count], lost: [0; 3] });
+    let tally =
+        std::cell::RefCell::new(Tally { sum: vec![[0.0; 3]; count], sum2: vec![[0.0; 3]; count], lost: [0; 3] });
     let photons = run_rounds(
         &options.budget,
         CHUNK,
