@@ -354,3 +354,56 @@ fn uniformly_lit_box_exitance_matches_the_half_space_reflectance() {
         assert_close(&format!("box, channel {c}, albedo {albedo}"), &estimate, exact, 2e-2);
     }
 }
+
+/// A measurement, not a check (`cargo test --test rte sphere -- --ignored --nocapture`): the
+/// closed-mesh reference on the 2 cm spheres (assets/scenes/sphere-marble.toml and
+/// sphere-ketchup.toml) for `TRANSLUCENT_RTE_SECONDS` each (default 60), the per-vertex standard
+/// error it reaches as a share of the lit mean, and the dipole truth's per-vertex error against
+/// it.
+#[test]
+#[ignore = "a measurement of minutes; run by hand"]
+fn sphere_reference_precision_and_the_dipoles_error_against_it() {
+    use translucent::reference::truth;
+    let seconds: f64 = std::env::var("TRANSLUCENT_RTE_SECONDS").ok().and_then(|s| s.parse().ok()).unwrap_or(60.0);
+    for name in ["sphere-marble", "sphere-ketchup"] {
+        let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("assets/scenes/{name}.toml"));
+        let scene = PreparedScene::new(&Scene::load(&path).unwrap(), &Overrides::default()).unwrap();
+        let budget = Budget { max_photons: u64::MAX / 2, relative_stderr: None, max_seconds: Some(seconds) };
+        let rte = rte_mesh::exitance(&scene, &MeshOptions { budget, seed: 1 }, &quiet).unwrap();
+        let rte = rte[0].as_ref().unwrap();
+        let start = std::time::Instant::now();
+        let t = truth::compute(&scene, &truth::TruthOptions::default(), &|_, _, _| {});
+        let truth_seconds = start.elapsed().as_secs_f64();
+        println!(
+            "{name}: {} vertices, {} photons in {:.0} s, lost {:?}; relative standard error (RMS over lit / lit mean, worst channel) {:.4}",
+            rte.exitance.len(),
+            rte.photons,
+            rte.seconds,
+            rte.lost,
+            rte.relative_stderr
+        );
+        for c in 0..3 {
+            let floor = truth::LIT_FLOOR * rte.exitance.iter().map(|m| m[c]).fold(0.0, f64::max);
+            let lit: Vec<usize> =
+                (0..rte.exitance.len()).filter(|&v| rte.exitance[v][c] >= floor && rte.exitance[v][c] > 0.0).collect();
+            let n = lit.len() as f64;
+            let mean = lit.iter().map(|&v| rte.exitance[v][c]).sum::<f64>() / n;
+            let se_rms = (lit.iter().map(|&v| rte.stderr[v][c].powi(2)).sum::<f64>() / n).sqrt();
+            let rel = |v: usize| t.exitance[0][v][c] / rte.exitance[v][c] - 1.0;
+            let err_rms = (lit.iter().map(|&v| rel(v).powi(2)).sum::<f64>() / n).sqrt();
+            let noise_rms =
+                (lit.iter().map(|&v| (rte.stderr[v][c] / rte.exitance[v][c]).powi(2)).sum::<f64>() / n).sqrt();
+            let total_truth: f64 = lit.iter().map(|&v| t.exitance[0][v][c]).sum();
+            let total_rte: f64 = lit.iter().map(|&v| rte.exitance[v][c]).sum();
+            println!(
+                "  channel {c}: {} lit vertices, standard error RMS {:.2}% of the lit mean; dipole truth against it: RMS {:.2}% per vertex (noise alone {:.2}%), sum over lit vertices {:+.2}% (truth {:.0} s)",
+                lit.len(),
+                100.0 * se_rms / mean,
+                100.0 * err_rms,
+                100.0 * noise_rms,
+                100.0 * (total_truth / total_rte - 1.0),
+                truth_seconds
+            );
+        }
+    }
+}
