@@ -4,9 +4,9 @@
 //! The medium is homogeneous, with absorption `sigma_a`, scattering `sigma_s` and a
 //! Henyey-Greenstein phase function of mean cosine `g` ([`Medium`]), behind a smooth dielectric
 //! boundary of relative index `eta` (exact Fresnel reflectance, `optics::fresnel`). Photons
-//! random-walk it (analog flights, exponential free paths, implicit capture of absorption with
-//! Russian roulette) and reflect internally or leave with the Fresnel probabilities at the
-//! boundary. The measured presets give reduced coefficients only, which are walked with an
+//! random-walk it (exponential free paths; absorption analog from albedo 0.5 up, else implicit
+//! capture with Russian roulette) and reflect internally or leave with the Fresnel
+//! probabilities at the boundary. The measured presets give reduced coefficients only, which are walked with an
 //! isotropic phase function and `sigma_s = sigma_s'` ([`Medium::reduced`], the similarity
 //! relation the dipole itself rests on).
 //!
