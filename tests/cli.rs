@@ -194,3 +194,45 @@ fn a_moving_camera_really_moves_and_only_reshades() {
     let differ = a.as_raw().iter().zip(b.as_raw()).filter(|(x, y)| x != y).count();
     assert!(differ > 500, "the view did not move: {differ} bytes differ");
 }
+
+/// `material --rte --json`: per channel, the library's half-space Monte Carlo (the command's
+/// fixed seed 1, its budget) beside the dipole's `R_d,total`, for custom coefficients.
+#[test]
+fn material_rte_reports_the_monte_carlo_reflectance_beside_the_dipole() {
+    use translucent::optics::Dipole;
+    use translucent::reference::rte::{self, Budget, Medium};
+    let sigma_a = [0.1, 0.01, 0.001];
+    let args = ["material", "--sigma-a", "0.1,0.01,0.001", "--sigma-s-prime", "0.9", "--eta", "1.3"];
+    let out = translucent(&[&args[..], &["--rte", "--rte-stderr", "0.01", "--json"]].concat(), &[]);
+    assert!(out.status.success(), "stderr: {}", text(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let budget = Budget { max_photons: 20_000_000, relative_stderr: Some(0.01), max_seconds: None };
+    for c in 0..3 {
+        let channel = &json["channels"][c];
+        let d = Dipole::new(sigma_a[c], 0.9, 1.3, c).unwrap();
+        let expected = rte::half_space_reflectance(&Medium::reduced(&d), 1.0, &budget, 1, &|_| {}).unwrap();
+        assert_eq!(channel["rd_total_rte"].as_f64(), Some(expected.mean), "channel {c}");
+        assert_eq!(channel["rd_total_rte_stderr"].as_f64(), Some(expected.stderr), "channel {c}");
+        assert!(expected.relative_stderr() <= 0.01);
+        let dipole = channel["rd_total_dipole"].as_f64().unwrap();
+        assert!((dipole - d.r_d_total()).abs() <= 1e-12 * dipole, "channel {c}: {dipole}");
+    }
+    // Without --rte the keys are absent.
+    let plain = translucent(&[&args[..], &["--json"]].concat(), &[]);
+    let json: serde_json::Value = serde_json::from_slice(&plain.stdout).unwrap();
+    assert!(json["channels"][0].get("rd_total_rte").is_none());
+}
+
+#[test]
+fn material_rte_table_and_bad_budgets() {
+    let out = translucent(&["material", "ketchup", "--rte", "--rte-stderr", "0.02"], &[]);
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "stderr: {}", text(&out.stderr));
+    for row in ["R_d,total (RTE)", "standard error", "R_d,total (dipole)", "dipole vs RTE"] {
+        assert!(stdout.contains(row), "no {row:?} in:\n{stdout}");
+    }
+    let stderr = assert_clean_failure(&translucent(&["material", "marble", "--rte", "--rte-stderr", "-1"], &[]));
+    assert!(stderr.contains("--rte-stderr") && stderr.contains("-1"), "{stderr}");
+    let stderr = assert_clean_failure(&translucent(&["material", "marble", "--rte", "--rte-photons", "0"], &[]));
+    assert!(stderr.contains("--rte-photons"), "{stderr}");
+}

@@ -3,12 +3,15 @@
 //! - `translucent material --list [--json]`
 //! - `translucent material NAME [--eta X] [--scale MM_PER_UNIT] [--json]`
 //! - `translucent material --sigma-a R,G,B --sigma-s-prime R,G,B --eta X [--scale ..] [--json]`
+//! - `... --rte [--rte-stderr REL] [--rte-photons N]`: beside each channel's `R_d,total`, the
+//!   half-space total diffuse reflectance by Monte Carlo radiative transfer (`reference::rte`).
 
 use anyhow::{Context, bail};
 use std::fmt::Write as _;
 use std::io::Write as _;
 use translucent::optics::presets::{self, MeasuredMaterial};
 use translucent::optics::{Dipole, Material};
+use translucent::reference::rte::{self, Budget, Estimate, Medium, RteProgress};
 
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Coefficients are in 1/mm; derived lengths are in scene units \
@@ -36,7 +39,21 @@ pub struct Args {
     /// Print JSON instead of a table
     #[arg(long)]
     pub json: bool,
+    /// Also estimate each channel's half-space total diffuse reflectance by Monte Carlo
+    /// radiative transfer (normal incidence, reduced coefficients walked with isotropic
+    /// scattering) and show the dipole's R_d,total against it
+    #[arg(long, conflicts_with = "list")]
+    pub rte: bool,
+    /// With --rte: stop each channel at this relative standard error
+    #[arg(long, value_name = "REL", default_value_t = 0.002, allow_hyphen_values = true)]
+    pub rte_stderr: f64,
+    /// With --rte: walk at most this many photons per channel
+    #[arg(long, value_name = "N", default_value_t = 20_000_000)]
+    pub rte_photons: u64,
 }
+
+/// The seed of `--rte`'s photons: fixed, so the command prints the same figures on every run.
+const RTE_SEED: u64 = 1;
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let text = render(args)?;
@@ -75,11 +92,71 @@ fn render(args: &Args) -> anyhow::Result<String> {
         ),
     };
     let dipoles = material.dipoles(args.scale)?;
+    let rte = if args.rte { Some(half_space_rte(&dipoles, args)?) } else { None };
     if args.json {
-        Ok(serde_json::to_string_pretty(&report(&material, source, args.scale, &dipoles))? + "\n")
+        Ok(serde_json::to_string_pretty(&report(&material, source, args.scale, &dipoles, rte.as_ref()))? + "\n")
     } else {
-        Ok(table(&material, source, args.scale, &dipoles))
+        let mut out = table(&material, source, args.scale, &dipoles);
+        if let Some(rte) = &rte {
+            out += &rte_table(&dipoles, rte, args);
+        }
+        Ok(out)
     }
+}
+
+/// Per channel, the half-space total diffuse reflectance by Monte Carlo (`--rte`), with a
+/// progress bar on stderr.
+fn half_space_rte(dipoles: &[Dipole; 3], args: &Args) -> anyhow::Result<[Estimate; 3]> {
+    if !(args.rte_stderr.is_finite() && args.rte_stderr > 0.0) {
+        bail!("--rte-stderr: {} is not a relative standard error > 0 (e.g. 0.002)", args.rte_stderr);
+    }
+    if args.rte_photons == 0 {
+        bail!("--rte-photons: 0 photons estimate nothing (e.g. --rte-photons 1000000)");
+    }
+    let budget = Budget { max_photons: args.rte_photons, relative_stderr: Some(args.rte_stderr), max_seconds: None };
+    let bar = indicatif::ProgressBar::new(args.rte_photons);
+    let mut out = Vec::new();
+    for (d, channel) in dipoles.iter().zip(["R", "G", "B"]) {
+        let progress = |p: RteProgress| {
+            bar.set_position(p.photons);
+            bar.set_message(format!("{channel}: relative standard error {:.2e}", p.relative_stderr));
+        };
+        bar.reset();
+        out.push(rte::half_space_reflectance(&Medium::reduced(d), 1.0, &budget, RTE_SEED, &progress)?);
+    }
+    bar.finish_and_clear();
+    Ok([out[0], out[1], out[2]])
+}
+
+/// The `--rte` rows under the table.
+fn rte_table(dipoles: &[Dipole; 3], rte: &[Estimate; 3], args: &Args) -> String {
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "Half-space, normal incidence, per unit flux entering; Monte Carlo radiative transfer \
+         (isotropic, sigma_s = sigma_s'; to {} relative standard error or {} photons, seed {RTE_SEED}):",
+        args.rte_stderr, args.rte_photons
+    );
+    let _ = writeln!(out, "{:<26}{:>13}{:>13}{:>13}", "", "R", "G", "B");
+    let mut row = |label: &str, cells: [String; 3]| {
+        let _ = writeln!(out, "{label:<26}{}", cells.map(|c| format!("{c:>13}")).join(""));
+    };
+    row("R_d,total (RTE)", rte.map(|e| fmt(e.mean)));
+    row("  standard error", rte.map(|e| fmt(e.stderr)));
+    row("  photons", rte.map(|e| e.photons.to_string()));
+    row("R_d,total (dipole)", dipoles.map(|d| fmt(d.r_d_total())));
+    let difference = |c: usize| {
+        let (d, m) = (dipoles[c].r_d_total(), rte[c].mean);
+        if m > 0.0 {
+            format!("{:+.2}%", 100.0 * (d / m - 1.0))
+        } else if d == 0.0 {
+            "both 0".into()
+        } else {
+            "n/a".into()
+        }
+    };
+    row("dipole vs RTE", [0, 1, 2].map(difference));
+    out
 }
 
 /// "1,2,3" -> [1, 2, 3]; "0.5" -> [0.5; 3]. Range checks are the material's job.
@@ -116,6 +193,18 @@ struct ChannelReport {
     mean_free_path: f64,
     /// `null` without absorption (infinite).
     diffusion_length: Option<f64>,
+    /// `--rte`: the half-space total diffuse reflectance by Monte Carlo radiative transfer.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rd_total_rte: Option<f64>,
+    /// `--rte`: its standard error.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rd_total_rte_stderr: Option<f64>,
+    /// `--rte`: the photons it took.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rd_total_rte_photons: Option<u64>,
+    /// `--rte`: the dipole's `R_d,total` (as `r_d_total`), beside it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rd_total_dipole: Option<f64>,
 }
 
 #[derive(serde::Serialize)]
@@ -132,11 +221,18 @@ struct Report<'a> {
     channels: Vec<ChannelReport>,
 }
 
-fn report<'a>(m: &'a Material, source: Option<&'a str>, scale: f64, dipoles: &[Dipole; 3]) -> Report<'a> {
+fn report<'a>(
+    m: &'a Material,
+    source: Option<&'a str>,
+    scale: f64,
+    dipoles: &[Dipole; 3],
+    rte: Option<&[Estimate; 3]>,
+) -> Report<'a> {
     let channels = dipoles
         .iter()
         .zip(["R", "G", "B"])
-        .map(|(d, channel)| ChannelReport {
+        .enumerate()
+        .map(|(c, (d, channel))| ChannelReport {
             channel,
             sigma_a: d.sigma_a,
             sigma_s_prime: d.sigma_s_prime,
@@ -151,6 +247,10 @@ fn report<'a>(m: &'a Material, source: Option<&'a str>, scale: f64, dipoles: &[D
             r_d_total: d.r_d_total(),
             mean_free_path: d.mean_free_path(),
             diffusion_length: Some(d.diffusion_length()).filter(|l| l.is_finite()),
+            rd_total_rte: rte.map(|e| e[c].mean),
+            rd_total_rte_stderr: rte.map(|e| e[c].stderr),
+            rd_total_rte_photons: rte.map(|e| e[c].photons),
+            rd_total_dipole: rte.map(|_| d.r_d_total()),
         })
         .collect();
     Report {

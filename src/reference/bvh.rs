@@ -132,10 +132,68 @@ impl Bvh {
         }
         false
     }
+
+    /// The first triangle hit along origin + t dir for t in (t_min, t_max), other than
+    /// `skip` (the triangle a ray leaves from, which a flat triangle cannot hit again): what
+    /// the radiative-transfer walk (`reference::rte_mesh`) needs to leave a closed mesh.
+    pub fn closest_hit(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64, skip: Option<usize>) -> Option<Hit> {
+        if self.triangles.is_empty() {
+            return None;
+        }
+        let inv = DVec3::ONE / dir;
+        let mut best: Option<Hit> = None;
+        let mut t_far = t_max;
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            if !node.bounds.hit(origin, inv, t_far) {
+                continue;
+            }
+            if node.count > 0 {
+                for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
+                    if skip == Some(t as usize) {
+                        continue;
+                    }
+                    if let Some((t_hit, u, v)) = intersect_uv(&self.triangles[t as usize], origin, dir)
+                        && t_hit > t_min
+                        && t_hit < t_far
+                    {
+                        t_far = t_hit;
+                        best = Some(Hit { t: t_hit, triangle: t as usize, u, v });
+                    }
+                }
+            } else if top + 2 <= stack.len() {
+                stack[top] = node.first;
+                stack[top + 1] = node.first + 1;
+                top += 2;
+            }
+        }
+        best
+    }
+}
+
+/// Where a ray first meets a triangle ([`Bvh::closest_hit`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter of the hit.
+    pub t: f64,
+    /// The triangle's index in the list given to [`Bvh::new`].
+    pub triangle: usize,
+    /// Barycentric coordinate of the triangle's corner 1 at the hit.
+    pub u: f64,
+    /// Barycentric coordinate of the triangle's corner 2 at the hit (corner 0's is `1 - u - v`).
+    pub v: f64,
 }
 
 /// Möller-Trumbore ray-triangle intersection (Möller and Trumbore 1997): the ray parameter t.
 fn intersect(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> Option<f64> {
+    intersect_uv(tri, origin, dir).map(|(t, ..)| t)
+}
+
+/// [`intersect`] with the barycentric coordinates `(u, v)` of corners 1 and 2 at the hit.
+fn intersect_uv(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> Option<(f64, f64, f64)> {
     let e1 = tri[1] - tri[0];
     let e2 = tri[2] - tri[0];
     let p = dir.cross(e2);
@@ -154,7 +212,7 @@ fn intersect(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> Option<f64> {
     if v < 0.0 || u + v > 1.0 {
         return None;
     }
-    Some(e2.dot(q) * inv)
+    Some((e2.dot(q) * inv, u, v))
 }
 
 #[cfg(test)]
@@ -184,6 +242,41 @@ mod tests {
             let brute = tris.iter().any(|t| intersect(t, origin, dir).is_some_and(|t| t > 1e-9 && t < 5.0));
             assert_eq!(bvh.occluded(origin, dir, 1e-9, 5.0), brute);
             hits += brute as u32;
+        }
+        assert!(hits > 50, "the test must exercise hits too ({hits})");
+    }
+
+    #[test]
+    fn closest_hit_matches_brute_force() {
+        let mut tris = Vec::new();
+        for i in 0..12 {
+            for j in 0..12 {
+                let o = DVec3::new(i as f64, (i * j % 5) as f64 * 0.4, j as f64);
+                tris.push([o, o + DVec3::new(1.3, 0.2, 0.1), o + DVec3::new(0.1, 0.3, 1.4)]);
+            }
+        }
+        let bvh = Bvh::new(tris.clone());
+        let mut state = 777u64;
+        let mut rnd = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let origin = DVec3::new(rnd() * 14.0 - 1.0, rnd() * 4.0 - 1.0, rnd() * 14.0 - 1.0);
+            let dir = DVec3::new(rnd() - 0.5, rnd() - 0.5, rnd() - 0.5);
+            let brute = (0..tris.len())
+                .filter(|&k| k != 3)
+                .filter_map(|k| intersect(&tris[k], origin, dir).filter(|t| *t > 1e-9 && *t < 5.0).map(|t| (t, k)))
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            let hit = bvh.closest_hit(origin, dir, 1e-9, 5.0, Some(3));
+            assert_eq!(hit.map(|h| (h.t, h.triangle)), brute);
+            if let Some(h) = hit {
+                let [a, b, c] = tris[h.triangle];
+                let p = a * (1.0 - h.u - h.v) + b * h.u + c * h.v;
+                assert!(p.distance(origin + dir * h.t) < 1e-9);
+                hits += 1;
+            }
         }
         assert!(hits > 50, "the test must exercise hits too ({hits})");
     }

@@ -1,8 +1,11 @@
 //! The CPU reference (f64): splat with ray-cast visibility through a BVH and the dipole gather
 //! with the f64 kernel of `optics::kernel`. The ground truth for the GPU passes' tests and for
-//! the accuracy study.
+//! the accuracy study. [`rte`] and [`rte_mesh`]: a Monte Carlo reference of the radiative
+//! transfer equation, what the dipole model itself approximates.
 
 pub mod bvh;
+pub mod rte;
+pub mod rte_mesh;
 pub mod tree;
 pub mod truth;
 
