@@ -372,7 +372,7 @@ fn sphere_reference_precision_and_the_dipoles_error_against_it() {
         let rte = rte_mesh::exitance(&scene, &MeshOptions { budget, seed: 1 }, &quiet).unwrap();
         let rte = rte[0].as_ref().unwrap();
         let start = std::time::Instant::now();
-        let t = truth::compute(&scene, &truth::TruthOptions::default(), &|_, _, _| {});
+        let t = truth::compute(&scene, &truth::TruthOptions::default(), &|_, _, _| {}).expect("the truth");
         let truth_seconds = start.elapsed().as_secs_f64();
         println!(
             "{name}: {} vertices, {} photons in {:.0} s, lost {:?}; relative standard error (RMS over lit / lit mean, worst channel) {:.4}",
