@@ -6,8 +6,8 @@ use ash::vk;
 use common::with_gpu;
 use std::sync::Arc;
 use translucent::gpu::{
-    Access, Binding, Buffer, DescriptorSet, Gpu, GpuTimer, GraphicsDesc, GraphicsPipeline, Image, ImageBarrier,
-    ImageDesc, Named, shaders,
+    Access, Binding, Buffer, ComputePipeline, DescriptorSet, Gpu, GpuTimer, GraphicsDesc, GraphicsPipeline, Image,
+    ImageBarrier, ImageDesc, Named, shaders,
 };
 use translucent::render::smoke;
 
@@ -201,4 +201,31 @@ fn validation_counts_a_leaked_object() {
     drop(gpu);
     assert!(counters.errors() > 0, "the leaked VkBuffer was not reported");
     assert!(counters.messages().iter().any(|m| m.contains("VkBuffer")), "{:?}", counters.messages());
+}
+
+#[test]
+fn a_saved_pipeline_cache_seeds_a_new_gpu_and_data_from_elsewhere_is_refused() {
+    let data = with_gpu(|gpu| {
+        ComputePipeline::new(gpu, "splat.comp").unwrap();
+        gpu.pipeline_cache_data().unwrap()
+    });
+    // At least the header; lavapipe (Mesa 22.3) keeps nothing past it (32 bytes), a GPU's
+    // driver keeps the compiled pipeline.
+    assert!(data.len() >= 32, "a cache with its header: {} bytes", data.len());
+    with_gpu(|gpu| {
+        gpu.seed_pipeline_cache(&data).unwrap();
+        ComputePipeline::new(gpu, "splat.comp").unwrap();
+        assert!(gpu.pipeline_cache_data().unwrap().len() >= 32);
+        // Another driver build (its pipelineCacheUUID), and bytes that are no cache at all.
+        let mut foreign = data.clone();
+        foreign[20] ^= 0xff;
+        let message = gpu.seed_pipeline_cache(&foreign).unwrap_err().to_string();
+        assert!(message.contains("pipelineCacheUUID"), "{message}");
+        let message = gpu.seed_pipeline_cache(&[1, 2, 3]).unwrap_err().to_string();
+        assert!(message.contains("shorter than its 32-byte header"), "{message}");
+        let mut other_device = data.clone();
+        other_device[12] ^= 0x01;
+        let message = gpu.seed_pipeline_cache(&other_device).unwrap_err().to_string();
+        assert!(message.contains("device"), "{message}");
+    });
 }

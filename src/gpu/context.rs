@@ -40,6 +40,8 @@ pub struct Gpu {
     counters: Arc<ValidationCounters>,
     recorded: super::RecordCounter,
     timeout: Duration,
+    /// Every pipeline is created through it (`pipeline_cache.rs`); locked for merges.
+    pub(super) pipeline_cache: Mutex<vk::PipelineCache>,
 }
 
 /// Vulkan objects owned by a host engine, for `Gpu::from_host`.
@@ -246,7 +248,26 @@ impl Gpu {
                 return Err(GpuError::Alloc { what: "allocator".into(), source });
             }
         };
+        let pipeline_cache = match super::pipeline_cache::create(&device) {
+            Ok(c) => c,
+            Err(e) => {
+                let mut owned_instance = owned_instance;
+                // SAFETY: nothing else was created from this device or instance but the
+                // allocator, which goes first.
+                unsafe {
+                    drop(allocator);
+                    if owns_device {
+                        device.destroy_device(None);
+                    }
+                    if let Some(o) = owned_instance.as_mut() {
+                        o.destroy();
+                    }
+                }
+                return Err(e);
+            }
+        };
         Ok(Arc::new(Gpu {
+            pipeline_cache: Mutex::new(pipeline_cache),
             entry,
             instance,
             owned_instance,
@@ -351,6 +372,8 @@ impl Drop for Gpu {
         // the messenger goes just before the instance (OwnedInstance::destroy).
         unsafe {
             let _ = self.device.device_wait_idle();
+            let cache = *self.pipeline_cache.get_mut().unwrap_or_else(|e| e.into_inner());
+            self.device.destroy_pipeline_cache(cache, None);
             ManuallyDrop::drop(&mut self.allocator);
             if self.owns_device {
                 self.device.destroy_device(None);

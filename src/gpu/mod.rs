@@ -19,6 +19,7 @@ mod hazard;
 mod image;
 mod instance;
 mod pipeline;
+mod pipeline_cache;
 mod sampler;
 pub mod shaders;
 pub use shaders::ShaderInterface;

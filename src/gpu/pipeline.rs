@@ -141,8 +141,9 @@ impl ComputePipeline {
             .module(module.raw)
             .name(c"main");
         let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout.pipeline_layout)];
-        // SAFETY: valid create info referencing live module and layout.
-        let pipeline = unsafe { gpu.device().create_compute_pipelines(vk::PipelineCache::null(), &info, None) }
+        let cache = gpu.pipeline_cache.lock().unwrap_or_else(|e| e.into_inner());
+        // SAFETY: valid create info referencing live module and layout; the cache is locked.
+        let pipeline = unsafe { gpu.device().create_compute_pipelines(*cache, &info, None) }
             .map_err(|(_, result)| GpuError::Vk { what: "vkCreateComputePipelines", result })?[0];
         Ok(ComputePipeline { pipeline, layout, name: shader.to_string(), local_size: interface.local_size })
     }
@@ -324,8 +325,9 @@ impl GraphicsPipeline {
             .dynamic_state(&dynamic)
             .layout(layout.pipeline_layout)
             .push_next(&mut rendering)];
+        let cache = gpu.pipeline_cache.lock().unwrap_or_else(|e| e.into_inner());
         // SAFETY: every pointer refers to locals alive for the call; dynamic rendering is enabled.
-        let pipeline = unsafe { gpu.device().create_graphics_pipelines(vk::PipelineCache::null(), &info, None) }
+        let pipeline = unsafe { gpu.device().create_graphics_pipelines(*cache, &info, None) }
             .map_err(|(_, result)| GpuError::Vk { what: "vkCreateGraphicsPipelines", result })?[0];
         Ok(GraphicsPipeline { pipeline, layout, name: desc.vertex.clone() })
     }
