@@ -165,7 +165,7 @@ pub enum SplatLights {
     /// Every light, the environment's directions included; their part is kept for later frames.
     #[default]
     All,
-    /// The key lights alone, added to the environment's part a earlier splat kept: only key
+    /// The key lights alone, added to the environment's part an earlier splat kept: only key
     /// lights changed since (`GpuScene::splat_environment`).
     KeyLights,
 }
