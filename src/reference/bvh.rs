@@ -103,46 +103,41 @@ impl Bvh {
 
     /// Is anything hit along origin + t dir for t in (t_min, t_max)? `dir` need not be unit.
     pub fn occluded(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> bool {
-        if self.triangles.is_empty() {
-            return false;
-        }
-        let inv = DVec3::ONE / dir;
-        let mut stack = [0u32; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let node = &self.nodes[stack[top] as usize];
-            if !node.bounds.hit(origin, inv, t_max) {
-                continue;
-            }
-            if node.count > 0 {
-                for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
-                    if let Some(t_hit) = intersect(&self.triangles[t as usize], origin, dir)
-                        && t_hit > t_min
-                        && t_hit < t_max
-                    {
-                        return true;
-                    }
-                }
-            } else if top + 2 <= stack.len() {
-                stack[top] = node.first;
-                stack[top + 1] = node.first + 1;
-                top += 2;
-            }
-        }
-        false
+        let mut hit = false;
+        self.walk(origin, dir, t_max, |t, _| {
+            hit = intersect(&self.triangles[t], origin, dir).is_some_and(|t_hit| t_hit > t_min && t_hit < t_max);
+            hit
+        });
+        hit
     }
 
     /// The first triangle hit along origin + t dir for t in (t_min, t_max), other than
     /// `skip` (the triangle a ray leaves from, which a flat triangle cannot hit again): what
     /// the radiative-transfer walk (`reference::rte_mesh`) needs to leave a closed mesh.
     pub fn closest_hit(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64, skip: Option<usize>) -> Option<Hit> {
+        let mut best = None;
+        self.walk(origin, dir, t_max, |t, t_far| {
+            if skip != Some(t)
+                && let Some((t_hit, u, v)) = intersect_uv(&self.triangles[t], origin, dir)
+                && t_hit > t_min
+                && t_hit < *t_far
+            {
+                *t_far = t_hit;
+                best = Some(Hit { t: t_hit, triangle: t, u, v });
+            }
+            false
+        });
+        best
+    }
+
+    /// The triangles of every leaf whose box the ray origin + t dir meets before `t_far`, each
+    /// given to `leaf` with the current `t_far`, which it may shorten (a closest hit prunes the
+    /// boxes behind it); `leaf` returning true ends the walk (any hit will do).
+    fn walk(&self, origin: DVec3, dir: DVec3, mut t_far: f64, mut leaf: impl FnMut(usize, &mut f64) -> bool) {
         if self.triangles.is_empty() {
-            return None;
+            return;
         }
         let inv = DVec3::ONE / dir;
-        let mut best: Option<Hit> = None;
-        let mut t_far = t_max;
         let mut stack = [0u32; 64];
         let mut top = 1;
         while top > 0 {
@@ -153,15 +148,8 @@ impl Bvh {
             }
             if node.count > 0 {
                 for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
-                    if skip == Some(t as usize) {
-                        continue;
-                    }
-                    if let Some((t_hit, u, v)) = intersect_uv(&self.triangles[t as usize], origin, dir)
-                        && t_hit > t_min
-                        && t_hit < t_far
-                    {
-                        t_far = t_hit;
-                        best = Some(Hit { t: t_hit, triangle: t as usize, u, v });
+                    if leaf(t as usize, &mut t_far) {
+                        return;
                     }
                 }
             } else if top + 2 <= stack.len() {
@@ -170,7 +158,6 @@ impl Bvh {
                 top += 2;
             }
         }
-        best
     }
 }
 
@@ -219,6 +206,14 @@ fn intersect_uv(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> Option<(f64, f64
 mod tests {
     use super::*;
 
+    /// Uniform numbers in [0, 1) from a 64-bit LCG seeded with `state`.
+    fn uniform(mut state: u64) -> impl FnMut() -> f64 {
+        move || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     #[test]
     fn occlusion_matches_brute_force() {
         // A grid of small triangles; rays from random points must agree with a linear scan.
@@ -230,11 +225,7 @@ mod tests {
             }
         }
         let bvh = Bvh::new(tris.clone());
-        let mut state = 12345u64;
-        let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(12345);
         let mut hits = 0;
         for _ in 0..2000 {
             let origin = DVec3::new(rnd() * 22.0 - 1.0, rnd() * 4.0 - 1.0, rnd() * 22.0 - 1.0);
@@ -256,11 +247,7 @@ mod tests {
             }
         }
         let bvh = Bvh::new(tris.clone());
-        let mut state = 777u64;
-        let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = uniform(777);
         let mut hits = 0;
         for _ in 0..2000 {
             let origin = DVec3::new(rnd() * 14.0 - 1.0, rnd() * 4.0 - 1.0, rnd() * 14.0 - 1.0);
