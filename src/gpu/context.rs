@@ -235,34 +235,18 @@ impl Gpu {
         let allocator = match allocator {
             Ok(a) => a,
             Err(source) => {
-                let mut owned_instance = owned_instance;
                 // SAFETY: nothing else was created from this device or instance.
-                unsafe {
-                    if owns_device {
-                        device.destroy_device(None);
-                    }
-                    if let Some(o) = owned_instance.as_mut() {
-                        o.destroy();
-                    }
-                }
+                unsafe { abandon(&device, owned_instance) };
                 return Err(GpuError::Alloc { what: "allocator".into(), source });
             }
         };
         let pipeline_cache = match super::pipeline_cache::create(&device) {
             Ok(c) => c,
             Err(e) => {
-                let mut owned_instance = owned_instance;
+                drop(allocator);
                 // SAFETY: nothing else was created from this device or instance but the
-                // allocator, which goes first.
-                unsafe {
-                    drop(allocator);
-                    if owns_device {
-                        device.destroy_device(None);
-                    }
-                    if let Some(o) = owned_instance.as_mut() {
-                        o.destroy();
-                    }
-                }
+                // allocator, which is gone.
+                unsafe { abandon(&device, owned_instance) };
                 return Err(e);
             }
         };
@@ -362,6 +346,21 @@ impl Gpu {
     pub fn memory_usage(&self) -> (u64, u64) {
         let report = self.allocator().generate_report();
         (report.total_allocated_bytes, report.total_capacity_bytes)
+    }
+}
+
+/// Destroy what `Gpu::assemble` was given to own when it fails: with `owned_instance` (ours),
+/// the device and the instance; without, nothing (they are the host's).
+///
+/// # Safety
+/// Nothing created from `device` or the instance may remain.
+unsafe fn abandon(device: &ash::Device, owned_instance: Option<OwnedInstance>) {
+    if let Some(mut owned) = owned_instance {
+        // SAFETY: the caller's contract.
+        unsafe {
+            device.destroy_device(None);
+            owned.destroy();
+        }
     }
 }
 
