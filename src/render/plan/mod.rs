@@ -196,9 +196,10 @@ pub struct ObjectPlan {
     pub splat: bool,
     /// From which lights, when it is splatted.
     pub splat_lights: SplatLights,
-    /// Whether the environment's part kept for its samples is current after this frame.
+    /// Whether the environment's part an earlier splat kept for its samples is still current
+    /// this frame (nothing since changed the environment, the geometry or its material).
     #[serde(skip)]
-    pub environment_kept_after: bool,
+    pub environment_kept: bool,
     /// Its exitance is gathered this frame.
     pub gather: bool,
     /// Why it is (or is not) splatted and gathered (`splat` and `gather` follow from it).

@@ -116,7 +116,7 @@ impl Frame<'_> {
             channels,
             splat,
             splat_lights,
-            environment_kept_after: splat || kept,
+            environment_kept: kept,
             gather,
             why,
             level,

@@ -170,8 +170,9 @@ impl Planner {
         }
         for o in &plan.objects {
             self.stale[o.object] = o.stale_after;
-            // Only a splat that runs writes the kept part.
-            self.environment_kept[o.object] = o.environment_kept_after && (!o.splat || plan.runs(Pass::Splat));
+            // A splat that runs keeps the environment's part; otherwise it stays as current as
+            // the plan found it.
+            self.environment_kept[o.object] = (o.splat && plan.runs(Pass::Splat)) || o.environment_kept;
             if o.gather && plan.runs(Pass::Gather) {
                 self.gathered[o.object] = if gather_by_level { o.level } else { 0 };
             }
