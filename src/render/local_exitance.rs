@@ -1,7 +1,7 @@
 //! Local-exitance pass (`glsl/local_exitance.comp`): the exitance shading draws for the channels
-//! the planner computes locally, `M = R_d,total E_t`, evaluated at every vertex of the objects
-//! that have such channels. It is not part of a frame: `Renderer::exitance_drawn` records it on
-//! demand, so that exported exitance is what the image shows, local channels included.
+//! the planner computes locally, `M = R_d,total E_t`, evaluated at every vertex of one object.
+//! It is not part of a frame: `Renderer::exitance_drawn` records it on demand, so that exported
+//! exitance is what the image shows, local channels included.
 //!
 //! Reads vertices, objects, lights, the shadow maps and the environment's per-vertex cache;
 //! writes the local exitance (vec4 per vertex), bound in that order (`BINDINGS`). Push:
@@ -39,20 +39,22 @@ const BINDINGS: [Resource; 6] = [
     Resource::LocalExitance,
 ];
 
-/// One dispatch of glsl/local_exitance.comp per translucent object with a local channel
-/// (`GpuScene::local_channels`), writing `GpuScene::local_exitance` at its vertices.
+/// One dispatch of glsl/local_exitance.comp for object `object` when it is translucent with a
+/// local channel (`GpuScene::local_channels`), writing `GpuScene::local_exitance` at its
+/// vertices.
 pub struct LocalExitancePass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
     key_light_count: u32,
+    object: usize,
 }
 
 impl LocalExitancePass {
-    /// The pipeline and one descriptor set over `BINDINGS`.
-    pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<LocalExitancePass> {
+    /// The pipeline and one descriptor set over `BINDINGS`, for object `object`.
+    pub fn new(gpu: &Arc<Gpu>, resources: &Resources, object: usize) -> GpuResult<LocalExitancePass> {
         let pipeline = ComputePipeline::new(gpu, "local_exitance.comp")?;
         let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
-        Ok(LocalExitancePass { pipeline, set, key_light_count: resources.scene.key_light_count })
+        Ok(LocalExitancePass { pipeline, set, key_light_count: resources.scene.key_light_count, object })
     }
 }
 
@@ -62,19 +64,18 @@ impl RenderPass for LocalExitancePass {
     }
 
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        for (i, r) in frame.scene.object_ranges().enumerate() {
-            // The channels the last recorded frame computed locally.
-            if r.eta == 0.0 || frame.scene.local_channels(i) == 0 {
-                continue;
-            }
-            let push = LocalExitancePush {
-                first_vertex: r.first_vertex,
-                vertex_count: r.vertex_count,
-                object: i as u32,
-                key_light_count: self.key_light_count,
-                shadow_radius: i32::from(!frame.plan.one_tap_shadows),
-            };
-            self.pipeline.dispatch(cmd, &self.set, &push, [r.vertex_count, 1, 1]);
+        let r = frame.scene.object_range(self.object);
+        // The channels the last recorded frame computed locally.
+        if r.eta == 0.0 || frame.scene.local_channels(self.object) == 0 {
+            return;
         }
+        let push = LocalExitancePush {
+            first_vertex: r.first_vertex,
+            vertex_count: r.vertex_count,
+            object: self.object as u32,
+            key_light_count: self.key_light_count,
+            shadow_radius: i32::from(!frame.plan.one_tap_shadows),
+        };
+        self.pipeline.dispatch(cmd, &self.set, &push, [r.vertex_count, 1, 1]);
     }
 }

@@ -790,7 +790,8 @@ impl Renderer {
         if mask == 0 {
             return Ok(exitance);
         }
-        let pass = LocalExitancePass::new(&self.gpu, &Resources { scene: &self.buffers, targets: &self.targets })?;
+        let resources = Resources { scene: &self.buffers, targets: &self.targets };
+        let pass = LocalExitancePass::new(&self.gpu, &resources, object)?;
         let plan = self.planner.plan_for(&self.needs, &self.view(), Change::Camera);
         self.gpu.one_shot("local exitance", |cmd| {
             let frame = self.inputs(&plan, None, None);
