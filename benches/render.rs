@@ -10,7 +10,11 @@
 //! records a barrier after each start stamp, which flushes there, and the two figures agree.
 //! Frames per second come from whole-frame wall time.
 
+#[path = "render/roofline.rs"]
+mod roofline;
+
 use ash::vk;
+use roofline::{Roofline, Yardsticks};
 use std::sync::Arc;
 use std::time::Instant;
 use translucent::gpu::{Binding, Buffer, BufferDesc, ComputePipeline, Gpu, GpuOptions, median};
@@ -619,6 +623,11 @@ fn frames(gpu: &Arc<Gpu>, prepared: PreparedScene) {
         &measure(&mut renderer, Change::Light(0)),
     );
     print("only the camera moves (shade, tone map):", &measure(&mut renderer, Change::Camera));
+    let mut roof = Roofline::new(gpu, &renderer);
+    for (title, change) in [("key light moving", Change::Light(0)), ("camera moving", Change::Camera)] {
+        let (passes, yard, pairs) = against_roofline(&mut renderer, &mut roof, change);
+        print_roofline(title, &passes, &yard, pairs, change);
+    }
     println!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
     let (ours, naive, pairs) = gather_against_naive(gpu, &mut renderer);
     println!(
@@ -690,4 +699,69 @@ fn fps_against_samples(gpu: &Arc<Gpu>, scene: &Scene) {
             );
         }
     }
+}
+
+/// Frames following `change`, each followed by a run of the yardsticks (so outside load falls
+/// on both alike): the frame's median timestamp per pass, the yardsticks' medians, and the
+/// vertex-sample pairs a flat gather of the frame would sum.
+fn against_roofline(
+    renderer: &mut Renderer,
+    roof: &mut Roofline,
+    change: Change,
+) -> (Vec<(String, f64)>, Yardsticks, f64) {
+    let mut stamps: Vec<(String, Vec<f64>)> = Vec::new();
+    let mut pairs = 0.0;
+    for frame in 0..WARM_UP + GATHER_FRAMES {
+        step(renderer, change);
+        let plan = renderer.plan(change);
+        let timings = renderer.frame(&plan).expect("frame");
+        roof.run(renderer, &plan);
+        pairs = roofline::frame_pairs(renderer, &plan);
+        if frame < WARM_UP {
+            continue;
+        }
+        for (pass, ms) in timings.passes {
+            let name = pass.name().to_string();
+            match stamps.iter_mut().find(|(n, _)| *n == name) {
+                Some((_, v)) => v.push(ms),
+                None => stamps.push((name, vec![ms])),
+            }
+        }
+    }
+    let passes = stamps.into_iter().map(|(n, mut v)| (n, median(&mut v))).collect();
+    (passes, roof.yardsticks(), pairs)
+}
+
+/// Each pass against its yardstick, and the frame against the roofline's sum.
+fn print_roofline(title: &str, passes: &[(String, f64)], yard: &Yardsticks, pairs: f64, change: Change) {
+    let light = matches!(change, Change::Light(_));
+    println!(
+        "\nRoofline, {title} (timestamps, median of {GATHER_FRAMES} frames, each followed by the yardsticks; \
+         submission: wall time of an empty one):"
+    );
+    println!("  {:<8} {:>10} {:>13} {:>7}  yardstick", "pass", "frame ms", "yardstick ms", "ratio");
+    let yardstick = |name: &str| match name {
+        "shade" => Some((yard.raster, "trivial shaders, same geometry and targets")),
+        "shadow" => Some((yard.shadow, "casters depth-only into one map")),
+        "tonemap" => Some((yard.tonemap, "texel fetch, clamp, pack")),
+        "gather" => Some((yard.gather, "naive kernel, same pair count as a flat gather")),
+        _ => None,
+    };
+    let mut total = 0.0;
+    for (name, ms) in passes {
+        total += ms;
+        match yardstick(name) {
+            Some((y, what)) => println!("  {name:<8} {ms:>10.2} {y:>13.2} {:>7.2}  {what}", ms / y),
+            None => println!("  {name:<8} {ms:>10.2} {:>13} {:>7}", "-", "-"),
+        }
+    }
+    let roof = if light { yard.light() } else { yard.camera() };
+    println!("  {:<8} {:>10.2} {:>13.2}", "submit", 0.0, yard.submit);
+    println!(
+        "  frame    {total:>10.2} {roof:>13.2} {:>7.2}  = {:.0} frames/s against {:.0} at the roofline{}",
+        total / roof,
+        1e3 / total,
+        1e3 / roof,
+        if light { format!(" ({:.1}M pairs in the naive gather)", pairs / 1e6) } else { String::new() }
+    );
 }

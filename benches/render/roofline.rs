@@ -1,0 +1,344 @@
+//! The frame's roofline: what the device takes for the same work done the plainest way, timed in
+//! the same run as the renderer's frames, so each pass can be read as a ratio to its yardstick.
+//!
+//! - raster: the shading pass's geometry (the renderer's own vertex and index buffers, each
+//!   object at the level the plan draws it) into targets of the same formats and size, with a
+//!   one-interpolant vertex stage and a fragment stage that writes the normal
+//!   (glsl/bench/raster_trivial.*);
+//! - shadow: the shadow casters at their caster levels, depth-only into one map of the scene's
+//!   size and format, no bias (glsl/bench/depth_only.vert): what a light frame redraws;
+//! - tone map: the HDR image texel by texel into packed RGBA8 with a clamp
+//!   (glsl/bench/tonemap_minimal.comp);
+//! - submission: an empty command buffer, submitted and waited for.
+//!
+//! The naive gather (glsl/bench/gather_naive.comp) is the gather's yardstick, measured in
+//! render.rs. Each part here is timed by timestamps inside one submission, as the frame is.
+
+use ash::vk;
+use std::sync::Arc;
+use std::time::Instant;
+use translucent::gpu::{
+    Access, Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuTimer, GraphicsDesc, GraphicsPipeline,
+    Image, ImageBarrier, ImageDesc, Named, Sampler, median,
+};
+use translucent::render::plan::Plan;
+use translucent::render::records::Vertex;
+use translucent::render::renderer::Renderer;
+use translucent::render::shade::HDR_FORMAT;
+
+/// The camera's depth format (`render::targets::CAMERA_DEPTH_FORMAT`).
+const CAMERA_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
+/// The shadow maps' format (`render::targets::SHADOW_FORMAT`).
+const SHADOW_DEPTH: vk::Format = vk::Format::D16_UNORM;
+
+/// Timed parts per submission: raster, shadow, tone map, gather.
+const PARTS: u32 = 4;
+
+/// Median milliseconds of each yardstick part.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Yardsticks {
+    /// Trivial-shader raster of the drawn geometry.
+    pub raster: f64,
+    /// Depth-only casters into one shadow map.
+    pub shadow: f64,
+    /// Minimal tone-map dispatch.
+    pub tonemap: f64,
+    /// The naive gather over as many vertex-sample pairs as the frame's gather.
+    pub gather: f64,
+    /// An empty submission, wall time from submission to fence.
+    pub submit: f64,
+}
+
+impl Yardsticks {
+    /// The camera frame's roofline: raster, tone map, submission.
+    pub fn camera(&self) -> f64 {
+        self.raster + self.tonemap + self.submit
+    }
+
+    /// The light frame's roofline: the camera frame's, one shadow map and the naive gather.
+    pub fn light(&self) -> f64 {
+        self.camera() + self.shadow + self.gather
+    }
+}
+
+/// The yardsticks' pipelines and targets, sized after one renderer.
+pub struct Roofline {
+    gpu: Arc<Gpu>,
+    raster: GraphicsPipeline,
+    depth: GraphicsPipeline,
+    tonemap: ComputePipeline,
+    tonemap_set: DescriptorSet,
+    naive: ComputePipeline,
+    naive_set: DescriptorSet,
+    _naive_out: Buffer,
+    colour: Image,
+    camera_depth: Image,
+    shadow: Image,
+    _output: Buffer,
+    _sampler: Sampler,
+    timer: GpuTimer,
+    /// Times per part, one entry per `run`.
+    times: [Vec<f64>; 5],
+}
+
+fn attachment(view: vk::ImageView, layout: vk::ImageLayout, depth: bool) -> vk::RenderingAttachmentInfo<'static> {
+    let clear = if depth {
+        vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } }
+    } else {
+        vk::ClearValue { color: vk::ClearColorValue { float32: [0.0, 0.0, 0.0, 1.0] } }
+    };
+    vk::RenderingAttachmentInfo::default()
+        .image_view(view)
+        .image_layout(layout)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(if depth { vk::AttachmentStoreOp::DONT_CARE } else { vk::AttachmentStoreOp::STORE })
+        .clear_value(clear)
+}
+
+impl Roofline {
+    /// Pipelines and targets for `renderer`'s camera image size and shadow-map size.
+    pub fn new(gpu: &Arc<Gpu>, renderer: &Renderer) -> Roofline {
+        let [width, height] = renderer.scene().scene.file.camera.resolution;
+        let map = renderer.scene().scene.file.render.shadow_map_size;
+        use vk::ImageUsageFlags as U;
+        let image =
+            |name, w, h, format, usage| Image::new(gpu, &ImageDesc::new(name, w, h, format, usage)).expect(name);
+        let colour = image("roofline colour", width, height, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED);
+        let camera_depth = image("roofline depth", width, height, CAMERA_DEPTH, U::DEPTH_STENCIL_ATTACHMENT);
+        let shadow = image("roofline shadow", map, map, SHADOW_DEPTH, U::DEPTH_STENCIL_ATTACHMENT);
+        let mut desc = GraphicsDesc::new("bench/raster_trivial.vert", Some("bench/raster_trivial.frag"));
+        desc.vertex_bindings = vec![Vertex::binding()];
+        desc.vertex_attributes = vec![Vertex::position_attribute(), Vertex::normal_attribute()];
+        desc.color_formats = vec![HDR_FORMAT];
+        desc.depth_format = Some(CAMERA_DEPTH);
+        let raster = GraphicsPipeline::new(gpu, &desc).expect("trivial raster pipeline");
+        let mut desc = GraphicsDesc::new("bench/depth_only.vert", None);
+        desc.vertex_bindings = vec![Vertex::binding()];
+        desc.vertex_attributes = vec![Vertex::position_attribute()];
+        desc.depth_format = Some(SHADOW_DEPTH);
+        let depth = GraphicsPipeline::new(gpu, &desc).expect("depth-only pipeline");
+        let tonemap = ComputePipeline::new(gpu, "bench/tonemap_minimal.comp").expect("minimal tone map");
+        let pixels = width as u64 * height as u64;
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let output = Buffer::new(gpu, &BufferDesc::gpu_only("roofline rgba8", 4 * pixels, usage)).expect("buffer");
+        let sampler = Sampler::new(gpu, vk::Filter::NEAREST).expect("sampler");
+        let hdr = Binding::Image {
+            view: colour.view(),
+            layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            sampler: sampler.raw(),
+        };
+        let tonemap_set = tonemap
+            .descriptor_set(&[
+                Named { name: "hdr", binding: hdr },
+                Named { name: "Tonemapped", binding: Binding::Buffer(&output) },
+            ])
+            .expect("tone-map set");
+        let (naive, naive_set, naive_out) = naive_gather(gpu, renderer);
+        let timer = GpuTimer::new(gpu, PARTS).expect("timer");
+        Roofline {
+            gpu: gpu.clone(),
+            raster,
+            depth,
+            tonemap,
+            tonemap_set,
+            naive,
+            naive_set,
+            _naive_out: naive_out,
+            colour,
+            camera_depth,
+            shadow,
+            _output: output,
+            _sampler: sampler,
+            timer,
+            times: Default::default(),
+        }
+    }
+
+    /// One run of every part for `renderer`'s current camera and `plan`'s levels, into the
+    /// medians `yardsticks` returns.
+    pub fn run(&mut self, renderer: &Renderer, plan: &Plan) {
+        let camera = renderer.camera();
+        let view_proj = (camera.projection * camera.view).to_cols_array_2d();
+        let scene = renderer.buffers();
+        let draws: Vec<_> = (0..scene.levels.len()).map(|i| scene.level(i, plan.level(i)).draw).collect();
+        let casters: Vec<_> = scene.casters.iter().map(|&(o, l)| scene.level(o, l).draw).collect();
+        let light = scene.light_matrices.first().copied().unwrap_or(view_proj);
+        let (vertices, indices) = (scene.vertices.raw(), scene.indices.raw());
+        let receivers = frame_receivers(renderer, plan);
+        let mut timer = std::mem::replace(&mut self.timer, GpuTimer::new(&self.gpu, PARTS).expect("timer"));
+        self.gpu
+            .one_shot("roofline", |cmd| {
+                timer.reset(cmd);
+                timer.begin(cmd, "raster");
+                self.record_raster(cmd, (vertices, indices), &draws, &view_proj);
+                timer.end(cmd);
+                timer.begin(cmd, "shadow");
+                self.record_shadow(cmd, (vertices, indices), &casters, &light);
+                timer.end(cmd);
+                timer.begin(cmd, "tonemap");
+                self.record_tonemap(cmd);
+                timer.end(cmd);
+                timer.begin(cmd, "gather");
+                self.record_naive(cmd, &receivers);
+                timer.end(cmd);
+            })
+            .expect("roofline submission");
+        for (i, (_, ms)) in timer.results().expect("roofline timings").into_iter().enumerate() {
+            self.times[i].push(ms);
+        }
+        self.timer = timer;
+        let start = Instant::now();
+        self.gpu.one_shot("empty submission", |_| ()).expect("empty submission");
+        self.times[4].push(start.elapsed().as_secs_f64() * 1e3);
+    }
+
+    /// The medians of every `run` so far.
+    pub fn yardsticks(&self) -> Yardsticks {
+        let m = |i: usize| median(&mut self.times[i].clone());
+        Yardsticks { raster: m(0), shadow: m(1), tonemap: m(2), gather: m(3), submit: m(4) }
+    }
+
+    fn record_raster(
+        &self,
+        cmd: vk::CommandBuffer,
+        (vertices, indices): (vk::Buffer, vk::Buffer),
+        draws: &[translucent::render::gpu_scene::DrawRange],
+        view_proj: &[[f32; 4]; 4],
+    ) {
+        let device = self.gpu.device();
+        let colour_access = [Access::ComputeSampledRead];
+        ImageBarrier::new(
+            self.colour.raw(),
+            vk::ImageAspectFlags::COLOR,
+            &colour_access,
+            &[Access::ColorAttachmentWrite],
+        )
+        .discard(true)
+        .record(device, cmd);
+        ImageBarrier::new(
+            self.camera_depth.raw(),
+            vk::ImageAspectFlags::DEPTH,
+            &[Access::Nothing],
+            &[Access::DepthAttachmentReadWrite],
+        )
+        .discard(true)
+        .record(device, cmd);
+        let colours = [attachment(self.colour.view(), vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, false)];
+        let depth = attachment(self.camera_depth.view(), vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL, true);
+        let extent = self.colour.extent();
+        let info = vk::RenderingInfo::default()
+            .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent })
+            .layer_count(1)
+            .color_attachments(&colours)
+            .depth_attachment(&depth);
+        // SAFETY: `cmd` is recording; the attachments are in the layouts the barriers set; the
+        // renderer's buffers outlive the submission (one_shot waits).
+        unsafe {
+            device.cmd_begin_rendering(cmd, &info);
+            device.cmd_bind_vertex_buffers(cmd, 0, &[vertices], &[0]);
+            device.cmd_bind_index_buffer(cmd, indices, 0, vk::IndexType::UINT32);
+        }
+        self.raster.bind(cmd, None, view_proj, extent);
+        for d in draws {
+            self.raster.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
+        }
+        unsafe { device.cmd_end_rendering(cmd) };
+        ImageBarrier::new(
+            self.colour.raw(),
+            vk::ImageAspectFlags::COLOR,
+            &[Access::ColorAttachmentWrite],
+            &[Access::ComputeSampledRead],
+        )
+        .record(device, cmd);
+    }
+
+    fn record_shadow(
+        &self,
+        cmd: vk::CommandBuffer,
+        (vertices, indices): (vk::Buffer, vk::Buffer),
+        casters: &[translucent::render::gpu_scene::DrawRange],
+        light: &[[f32; 4]; 4],
+    ) {
+        let device = self.gpu.device();
+        ImageBarrier::new(
+            self.shadow.raw(),
+            vk::ImageAspectFlags::DEPTH,
+            &[Access::Nothing],
+            &[Access::DepthAttachmentReadWrite],
+        )
+        .discard(true)
+        .record(device, cmd);
+        let depth = attachment(self.shadow.view(), vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL, true);
+        let extent = self.shadow.extent();
+        let info = vk::RenderingInfo::default()
+            .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent })
+            .layer_count(1)
+            .depth_attachment(&depth);
+        // SAFETY: as in `record_raster`.
+        unsafe {
+            device.cmd_begin_rendering(cmd, &info);
+            device.cmd_bind_vertex_buffers(cmd, 0, &[vertices], &[0]);
+            device.cmd_bind_index_buffer(cmd, indices, 0, vk::IndexType::UINT32);
+        }
+        self.depth.bind(cmd, None, light, extent);
+        for d in casters {
+            self.depth.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
+        }
+        unsafe { device.cmd_end_rendering(cmd) };
+    }
+
+    /// The naive kernel over `receivers` (object, vertex count): the first that many vertices of
+    /// each object, as many pairs as the frame's gather at the level it gathers at.
+    fn record_naive(&self, cmd: vk::CommandBuffer, receivers: &[(u32, u32)]) {
+        for &(object, count) in receivers {
+            self.naive.dispatch(cmd, &self.naive_set, &object, [count, 1, 1]);
+        }
+    }
+
+    fn record_tonemap(&self, cmd: vk::CommandBuffer) {
+        let extent = self.colour.extent();
+        let size = [extent.width, extent.height];
+        self.tonemap.dispatch(cmd, &self.tonemap_set, &size, [extent.width, extent.height, 1]);
+    }
+}
+
+/// Each translucent object the frame of `plan` gathers, and its receiver count there.
+pub fn frame_receivers(renderer: &Renderer, plan: &Plan) -> Vec<(u32, u32)> {
+    let scene = renderer.buffers();
+    (0..scene.receivers.len())
+        .map(|j| {
+            let object = scene.receivers[j].object;
+            (object, scene.level(object as usize, plan.level(object as usize)).vertex_count)
+        })
+        .collect()
+}
+
+/// Vertex-sample pairs of the frame of `plan`'s gather, if it were flat.
+pub fn frame_pairs(renderer: &Renderer, plan: &Plan) -> f64 {
+    let scene = renderer.buffers();
+    frame_receivers(renderer, plan)
+        .iter()
+        .zip(&scene.receivers)
+        .map(|(&(_, count), r)| count as f64 * r.sample_count as f64)
+        .sum()
+}
+
+/// glsl/bench/gather_naive.comp bound to `renderer`'s buffers, writing into its own.
+fn naive_gather(gpu: &Arc<Gpu>, renderer: &Renderer) -> (ComputePipeline, DescriptorSet, Buffer) {
+    use translucent::render::graph::Resource;
+    let naive = ComputePipeline::new(gpu, "bench/gather_naive.comp").expect("naive gather pipeline");
+    let b = renderer.buffers();
+    let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+    let size = 16 * b.vertex_count.max(1) as u64;
+    let out = Buffer::new(gpu, &BufferDesc::gpu_only("naive exitance", size, usage)).expect("buffer");
+    let set = naive
+        .descriptor_set(&[
+            Resource::Vertices.bind(Binding::Buffer(&b.vertices)),
+            Resource::Samples.bind(Binding::Buffer(&b.samples)),
+            Resource::Splat.bind(Binding::Buffer(&b.splat)),
+            Resource::Objects.bind(Binding::Buffer(&b.objects)),
+            Resource::Exitance.bind(Binding::Buffer(&out)),
+        ])
+        .expect("descriptor set");
+    (naive, set, out)
+}
