@@ -270,10 +270,11 @@ struct Force {
 /// Renderers on the default scene at 512x512, one per configuration, stepped side by side
 /// through the same frames (alternating, so outside load falls on all alike), each with its
 /// `Force`. Returns each one's median frame wall time (ms) and its last image (RGBA8).
-fn side_by_side(renderers: &mut [(Renderer, Force)], change: Change, frames: usize) -> Vec<(f64, Vec<u8>)> {
+fn side_by_side(renderers: &mut [(Renderer, Force)], change: Change, frames: usize) -> Vec<(f64, Vec<u8>, f64)> {
     let mut times = vec![Vec::new(); renderers.len()];
+    let mut shade = vec![Vec::new(); renderers.len()];
     for frame in 0..WARM_UP + frames {
-        for ((renderer, force), t) in renderers.iter_mut().zip(&mut times) {
+        for (((renderer, force), t), shade) in renderers.iter_mut().zip(&mut times).zip(&mut shade) {
             step(renderer, change);
             let mut plan = renderer.plan(change);
             if let Some(level) = force.level {
@@ -289,13 +290,16 @@ fn side_by_side(renderers: &mut [(Renderer, Force)], change: Change, frames: usi
                 plan.objects.iter_mut().filter(|o| o.channels.is_empty()).for_each(|o| o.level = 0);
             }
             let start = Instant::now();
-            renderer.frame(&plan).expect("frame");
+            let timings = renderer.frame(&plan).expect("frame");
             if frame >= WARM_UP {
                 t.push(start.elapsed().as_secs_f64() * 1e3);
+                shade.push(timings.get(Pass::Shade).unwrap_or(f64::NAN));
             }
         }
     }
-    renderers.iter().zip(&mut times).map(|((r, _), t)| (median(t), r.image().expect("image").0)).collect()
+    let image = |r: &Renderer| r.image().expect("image").0;
+    let rows = renderers.iter().zip(&mut times).zip(&mut shade);
+    rows.map(|(((r, _), t), shade)| (median(t), image(r), median(shade))).collect()
 }
 
 /// The default scene at 512x512 with `overrides`, after a first frame of everything.
@@ -416,13 +420,14 @@ fn terms(gpu: &Arc<Gpu>) {
         "\nShading terms, default scene 512x512, every saving on, camera-only frames side by side (median of \
          {GATHER_FRAMES}):"
     );
-    println!("  {:<38} {:>10} {:>12} {:>10}", "", "frame ms", "term costs", "FLIP");
+    println!("  {:<38} {:>10} {:>12} {:>10} {:>12}", "", "frame ms", "term costs", "FLIP", "shade ms (ts)");
     for (i, (name, _)) in rows.iter().enumerate() {
         println!(
-            "  {name:<38} {:>10.1} {:>12.1} {:>10.4}",
+            "  {name:<38} {:>10.1} {:>12.1} {:>10.4} {:>12.2}",
             camera[i].0,
             camera[0].0 - camera[i].0,
-            flip(&camera[0].1, &camera[i].1)
+            flip(&camera[0].1, &camera[i].1),
+            camera[i].2
         );
     }
 }
