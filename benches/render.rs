@@ -2,7 +2,7 @@
 //! seed paper's FPS-against-sample-count comparison (its Figure 7), on whatever device the
 //! loader offers (TRANSLUCENT_DEVICE to choose). Prints figures; asserts nothing.
 //!
-//!     cargo bench --bench render [-- frames|savings|levels|terms|hierarchy|planner|gathers]
+//!     cargo bench --bench render [-- frames|savings|levels|terms|hierarchy|growth|planner|gathers]
 //!
 //! Two timings per pass: GPU timestamp queries inside one submission, and the wall time of the
 //! pass submitted alone (submission to fence). On lavapipe a timestamp used to be taken only at
@@ -10,6 +10,8 @@
 //! records a barrier after each start stamp, which flushes there, and the two figures agree.
 //! Frames per second come from whole-frame wall time.
 
+#[path = "render/growth.rs"]
+mod growth;
 #[path = "render/roofline.rs"]
 mod roofline;
 
@@ -606,6 +608,9 @@ fn main() {
     }
     if wanted("hierarchy") {
         hierarchy(&gpu);
+    }
+    if wanted("growth") {
+        growth::growth(&gpu);
     }
     if wanted("planner") {
         planner(&gpu);
