@@ -58,6 +58,13 @@ pub enum RenderError {
     /// `resize` of a renderer drawing into a host's target.
     #[error("resize: a host target's size comes with each frame's HostTarget")]
     ResizeHostTarget,
+    /// `record_exitance` of a renderer drawing into its own images: its levels of detail follow
+    /// its own image, and `frame` with `exitance` reads its exitance.
+    #[error("record_exitance is for a host-target renderer (TargetDesc::Host); this one draws into its own images")]
+    ExitanceOnOwnTarget,
+    /// `record_exitance` told that the host will write the exitance, or access it not at all.
+    #[error("record_exitance: {0:?} is not a read; the host may only read the exitance it is handed")]
+    ExitanceReader(Access),
     /// A `HostTarget` given to a renderer that draws into its own images.
     #[error("this renderer draws into its own images: record it without a HostTarget")]
     UnexpectedHostTarget,
@@ -565,14 +572,61 @@ impl Renderer {
     ) -> Result<RecordedFrame, RenderError> {
         if let Some(t) = target {
             super::host::check_target(&self.gpu, self.target, t)?;
-            if self.host_extent.is_some_and(|e| e != t.extent) {
-                // As for the own image's `resize`: the levels of detail follow the new size.
-                self.planner.mark(Change::Camera);
-            }
-            self.host_extent = Some(t.extent);
+            self.follow_extent(t.extent);
         }
         let plan = self.planner.plan(&self.needs, &self.view());
         self.record_plan(cmd, &plan, target)
+    }
+
+    /// Record the exitance that what changed since the last frame calls for, without shading,
+    /// into `cmd` (recording, outside any rendering), for a host that shades itself: the passes
+    /// `record_frame` would record up to the gather (shadow maps, sky light, splat, gather), and
+    /// none after. No submission and no wait; `read_timings` and the lifetime rule are those
+    /// of `record_frame`.
+    ///
+    /// `extent` is the size in pixels the host draws the view at (set with `set_camera`): the
+    /// levels of detail follow it, as they follow a `HostTarget`'s extent. `readers` are the
+    /// accesses the host will read the output with (`Access::VertexAttributeRead` for a vertex
+    /// stream, `ComputeRead`, `FragmentRead`, `TransferRead`, `HostRead`): the call ends with
+    /// the barrier from the gather's writes to them, and the next frame's writes wait for them.
+    ///
+    /// The output is `buffers().exitance`, and `buffers().environment_irradiance` for the sky
+    /// light, one `vec4` per vertex of every object in scene order (docs/GPU.md, "The exitance
+    /// as an output"). It equals what `record_frame` gathers for the same change and view.
+    pub fn record_exitance(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        extent: vk::Extent2D,
+        readers: &[Access],
+    ) -> Result<RecordedFrame, RenderError> {
+        if self.target == TargetDesc::Own {
+            return Err(RenderError::ExitanceOnOwnTarget);
+        }
+        if extent.width == 0 || extent.height == 0 {
+            return Err(RenderError::HostTargetEmpty { extent: [extent.width, extent.height] });
+        }
+        if let Some(&bad) = readers.iter().find(|a| a.writes() || **a == Access::Nothing) {
+            return Err(RenderError::ExitanceReader(bad));
+        }
+        self.follow_extent(extent);
+        let mut plan = self.planner.plan(&self.needs, &self.view());
+        plan.passes.retain(|(p, _)| !matches!(p, Pass::Shade | Pass::Tonemap));
+        let frame = self.record_checked(cmd, &plan, None);
+        let uses: Vec<_> = [Resource::Exitance, Resource::EnvironmentIrradiance]
+            .iter()
+            .flat_map(|&r| readers.iter().map(move |&a| read(r, a)))
+            .collect();
+        self.hazards.get_mut().before(self.gpu.device(), cmd, &uses);
+        Ok(frame)
+    }
+
+    /// The levels of detail follow `extent`, the host's: a new extent replans as a camera move
+    /// does (as the own image's `resize`).
+    fn follow_extent(&mut self, extent: vk::Extent2D) {
+        if self.host_extent.is_some_and(|e| e != extent) {
+            self.planner.mark(Change::Camera);
+        }
+        self.host_extent = Some(extent);
     }
 
     /// Record the passes of `plan` into `cmd` (as `record_frame` does, with a plan of the
@@ -591,6 +645,11 @@ impl Renderer {
             (_, Some(t)) => super::host::check_target(&self.gpu, self.target, t)?,
             _ => {}
         }
+        Ok(self.record_checked(cmd, plan, target))
+    }
+
+    /// `record_plan` after its checks: `target` suits this renderer, or `plan` does not shade.
+    fn record_checked(&mut self, cmd: vk::CommandBuffer, plan: &Plan, target: Option<&HostTarget>) -> RecordedFrame {
         self.generation += 1;
         let slot = (!self.timers.is_empty()).then(|| {
             let slot = (self.generation - 1) as usize % self.timers.len();
@@ -623,7 +682,7 @@ impl Renderer {
         if self.planner.baked_levels() != baked {
             self.needs = Self::needs_of(&self.scene, self.target, &self.planner);
         }
-        Ok(RecordedFrame { passes: recorded, slot, generation: self.generation, renderer: self.id() })
+        RecordedFrame { passes: recorded, slot, generation: self.generation, renderer: self.id() }
     }
 
     /// Identifies this renderer's frames: a number no other renderer of this process has.
@@ -654,7 +713,8 @@ impl Renderer {
             Some(slot) => self.timers[slot].results_if_done()?.ok_or(RenderError::FrameNotDone(frame.generation))?,
             None => Vec::new(),
         };
-        if frame.slot.is_some() {
+        // A frame of no pass wrote no query, so its answer says nothing of its submission.
+        if frame.slot.is_some() && !frame.passes.is_empty() {
             // Frames finish in the order they were recorded (the host's contract).
             self.finished.set(self.finished.get().max(frame.generation));
         }
