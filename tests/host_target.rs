@@ -15,7 +15,10 @@ use translucent::gpu::{
     Named, memory_barrier,
 };
 use translucent::render::plan::Pass;
-use translucent::{CameraView, Change, Overrides, PreparedScene, RenderError, Renderer, Scene};
+use translucent::{
+    CameraView, Change, DepthConvention, DepthTest, HostTarget, Overrides, PreparedScene, RenderError, Renderer,
+    RendererOptions, Scene, TargetDesc,
+};
 
 /// The embed example's sphere scene.
 fn sphere() -> PreparedScene {
@@ -344,4 +347,155 @@ fn the_same_reader_undeclared_is_a_hazard_synchronisation_validation_reports() {
         two_exitances_read_by_the_host(gpu, &[]);
     });
     assert!(messages.iter().any(|m| m.contains("SYNC-HAZARD")), "no hazard reported: {messages:?}");
+}
+
+#[test]
+fn a_host_chosen_frames_in_flight_count_is_when_timings_are_overwritten() {
+    common::with_gpu(|gpu| {
+        for in_flight in [1, 5] {
+            let options = RendererOptions { frames_in_flight: in_flight, ..RendererOptions::default() };
+            let mut renderer = Renderer::with_options(gpu, sphere(), host::desc(), options).unwrap();
+            let images = HostImages::new(gpu, 32, 32, host::COLOR);
+            let mut frames: Vec<_> =
+                (0..in_flight).map(|_| record(gpu, &mut renderer, &images, &images.whole()).unwrap()).collect();
+            for f in &frames {
+                assert!(renderer.read_timings(f).is_ok(), "{in_flight} in flight: frame {} refused", f.generation());
+            }
+            frames.push(record(gpu, &mut renderer, &images, &images.whole()).unwrap());
+            let error = renderer.read_timings(&frames[0]).unwrap_err();
+            let by = in_flight as u64 + 1;
+            assert!(
+                matches!(error, RenderError::TimingsOverwritten { frame: 1, by: b, in_flight: n } if b == by && n == in_flight),
+                "{error}"
+            );
+            for f in &frames[1..] {
+                assert!(renderer.read_timings(f).is_ok(), "{in_flight} in flight: frame {} refused", f.generation());
+            }
+        }
+    });
+}
+
+#[test]
+fn renderer_options_out_of_range_are_refused_naming_them() {
+    common::with_gpu(|gpu| {
+        let with = |options| Renderer::with_options(gpu, sphere(), host::desc(), options).err().expect("refused");
+        for given in [0, Renderer::MAX_FRAMES_IN_FLIGHT + 1] {
+            let error = with(RendererOptions { frames_in_flight: given, ..RendererOptions::default() });
+            assert!(matches!(error, RenderError::FramesInFlight { given: g, .. } if g == given), "{error}");
+        }
+        let wrong = DepthTest { convention: DepthConvention::Reversed, compare: vk::CompareOp::LESS_OR_EQUAL };
+        let error = with(RendererOptions { depth: wrong, ..RendererOptions::default() });
+        assert!(error.to_string().contains("GREATER or GREATER_OR_EQUAL"), "{error}");
+        let wrong = DepthTest { convention: DepthConvention::Standard, compare: vk::CompareOp::NEVER };
+        assert!(matches!(
+            with(RendererOptions { depth: wrong, ..RendererOptions::default() }),
+            RenderError::DepthCompare { .. }
+        ));
+    });
+}
+
+/// RGBA32F host images, so that images compare in linear radiance.
+const LINEAR: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+
+/// A renderer of the sphere into RGBA32F host images with `depth`'s test.
+fn linear_renderer(gpu: &Arc<Gpu>, depth: DepthTest) -> Renderer {
+    let desc = TargetDesc::Host { color_format: LINEAR, depth_format: host::DEPTH };
+    Renderer::with_options(gpu, sphere(), desc, RendererOptions { depth, ..RendererOptions::default() }).unwrap()
+}
+
+/// One frame of `renderer` into `target` of `images`, after the host cleared them (colour,
+/// depth) when `clear` says; the colour image afterwards, RGBA f32 per pixel.
+fn draw(
+    gpu: &Arc<Gpu>,
+    renderer: &mut Renderer,
+    images: &HostImages,
+    target: &HostTarget,
+    clear: Option<([f32; 4], f32)>,
+) -> Vec<[f32; 4]> {
+    gpu.one_shot("host frame", |cmd| {
+        images.to_attachments(gpu, cmd);
+        if let Some((color, depth)) = clear {
+            images.clear(gpu, cmd, color, depth);
+        }
+        renderer.record_frame(cmd, Some(target))
+    })
+    .unwrap()
+    .unwrap();
+    bytemuck::pod_collect_to_vec(&images.read_color())
+}
+
+/// The largest difference of two linear images in 8-bit display levels, and how many pixels
+/// are lit (not the black background) in `a`.
+fn display_difference(a: &[[f32; 4]], b: &[[f32; 4]]) -> (i64, usize) {
+    use translucent::render::tonemap::display_value;
+    let level = |v: f32| display_value(f64::from(v), 1.0) as i64;
+    let max = a.iter().zip(b).flat_map(|(p, q)| (0..3).map(move |c| (level(p[c]) - level(q[c])).abs())).max();
+    (max.unwrap_or(0), a.iter().filter(|p| p[0] > 0.0).count())
+}
+
+#[test]
+fn a_reversed_z_host_draws_what_a_standard_depth_host_draws() {
+    common::with_gpu(|gpu| {
+        let images = HostImages::new(gpu, 64, 64, LINEAR);
+        let standard = draw(gpu, &mut linear_renderer(gpu, DepthTest::STANDARD), &images, &images.whole(), None);
+        let mut reversed = linear_renderer(gpu, DepthTest::REVERSED);
+        let cleared = draw(gpu, &mut reversed, &images, &images.whole(), None);
+        // The host's own reversed-Z depth, cleared to its far plane (0), kept (`load`).
+        let mut loaded = images.whole();
+        loaded.load = true;
+        reversed.set_camera(CameraView::of_scene(reversed.scene()).reversed_depth());
+        let kept = draw(gpu, &mut reversed, &images, &loaded, Some(([0.0, 0.0, 0.0, 1.0], 0.0)));
+        let (cleared_max, lit) = display_difference(&standard, &cleared);
+        let (kept_max, _) = display_difference(&standard, &kept);
+        eprintln!(
+            "reversed-Z against standard: {lit} lit pixels, largest difference {cleared_max}/255 (cleared), {kept_max}/255 (host's depth)"
+        );
+        assert!(lit > 64 * 64 / 10, "only {lit} lit pixels: the sphere is not drawn");
+        assert!(cleared_max <= 1 && kept_max <= 1, "differences {cleared_max}/255, {kept_max}/255");
+        // The control: a standard-depth renderer against that reversed-Z depth draws nothing
+        // (issue 28's case), so the images above did depend on the convention.
+        let mut standard = linear_renderer(gpu, DepthTest::STANDARD);
+        let hidden = draw(gpu, &mut standard, &images, &loaded, Some(([0.0, 0.0, 0.0, 1.0], 0.0)));
+        assert_eq!(display_difference(&hidden, &hidden).1, 0, "standard depth drew behind the far plane");
+    });
+}
+
+#[test]
+fn a_host_target_offset_draws_the_same_view_into_that_rectangle_only() {
+    common::with_gpu(|gpu| {
+        let small = HostImages::new(gpu, 64, 64, LINEAR);
+        let whole = draw(gpu, &mut linear_renderer(gpu, DepthTest::STANDARD), &small, &small.whole(), None);
+        let (width, height, offset) = (96usize, 80usize, vk::Offset2D { x: 24, y: 10 });
+        let large = HostImages::new(gpu, width as u32, height as u32, LINEAR);
+        let mut target = large.target(extent(64, 64));
+        target.offset = offset;
+        let marker = [0.25, 0.5, 0.75, 1.0];
+        let mut renderer = linear_renderer(gpu, DepthTest::STANDARD);
+        let drawn = draw(gpu, &mut renderer, &large, &target, Some((marker, 1.0)));
+        let (x0, y0) = (offset.x as usize, offset.y as usize);
+        let inside = |x: usize, y: usize| (x0..x0 + 64).contains(&x) && (y0..y0 + 64).contains(&y);
+        let cut: Vec<_> =
+            (0..64).flat_map(|y| (0..64).map(move |x| (x, y))).map(|(x, y)| drawn[(y0 + y) * width + x0 + x]).collect();
+        let (max, lit) = display_difference(&whole, &cut);
+        let outside = (0..height).flat_map(|y| (0..width).map(move |x| (x, y))).filter(|&(x, y)| !inside(x, y));
+        let untouched = outside.clone().filter(|&(x, y)| drawn[y * width + x] == marker).count();
+        eprintln!(
+            "offset target: {lit} lit pixels, largest difference {max}/255 from a 64x64 image; {untouched} of {} outside untouched",
+            outside.count()
+        );
+        assert!(lit > 64 * 64 / 10 && max <= 1, "the rectangle differs from the 64x64 image by up to {max}/255");
+        assert_eq!(untouched, width * height - 64 * 64, "pixels outside the render area were written");
+        // An area past the image from its offset, or at a negative offset, is refused.
+        target.offset = vk::Offset2D { x: 40, y: 10 };
+        let error = draw_refused(gpu, &mut renderer, &large, &target);
+        assert!(matches!(error, RenderError::HostTargetTooLarge { offset: [40, 10], .. }), "{error}");
+        target.offset = vk::Offset2D { x: -1, y: 0 };
+        let error = draw_refused(gpu, &mut renderer, &large, &target);
+        assert!(matches!(error, RenderError::HostTargetOffset { offset: [-1, 0] }), "{error}");
+    });
+}
+
+/// `record_frame` into `target` of `images`, which must refuse.
+fn draw_refused(gpu: &Arc<Gpu>, renderer: &mut Renderer, images: &HostImages, target: &HostTarget) -> RenderError {
+    record(gpu, renderer, images, target).expect_err("refused")
 }
