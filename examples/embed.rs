@@ -848,6 +848,7 @@ fn render_frames(engine: &Engine, gpu: Arc<Gpu>, options: &Options) -> Result<Ru
         color: HostAttachment { view: engine.color.view, format: COLOR_FORMAT, extent },
         depth: HostAttachment { view: engine.depth.view, format: DEPTH_FORMAT, extent },
         extent,
+        offset: vk::Offset2D::default(),
         load: true,
     };
     let mut frames = Vec::new();

@@ -50,7 +50,9 @@ pub use gpu::{EnabledFeatures, Gpu, GpuError, GpuOptions, HostVulkan, RequiredFe
 pub use optics::Material;
 pub use output::{OutputError, OutputSet};
 pub use render::plan::{Change, Pass, Plan};
-pub use render::renderer::{CameraView, FrameTimings, NonFinite, RecordedFrame, RenderError, Renderer};
-pub use render::shade::{HostAttachment, HostTarget, TargetDesc};
+pub use render::renderer::{
+    CameraView, FrameTimings, NonFinite, RecordedFrame, RenderError, Renderer, RendererOptions,
+};
+pub use render::shade::{DepthConvention, DepthTest, HostAttachment, HostTarget, TargetDesc};
 pub use scene::build::{Overrides, PreparedScene};
 pub use scene::{GatherMode, Scene, SceneError};

@@ -10,9 +10,15 @@ mod embed;
 use ash::vk;
 use common::host::{self, HostCommands, HostImages};
 use std::sync::Arc;
-use translucent::gpu::{EnabledFeatures, Gpu, GpuOptions, HostVulkan};
+use translucent::gpu::{
+    Access, Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, EnabledFeatures, Gpu, GpuOptions, HostVulkan,
+    Named, memory_barrier,
+};
 use translucent::render::plan::Pass;
-use translucent::{CameraView, Change, Overrides, PreparedScene, RenderError, Renderer, Scene};
+use translucent::{
+    CameraView, Change, DepthConvention, DepthTest, HostTarget, Overrides, PreparedScene, RenderError, Renderer,
+    RendererOptions, Scene, TargetDesc,
+};
 
 /// The embed example's sphere scene.
 fn sphere() -> PreparedScene {
@@ -199,4 +205,297 @@ fn a_host_device_lacking_several_features_gets_all_of_them_named() {
         let error = unsafe { Gpu::from_host(host, &GpuOptions::default()) }.err().expect("refused").to_string();
         assert!(error.contains("synchronization2, shaderOutputLayer features"), "{error}");
     });
+}
+
+/// The messages of a validated `Gpu` with synchronisation validation on, after `f` and the
+/// device are done.
+fn sync_messages(f: impl FnOnce(&Arc<Gpu>)) -> Vec<String> {
+    let options = GpuOptions { sync_validation: true, ..common::validated_options() };
+    let gpu = Gpu::new(&options).expect("a Vulkan device with validation layers (bash scripts/setup)");
+    let counters = gpu.validation();
+    f(&gpu);
+    assert_eq!(Arc::strong_count(&gpu), 1, "a GPU resource outlived the test body");
+    drop(gpu);
+    counters.messages()
+}
+
+/// The sphere's light turned about the vertical axis by `degrees`.
+fn turned_light(renderer: &Renderer, degrees: f32) -> translucent::scene::Light {
+    let mut light = renderer.scene().scene.file.lights[0].clone();
+    if let translucent::scene::Light::Directional { direction, .. } = &mut light {
+        *direction = glam::Quat::from_rotation_y(degrees.to_radians()).mul_vec3(glam::Vec3::from(*direction)).into();
+    }
+    light
+}
+
+#[test]
+fn recorded_exitance_without_shading_equals_what_record_frame_gathers() {
+    common::with_gpu(|gpu| {
+        let images = HostImages::new(gpu, 64, 64, host::COLOR);
+        let (mut framed, mut alone) = (host_renderer(gpu), host_renderer(gpu));
+        for step in 0..2 {
+            if step == 1 {
+                // A partial frame: one light moved, its shadows, splat and gather rerun.
+                let light = turned_light(&framed, 40.0);
+                framed.set_light(0, light.clone()).unwrap();
+                alone.set_light(0, light).unwrap();
+            }
+            record(gpu, &mut framed, &images, &images.whole()).unwrap();
+            let frame = gpu
+                .one_shot("exitance", |cmd| alone.record_exitance(cmd, extent(64, 64), &[Access::HostRead]))
+                .unwrap()
+                .unwrap();
+            assert!(frame.passes.contains(&Pass::Gather), "step {step}: {:?}", frame.passes);
+            assert!(!frame.passes.contains(&Pass::Shade), "step {step}: shading recorded: {:?}", frame.passes);
+            let framed_exitance: Vec<[f32; 4]> = framed.buffers().exitance.read().unwrap();
+            let exitance: Vec<[f32; 4]> = alone.buffers().exitance.read().unwrap();
+            assert!(exitance.iter().filter(|e| e[0] > 0.0).count() > exitance.len() / 4, "step {step}: little lit");
+            assert_eq!(exitance, framed_exitance, "step {step}: record_exitance and record_frame differ");
+        }
+        // Nothing changed since: nothing to record, and shading still follows in record_frame.
+        let idle = gpu.one_shot("idle", |cmd| alone.record_exitance(cmd, extent(64, 64), &[])).unwrap().unwrap();
+        assert!(idle.passes.is_empty(), "{:?}", idle.passes);
+    });
+}
+
+#[test]
+fn record_exitance_refuses_an_own_target_a_write_and_an_empty_extent() {
+    common::with_gpu(|gpu| {
+        let mut host = host_renderer(gpu);
+        let commands = HostCommands::begin(gpu);
+        let error = host.record_exitance(commands.cmd, extent(64, 64), &[Access::ComputeWrite]).unwrap_err();
+        assert!(matches!(error, RenderError::ExitanceReader(Access::ComputeWrite)), "{error}");
+        let error = host.record_exitance(commands.cmd, extent(0, 64), &[]).unwrap_err();
+        assert!(matches!(error, RenderError::HostTargetEmpty { extent: [0, 64] }), "{error}");
+        let mut own = Renderer::new(gpu, sphere()).unwrap();
+        let error = own.record_exitance(commands.cmd, extent(64, 64), &[]).unwrap_err();
+        assert!(matches!(error, RenderError::ExitanceOnOwnTarget), "{error}");
+        // Nothing was recorded: the first frame still runs everything.
+        let frame = host.record_exitance(commands.cmd, extent(64, 64), &[]).unwrap();
+        assert!(frame.passes.contains(&Pass::Splat), "{:?}", frame.passes);
+        commands.submit();
+        commands.wait();
+    });
+}
+
+/// The host's compute reader of the exitance (glsl/test/exitance_probe.comp: a copy into a
+/// buffer of its own), recorded into `cmd` after `record_exitance`, then read after the fence.
+struct HostReader {
+    pipeline: ComputePipeline,
+    set: DescriptorSet,
+    out: Buffer,
+    count: u32,
+}
+
+impl HostReader {
+    fn new(gpu: &Arc<Gpu>, renderer: &Renderer) -> HostReader {
+        let pipeline = ComputePipeline::new(gpu, "test/exitance_probe.comp").unwrap();
+        let exitance = &renderer.buffers().exitance;
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let out = Buffer::new(gpu, &BufferDesc::readback("host's copy", exitance.size(), usage)).unwrap();
+        let set = pipeline
+            .descriptor_set(&[
+                Named { name: "Exitance", binding: Binding::Buffer(exitance) },
+                Named { name: "Probe", binding: Binding::Buffer(&out) },
+            ])
+            .unwrap();
+        HostReader { pipeline, set, out, count: (exitance.size() / 16) as u32 }
+    }
+
+    fn record(&self, gpu: &Gpu, cmd: vk::CommandBuffer) {
+        self.pipeline.dispatch(cmd, &self.set, &self.count, [self.count, 1, 1]);
+        memory_barrier(gpu.device(), cmd, &[Access::ComputeWrite], &[Access::HostRead]);
+    }
+}
+
+/// Two `record_exitance` calls in one command buffer, a light turned between them, each
+/// followed by a host compute pass reading the exitance as `readers` declares (nothing else
+/// of the host's orders them); the values each read.
+fn two_exitances_read_by_the_host(gpu: &Arc<Gpu>, readers: &[Access]) -> [Vec<[f32; 4]>; 2] {
+    let mut renderer = host_renderer(gpu);
+    let light = turned_light(&renderer, 60.0);
+    let probes = [HostReader::new(gpu, &renderer), HostReader::new(gpu, &renderer)];
+    gpu.one_shot("host frame", |cmd| {
+        renderer.record_exitance(cmd, extent(64, 64), readers).unwrap();
+        probes[0].record(gpu, cmd);
+        // The next gather overwrites what the host's pass reads: it must wait for that pass.
+        renderer.set_light(0, light).unwrap();
+        renderer.record_exitance(cmd, extent(64, 64), readers).unwrap();
+        probes[1].record(gpu, cmd);
+    })
+    .unwrap();
+    let last: Vec<[f32; 4]> = renderer.buffers().exitance.read().unwrap();
+    let read = probes.map(|p| p.out.read::<[f32; 4]>().unwrap());
+    assert_eq!(read[1], last, "the host's second read holds the second gather");
+    read
+}
+
+#[test]
+fn a_host_reader_declared_to_record_exitance_needs_no_barrier_of_its_own() {
+    let messages = sync_messages(|gpu| {
+        let [first, second] = two_exitances_read_by_the_host(gpu, &[Access::ComputeRead]);
+        assert_ne!(first, second, "the light turned between the two gathers");
+        assert!(first.iter().filter(|e| e[0] > 0.0).count() > first.len() / 4, "the first read holds a gather");
+    });
+    assert!(messages.is_empty(), "validation:\n{}", messages.join("\n"));
+}
+
+#[test]
+fn the_same_reader_undeclared_is_a_hazard_synchronisation_validation_reports() {
+    // The control: the layer sees the host's pass, so the clean run above means something.
+    let messages = sync_messages(|gpu| {
+        two_exitances_read_by_the_host(gpu, &[]);
+    });
+    assert!(messages.iter().any(|m| m.contains("SYNC-HAZARD")), "no hazard reported: {messages:?}");
+}
+
+#[test]
+fn a_host_chosen_frames_in_flight_count_is_when_timings_are_overwritten() {
+    common::with_gpu(|gpu| {
+        for in_flight in [1, 5] {
+            let options = RendererOptions { frames_in_flight: in_flight, ..RendererOptions::default() };
+            let mut renderer = Renderer::with_options(gpu, sphere(), host::desc(), options).unwrap();
+            let images = HostImages::new(gpu, 32, 32, host::COLOR);
+            let mut frames: Vec<_> =
+                (0..in_flight).map(|_| record(gpu, &mut renderer, &images, &images.whole()).unwrap()).collect();
+            for f in &frames {
+                assert!(renderer.read_timings(f).is_ok(), "{in_flight} in flight: frame {} refused", f.generation());
+            }
+            frames.push(record(gpu, &mut renderer, &images, &images.whole()).unwrap());
+            let error = renderer.read_timings(&frames[0]).unwrap_err();
+            let by = in_flight as u64 + 1;
+            assert!(
+                matches!(error, RenderError::TimingsOverwritten { frame: 1, by: b, in_flight: n } if b == by && n == in_flight),
+                "{error}"
+            );
+            for f in &frames[1..] {
+                assert!(renderer.read_timings(f).is_ok(), "{in_flight} in flight: frame {} refused", f.generation());
+            }
+        }
+    });
+}
+
+#[test]
+fn renderer_options_out_of_range_are_refused_naming_them() {
+    common::with_gpu(|gpu| {
+        let with = |options| Renderer::with_options(gpu, sphere(), host::desc(), options).err().expect("refused");
+        for given in [0, Renderer::MAX_FRAMES_IN_FLIGHT + 1] {
+            let error = with(RendererOptions { frames_in_flight: given, ..RendererOptions::default() });
+            assert!(matches!(error, RenderError::FramesInFlight { given: g, .. } if g == given), "{error}");
+        }
+        let wrong = DepthTest { convention: DepthConvention::Reversed, compare: vk::CompareOp::LESS_OR_EQUAL };
+        let error = with(RendererOptions { depth: wrong, ..RendererOptions::default() });
+        assert!(error.to_string().contains("GREATER or GREATER_OR_EQUAL"), "{error}");
+        let wrong = DepthTest { convention: DepthConvention::Standard, compare: vk::CompareOp::NEVER };
+        assert!(matches!(
+            with(RendererOptions { depth: wrong, ..RendererOptions::default() }),
+            RenderError::DepthCompare { .. }
+        ));
+    });
+}
+
+/// RGBA32F host images, so that images compare in linear radiance.
+const LINEAR: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+
+/// A renderer of the sphere into RGBA32F host images with `depth`'s test.
+fn linear_renderer(gpu: &Arc<Gpu>, depth: DepthTest) -> Renderer {
+    let desc = TargetDesc::Host { color_format: LINEAR, depth_format: host::DEPTH };
+    Renderer::with_options(gpu, sphere(), desc, RendererOptions { depth, ..RendererOptions::default() }).unwrap()
+}
+
+/// One frame of `renderer` into `target` of `images`, after the host cleared them (colour,
+/// depth) when `clear` says; the colour image afterwards, RGBA f32 per pixel.
+fn draw(
+    gpu: &Arc<Gpu>,
+    renderer: &mut Renderer,
+    images: &HostImages,
+    target: &HostTarget,
+    clear: Option<([f32; 4], f32)>,
+) -> Vec<[f32; 4]> {
+    gpu.one_shot("host frame", |cmd| {
+        images.to_attachments(gpu, cmd);
+        if let Some((color, depth)) = clear {
+            images.clear(gpu, cmd, color, depth);
+        }
+        renderer.record_frame(cmd, Some(target))
+    })
+    .unwrap()
+    .unwrap();
+    bytemuck::pod_collect_to_vec(&images.read_color())
+}
+
+/// The largest difference of two linear images in 8-bit display levels, and how many pixels
+/// are lit (not the black background) in `a`.
+fn display_difference(a: &[[f32; 4]], b: &[[f32; 4]]) -> (i64, usize) {
+    use translucent::render::tonemap::display_value;
+    let level = |v: f32| display_value(f64::from(v), 1.0) as i64;
+    let max = a.iter().zip(b).flat_map(|(p, q)| (0..3).map(move |c| (level(p[c]) - level(q[c])).abs())).max();
+    (max.unwrap_or(0), a.iter().filter(|p| p[0] > 0.0).count())
+}
+
+#[test]
+fn a_reversed_z_host_draws_what_a_standard_depth_host_draws() {
+    common::with_gpu(|gpu| {
+        let images = HostImages::new(gpu, 64, 64, LINEAR);
+        let standard = draw(gpu, &mut linear_renderer(gpu, DepthTest::STANDARD), &images, &images.whole(), None);
+        let mut reversed = linear_renderer(gpu, DepthTest::REVERSED);
+        let cleared = draw(gpu, &mut reversed, &images, &images.whole(), None);
+        // The host's own reversed-Z depth, cleared to its far plane (0), kept (`load`).
+        let mut loaded = images.whole();
+        loaded.load = true;
+        reversed.set_camera(CameraView::of_scene(reversed.scene()).reversed_depth());
+        let kept = draw(gpu, &mut reversed, &images, &loaded, Some(([0.0, 0.0, 0.0, 1.0], 0.0)));
+        let (cleared_max, lit) = display_difference(&standard, &cleared);
+        let (kept_max, _) = display_difference(&standard, &kept);
+        eprintln!(
+            "reversed-Z against standard: {lit} lit pixels, largest difference {cleared_max}/255 (cleared), {kept_max}/255 (host's depth)"
+        );
+        assert!(lit > 64 * 64 / 10, "only {lit} lit pixels: the sphere is not drawn");
+        assert!(cleared_max <= 1 && kept_max <= 1, "differences {cleared_max}/255, {kept_max}/255");
+        // The control: a standard-depth renderer against that reversed-Z depth draws nothing
+        // (issue 28's case), so the images above did depend on the convention.
+        let mut standard = linear_renderer(gpu, DepthTest::STANDARD);
+        let hidden = draw(gpu, &mut standard, &images, &loaded, Some(([0.0, 0.0, 0.0, 1.0], 0.0)));
+        assert_eq!(display_difference(&hidden, &hidden).1, 0, "standard depth drew behind the far plane");
+    });
+}
+
+#[test]
+fn a_host_target_offset_draws_the_same_view_into_that_rectangle_only() {
+    common::with_gpu(|gpu| {
+        let small = HostImages::new(gpu, 64, 64, LINEAR);
+        let whole = draw(gpu, &mut linear_renderer(gpu, DepthTest::STANDARD), &small, &small.whole(), None);
+        let (width, height, offset) = (96usize, 80usize, vk::Offset2D { x: 24, y: 10 });
+        let large = HostImages::new(gpu, width as u32, height as u32, LINEAR);
+        let mut target = large.target(extent(64, 64));
+        target.offset = offset;
+        let marker = [0.25, 0.5, 0.75, 1.0];
+        let mut renderer = linear_renderer(gpu, DepthTest::STANDARD);
+        let drawn = draw(gpu, &mut renderer, &large, &target, Some((marker, 1.0)));
+        let (x0, y0) = (offset.x as usize, offset.y as usize);
+        let inside = |x: usize, y: usize| (x0..x0 + 64).contains(&x) && (y0..y0 + 64).contains(&y);
+        let cut: Vec<_> =
+            (0..64).flat_map(|y| (0..64).map(move |x| (x, y))).map(|(x, y)| drawn[(y0 + y) * width + x0 + x]).collect();
+        let (max, lit) = display_difference(&whole, &cut);
+        let outside = (0..height).flat_map(|y| (0..width).map(move |x| (x, y))).filter(|&(x, y)| !inside(x, y));
+        let untouched = outside.clone().filter(|&(x, y)| drawn[y * width + x] == marker).count();
+        eprintln!(
+            "offset target: {lit} lit pixels, largest difference {max}/255 from a 64x64 image; {untouched} of {} outside untouched",
+            outside.count()
+        );
+        assert!(lit > 64 * 64 / 10 && max <= 1, "the rectangle differs from the 64x64 image by up to {max}/255");
+        assert_eq!(untouched, width * height - 64 * 64, "pixels outside the render area were written");
+        // An area past the image from its offset, or at a negative offset, is refused.
+        target.offset = vk::Offset2D { x: 40, y: 10 };
+        let error = draw_refused(gpu, &mut renderer, &large, &target);
+        assert!(matches!(error, RenderError::HostTargetTooLarge { offset: [40, 10], .. }), "{error}");
+        target.offset = vk::Offset2D { x: -1, y: 0 };
+        let error = draw_refused(gpu, &mut renderer, &large, &target);
+        assert!(matches!(error, RenderError::HostTargetOffset { offset: [-1, 0] }), "{error}");
+    });
+}
+
+/// `record_frame` into `target` of `images`, which must refuse.
+fn draw_refused(gpu: &Arc<Gpu>, renderer: &mut Renderer, images: &HostImages, target: &HostTarget) -> RenderError {
+    record(gpu, renderer, images, target).expect_err("refused")
 }

@@ -215,9 +215,12 @@ pub struct GraphicsDesc {
     pub vertex_attributes: Vec<vk::VertexInputAttributeDescription>,
     /// Formats of the colour attachments, in attachment order; empty for depth-only passes.
     pub color_formats: Vec<vk::Format>,
-    /// Format of the depth attachment; with one, depth test (LESS_OR_EQUAL) and depth writes are
-    /// on.
+    /// Format of the depth attachment; with one, depth test (`depth_compare`) and depth writes
+    /// are on.
     pub depth_format: Option<vk::Format>,
+    /// The depth test's comparison, with a depth attachment: LESS_OR_EQUAL unless set (0 near,
+    /// 1 far); a reversed-Z target's is GREATER_OR_EQUAL.
+    pub depth_compare: vk::CompareOp,
     /// Faces to cull (counter-clockwise is front); NONE unless set.
     pub cull: vk::CullModeFlags,
     /// Constant and slope depth bias, for shadow maps.
@@ -235,6 +238,7 @@ impl GraphicsDesc {
             vertex_attributes: Vec::new(),
             color_formats: Vec::new(),
             depth_format: None,
+            depth_compare: vk::CompareOp::LESS_OR_EQUAL,
             cull: vk::CullModeFlags::NONE,
             depth_bias: None,
         }
@@ -301,7 +305,7 @@ impl GraphicsPipeline {
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth_format.is_some())
             .depth_write_enable(desc.depth_format.is_some())
-            .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL);
+            .depth_compare_op(desc.depth_compare);
         let attachments: Vec<_> = desc
             .color_formats
             .iter()
@@ -347,13 +351,25 @@ impl GraphicsPipeline {
         push: &P,
         extent: vk::Extent2D,
     ) {
+        self.bind_area(cmd, set, push, vk::Rect2D { offset: vk::Offset2D::default(), extent });
+    }
+
+    /// As `bind`, with the viewport and scissor over `area` (a sub-rectangle of the attachments,
+    /// the render area).
+    pub fn bind_area<P: bytemuck::Pod>(
+        &self,
+        cmd: vk::CommandBuffer,
+        set: Option<&DescriptorSet>,
+        push: &P,
+        area: vk::Rect2D,
+    ) {
         let push = self.layout.check_push(bytemuck::bytes_of(push));
         let device = self.layout.gpu.device();
         let viewport = vk::Viewport {
-            x: 0.0,
-            y: 0.0,
-            width: extent.width as f32,
-            height: extent.height as f32,
+            x: area.offset.x as f32,
+            y: area.offset.y as f32,
+            width: area.extent.width as f32,
+            height: area.extent.height as f32,
             min_depth: 0.0,
             max_depth: 1.0,
         };
@@ -361,7 +377,7 @@ impl GraphicsPipeline {
         unsafe {
             device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
             device.cmd_set_viewport(cmd, 0, &[viewport]);
-            device.cmd_set_scissor(cmd, 0, &[vk::Rect2D { offset: vk::Offset2D::default(), extent }]);
+            device.cmd_set_scissor(cmd, 0, &[area]);
         }
         self.layout.bind(cmd, vk::PipelineBindPoint::GRAPHICS, set, push);
     }

@@ -12,7 +12,7 @@ use super::graph::{HOST_READ, Resource, Resources, read, write};
 use super::local_exitance::LocalExitancePass;
 use super::pass::{FrameInputs, RenderPass};
 use super::plan::{self, Change, Pass, Plan, Planner};
-use super::shade::{HostTarget, ShadePass, TargetDesc};
+use super::shade::{DepthConvention, DepthTest, HostTarget, ShadePass, TargetDesc};
 use super::shadow::ShadowPass;
 use super::splat::SplatPass;
 use super::targets::{CameraTargets, FrameTargets};
@@ -58,6 +58,13 @@ pub enum RenderError {
     /// `resize` of a renderer drawing into a host's target.
     #[error("resize: a host target's size comes with each frame's HostTarget")]
     ResizeHostTarget,
+    /// `record_exitance` of a renderer drawing into its own images: its levels of detail follow
+    /// its own image, and `frame` with `exitance` reads its exitance.
+    #[error("record_exitance is for a host-target renderer (TargetDesc::Host); this one draws into its own images")]
+    ExitanceOnOwnTarget,
+    /// `record_exitance` told that the host will write the exitance, or access it not at all.
+    #[error("record_exitance: {0:?} is not a read; the host may only read the exitance it is handed")]
+    ExitanceReader(Access),
     /// A `HostTarget` given to a renderer that draws into its own images.
     #[error("this renderer draws into its own images: record it without a HostTarget")]
     UnexpectedHostTarget,
@@ -70,16 +77,48 @@ pub enum RenderError {
         /// The extent given.
         extent: [u32; 2],
     },
-    /// A `HostTarget` whose render area is larger than one of its images, or than the device
-    /// allows.
-    #[error("HostTarget extent {}x{} is larger than {what} ({}x{})", extent[0], extent[1], limit[0], limit[1])]
+    /// A `HostTarget` whose render area, from its offset, reaches past one of its images, or
+    /// past what the device allows.
+    #[error(
+        "HostTarget extent {}x{} at offset ({}, {}) is larger than {what} ({}x{})",
+        extent[0], extent[1], offset[0], offset[1], limit[0], limit[1]
+    )]
     HostTargetTooLarge {
-        /// The render area given.
+        /// The render area's size.
         extent: [u32; 2],
+        /// The render area's offset.
+        offset: [i32; 2],
         /// What it exceeds: "the colour image", "the depth image" or the device limit.
         what: &'static str,
         /// Its size.
         limit: [u32; 2],
+    },
+    /// A `HostTarget` whose render area begins left of or above its images.
+    #[error("HostTarget offset ({}, {}): a render area's offset must not be negative", offset[0], offset[1])]
+    HostTargetOffset {
+        /// The offset given.
+        offset: [i32; 2],
+    },
+    /// `RendererOptions::frames_in_flight` of 0, or past `Renderer::MAX_FRAMES_IN_FLIGHT`.
+    #[error("frames_in_flight = {given}: a renderer takes 1 to {max} frames in flight")]
+    FramesInFlight {
+        /// The count given.
+        given: usize,
+        /// `Renderer::MAX_FRAMES_IN_FLIGHT`.
+        max: usize,
+    },
+    /// A `DepthTest` whose comparison does not pass nearer fragments under its convention.
+    #[error(
+        "depth compare {compare:?} under {convention:?} depth would hide what is nearer: use {expected} (or EQUAL, \
+         ALWAYS)"
+    )]
+    DepthCompare {
+        /// The comparison given.
+        compare: vk::CompareOp,
+        /// The convention given.
+        convention: DepthConvention,
+        /// The comparisons that suit it.
+        expected: &'static str,
     },
     /// A `HostTarget` attachment of another format than the `TargetDesc` the pipelines were
     /// made for.
@@ -101,7 +140,7 @@ pub enum RenderError {
     /// `read_timings` of a frame whose timestamp queries a later frame has reused.
     #[error(
         "frame {frame}'s timings were overwritten by frame {by}: read them before {in_flight} more frames are \
-         recorded (Renderer::FRAMES_IN_FLIGHT)"
+         recorded (RendererOptions::frames_in_flight)"
     )]
     TimingsOverwritten {
         /// The frame asked for (`RecordedFrame::generation`).
@@ -216,6 +255,19 @@ impl CameraView {
         }
     }
 
+    /// This camera with its depth reversed (reversed-Z, `DepthConvention::Reversed`): clip
+    /// depth `z` becomes `w - z`, so that the near plane is at 1 and the far plane at 0; what
+    /// is drawn where is unchanged.
+    pub fn reversed_depth(self) -> CameraView {
+        let reverse = Mat4::from_cols(
+            glam::Vec4::X,
+            glam::Vec4::Y,
+            glam::Vec4::new(0.0, 0.0, -1.0, 0.0),
+            glam::Vec4::new(0.0, 0.0, 1.0, 1.0),
+        );
+        CameraView { projection: reverse * self.projection, ..self }
+    }
+
     /// This camera turned by `degrees` about the vertical axis through `centre` (the world
     /// turning the other way in its view).
     pub fn orbited(self, centre: Vec3, degrees: f32) -> CameraView {
@@ -262,6 +314,45 @@ pub struct LevelExitance {
     pub values: Vec<[f32; 3]>,
 }
 
+/// What a host chooses of a renderer beyond its target (`Renderer::with_options`); `default()`
+/// is what `Renderer::new` and `with_target` take.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RendererOptions {
+    /// Frames that may be in flight at once, each with its own timestamp queries: a frame's
+    /// timings can be read until this many later frames are recorded (`read_timings`).
+    /// 1 to `Renderer::MAX_FRAMES_IN_FLIGHT`; `Renderer::FRAMES_IN_FLIGHT` (3) by default.
+    pub frames_in_flight: usize,
+    /// The depth test shading makes against the target's depth, and what it clears depth to;
+    /// standard depth (0 near, LESS_OR_EQUAL) by default. With reversed-Z, give the renderer
+    /// reversed projections (`CameraView::reversed_depth`); its first camera is reversed so.
+    pub depth: DepthTest,
+}
+
+impl Default for RendererOptions {
+    fn default() -> Self {
+        RendererOptions { frames_in_flight: Renderer::FRAMES_IN_FLIGHT, depth: DepthTest::STANDARD }
+    }
+}
+
+impl RendererOptions {
+    /// An error naming what the options get wrong.
+    fn check(&self) -> Result<(), RenderError> {
+        let max = Renderer::MAX_FRAMES_IN_FLIGHT;
+        if self.frames_in_flight == 0 || self.frames_in_flight > max {
+            return Err(RenderError::FramesInFlight { given: self.frames_in_flight, max });
+        }
+        if !self.depth.is_consistent() {
+            let expected = match self.depth.convention {
+                DepthConvention::Standard => "LESS or LESS_OR_EQUAL",
+                DepthConvention::Reversed => "GREATER or GREATER_OR_EQUAL",
+            };
+            let DepthTest { compare, convention } = self.depth;
+            return Err(RenderError::DepthCompare { compare, convention, expected });
+        }
+        Ok(())
+    }
+}
+
 /// Renders one prepared scene: its passes over its GPU data, recording the passes each frame
 /// needs into a command buffer (the host's, or its own for `frame`).
 ///
@@ -306,6 +397,8 @@ pub struct Renderer {
     hazards: RefCell<Hazards<Resource>>,
     background: [f32; 3],
     target: TargetDesc,
+    /// The host's choices it was made with.
+    options: RendererOptions,
     camera: CameraView,
     /// The frames' history: pending change, stale objects, gathered levels, baked levels.
     planner: Planner,
@@ -322,8 +415,12 @@ pub const SKY_LOCK_SHARE: f32 = 0.002;
 static NEXT_RENDERER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 impl Renderer {
-    /// Frames a host may have in flight at once: each has its own timestamp queries.
+    /// Frames a host may have in flight at once unless it chooses
+    /// (`RendererOptions::frames_in_flight`): each has its own timestamp queries.
     pub const FRAMES_IN_FLIGHT: usize = 3;
+    /// The most frames in flight a renderer takes: each is a query pool, and a count past
+    /// what any swapchain holds is more likely a mistake than a wish.
+    pub const MAX_FRAMES_IN_FLIGHT: usize = 16;
 
     /// A renderer drawing into its own HDR image, tone-mapped for readback (the CLI's path).
     pub fn new(gpu: &Arc<Gpu>, scene: PreparedScene) -> Result<Renderer, RenderError> {
@@ -333,6 +430,18 @@ impl Renderer {
     /// A renderer drawing into `target`: its own images, or a host engine's of the given
     /// formats (then `record_frame` takes the host's attachments, and there is no tone map).
     pub fn with_target(gpu: &Arc<Gpu>, scene: PreparedScene, target: TargetDesc) -> Result<Renderer, RenderError> {
+        Renderer::with_options(gpu, scene, target, RendererOptions::default())
+    }
+
+    /// As `with_target`, with the host's choices (`RendererOptions`: frames in flight, the
+    /// depth test), checked before anything is made.
+    pub fn with_options(
+        gpu: &Arc<Gpu>,
+        scene: PreparedScene,
+        target: TargetDesc,
+        options: RendererOptions,
+    ) -> Result<Renderer, RenderError> {
+        options.check()?;
         check_fits(gpu, &scene)?;
         if let TargetDesc::Host { color_format, depth_format } = target {
             check_host_formats(gpu, color_format, depth_format)?;
@@ -347,12 +456,12 @@ impl Renderer {
         let camera = (target == TargetDesc::Own).then_some((scene.scene.file.camera.resolution, needs.pixel_gather));
         let targets = FrameTargets::new(gpu, settings.shadow_map_size, scene.shadow_layers, camera)?;
         let resources = Resources { scene: &buffers, targets: &targets };
-        let shade = ShadePass::new(gpu, target, &resources, needs.pixel_gather)?;
+        let shade = ShadePass::new(gpu, target, &resources, needs.pixel_gather, options.depth)?;
         let gather = Self::gather_pass(gpu, &resources, settings.gather, needs.pixel_gather)?;
         let mut hazards = Hazards::new();
         targets.track(&mut hazards);
         // Timing is optional: a queue without timestamps still renders.
-        let timers = (0..Self::FRAMES_IN_FLIGHT)
+        let timers = (0..options.frames_in_flight)
             .map(|_| GpuTimer::new(gpu, 8))
             .collect::<Result<Vec<_>, _>>()
             .inspect_err(|e| log::warn!("no GPU timings: {e}"))
@@ -377,7 +486,11 @@ impl Renderer {
             background: scene.background(),
             needs,
             target,
-            camera: CameraView::of_scene(&scene),
+            camera: match options.depth.convention {
+                DepthConvention::Standard => CameraView::of_scene(&scene),
+                DepthConvention::Reversed => CameraView::of_scene(&scene).reversed_depth(),
+            },
+            options,
             planner,
             scene,
         })
@@ -396,6 +509,11 @@ impl Renderer {
             GatherMode::Hierarchical => Box::new(GatherTreePass::new(gpu, resources)?),
             _ => Box::new(GatherPass::new(gpu, resources)?),
         })
+    }
+
+    /// The host's choices this renderer was made with.
+    pub fn options(&self) -> RendererOptions {
+        self.options
     }
 
     /// The prepared scene this renderer draws.
@@ -565,14 +683,61 @@ impl Renderer {
     ) -> Result<RecordedFrame, RenderError> {
         if let Some(t) = target {
             super::host::check_target(&self.gpu, self.target, t)?;
-            if self.host_extent.is_some_and(|e| e != t.extent) {
-                // As for the own image's `resize`: the levels of detail follow the new size.
-                self.planner.mark(Change::Camera);
-            }
-            self.host_extent = Some(t.extent);
+            self.follow_extent(t.extent);
         }
         let plan = self.planner.plan(&self.needs, &self.view());
         self.record_plan(cmd, &plan, target)
+    }
+
+    /// Record the exitance that what changed since the last frame calls for, without shading,
+    /// into `cmd` (recording, outside any rendering), for a host that shades itself: the passes
+    /// `record_frame` would record up to the gather (shadow maps, sky light, splat, gather), and
+    /// none after. No submission and no wait; `read_timings` and the lifetime rule are those
+    /// of `record_frame`.
+    ///
+    /// `extent` is the size in pixels the host draws the view at (set with `set_camera`): the
+    /// levels of detail follow it, as they follow a `HostTarget`'s extent. `readers` are the
+    /// accesses the host will read the output with (`Access::VertexAttributeRead` for a vertex
+    /// stream, `ComputeRead`, `FragmentRead`, `TransferRead`, `HostRead`): the call ends with
+    /// the barrier from the gather's writes to them, and the next frame's writes wait for them.
+    ///
+    /// The output is `buffers().exitance`, and `buffers().environment_irradiance` for the sky
+    /// light, one `vec4` per vertex of every object in scene order (docs/GPU.md, "The exitance
+    /// as an output"). It equals what `record_frame` gathers for the same change and view.
+    pub fn record_exitance(
+        &mut self,
+        cmd: vk::CommandBuffer,
+        extent: vk::Extent2D,
+        readers: &[Access],
+    ) -> Result<RecordedFrame, RenderError> {
+        if self.target == TargetDesc::Own {
+            return Err(RenderError::ExitanceOnOwnTarget);
+        }
+        if extent.width == 0 || extent.height == 0 {
+            return Err(RenderError::HostTargetEmpty { extent: [extent.width, extent.height] });
+        }
+        if let Some(&bad) = readers.iter().find(|a| a.writes() || **a == Access::Nothing) {
+            return Err(RenderError::ExitanceReader(bad));
+        }
+        self.follow_extent(extent);
+        let mut plan = self.planner.plan(&self.needs, &self.view());
+        plan.passes.retain(|(p, _)| !matches!(p, Pass::Shade | Pass::Tonemap));
+        let frame = self.record_checked(cmd, &plan, None);
+        let uses: Vec<_> = [Resource::Exitance, Resource::EnvironmentIrradiance]
+            .iter()
+            .flat_map(|&r| readers.iter().map(move |&a| read(r, a)))
+            .collect();
+        self.hazards.get_mut().before(self.gpu.device(), cmd, &uses);
+        Ok(frame)
+    }
+
+    /// The levels of detail follow `extent`, the host's: a new extent replans as a camera move
+    /// does (as the own image's `resize`).
+    fn follow_extent(&mut self, extent: vk::Extent2D) {
+        if self.host_extent.is_some_and(|e| e != extent) {
+            self.planner.mark(Change::Camera);
+        }
+        self.host_extent = Some(extent);
     }
 
     /// Record the passes of `plan` into `cmd` (as `record_frame` does, with a plan of the
@@ -591,6 +756,11 @@ impl Renderer {
             (_, Some(t)) => super::host::check_target(&self.gpu, self.target, t)?,
             _ => {}
         }
+        Ok(self.record_checked(cmd, plan, target))
+    }
+
+    /// `record_plan` after its checks: `target` suits this renderer, or `plan` does not shade.
+    fn record_checked(&mut self, cmd: vk::CommandBuffer, plan: &Plan, target: Option<&HostTarget>) -> RecordedFrame {
         self.generation += 1;
         let slot = (!self.timers.is_empty()).then(|| {
             let slot = (self.generation - 1) as usize % self.timers.len();
@@ -623,7 +793,7 @@ impl Renderer {
         if self.planner.baked_levels() != baked {
             self.needs = Self::needs_of(&self.scene, self.target, &self.planner);
         }
-        Ok(RecordedFrame { passes: recorded, slot, generation: self.generation, renderer: self.id() })
+        RecordedFrame { passes: recorded, slot, generation: self.generation, renderer: self.id() }
     }
 
     /// Identifies this renderer's frames: a number no other renderer of this process has.
@@ -632,13 +802,14 @@ impl Renderer {
     }
 
     /// GPU milliseconds of each pass of `frame`, from its timestamps: call after the host's
-    /// fence for the submission holding it, and before `FRAMES_IN_FLIGHT` more frames were
-    /// recorded (they reuse its queries). Never blocks: before the submission has finished it
-    /// answers `FrameNotDone`, after its queries were reused `TimingsOverwritten`. Empty on a
-    /// queue without timestamps (then nothing tells whether the frame finished). Before the
-    /// fence, `FrameNotDone` is certain only for a slot's first frame: until the GPU begins a
-    /// later one, the slot's queries still hold the results of the frame `FRAMES_IN_FLIGHT`
-    /// before it (docs/GPU.md, "Timestamps").
+    /// fence for the submission holding it, and before `frames_in_flight` more frames were
+    /// recorded (`RendererOptions`; they reuse its queries). Never blocks: before the submission
+    /// has finished it answers `FrameNotDone`, after its queries were reused
+    /// `TimingsOverwritten`. Empty on a queue without timestamps, and for a frame of no pass
+    /// (then nothing tells whether the frame finished). Before the fence, `FrameNotDone` is
+    /// certain only for a slot's first frame: until the GPU begins a later one, the slot's
+    /// queries still hold the results of the frame `frames_in_flight` before it (docs/GPU.md,
+    /// "Timestamps").
     pub fn read_timings(&self, frame: &RecordedFrame) -> Result<FrameTimings, RenderError> {
         if frame.renderer != self.id() {
             return Err(RenderError::ForeignFrame);
@@ -654,7 +825,8 @@ impl Renderer {
             Some(slot) => self.timers[slot].results_if_done()?.ok_or(RenderError::FrameNotDone(frame.generation))?,
             None => Vec::new(),
         };
-        if frame.slot.is_some() {
+        // A frame of no pass wrote no query, so its answer says nothing of its submission.
+        if frame.slot.is_some() && !frame.passes.is_empty() {
             // Frames finish in the order they were recorded (the host's contract).
             self.finished.set(self.finished.get().max(frame.generation));
         }
@@ -938,7 +1110,7 @@ impl Renderer {
         // Built first, then swapped in: an error leaves the renderer as it was.
         let gather = Self::gather_pass(&gpu, &resources, settings.gather, self.needs.pixel_gather)?;
         let (vertex_light, splat) = (VertexLightPass::new(&gpu, &resources)?, SplatPass::new(&gpu, &resources)?);
-        let shade = ShadePass::new(&gpu, self.target, &resources, self.needs.pixel_gather)?;
+        let shade = ShadePass::new(&gpu, self.target, &resources, self.needs.pixel_gather, self.options.depth)?;
         (self.gather, self.vertex_light, self.splat, self.shade) = (gather, vertex_light, splat, shade);
         self.buffers = buffers;
         let hazards = self.hazards.get_mut();

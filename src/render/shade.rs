@@ -47,13 +47,71 @@ pub enum TargetDesc {
     Own,
     /// A host engine's colour and depth images of these formats, given each frame as a
     /// `HostTarget`. The pass writes linear radiance (alpha 1) and depth-tests against the host's
-    /// depth (0 near, 1 far, LESS_OR_EQUAL, depth written).
+    /// depth, depth written, as the renderer's `DepthTest` says (`RendererOptions::depth`: 0 near,
+    /// 1 far and LESS_OR_EQUAL unless the host chose reversed-Z).
     Host {
         /// Format of the host's colour image.
         color_format: vk::Format,
         /// Format of the host's depth image.
         depth_format: vk::Format,
     },
+}
+
+/// Which way depth runs in the target's depth image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum DepthConvention {
+    /// 0 at the near plane, 1 at the far plane: cleared to 1, nearer is less.
+    #[default]
+    Standard,
+    /// Reversed-Z: 1 at the near plane, 0 at the far plane: cleared to 0, nearer is greater
+    /// (float depth's precision then spreads over distance). The camera's projection must map
+    /// so too (`CameraView::reversed_depth`).
+    Reversed,
+}
+
+/// The depth test shading makes against the target's depth (and writes it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DepthTest {
+    /// Which way depth runs: what `load: false` clears to, and which comparisons make sense.
+    pub convention: DepthConvention,
+    /// The comparison: one that passes nearer fragments under `convention` (LESS or
+    /// LESS_OR_EQUAL for standard depth, GREATER or GREATER_OR_EQUAL for reversed), or EQUAL
+    /// (after the host's depth pre-pass) or ALWAYS under either; `Renderer::with_options`
+    /// refuses the others (`RenderError::DepthCompare`).
+    pub compare: vk::CompareOp,
+}
+
+impl DepthTest {
+    /// 0 near, 1 far, LESS_OR_EQUAL: the default, and the CLI's.
+    pub const STANDARD: DepthTest =
+        DepthTest { convention: DepthConvention::Standard, compare: vk::CompareOp::LESS_OR_EQUAL };
+    /// Reversed-Z: 1 near, 0 far, GREATER_OR_EQUAL.
+    pub const REVERSED: DepthTest =
+        DepthTest { convention: DepthConvention::Reversed, compare: vk::CompareOp::GREATER_OR_EQUAL };
+
+    /// The far plane's depth, which `load: false` clears to.
+    pub fn far(self) -> f32 {
+        match self.convention {
+            DepthConvention::Standard => 1.0,
+            DepthConvention::Reversed => 0.0,
+        }
+    }
+
+    /// Whether `compare` passes nearer fragments under `convention` (see `compare`).
+    pub fn is_consistent(self) -> bool {
+        use vk::CompareOp as C;
+        match (self.convention, self.compare) {
+            (_, C::EQUAL | C::ALWAYS) => true,
+            (DepthConvention::Standard, c) => c == C::LESS || c == C::LESS_OR_EQUAL,
+            (DepthConvention::Reversed, c) => c == C::GREATER || c == C::GREATER_OR_EQUAL,
+        }
+    }
+}
+
+impl Default for DepthTest {
+    fn default() -> Self {
+        DepthTest::STANDARD
+    }
 }
 
 /// A host's attachments for one frame (`TargetDesc::Host`). On entry and on exit the colour
@@ -71,9 +129,13 @@ pub struct HostTarget {
     pub color: HostAttachment,
     /// The host's depth image.
     pub depth: HostAttachment,
-    /// The render area (from the images' origin), viewport and scissor: at least 1x1, and
-    /// within both images.
+    /// The render area's size, and the viewport's and scissor's: at least 1x1, and within both
+    /// images from `offset`. The camera's projection is for this size's aspect ratio, and
+    /// levels of detail follow it.
     pub extent: vk::Extent2D,
+    /// The render area's top-left corner in both images (`vk::Offset2D::default()`: the
+    /// origin): not negative. Pixels outside the area are neither cleared nor drawn.
+    pub offset: vk::Offset2D,
     /// Keep the host's colour and depth (`true`), or clear them to the scene's background and
     /// the far plane (`false`).
     pub load: bool,
@@ -101,6 +163,8 @@ pub struct ShadePass {
     set: DescriptorSet,
     /// Whether it draws the surface image too (shade_pixel.frag's second attachment).
     pixel_gather: bool,
+    /// What the depth attachment is cleared to when not loaded: the far plane.
+    depth_clear: f32,
 }
 
 /// A per-vertex vec4 stream (exitance, cached irradiance) at `binding`, read at `location`.
@@ -115,33 +179,44 @@ fn vec4_stream(
 }
 
 impl ShadePass {
-    /// The pipeline for `target`'s formats and one descriptor set over `BINDINGS`.
-    pub fn new(gpu: &Arc<Gpu>, target: TargetDesc, resources: &Resources, pixel_gather: bool) -> GpuResult<ShadePass> {
+    /// The pipeline for `target`'s formats and `depth`'s test, and one descriptor set over
+    /// `BINDINGS`.
+    pub fn new(
+        gpu: &Arc<Gpu>,
+        target: TargetDesc,
+        resources: &Resources,
+        pixel_gather: bool,
+        depth: DepthTest,
+    ) -> GpuResult<ShadePass> {
         let fragment = if pixel_gather { "shade_pixel.frag" } else { "shade.frag" };
         let mut desc = GraphicsDesc::new("shade.vert", Some(fragment));
         let (exitance, environment) = (vec4_stream(1, 2), vec4_stream(2, 3));
         desc.vertex_bindings = vec![Vertex::binding(), exitance.0, environment.0];
         desc.vertex_attributes =
             vec![Vertex::position_attribute(), Vertex::normal_attribute(), exitance.1, environment.1];
-        let (color, depth) = match target {
+        let (color, depth_format) = match target {
             TargetDesc::Own => (HDR_FORMAT, CAMERA_DEPTH_FORMAT),
             TargetDesc::Host { color_format, depth_format } => (color_format, depth_format),
         };
         desc.color_formats = if pixel_gather { vec![color, SURFACE_FORMAT] } else { vec![color] };
-        desc.depth_format = Some(depth);
+        desc.depth_format = Some(depth_format);
+        desc.depth_compare = depth.compare;
         let pipeline = GraphicsPipeline::new(gpu, &desc)?;
         let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
-        Ok(ShadePass { pipeline, set, pixel_gather })
+        Ok(ShadePass { pipeline, set, pixel_gather, depth_clear: depth.far() })
     }
 
-    /// Views, depth view, extent and whether to load: the frame targets' camera images, or the
-    /// host's attachments.
-    fn attachments(&self, frame: &FrameInputs) -> (Vec<vk::ImageView>, vk::ImageView, vk::Extent2D, bool) {
+    /// Views, depth view, render area and whether to load: the frame targets' camera images, or
+    /// the host's attachments.
+    fn attachments(&self, frame: &FrameInputs) -> (Vec<vk::ImageView>, vk::ImageView, vk::Rect2D, bool) {
         match (frame.target, &frame.targets.camera) {
-            (Some(t), _) => (vec![t.color.view], t.depth.view, t.extent, t.load),
+            (Some(t), _) => {
+                (vec![t.color.view], t.depth.view, vk::Rect2D { offset: t.offset, extent: t.extent }, t.load)
+            }
             (None, Some(c)) => {
                 let colors = std::iter::once(&c.hdr).chain(c.surface.as_ref().filter(|_| self.pixel_gather));
-                (colors.map(|i| i.view()).collect(), c.depth.view(), c.hdr.extent(), false)
+                let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: c.hdr.extent() };
+                (colors.map(|i| i.view()).collect(), c.depth.view(), area, false)
             }
             (None, None) => unreachable!("Renderer checks that a host target is given"),
         }
@@ -178,7 +253,7 @@ impl RenderPass for ShadePass {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         let device = frame.gpu.device();
         let scene = frame.scene;
-        let (views, depth_view, extent, load) = self.attachments(frame);
+        let (views, depth_view, area, load) = self.attachments(frame);
         let load_op = if load { vk::AttachmentLoadOp::LOAD } else { vk::AttachmentLoadOp::CLEAR };
         let [r, g, b] = frame.background;
         let clears = [[r, g, b, 1.0], [0.0; 4]];
@@ -204,9 +279,11 @@ impl RenderPass for ShadePass {
             } else {
                 vk::AttachmentStoreOp::DONT_CARE
             })
-            .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
+            .clear_value(vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue { depth: self.depth_clear, stencil: 0 },
+            });
         let info = vk::RenderingInfo::default()
-            .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent })
+            .render_area(area)
             .layer_count(1)
             .color_attachments(&colors)
             .depth_attachment(&depth);
@@ -230,7 +307,7 @@ impl RenderPass for ShadePass {
                     frame.plan.skip_terms,
                 ],
             };
-            self.pipeline.bind(cmd, Some(&self.set), &push, extent);
+            self.pipeline.bind_area(cmd, Some(&self.set), &push, area);
             self.pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
         }
         unsafe { device.cmd_end_rendering(cmd) };

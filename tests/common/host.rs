@@ -36,7 +36,13 @@ impl HostImages {
     pub fn target(&self, extent: vk::Extent2D) -> HostTarget {
         let attachment =
             |image: &Image| HostAttachment { view: image.view(), format: image.desc().format, extent: image.extent() };
-        HostTarget { color: attachment(&self.color), depth: attachment(&self.depth), extent, load: false }
+        HostTarget {
+            color: attachment(&self.color),
+            depth: attachment(&self.depth),
+            extent,
+            offset: vk::Offset2D::default(),
+            load: false,
+        }
     }
 
     /// The target over the whole images.
@@ -58,6 +64,34 @@ impl HostImages {
                 discard: true,
             };
             barrier.record(gpu.device(), cmd);
+        }
+    }
+
+    /// Record the host's own clear of both whole images (colour to `color`, depth to `depth`),
+    /// in the attachment layouts (after `to_attachments`), as its drawing before translucent's.
+    pub fn clear(&self, gpu: &Gpu, cmd: vk::CommandBuffer, color: [f32; 4], depth: f32) {
+        let colors = [vk::RenderingAttachmentInfo::default()
+            .image_view(self.color.view())
+            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: color } })];
+        let depth = vk::RenderingAttachmentInfo::default()
+            .image_view(self.depth.view())
+            .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth, stencil: 0 } });
+        let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: self.color.extent() };
+        let info = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(&colors)
+            .depth_attachment(&depth);
+        // SAFETY: `cmd` is recording outside rendering; both images are in the layouts named.
+        unsafe {
+            gpu.device().cmd_begin_rendering(cmd, &info);
+            gpu.device().cmd_end_rendering(cmd);
         }
     }
 
