@@ -30,6 +30,12 @@ layout(std430, set = 0, binding = 1) readonly buffer Lights { Light lights[]; };
 layout(set = 0, binding = 2) uniform sampler2DArrayShadow shadow_maps;
 #include "shade_push.glsl"
 
+// Specialization constants: ShadePass makes a pipeline per translucent-or-opaque and per shadow
+// filter, so neither is a branch at run time (a CPU driver runs both sides of a branch it cannot
+// prove uniform; the four-tap filter then cost its taps on every pixel).
+layout(constant_id = 0) const bool SHADE_TRANSLUCENT = false;
+layout(constant_id = 1) const int SHADE_SHADOW_RADIUS = 0;  // light_visibility's radius: 0 one tap, 1 four
+
 // GGX / Trowbridge-Reitz microfacet specular (Walter et al. 2007) with the height-correlated
 // Smith visibility term (Heitz 2014); returns f_s cos(theta_i) without the Fresnel factor.
 float ggx_specular(vec3 n, vec3 wi, vec3 wo, float alpha) {
@@ -58,7 +64,7 @@ void main() {
     // Seen from behind (open meshes, the far side of a thin plane): shade the visible side.
     if (dot(n, wo) < 0.0) n = -n;
     float cos_o = max(dot(n, wo), 0.0);
-    bool translucent = o.kind == MATERIAL_TRANSLUCENT;
+    bool translucent = SHADE_TRANSLUCENT;
     float eta = translucent ? o.eta : 1.5;
     float roughness = o.albedo_roughness.w;
     float alpha = max(roughness * roughness, 1e-3);
@@ -76,7 +82,7 @@ void main() {
         light_incidence(lights[l], v_position, wi, irradiance);
         float cos_i = dot(n, wi);
         if (cos_i <= 0.0) continue;
-        float v = shade_skips(SHADE_SKIP_SHADOW) ? 1.0 : light_visibility(lights[l], shadow_maps, v_position, n, int(push.counts.z));
+        float v = shade_skips(SHADE_SKIP_SHADOW) ? 1.0 : light_visibility(lights[l], shadow_maps, v_position, n, SHADE_SHADOW_RADIUS);
         vec3 lit = irradiance * v;
         if (!shade_skips(SHADE_SKIP_SPECULAR)) {
             vec3 h = normalize(wi + wo);

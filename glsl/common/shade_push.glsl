@@ -7,7 +7,8 @@ struct ShadePush {
     mat4 view_proj;
     vec4 eye_object;        // xyz: camera position; w: object index
     uvec4 counts;           // x: light count; y: key (non-environment) lights, first in the buffer;
-                            // z: shadow filter radius (light_visibility: 0 one tap, 1 four);
+                            // z: shadow filter radius (light_visibility: 0 one tap, 1 four),
+                            //    which the shaders take from SHADE_SHADOW_RADIUS instead;
                             // w: terms left out, to measure their cost (SHADE_SKIP_*)
 };
 layout(push_constant) uniform ShadePushBlock { ShadePush push; };

@@ -225,6 +225,10 @@ pub struct GraphicsDesc {
     pub cull: vk::CullModeFlags,
     /// Constant and slope depth bias, for shadow maps.
     pub depth_bias: Option<(f32, f32)>,
+    /// Specialization constants of both stages: `constant_id` i takes value i (a bool is 0 or
+    /// 1). The driver folds them before compiling, so a branch on one costs nothing, where a
+    /// branch on a push constant is taken lane by lane on a CPU driver (both sides run).
+    pub specialization: Vec<u32>,
 }
 
 impl GraphicsDesc {
@@ -241,6 +245,7 @@ impl GraphicsDesc {
             depth_compare: vk::CompareOp::LESS_OR_EQUAL,
             cull: vk::CullModeFlags::NONE,
             depth_bias: None,
+            specialization: Vec::new(),
         }
     }
 }
@@ -272,19 +277,21 @@ impl GraphicsPipeline {
         let layout = Layout::new(gpu, &shader, &ShaderInterface::merge(&interfaces)?, stages_flags)?;
         let vertex = Module::new(gpu, &desc.vertex)?;
         let fragment = desc.fragment.as_deref().map(|f| Module::new(gpu, f)).transpose()?;
-        let mut stages = vec![
+        let entries: Vec<_> = (0..desc.specialization.len() as u32)
+            .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
+            .collect();
+        let specialization =
+            vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(&desc.specialization));
+        let stage = |flags, module| {
             vk::PipelineShaderStageCreateInfo::default()
-                .stage(vk::ShaderStageFlags::VERTEX)
-                .module(vertex.raw)
-                .name(c"main"),
-        ];
+                .stage(flags)
+                .module(module)
+                .name(c"main")
+                .specialization_info(&specialization)
+        };
+        let mut stages = vec![stage(vk::ShaderStageFlags::VERTEX, vertex.raw)];
         if let Some(f) = &fragment {
-            stages.push(
-                vk::PipelineShaderStageCreateInfo::default()
-                    .stage(vk::ShaderStageFlags::FRAGMENT)
-                    .module(f.raw)
-                    .name(c"main"),
-            );
+            stages.push(stage(vk::ShaderStageFlags::FRAGMENT, f.raw));
         }
         let vertex_input = vk::PipelineVertexInputStateCreateInfo::default()
             .vertex_binding_descriptions(&desc.vertex_bindings)

@@ -159,8 +159,9 @@ const BINDINGS: [Resource; 3] = [Resource::Objects, Resource::Lights, Resource::
 /// for the pixel gather) and its descriptor set, drawing into the frame targets' camera images
 /// (`FrameTargets::camera`) or a host's. One indexed draw per object.
 pub struct ShadePass {
-    pipeline: GraphicsPipeline,
-    set: DescriptorSet,
+    /// Per `[translucent][shadow radius]` (glsl/common/shade.glsl's specialization constants):
+    /// a pipeline and its set.
+    variants: [[(GraphicsPipeline, DescriptorSet); 2]; 2],
     /// Whether it draws the surface image too (shade_pixel.frag's second attachment).
     pixel_gather: bool,
     /// What the depth attachment is cleared to when not loaded: the far plane.
@@ -201,9 +202,15 @@ impl ShadePass {
         desc.color_formats = if pixel_gather { vec![color, SURFACE_FORMAT] } else { vec![color] };
         desc.depth_format = Some(depth_format);
         desc.depth_compare = depth.compare;
-        let pipeline = GraphicsPipeline::new(gpu, &desc)?;
-        let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
-        Ok(ShadePass { pipeline, set, pixel_gather, depth_clear: depth.far() })
+        let bindings = resources.bind_all(&BINDINGS)?;
+        let variant = |translucent: u32, radius: u32| -> GpuResult<(GraphicsPipeline, DescriptorSet)> {
+            let desc = GraphicsDesc { specialization: vec![translucent, radius], ..desc.clone() };
+            let pipeline = GraphicsPipeline::new(gpu, &desc)?;
+            let set = pipeline.descriptor_set(&bindings)?;
+            Ok((pipeline, set))
+        };
+        let variants = [[variant(0, 0)?, variant(0, 1)?], [variant(1, 0)?, variant(1, 1)?]];
+        Ok(ShadePass { variants, pixel_gather, depth_clear: depth.far() })
     }
 
     /// Views, depth view, render area and whether to load: the frame targets' camera images, or
@@ -307,8 +314,10 @@ impl RenderPass for ShadePass {
                     frame.plan.skip_terms,
                 ],
             };
-            self.pipeline.bind_area(cmd, Some(&self.set), &push, area);
-            self.pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
+            let translucent = scene.object_range(i).eta > 0.0;
+            let (pipeline, set) = &self.variants[usize::from(translucent)][usize::from(!frame.plan.one_tap_shadows)];
+            pipeline.bind_area(cmd, Some(set), &push, area);
+            pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
         }
         unsafe { device.cmd_end_rendering(cmd) };
     }
