@@ -195,7 +195,8 @@ fn run_on_gpu(inputs: &[DipoleEvalInput]) -> Vec<DipoleEvalOutput> {
             .descriptor_set(&[
                 Named { name: "Inputs", binding: Binding::Buffer(&src) },
                 Named { name: "Outputs", binding: Binding::Buffer(&dst) },
-            ]).expect("descriptor set");
+            ])
+            .expect("descriptor set");
         gpu.one_shot("dipole_eval", |cmd| {
             pipeline.dispatch(cmd, &set, &count, [count, 1, 1]);
             memory_barrier(gpu.device(), cmd, &[Access::ComputeWrite], &[Access::HostRead]);
