@@ -529,3 +529,25 @@ count = 64
         assert!(worst < 1e-4, "worst relative difference {worst:e}");
     });
 }
+
+/// The shading pass is specialised per shadow filter (one pipeline each): forcing the four-tap
+/// filter must change the picture (so its pipeline is the one drawn), and only at shadow edges.
+#[test]
+fn both_shadow_filter_pipelines_draw_the_built_in_scene_and_differ_only_at_shadow_edges() {
+    with_gpu(|gpu| {
+        let prepared = builtin(&Overrides { resolution: Some([128, 128]), samples: Some(400), ..Default::default() });
+        let mut renderer = Renderer::new(gpu, prepared).unwrap();
+        let mut images = Vec::new();
+        for one_tap in [true, false] {
+            let mut plan = renderer.plan(Change::Everything);
+            plan.one_tap_shadows = one_tap;
+            renderer.frame(&plan).unwrap();
+            images.push(renderer.image().unwrap().0);
+        }
+        let differing = images[0].iter().zip(&images[1]).filter(|(a, b)| a != b).count();
+        let flip = translucent::study::flip::flip_mean(&images[0], &images[1], 128, 128).unwrap();
+        eprintln!("one tap against four: {differing} bytes differ, FLIP mean {flip:.4}");
+        assert!(differing > 0, "the four-tap filter drew the one-tap image");
+        assert!(flip < 0.02, "the filters differ by FLIP {flip}");
+    });
+}
