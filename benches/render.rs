@@ -765,6 +765,10 @@ fn print_roofline(title: &str, passes: &[(String, f64)], yard: &Yardsticks, pair
             None => println!("  {name:<8} {ms:>10.2} {:>13} {:>7}", "-", "-"),
         }
     }
+    println!(
+        "  (the raster yardstick with the shading pass's vertex stage and its four interpolants read: {:.2} ms)",
+        yard.raster_inputs
+    );
     let roof = if light { yard.light() } else { yard.camera() };
     println!("  {:<8} {:>10.2} {:>13.2}", "submit", 0.0, yard.submit);
     println!(

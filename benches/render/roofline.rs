@@ -24,15 +24,16 @@ use translucent::gpu::{
 use translucent::render::plan::Plan;
 use translucent::render::records::Vertex;
 use translucent::render::renderer::Renderer;
-use translucent::render::shade::HDR_FORMAT;
+use translucent::render::shade::{HDR_FORMAT, ShadePush};
 
 /// The camera's depth format (`render::targets::CAMERA_DEPTH_FORMAT`).
 const CAMERA_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
 /// The shadow maps' format (`render::targets::SHADOW_FORMAT`).
 const SHADOW_DEPTH: vk::Format = vk::Format::D16_UNORM;
 
-/// Timed parts per submission: raster, shadow, tone map, gather.
-const PARTS: u32 = 4;
+/// Timed parts per submission: raster, shadow, tone map, gather, raster with the shading pass's
+/// inputs.
+const PARTS: u32 = 5;
 
 /// Median milliseconds of each yardstick part.
 #[derive(Clone, Copy, Debug, Default)]
@@ -45,6 +46,10 @@ pub struct Yardsticks {
     pub tonemap: f64,
     /// The naive gather over as many vertex-sample pairs as the frame's gather.
     pub gather: f64,
+    /// Not part of the roofline: the raster yardstick with the shading pass's own vertex stage
+    /// and interpolants (shade.vert, glsl/bench/raster_inputs.frag), which says how much of the
+    /// gap is the inputs.
+    pub raster_inputs: f64,
     /// An empty submission, wall time from submission to fence.
     pub submit: f64,
 }
@@ -65,6 +70,7 @@ impl Yardsticks {
 pub struct Roofline {
     gpu: Arc<Gpu>,
     raster: GraphicsPipeline,
+    inputs: GraphicsPipeline,
     depth: GraphicsPipeline,
     tonemap: ComputePipeline,
     tonemap_set: DescriptorSet,
@@ -78,7 +84,7 @@ pub struct Roofline {
     _sampler: Sampler,
     timer: GpuTimer,
     /// Times per part, one entry per `run`.
-    times: [Vec<f64>; 5],
+    times: [Vec<f64>; 6],
 }
 
 fn attachment(view: vk::ImageView, layout: vk::ImageLayout, depth: bool) -> vk::RenderingAttachmentInfo<'static> {
@@ -112,6 +118,7 @@ impl Roofline {
         desc.color_formats = vec![HDR_FORMAT];
         desc.depth_format = Some(CAMERA_DEPTH);
         let raster = GraphicsPipeline::new(gpu, &desc).expect("trivial raster pipeline");
+        let inputs = inputs_pipeline(gpu);
         let mut desc = GraphicsDesc::new("bench/depth_only.vert", None);
         desc.vertex_bindings = vec![Vertex::binding()];
         desc.vertex_attributes = vec![Vertex::position_attribute()];
@@ -138,6 +145,7 @@ impl Roofline {
         Roofline {
             gpu: gpu.clone(),
             raster,
+            inputs,
             depth,
             tonemap,
             tonemap_set,
@@ -181,6 +189,9 @@ impl Roofline {
                 timer.begin(cmd, "gather");
                 self.record_naive(cmd, &receivers);
                 timer.end(cmd);
+                timer.begin(cmd, "inputs");
+                self.record_inputs(cmd, renderer, &draws, &view_proj);
+                timer.end(cmd);
             })
             .expect("roofline submission");
         for (i, (_, ms)) in timer.results().expect("roofline timings").into_iter().enumerate() {
@@ -189,13 +200,13 @@ impl Roofline {
         self.timer = timer;
         let start = Instant::now();
         self.gpu.one_shot("empty submission", |_| ()).expect("empty submission");
-        self.times[4].push(start.elapsed().as_secs_f64() * 1e3);
+        self.times[5].push(start.elapsed().as_secs_f64() * 1e3);
     }
 
     /// The medians of every `run` so far.
     pub fn yardsticks(&self) -> Yardsticks {
         let m = |i: usize| median(&mut self.times[i].clone());
-        Yardsticks { raster: m(0), shadow: m(1), tonemap: m(2), gather: m(3), submit: m(4) }
+        Yardsticks { raster: m(0), shadow: m(1), tonemap: m(2), gather: m(3), raster_inputs: m(4), submit: m(5) }
     }
 
     fn record_raster(
@@ -205,6 +216,50 @@ impl Roofline {
         draws: &[translucent::render::gpu_scene::DrawRange],
         view_proj: &[[f32; 4]; 4],
     ) {
+        let draw = |cmd| {
+            // SAFETY: inside the rendering `raster_into` began; the buffers outlive the submission.
+            unsafe {
+                let device = self.gpu.device();
+                device.cmd_bind_vertex_buffers(cmd, 0, &[vertices], &[0]);
+                device.cmd_bind_index_buffer(cmd, indices, 0, vk::IndexType::UINT32);
+            }
+            self.raster.bind(cmd, None, view_proj, self.colour.extent());
+            for d in draws {
+                self.raster.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
+            }
+        };
+        self.raster_into(cmd, draw);
+    }
+
+    /// The shading pass's vertex stage and streams with glsl/bench/raster_inputs.frag.
+    fn record_inputs(
+        &self,
+        cmd: vk::CommandBuffer,
+        renderer: &Renderer,
+        draws: &[translucent::render::gpu_scene::DrawRange],
+        view_proj: &[[f32; 4]; 4],
+    ) {
+        let scene = renderer.buffers();
+        let streams = [scene.vertices.raw(), scene.exitance.raw(), scene.environment_irradiance.raw()];
+        let push = ShadePush { view_proj: *view_proj, eye_object: [0.0; 4], counts: [0; 4] };
+        let draw = |cmd| {
+            // SAFETY: as in `record_raster`.
+            unsafe {
+                let device = self.gpu.device();
+                device.cmd_bind_vertex_buffers(cmd, 0, &streams, &[0, 0, 0]);
+                device.cmd_bind_index_buffer(cmd, scene.indices.raw(), 0, vk::IndexType::UINT32);
+            }
+            self.inputs.bind(cmd, None, &push, self.colour.extent());
+            for d in draws {
+                self.inputs.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
+            }
+        };
+        self.raster_into(cmd, draw);
+    }
+
+    /// Clear the colour and depth targets, record `draw` into them, and leave the colour image
+    /// ready for the tone map.
+    fn raster_into(&self, cmd: vk::CommandBuffer, draw: impl FnOnce(vk::CommandBuffer)) {
         let device = self.gpu.device();
         let colour_access = [Access::ComputeSampledRead];
         ImageBarrier::new(
@@ -231,17 +286,9 @@ impl Roofline {
             .layer_count(1)
             .color_attachments(&colours)
             .depth_attachment(&depth);
-        // SAFETY: `cmd` is recording; the attachments are in the layouts the barriers set; the
-        // renderer's buffers outlive the submission (one_shot waits).
-        unsafe {
-            device.cmd_begin_rendering(cmd, &info);
-            device.cmd_bind_vertex_buffers(cmd, 0, &[vertices], &[0]);
-            device.cmd_bind_index_buffer(cmd, indices, 0, vk::IndexType::UINT32);
-        }
-        self.raster.bind(cmd, None, view_proj, extent);
-        for d in draws {
-            self.raster.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
-        }
+        // SAFETY: `cmd` is recording; the attachments are in the layouts the barriers set.
+        unsafe { device.cmd_begin_rendering(cmd, &info) };
+        draw(cmd);
         unsafe { device.cmd_end_rendering(cmd) };
         ImageBarrier::new(
             self.colour.raw(),
@@ -341,4 +388,27 @@ fn naive_gather(gpu: &Arc<Gpu>, renderer: &Renderer) -> (ComputePipeline, Descri
         ])
         .expect("descriptor set");
     (naive, set, out)
+}
+
+/// shade.vert (the shading pass's vertex stage and three streams) with
+/// glsl/bench/raster_inputs.frag, into the same targets as the raster yardstick.
+fn inputs_pipeline(gpu: &Arc<Gpu>) -> GraphicsPipeline {
+    let stream = |binding: u32, location: u32| {
+        (
+            vk::VertexInputBindingDescription { binding, stride: 16, input_rate: vk::VertexInputRate::VERTEX },
+            vk::VertexInputAttributeDescription {
+                location,
+                binding,
+                format: vk::Format::R32G32B32A32_SFLOAT,
+                offset: 0,
+            },
+        )
+    };
+    let (exitance, environment) = (stream(1, 2), stream(2, 3));
+    let mut desc = GraphicsDesc::new("shade.vert", Some("bench/raster_inputs.frag"));
+    desc.vertex_bindings = vec![Vertex::binding(), exitance.0, environment.0];
+    desc.vertex_attributes = vec![Vertex::position_attribute(), Vertex::normal_attribute(), exitance.1, environment.1];
+    desc.color_formats = vec![HDR_FORMAT];
+    desc.depth_format = Some(CAMERA_DEPTH);
+    GraphicsPipeline::new(gpu, &desc).expect("inputs raster pipeline")
 }
