@@ -551,3 +551,45 @@ fn both_shadow_filter_pipelines_draw_the_built_in_scene_and_differ_only_at_shado
         assert!(flip < 0.02, "the filters differ by FLIP {flip}");
     });
 }
+
+/// The shading pass has a pipeline for scenes whose key lights are all directional, without the
+/// point and spot falloff: a point light far off along the same direction, its intensity
+/// scaled by the distance squared, must draw the same picture through the general pipeline.
+#[test]
+fn a_distant_point_light_draws_what_the_directional_light_it_stands_for_draws() {
+    let scene = |light: &str| {
+        format!(
+            "[camera]\neye = [0.0, 0.01, 0.05]\ntarget = [0.0, 0.0, 0.0]\nresolution = [96, 96]\n\
+             [[object]]\nshape = {{ type = \"sphere\", radius = 0.01, divisions = 24 }}\n\
+             material = {{ type = \"translucent\", preset = \"marble\", mm_per_unit = 1000.0 }}\n\
+             [[light]]\n{light}\nshadows = false\n[sampling]\ncount = 400\n"
+        )
+    };
+    let direction = glam::Vec3::new(0.6, 0.7, 0.4).normalize();
+    let distance = 1000.0f32;
+    let p = direction * distance;
+    let directional = scene("type = \"directional\"\ndirection = [0.6, 0.7, 0.4]\nirradiance = [1.0, 0.9, 0.8]");
+    let point = scene(&format!(
+        "type = \"point\"\nposition = [{}, {}, {}]\nintensity = [{}, {}, {}]",
+        p.x,
+        p.y,
+        p.z,
+        distance * distance,
+        0.9 * distance * distance,
+        0.8 * distance * distance
+    ));
+    with_gpu(|gpu| {
+        let images: Vec<Vec<u8>> = [directional, point]
+            .iter()
+            .map(|toml| {
+                let renderer = run_all(gpu, prepare(toml, &Overrides::default()));
+                renderer.image().unwrap().0
+            })
+            .collect();
+        let worst = images[0].iter().zip(&images[1]).map(|(a, b)| a.abs_diff(*b)).max().unwrap();
+        let lit = images[0].iter().filter(|&&v| v > 8).count();
+        eprintln!("worst difference {worst}/255 over {lit} lit channel values");
+        assert!(lit > 1000, "the sphere is lit");
+        assert!(worst <= 2, "the two lights drew pictures {worst}/255 apart");
+    });
+}

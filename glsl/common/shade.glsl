@@ -35,6 +35,9 @@ layout(set = 0, binding = 2) uniform sampler2DArrayShadow shadow_maps;
 // prove uniform; the four-tap filter then cost its taps on every pixel).
 layout(constant_id = 0) const bool SHADE_TRANSLUCENT = false;
 layout(constant_id = 1) const int SHADE_SHADOW_RADIUS = 0;  // light_visibility's radius: 0 one tap, 1 four
+// Every key light is directional: the point and spot lights' falloff, which would run (and read
+// its light fields) for every pixel whatever the light, is left out.
+layout(constant_id = 2) const bool SHADE_DIRECTIONAL_KEYS = false;
 
 // GGX / Trowbridge-Reitz microfacet specular (Walter et al. 2007) with the height-correlated
 // Smith visibility term (Heitz 2014); returns f_s cos(theta_i) without the Fresnel factor.
@@ -79,7 +82,12 @@ void main() {
     // The key lights come first in the buffer (scene::lights::prepare); counts.y of them.
     for (uint l = 0u; l < push.counts.y; ++l) {
         vec3 wi, irradiance;
-        light_incidence(lights[l], v_position, wi, irradiance);
+        if (SHADE_DIRECTIONAL_KEYS) {
+            wi = lights[l].direction_cos.xyz;
+            irradiance = lights[l].power_layer.rgb;
+        } else {
+            light_incidence(lights[l], v_position, wi, irradiance);
+        }
         float cos_i = dot(n, wi);
         if (cos_i <= 0.0) continue;
         float v = shade_skips(SHADE_SKIP_SHADOW) ? 1.0 : light_visibility(lights[l], shadow_maps, v_position, n, SHADE_SHADOW_RADIUS);

@@ -157,6 +157,9 @@ pub struct GpuScene {
     pub light_count: u32,
     /// Lights that are not environment directions; they come first in the light buffer.
     pub key_light_count: u32,
+    /// Whether every key light is directional (`lights::key_lights_directional`), for the
+    /// shading pass's choice of pipeline; kept with the records `set_lights` uploads.
+    pub key_lights_directional: bool,
     /// Light records waiting to be copied into `lights` by the next recorded frame.
     pending_lights: Option<Vec<LightGpu>>,
     /// The object records as last packed; copied into `objects` by the next recorded frame when
@@ -440,6 +443,7 @@ impl GpuScene {
             sample_count: p.samples.len() as u32,
             light_count: scene.lights.len() as u32,
             key_light_count: crate::scene::lights::key_light_count(&scene.lights) as u32,
+            key_lights_directional: crate::scene::lights::key_lights_directional(&scene.lights),
             pending_lights: None,
             object_records: p.objects,
             pending_objects: false,
@@ -457,6 +461,7 @@ impl GpuScene {
             }
         }
         self.pending_lights = Some(scene.lights.iter().map(LightGpu::new).collect());
+        self.key_lights_directional = crate::scene::lights::key_lights_directional(&scene.lights);
     }
 
     /// Every object's vertex and sample range and index of refraction, in scene order, read from

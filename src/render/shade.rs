@@ -159,9 +159,9 @@ const BINDINGS: [Resource; 3] = [Resource::Objects, Resource::Lights, Resource::
 /// for the pixel gather) and its descriptor set, drawing into the frame targets' camera images
 /// (`FrameTargets::camera`) or a host's. One indexed draw per object.
 pub struct ShadePass {
-    /// Per `[translucent][shadow radius]` (glsl/common/shade.glsl's specialization constants):
-    /// a pipeline and its set.
-    variants: [[(GraphicsPipeline, DescriptorSet); 2]; 2],
+    /// Per `[translucent][shadow radius][key lights all directional]` (glsl/common/shade.glsl's
+    /// specialization constants): a pipeline and its set.
+    variants: [[[(GraphicsPipeline, DescriptorSet); 2]; 2]; 2],
     /// Whether it draws the surface image too (shade_pixel.frag's second attachment).
     pixel_gather: bool,
     /// What the depth attachment is cleared to when not loaded: the far plane.
@@ -203,13 +203,16 @@ impl ShadePass {
         desc.depth_format = Some(depth_format);
         desc.depth_compare = depth.compare;
         let bindings = resources.bind_all(&BINDINGS)?;
-        let variant = |translucent: u32, radius: u32| -> GpuResult<(GraphicsPipeline, DescriptorSet)> {
-            let desc = GraphicsDesc { specialization: vec![translucent, radius], ..desc.clone() };
-            let pipeline = GraphicsPipeline::new(gpu, &desc)?;
-            let set = pipeline.descriptor_set(&bindings)?;
-            Ok((pipeline, set))
-        };
-        let variants = [[variant(0, 0)?, variant(0, 1)?], [variant(1, 0)?, variant(1, 1)?]];
+        let variant =
+            |translucent: u32, radius: u32, directional: u32| -> GpuResult<(GraphicsPipeline, DescriptorSet)> {
+                let desc = GraphicsDesc { specialization: vec![translucent, radius, directional], ..desc.clone() };
+                let pipeline = GraphicsPipeline::new(gpu, &desc)?;
+                let set = pipeline.descriptor_set(&bindings)?;
+                Ok((pipeline, set))
+            };
+        let by_lights =
+            |t, r| -> GpuResult<[(GraphicsPipeline, DescriptorSet); 2]> { Ok([variant(t, r, 0)?, variant(t, r, 1)?]) };
+        let variants = [[by_lights(0, 0)?, by_lights(0, 1)?], [by_lights(1, 0)?, by_lights(1, 1)?]];
         Ok(ShadePass { variants, pixel_gather, depth_clear: depth.far() })
     }
 
@@ -315,7 +318,9 @@ impl RenderPass for ShadePass {
                 ],
             };
             let translucent = scene.object_range(i).eta > 0.0;
-            let (pipeline, set) = &self.variants[usize::from(translucent)][usize::from(!frame.plan.one_tap_shadows)];
+            let filter = usize::from(!frame.plan.one_tap_shadows);
+            let (pipeline, set) =
+                &self.variants[usize::from(translucent)][filter][usize::from(scene.key_lights_directional)];
             pipeline.bind_area(cmd, Some(set), &push, area);
             pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
         }

@@ -506,6 +506,12 @@ pub fn key_light_count(lights: &[PreparedLight]) -> usize {
     lights.iter().take_while(|l| !l.environment).count()
 }
 
+/// Whether every key light of `lights` is directional (the shading pass then leaves the point
+/// and spot lights' falloff out of its pipeline).
+pub fn key_lights_directional(lights: &[PreparedLight]) -> bool {
+    lights.iter().filter(|l| !l.environment).all(|l| matches!(l.kind, LightKind::Directional { .. }))
+}
+
 /// Assign shadow-map layers to the lights that cast shadows; returns the layer count.
 pub fn assign_shadow_layers(lights: &mut [PreparedLight], any_caster: bool) -> u32 {
     let mut layers = 0;
