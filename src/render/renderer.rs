@@ -676,6 +676,34 @@ impl Renderer {
     /// into `cmd`, a primary command buffer the host is recording, outside any rendering. No
     /// submission and no wait: the host submits, and may read `read_timings` after its fence.
     /// `target` is the host's attachments for a `TargetDesc::Host` renderer, `None` otherwise.
+    ///
+    /// ```no_run
+    /// use translucent::ash::vk;
+    /// use translucent::{Gpu, HostAttachment, HostTarget, Overrides, PreparedScene, Renderer, Scene, TargetDesc};
+    /// # fn frame(
+    /// #     gpu: &std::sync::Arc<Gpu>,
+    /// #     cmd: vk::CommandBuffer,
+    /// #     color_view: vk::ImageView,
+    /// #     depth_view: vk::ImageView,
+    /// # ) -> Result<(), Box<dyn std::error::Error>> {
+    /// let (color_format, depth_format) = (vk::Format::R16G16B16A16_SFLOAT, vk::Format::D32_SFLOAT);
+    /// let scene = PreparedScene::new(&Scene::builtin(), &Overrides::default())?;
+    /// let mut renderer = Renderer::with_target(gpu, scene, TargetDesc::Host { color_format, depth_format })?;
+    /// // Each frame: `cmd` is recording, outside any rendering, and the engine's images are in
+    /// // COLOR_ATTACHMENT_OPTIMAL and DEPTH_ATTACHMENT_OPTIMAL (docs/GPU.md).
+    /// let extent = vk::Extent2D { width: 1280, height: 720 };
+    /// let target = HostTarget {
+    ///     color: HostAttachment { view: color_view, format: color_format, extent },
+    ///     depth: HostAttachment { view: depth_view, format: depth_format, extent },
+    ///     extent,
+    ///     offset: vk::Offset2D::default(),
+    ///     load: true,
+    /// };
+    /// let recorded = renderer.record_frame(cmd, Some(&target))?;
+    /// // ... the engine's own passes; it ends `cmd`, submits it and waits on its fence ...
+    /// let timings = renderer.read_timings(&recorded)?;
+    /// # Ok(()) }
+    /// ```
     pub fn record_frame(
         &mut self,
         cmd: vk::CommandBuffer,
