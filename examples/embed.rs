@@ -16,6 +16,7 @@ use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use translucent::gpu::{EnabledFeatures, Gpu, GpuOptions, HostVulkan, required_features};
+use translucent::render::host::HostSync;
 use translucent::render::plan::Pass;
 use translucent::render::renderer::{CameraView, Renderer};
 use translucent::render::shade::{HostAttachment, HostTarget, TargetDesc};
@@ -849,6 +850,7 @@ fn render_frames(engine: &Engine, gpu: Arc<Gpu>, options: &Options) -> Result<Ru
         depth: HostAttachment { view: engine.depth.view, format: DEPTH_FORMAT, extent },
         extent,
         offset: vk::Offset2D::default(),
+        sync: HostSync::Attachments,
         load: true,
     };
     let mut frames = Vec::new();

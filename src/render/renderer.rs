@@ -9,6 +9,7 @@ use super::gather_sparse::GatherSparsePass;
 use super::gather_tree::GatherTreePass;
 use super::gpu_scene::GpuScene;
 use super::graph::{HOST_READ, Resource, Resources, read, write};
+use super::host::HostSync;
 use super::local_exitance::LocalExitancePass;
 use super::pass::{FrameInputs, RenderPass};
 use super::plan::{self, Change, Pass, Plan, Planner};
@@ -92,6 +93,14 @@ pub enum RenderError {
         what: &'static str,
         /// Its size.
         limit: [u32; 2],
+    },
+    /// A `HostTarget` whose declared image states (`HostSync::Declared`) cannot be right.
+    #[error("the HostTarget's {which} image: {reason}")]
+    HostTargetState {
+        /// "colour" or "depth".
+        which: &'static str,
+        /// What is wrong.
+        reason: &'static str,
     },
     /// A `HostTarget` whose render area begins left of or above its images.
     #[error("HostTarget offset ({}, {}): a render area's offset must not be negative", offset[0], offset[1])]
@@ -679,7 +688,9 @@ impl Renderer {
     ///
     /// ```no_run
     /// use translucent::ash::vk;
-    /// use translucent::{Gpu, HostAttachment, HostTarget, Overrides, PreparedScene, Renderer, Scene, TargetDesc};
+    /// use translucent::{
+    ///     Gpu, HostAttachment, HostSync, HostTarget, Overrides, PreparedScene, Renderer, Scene, TargetDesc,
+    /// };
     /// # fn frame(
     /// #     gpu: &std::sync::Arc<Gpu>,
     /// #     cmd: vk::CommandBuffer,
@@ -697,6 +708,7 @@ impl Renderer {
     ///     depth: HostAttachment { view: depth_view, format: depth_format, extent },
     ///     extent,
     ///     offset: vk::Offset2D::default(),
+    ///     sync: HostSync::Attachments,
     ///     load: true,
     /// };
     /// let recorded = renderer.record_frame(cmd, Some(&target))?;
@@ -872,11 +884,17 @@ impl Renderer {
         target: Option<&HostTarget>,
     ) -> Vec<Pass> {
         let layers = plan.shadow_light.map(|source| self.scene.shadow_layers_of(source));
-        if target.is_some() {
-            // The host's contract: it drew into its attachments before this frame.
+        if let Some(t) = target {
             let mut hazards = self.hazards.borrow_mut();
-            hazards.external(Resource::HostColor, Access::ColorAttachmentWrite);
-            hazards.external(Resource::HostDepth, Access::DepthAttachmentReadWrite);
+            if t.sync == HostSync::Attachments {
+                // The host's contract: it drew into its attachments before this frame.
+                hazards.external(Resource::HostColor, Access::ColorAttachmentWrite);
+                hazards.external(Resource::HostDepth, Access::DepthAttachmentReadWrite);
+            } else {
+                // The shading pass records the barriers from and to the declared states itself.
+                hazards.forget(Resource::HostColor);
+                hazards.forget(Resource::HostDepth);
+            }
         }
         let frame = self.inputs(plan, layers.as_deref(), target);
         let mut recorded = Vec::new();

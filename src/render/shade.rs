@@ -9,6 +9,7 @@
 //! Bindings: 0 = objects, 1 = lights, 2 = shadow maps. Push: `ShadePush`.
 
 use super::graph::{Resource, Resources, Use, overwrite, read, write};
+use super::host::HostSync;
 use super::pass::{FrameInputs, RenderPass};
 use super::records::Vertex;
 use crate::gpu::{Access, DescriptorSet, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline};
@@ -114,10 +115,12 @@ impl Default for DepthTest {
     }
 }
 
-/// A host's attachments for one frame (`TargetDesc::Host`). On entry and on exit the colour
-/// image is in COLOR_ATTACHMENT_OPTIMAL and the depth image in DEPTH_ATTACHMENT_OPTIMAL; the
-/// pass waits for earlier attachment writes, and its own writes are done at the colour-output
-/// and late-fragment-test stages, where the host's next barrier picks them up.
+/// A host's attachments for one frame (`TargetDesc::Host`). By default (`HostSync::Attachments`)
+/// on entry and on exit the colour image is in COLOR_ATTACHMENT_OPTIMAL and the depth image in
+/// DEPTH_ATTACHMENT_OPTIMAL; the pass waits for earlier attachment writes, and its own writes
+/// are done at the colour-output and late-fragment-test stages, where the host's next barrier
+/// picks them up. With `HostSync::Declared` the pass records the barriers from and to the
+/// states the host declares instead.
 ///
 /// Each attachment carries its image's format and size, because a view does not say them and
 /// Vulkan cannot be asked: `record_frame` checks them against the `TargetDesc` the pipelines
@@ -136,6 +139,9 @@ pub struct HostTarget {
     /// The render area's top-left corner in both images (`vk::Offset2D::default()`: the
     /// origin): not negative. Pixels outside the area are neither cleared nor drawn.
     pub offset: vk::Offset2D,
+    /// How the images are handed over: in the attachment layouts (`HostSync::Attachments`,
+    /// the default), or in states the host declares for entry and exit (`HostSync::Declared`).
+    pub sync: HostSync,
     /// Keep the host's colour and depth (`true`), or clear them to the scene's background and
     /// the far plane (`false`).
     pub load: bool,
@@ -287,6 +293,9 @@ impl RenderPass for ShadePass {
             .layer_count(1)
             .color_attachments(&colors)
             .depth_attachment(&depth);
+        if let Some(t) = frame.target {
+            super::host::record_entry(device, cmd, t);
+        }
         // SAFETY: `cmd` is recording; attachments are in the layouts the barriers above set.
         unsafe {
             device.cmd_begin_rendering(cmd, &info);
@@ -311,5 +320,8 @@ impl RenderPass for ShadePass {
             self.pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
         }
         unsafe { device.cmd_end_rendering(cmd) };
+        if let Some(t) = frame.target {
+            super::host::record_exit(device, cmd, t);
+        }
     }
 }

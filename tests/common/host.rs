@@ -5,7 +5,7 @@
 use ash::vk;
 use std::sync::Arc;
 use translucent::gpu::{Access, Gpu, Image, ImageBarrier, ImageDesc, aspect_of};
-use translucent::{HostAttachment, HostTarget, TargetDesc};
+use translucent::{HostAttachment, HostSync, HostTarget, TargetDesc};
 
 /// The host's formats in these tests.
 pub const COLOR: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
@@ -41,6 +41,7 @@ impl HostImages {
             depth: attachment(&self.depth),
             extent,
             offset: vk::Offset2D::default(),
+            sync: HostSync::Attachments,
             load: false,
         }
     }
