@@ -844,10 +844,12 @@ fn render_frames(engine: &Engine, gpu: Arc<Gpu>, options: &Options) -> Result<Ru
         None
     };
     let extent = vk::Extent2D { width: SIZE, height: SIZE };
+    const SINGLE: vk::SampleCountFlags = vk::SampleCountFlags::TYPE_1;
     // Each image with its format and size, which translucent checks against its pipelines.
     let host_target = HostTarget {
-        color: HostAttachment { view: engine.color.view, format: COLOR_FORMAT, extent },
-        depth: HostAttachment { view: engine.depth.view, format: DEPTH_FORMAT, extent },
+        color: HostAttachment { view: engine.color.view, format: COLOR_FORMAT, extent, samples: SINGLE },
+        depth: HostAttachment { view: engine.depth.view, format: DEPTH_FORMAT, extent, samples: SINGLE },
+        resolve: None,
         extent,
         offset: vk::Offset2D::default(),
         sync: HostSync::Attachments,

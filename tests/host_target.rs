@@ -621,3 +621,80 @@ fn declared_states_that_cannot_be_right_are_refused() {
         }
     });
 }
+
+/// Whether pixel (x, y) of a 64x64 `image` and its eight neighbours are all lit or all
+/// background: away from the silhouette, where multisampling changes nothing.
+fn inside_or_outside(image: &[[f32; 4]], x: usize, y: usize) -> bool {
+    let lit = |x: usize, y: usize| image[y * 64 + x][0] > 0.0;
+    let around = (y.saturating_sub(1)..=(y + 1).min(63))
+        .flat_map(|j| (x.saturating_sub(1)..=(x + 1).min(63)).map(move |i| (i, j)));
+    let mut states = around.map(|(i, j)| lit(i, j));
+    let first = states.next().unwrap_or(false);
+    states.all(|s| s == first)
+}
+
+#[test]
+fn a_multisampled_host_draws_the_single_sampled_image_away_from_the_silhouette() {
+    common::with_gpu(|gpu| {
+        let single = HostImages::new(gpu, 64, 64, LINEAR);
+        let reference = draw(gpu, &mut linear_renderer(gpu, DepthTest::STANDARD), &single, &single.whole(), None);
+        let samples = vk::SampleCountFlags::TYPE_4;
+        let desc = TargetDesc::Host { color_format: LINEAR, depth_format: host::DEPTH };
+        let options = RendererOptions { samples, ..RendererOptions::default() };
+        let mut renderer = Renderer::with_options(gpu, sphere(), desc, options).unwrap();
+        let (msaa, resolved) =
+            (HostImages::multisampled(gpu, 64, 64, LINEAR, samples), HostImages::new(gpu, 64, 64, LINEAR));
+        let target = HostTarget { resolve: Some(resolved.whole().color), ..msaa.whole() };
+        gpu.one_shot("multisampled frame", |cmd| {
+            msaa.to_attachments(gpu, cmd);
+            resolved.to_attachments(gpu, cmd);
+            renderer.record_frame(cmd, Some(&target))
+        })
+        .unwrap()
+        .unwrap();
+        let image: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&resolved.read_color());
+        let (mut inner, mut outer): (Vec<usize>, Vec<usize>) = (Vec::new(), Vec::new());
+        for i in 0..64 * 64 {
+            if inside_or_outside(&reference, i % 64, i / 64) { inner.push(i) } else { outer.push(i) }
+        }
+        let pick = |image: &[[f32; 4]], at: &[usize]| at.iter().map(|&i| image[i]).collect::<Vec<_>>();
+        // A pixel a triangle edge crosses is shaded once per triangle and averaged, so even
+        // away from the silhouette a few pixels differ: the claim is on the mean and the share.
+        let differences: Vec<i64> = inner.iter().map(|&i| display_difference(&[reference[i]], &[image[i]]).0).collect();
+        let mean = differences.iter().sum::<i64>() as f64 / inner.len() as f64;
+        let within = differences.iter().filter(|&&d| d <= 1).count();
+        let (max, lit) = display_difference(&pick(&reference, &inner), &pick(&image, &inner));
+        let (edge_max, _) = display_difference(&pick(&reference, &outer), &pick(&image, &outer));
+        eprintln!(
+            "4x MSAA: {} pixels away from the silhouette ({lit} lit): mean {mean:.3}/255, {within} within 1/255, \
+             largest {max}/255; {} at it, up to {edge_max}/255 apart",
+            inner.len(),
+            outer.len()
+        );
+        assert!(lit > 64 * 64 / 20, "only {lit} lit pixels");
+        assert!(mean <= 1.0 / 16.0, "mean difference {mean:.3}/255 away from the silhouette");
+        assert!(within * 100 >= inner.len() * 99, "only {within} of {} pixels within 1/255", inner.len());
+        assert!(edge_max > 1, "the silhouette is not antialiased: were 4 samples drawn?");
+    });
+}
+
+#[test]
+fn sample_counts_that_cannot_be_drawn_are_refused() {
+    common::with_gpu(|gpu| {
+        let options = |samples| RendererOptions { samples, ..RendererOptions::default() };
+        let four = vk::SampleCountFlags::TYPE_4;
+        let error = Renderer::with_options(gpu, sphere(), TargetDesc::Own, options(four)).err().expect("refused");
+        assert!(matches!(error, RenderError::Samples { .. }) && error.to_string().contains("host target"), "{error}");
+        let error = Renderer::with_options(gpu, sphere(), host::desc(), options(four | vk::SampleCountFlags::TYPE_1));
+        assert!(matches!(error.err(), Some(RenderError::Samples { .. })));
+        // Single-sampled images for a 4x renderer, and a resolve image for a 1x one.
+        let mut renderer = Renderer::with_options(gpu, sphere(), host::desc(), options(four)).unwrap();
+        let images = HostImages::new(gpu, 32, 32, host::COLOR);
+        let error = draw_refused(gpu, &mut renderer, &images, &images.whole());
+        assert!(matches!(error, RenderError::HostTargetSamples { which: "colour", .. }), "{error}");
+        let mut single = host_renderer(gpu);
+        let target = HostTarget { resolve: Some(images.whole().color), ..images.whole() };
+        let error = draw_refused(gpu, &mut single, &images, &target);
+        assert!(matches!(error, RenderError::HostTargetState { which: "resolve", .. }), "{error}");
+    });
+}

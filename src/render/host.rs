@@ -171,7 +171,12 @@ fn record(
 /// negative (`VUID-VkRenderingInfo-pNext-06077`, `-06078`), reaching no further than either
 /// image (`-06079`, `-06080`) nor than `maxFramebufferWidth/Height`
 /// (`VUID-VkRenderingInfo-renderArea-07815`, `-07816`).
-pub(super) fn check_target(gpu: &Gpu, desc: TargetDesc, target: &HostTarget) -> Result<(), RenderError> {
+pub(super) fn check_target(
+    gpu: &Gpu,
+    desc: TargetDesc,
+    samples: vk::SampleCountFlags,
+    target: &HostTarget,
+) -> Result<(), RenderError> {
     let TargetDesc::Host { color_format, depth_format } = desc else {
         return Err(RenderError::UnexpectedHostTarget);
     };
@@ -183,12 +188,25 @@ pub(super) fn check_target(gpu: &Gpu, desc: TargetDesc, target: &HostTarget) -> 
     if x < 0 || y < 0 {
         return Err(RenderError::HostTargetOffset { offset: [x, y] });
     }
-    for (which, attachment, declared) in [("colour", target.color, color_format), ("depth", target.depth, depth_format)]
-    {
+    let single = vk::SampleCountFlags::TYPE_1;
+    let resolve = target.resolve.map(|r| ("resolve", r, color_format, single));
+    let attachments = [("colour", target.color, color_format, samples), ("depth", target.depth, depth_format, samples)];
+    if resolve.is_some() && (samples == single || target.sync != HostSync::Attachments) {
+        let reason = "a resolve image is for multisampled attachments, handed over in the attachment layouts";
+        return Err(RenderError::HostTargetState { which: "resolve", reason });
+    }
+    for (which, attachment, declared, expected) in attachments.into_iter().chain(resolve) {
+        if attachment.samples != expected {
+            return Err(RenderError::HostTargetSamples { which, given: attachment.samples, expected });
+        }
         if attachment.format != declared {
             return Err(RenderError::HostTargetFormat { which, given: attachment.format, declared });
         }
-        let what = if which == "colour" { "the colour image" } else { "the depth image" };
+        let what = match which {
+            "colour" => "the colour image",
+            "depth" => "the depth image",
+            _ => "the resolve image",
+        };
         check_reach(target, what, attachment.extent)?;
     }
     if let HostSync::Declared { color, depth } = &target.sync {

@@ -13,7 +13,7 @@ use super::host::HostSync;
 use super::local_exitance::LocalExitancePass;
 use super::pass::{FrameInputs, RenderPass};
 use super::plan::{self, Change, Pass, Plan, Planner};
-use super::shade::{DepthConvention, DepthTest, HostTarget, ShadePass, TargetDesc};
+use super::shade::{DepthConvention, DepthTest, HostTarget, ShadeOptions, ShadePass, TargetDesc};
 use super::shadow::ShadowPass;
 use super::splat::SplatPass;
 use super::targets::{CameraTargets, FrameTargets};
@@ -115,6 +115,26 @@ pub enum RenderError {
         given: usize,
         /// `Renderer::MAX_FRAMES_IN_FLIGHT`.
         max: usize,
+    },
+    /// `RendererOptions::samples` this renderer cannot draw at.
+    #[error("samples {given:?}: {reason} (this device supports {supported:?})")]
+    Samples {
+        /// The count given.
+        given: vk::SampleCountFlags,
+        /// The counts the device supports for colour and depth attachments both.
+        supported: vk::SampleCountFlags,
+        /// Why it is refused.
+        reason: &'static str,
+    },
+    /// A `HostTarget` attachment of another sample count than the renderer draws at.
+    #[error("the HostTarget's {which} image has {given:?} samples, but the renderer draws at {expected:?}")]
+    HostTargetSamples {
+        /// "colour", "depth" or "resolve".
+        which: &'static str,
+        /// The attachment's samples.
+        given: vk::SampleCountFlags,
+        /// What it must have.
+        expected: vk::SampleCountFlags,
     },
     /// A `DepthTest` whose comparison does not pass nearer fragments under its convention.
     #[error(
@@ -335,17 +355,46 @@ pub struct RendererOptions {
     /// standard depth (0 near, LESS_OR_EQUAL) by default. With reversed-Z, give the renderer
     /// reversed projections (`CameraView::reversed_depth`); its first camera is reversed so.
     pub depth: DepthTest,
+    /// Samples per pixel of the host's colour and depth images (MSAA): shading rasterises at
+    /// that rate and resolves into `HostTarget::resolve` when given. TYPE_1 by default; above it,
+    /// a host target only, and a count the device supports for colour and depth attachments
+    /// (`framebufferColorSampleCounts`, `framebufferDepthSampleCounts`).
+    pub samples: vk::SampleCountFlags,
 }
 
 impl Default for RendererOptions {
     fn default() -> Self {
-        RendererOptions { frames_in_flight: Renderer::FRAMES_IN_FLIGHT, depth: DepthTest::STANDARD }
+        RendererOptions {
+            frames_in_flight: Renderer::FRAMES_IN_FLIGHT,
+            depth: DepthTest::STANDARD,
+            samples: vk::SampleCountFlags::TYPE_1,
+        }
     }
 }
 
 impl RendererOptions {
-    /// An error naming what the options get wrong.
-    fn check(&self) -> Result<(), RenderError> {
+    /// What the shading pass takes of them.
+    fn shade(&self) -> ShadeOptions {
+        ShadeOptions { depth: self.depth, samples: self.samples }
+    }
+
+    /// An error naming what the options get wrong for `target` on `gpu`.
+    fn check(&self, gpu: &Gpu, target: TargetDesc) -> Result<(), RenderError> {
+        let samples = self.samples;
+        let limits = &gpu.properties().limits;
+        let supported = limits.framebuffer_color_sample_counts & limits.framebuffer_depth_sample_counts;
+        let reason = if samples.as_raw().count_ones() != 1 {
+            Some("a sample count is one of the SampleCountFlags bits")
+        } else if !supported.contains(samples) {
+            Some("the device does not support it for both colour and depth attachments")
+        } else if samples != vk::SampleCountFlags::TYPE_1 && target == TargetDesc::Own {
+            Some("the renderer's own images are single-sampled: multisampling is for a host target")
+        } else {
+            None
+        };
+        if let Some(reason) = reason {
+            return Err(RenderError::Samples { given: samples, supported, reason });
+        }
         let max = Renderer::MAX_FRAMES_IN_FLIGHT;
         if self.frames_in_flight == 0 || self.frames_in_flight > max {
             return Err(RenderError::FramesInFlight { given: self.frames_in_flight, max });
@@ -450,7 +499,7 @@ impl Renderer {
         target: TargetDesc,
         options: RendererOptions,
     ) -> Result<Renderer, RenderError> {
-        options.check()?;
+        options.check(gpu, target)?;
         check_fits(gpu, &scene)?;
         if let TargetDesc::Host { color_format, depth_format } = target {
             check_host_formats(gpu, color_format, depth_format)?;
@@ -465,7 +514,7 @@ impl Renderer {
         let camera = (target == TargetDesc::Own).then_some((scene.scene.file.camera.resolution, needs.pixel_gather));
         let targets = FrameTargets::new(gpu, settings.shadow_map_size, scene.shadow_layers, camera)?;
         let resources = Resources { scene: &buffers, targets: &targets };
-        let shade = ShadePass::new(gpu, target, &resources, needs.pixel_gather, options.depth)?;
+        let shade = ShadePass::new(gpu, target, &resources, needs.pixel_gather, options.shade())?;
         let gather = Self::gather_pass(gpu, &resources, settings.gather, needs.pixel_gather)?;
         let mut hazards = Hazards::new();
         targets.track(&mut hazards);
@@ -702,10 +751,11 @@ impl Renderer {
     /// let mut renderer = Renderer::with_target(gpu, scene, TargetDesc::Host { color_format, depth_format })?;
     /// // Each frame: `cmd` is recording, outside any rendering, and the engine's images are in
     /// // COLOR_ATTACHMENT_OPTIMAL and DEPTH_ATTACHMENT_OPTIMAL (docs/GPU.md).
-    /// let extent = vk::Extent2D { width: 1280, height: 720 };
+    /// let (extent, samples) = (vk::Extent2D { width: 1280, height: 720 }, vk::SampleCountFlags::TYPE_1);
     /// let target = HostTarget {
-    ///     color: HostAttachment { view: color_view, format: color_format, extent },
-    ///     depth: HostAttachment { view: depth_view, format: depth_format, extent },
+    ///     color: HostAttachment { view: color_view, format: color_format, extent, samples },
+    ///     depth: HostAttachment { view: depth_view, format: depth_format, extent, samples },
+    ///     resolve: None,
     ///     extent,
     ///     offset: vk::Offset2D::default(),
     ///     sync: HostSync::Attachments,
@@ -722,7 +772,7 @@ impl Renderer {
         target: Option<&HostTarget>,
     ) -> Result<RecordedFrame, RenderError> {
         if let Some(t) = target {
-            super::host::check_target(&self.gpu, self.target, t)?;
+            super::host::check_target(&self.gpu, self.target, self.options.samples, t)?;
             self.follow_extent(t.extent);
         }
         let plan = self.planner.plan(&self.needs, &self.view());
@@ -793,7 +843,7 @@ impl Renderer {
             (TargetDesc::Host { .. }, None) => {
                 return Err(RenderError::MissingHostTarget);
             }
-            (_, Some(t)) => super::host::check_target(&self.gpu, self.target, t)?,
+            (_, Some(t)) => super::host::check_target(&self.gpu, self.target, self.options.samples, t)?,
             _ => {}
         }
         Ok(self.record_checked(cmd, plan, target))
@@ -1156,7 +1206,7 @@ impl Renderer {
         // Built first, then swapped in: an error leaves the renderer as it was.
         let gather = Self::gather_pass(&gpu, &resources, settings.gather, self.needs.pixel_gather)?;
         let (vertex_light, splat) = (VertexLightPass::new(&gpu, &resources)?, SplatPass::new(&gpu, &resources)?);
-        let shade = ShadePass::new(&gpu, self.target, &resources, self.needs.pixel_gather, self.options.depth)?;
+        let shade = ShadePass::new(&gpu, self.target, &resources, self.needs.pixel_gather, self.options.shade())?;
         (self.gather, self.vertex_light, self.splat, self.shade) = (gather, vertex_light, splat, shade);
         self.buffers = buffers;
         let hazards = self.hazards.get_mut();

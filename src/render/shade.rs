@@ -139,6 +139,11 @@ pub struct HostTarget {
     /// The render area's top-left corner in both images (`vk::Offset2D::default()`: the
     /// origin): not negative. Pixels outside the area are neither cleared nor drawn.
     pub offset: vk::Offset2D,
+    /// With multisampled attachments (`RendererOptions::samples` above 1), the single-sampled
+    /// image of the colour format that shading resolves the colour into (averaged), in
+    /// COLOR_ATTACHMENT_OPTIMAL on entry and exit like the colour image (`HostSync::Attachments`
+    /// only); `None` leaves the resolve to the host.
+    pub resolve: Option<HostAttachment>,
     /// How the images are handed over: in the attachment layouts (`HostSync::Attachments`,
     /// the default), or in states the host declares for entry and exit (`HostSync::Declared`).
     pub sync: HostSync,
@@ -156,6 +161,9 @@ pub struct HostAttachment {
     pub format: vk::Format,
     /// The image's width and height at mip level 0.
     pub extent: vk::Extent2D,
+    /// The image's samples per pixel: must be `RendererOptions::samples` for the colour and
+    /// depth images, TYPE_1 for a resolve image.
+    pub samples: vk::SampleCountFlags,
 }
 
 /// glsl/common/shade.glsl's bindings, in binding order.
@@ -171,6 +179,16 @@ pub struct ShadePass {
     pixel_gather: bool,
     /// What the depth attachment is cleared to when not loaded: the far plane.
     depth_clear: f32,
+}
+
+/// How the shading pass draws: its depth test and its samples per pixel
+/// (`RendererOptions`).
+#[derive(Clone, Copy, Debug)]
+pub struct ShadeOptions {
+    /// The depth test and convention.
+    pub depth: DepthTest,
+    /// Samples per pixel of the attachments.
+    pub samples: vk::SampleCountFlags,
 }
 
 /// A per-vertex vec4 stream (exitance, cached irradiance) at `binding`, read at `location`.
@@ -192,7 +210,7 @@ impl ShadePass {
         target: TargetDesc,
         resources: &Resources,
         pixel_gather: bool,
-        depth: DepthTest,
+        options: ShadeOptions,
     ) -> GpuResult<ShadePass> {
         let fragment = if pixel_gather { "shade_pixel.frag" } else { "shade.frag" };
         let mut desc = GraphicsDesc::new("shade.vert", Some(fragment));
@@ -206,10 +224,11 @@ impl ShadePass {
         };
         desc.color_formats = if pixel_gather { vec![color, SURFACE_FORMAT] } else { vec![color] };
         desc.depth_format = Some(depth_format);
-        desc.depth_compare = depth.compare;
+        desc.depth_compare = options.depth.compare;
+        desc.samples = options.samples;
         let pipeline = GraphicsPipeline::new(gpu, &desc)?;
         let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
-        Ok(ShadePass { pipeline, set, pixel_gather, depth_clear: depth.far() })
+        Ok(ShadePass { pipeline, set, pixel_gather, depth_clear: options.depth.far() })
     }
 
     /// Views, depth view, render area and whether to load: the frame targets' camera images, or
@@ -263,7 +282,7 @@ impl RenderPass for ShadePass {
         let load_op = if load { vk::AttachmentLoadOp::LOAD } else { vk::AttachmentLoadOp::CLEAR };
         let [r, g, b] = frame.background;
         let clears = [[r, g, b, 1.0], [0.0; 4]];
-        let colors: Vec<_> = views
+        let mut colors: Vec<_> = views
             .iter()
             .zip(clears)
             .map(|(view, clear)| {
@@ -275,6 +294,13 @@ impl RenderPass for ShadePass {
                     .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: clear } })
             })
             .collect();
+        if let Some(resolve) = frame.target.and_then(|t| t.resolve) {
+            // A host target has one colour attachment; its samples are averaged into `resolve`.
+            colors[0] = colors[0]
+                .resolve_mode(vk::ResolveModeFlags::AVERAGE)
+                .resolve_image_view(resolve.view)
+                .resolve_image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+        }
         let depth = vk::RenderingAttachmentInfo::default()
             .image_view(depth_view)
             .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
