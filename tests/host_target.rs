@@ -698,3 +698,32 @@ fn sample_counts_that_cannot_be_drawn_are_refused() {
         assert!(matches!(error, RenderError::HostTargetState { which: "resolve", .. }), "{error}");
     });
 }
+
+#[test]
+fn declared_states_with_a_render_area_smaller_than_the_image_keep_the_pixels_outside_it() {
+    common::with_gpu(|gpu| {
+        let (width, height) = (96usize, 80usize);
+        let images = HostImages::new(gpu, width as u32, height as u32, LINEAR);
+        let drawing = ImageState {
+            layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+            stages: vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT,
+            access: vk::AccessFlags2::COLOR_ATTACHMENT_WRITE,
+        };
+        let sync = HostSync::Declared {
+            color: DeclaredImage { image: images.color.raw(), entry: drawing, exit: drawing },
+            depth: DeclaredImage { image: images.depth.raw(), entry: depth_testing(), exit: depth_testing() },
+        };
+        let target = HostTarget { offset: vk::Offset2D { x: 24, y: 10 }, sync, ..images.target(extent(64, 64)) };
+        let marker = [0.25, 0.5, 0.75, 1.0];
+        let mut renderer = linear_renderer(gpu, DepthTest::STANDARD);
+        // Not loaded: the render area is cleared, but a discard of the whole image would lose the
+        // host's pixels around it (lavapipe keeps memory through a discard, so this checks the
+        // rest: validation and what is drawn where).
+        let drawn = draw(gpu, &mut renderer, &images, &target, Some((marker, 1.0)));
+        let inside = |i: usize| (24..88).contains(&(i % width)) && (10..74).contains(&(i / width));
+        let untouched = (0..width * height).filter(|&i| !inside(i) && drawn[i] == marker).count();
+        let lit = (0..width * height).filter(|&i| inside(i) && drawn[i][0] > 0.0).count();
+        assert_eq!(untouched, width * height - 64 * 64, "pixels outside the render area were written");
+        assert!(lit > 64 * 64 / 10, "only {lit} lit pixels in the render area");
+    });
+}

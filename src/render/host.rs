@@ -102,20 +102,26 @@ fn check_declared(which: &'static str, image: &DeclaredImage, load: bool) -> Res
 }
 
 /// Record the barriers that move the host's declared images from their entry states to the
-/// shading pass's attachment use (nothing for `HostSync::Attachments`). Not loaded, an image's
-/// contents are dropped (old layout UNDEFINED).
+/// shading pass's attachment use (nothing for `HostSync::Attachments`). Not loaded and drawn
+/// whole, an image's contents are dropped (old layout UNDEFINED); a render area smaller than
+/// the image keeps them, since the pixels outside it are the host's.
 pub(super) fn record_entry(device: &ash::Device, cmd: vk::CommandBuffer, target: &HostTarget) {
     if let HostSync::Declared { color, depth } = target.sync {
-        let from = |i: DeclaredImage| {
-            if target.load { i.entry } else { ImageState { layout: vk::ImageLayout::UNDEFINED, ..i.entry } }
+        let whole = |size: vk::Extent2D| target.offset == vk::Offset2D::default() && target.extent == size;
+        let from = |i: DeclaredImage, size| {
+            if target.load || !whole(size) {
+                i.entry
+            } else {
+                ImageState { layout: vk::ImageLayout::UNDEFINED, ..i.entry }
+            }
         };
         let depth_aspect = aspect_of(target.depth.format);
         record(
             device,
             cmd,
             &[
-                (color.image, vk::ImageAspectFlags::COLOR, from(color), COLOR_USE),
-                (depth.image, depth_aspect, from(depth), DEPTH_USE),
+                (color.image, vk::ImageAspectFlags::COLOR, from(color, target.color.extent), COLOR_USE),
+                (depth.image, depth_aspect, from(depth, target.depth.extent), DEPTH_USE),
             ],
         );
     }
