@@ -414,12 +414,12 @@ impl RendererOptions {
 /// Renders one prepared scene: its passes over its GPU data, recording the passes each frame
 /// needs into a command buffer (the host's, or its own for `frame`).
 ///
-/// **Lifetime.** Frames recorded with `record_frame` into a host's command buffer use the
-/// renderer's pipelines, buffers and images until their submission finishes. Dropping the
-/// renderer (and `set_transform`, `bake_static_levels`, `resize`, which replace some of them)
-/// therefore first waits for the `Gpu`'s queue to go idle (`vkQueueWaitIdle`) unless every
-/// frame it recorded was seen finished: by `read_timings` succeeding on the last one, or by
-/// `frame`. So no order of safe calls destroys what a frame in flight uses; a host that does
+/// **Lifetime.** Frames recorded with `record_frame` or `record_exitance` into a host's
+/// command buffer use the renderer's pipelines, buffers and images until their submission
+/// finishes. Dropping the renderer (and `set_transform`, `bake_static_levels`, `resize`, which
+/// replace some of them) therefore first waits for the `Gpu`'s queue to go idle
+/// (`vkQueueWaitIdle`) unless every frame it recorded was seen finished: by `read_timings`
+/// succeeding on the last one (of at least one pass), or by `frame`. So no order of safe calls destroys what a frame in flight uses; a host that does
 /// not want the wait reads the last frame's timings after its fence first. A host must submit
 /// the command buffers it recorded into before dropping the renderer, or never (a buffer
 /// recorded against a dropped renderer is invalid, as after any destroyed object).
