@@ -16,9 +16,10 @@ use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use translucent::gpu::{EnabledFeatures, Gpu, GpuOptions, HostVulkan, required_features};
+use translucent::render::host::HostSync;
 use translucent::render::plan::Pass;
-use translucent::render::renderer::{CameraView, Renderer};
-use translucent::render::shade::{HostAttachment, HostTarget, TargetDesc};
+use translucent::render::renderer::{CameraView, Renderer, RendererOptions};
+use translucent::render::shade::{DepthConvention, DepthTest, HostAttachment, HostTarget, TargetDesc};
 use translucent::scene::Scene;
 use translucent::scene::build::{Overrides, PreparedScene};
 
@@ -90,6 +91,9 @@ pub struct Options {
     pub frames: usize,
     /// Height of the ground quad (it hides what of the sphere is below it).
     pub ground_y: f32,
+    /// The engine's depth test, translucent's too: standard, or reversed-Z (cleared to 0,
+    /// GREATER_OR_EQUAL, projections reversed).
+    pub depth: DepthTest,
 }
 
 impl Default for Options {
@@ -100,6 +104,7 @@ impl Default for Options {
             second_renderer: false,
             frames: 3,
             ground_y: -0.005,
+            depth: DepthTest::STANDARD,
         }
     }
 }
@@ -346,7 +351,7 @@ struct GroundPush {
 }
 
 impl Ground {
-    fn new(device: &ash::Device) -> Ground {
+    fn new(device: &ash::Device, compare: vk::CompareOp) -> Ground {
         let module = |name: &str| {
             let words = translucent::gpu::shaders::spirv(name).unwrap();
             // SAFETY: SPIR-V compiled by glslang; destroyed below once the pipeline exists.
@@ -391,7 +396,7 @@ impl Ground {
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(true)
             .depth_write_enable(true)
-            .depth_compare_op(vk::CompareOp::LESS_OR_EQUAL);
+            .depth_compare_op(compare);
         let blend_attachments =
             [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
@@ -446,9 +451,14 @@ fn barrier(
     unsafe { device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&b)) };
 }
 
-/// The camera of frame `i`: the scene's, turned 10 degrees a frame about the vertical axis.
-fn camera_of(prepared: &PreparedScene, i: usize) -> CameraView {
-    CameraView::of_scene(prepared).orbited(glam::Vec3::ZERO, 10.0 * i as f32)
+/// The camera of frame `i`: the scene's, turned 10 degrees a frame about the vertical axis,
+/// its depth reversed for a reversed-Z engine.
+fn camera_of(prepared: &PreparedScene, i: usize, depth: DepthTest) -> CameraView {
+    let camera = CameraView::of_scene(prepared).orbited(glam::Vec3::ZERO, 10.0 * i as f32);
+    match depth.convention {
+        DepthConvention::Standard => camera,
+        DepthConvention::Reversed => camera.reversed_depth(),
+    }
 }
 
 /// Run the engine. An error is translucent's or the host's setup failing, as text.
@@ -511,6 +521,8 @@ struct Engine<'a> {
     /// The ground quad's vertices.
     quad: Mapped,
     ground: Ground,
+    /// The far plane's depth, which the engine clears its depth to (`Options::depth`).
+    far: f32,
     pool: vk::CommandPool,
     /// The one command buffer every frame is recorded into, and its fence.
     cmd: vk::CommandBuffer,
@@ -572,7 +584,7 @@ impl<'a> Engine<'a> {
         unsafe {
             std::ptr::copy_nonoverlapping(vertices.as_ptr().cast::<u8>(), quad.ptr.cast::<u8>(), size_of_val(&vertices))
         };
-        let ground = Ground::new(device);
+        let ground = Ground::new(device, options.depth.compare);
         // SAFETY: valid create infos; destroyed in `destroy`.
         let pool = unsafe {
             device.create_command_pool(
@@ -590,7 +602,8 @@ impl<'a> Engine<'a> {
         }
         .unwrap()[0];
         let fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }.unwrap();
-        Engine { host, color, depth, ldr, linear_readback, ldr_readback, quad, ground, pool, cmd, fence }
+        let far = options.depth.far();
+        Engine { host, color, depth, ldr, linear_readback, ldr_readback, quad, ground, far, pool, cmd, fence }
     }
 
     /// One frame of the host: clear, its quad, then whatever `between` records, then its post
@@ -655,7 +668,7 @@ impl<'a> Engine<'a> {
             .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
             .load_op(vk::AttachmentLoadOp::CLEAR)
             .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
+            .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: self.far, stencil: 0 } });
         let rendering = vk::RenderingInfo::default()
             .render_area(extent.into())
             .layer_count(1)
@@ -831,29 +844,30 @@ impl<'a> Engine<'a> {
 /// that it is dropped here, on an error too, before the host destroys its own objects.
 fn render_frames(engine: &Engine, gpu: Arc<Gpu>, options: &Options) -> Result<Run, String> {
     let target = TargetDesc::Host { color_format: COLOR_FORMAT, depth_format: DEPTH_FORMAT };
+    let renderer_options = RendererOptions { depth: options.depth, ..RendererOptions::default() };
     let prepare = |text: &str| {
         let scene = Scene::parse(text, "embedded scene", None).map_err(|e| e.to_string())?;
         PreparedScene::new(&scene, &Overrides::default()).map_err(|e| e.to_string())
     };
     let prepared = prepare(SPHERE_SCENE)?;
-    let mut renderer = Renderer::with_target(&gpu, prepared.clone(), target).map_err(|e| e.to_string())?;
-    let mut second = if options.second_renderer {
-        Some(Renderer::with_target(&gpu, prepare(SECOND_SCENE)?, target).map_err(|e| e.to_string())?)
-    } else {
-        None
-    };
+    let renderer_for = |scene| Renderer::with_options(&gpu, scene, target, renderer_options).map_err(|e| e.to_string());
+    let mut renderer = renderer_for(prepared.clone())?;
+    let mut second = if options.second_renderer { Some(renderer_for(prepare(SECOND_SCENE)?)?) } else { None };
     let extent = vk::Extent2D { width: SIZE, height: SIZE };
+    const SINGLE: vk::SampleCountFlags = vk::SampleCountFlags::TYPE_1;
     // Each image with its format and size, which translucent checks against its pipelines.
     let host_target = HostTarget {
-        color: HostAttachment { view: engine.color.view, format: COLOR_FORMAT, extent },
-        depth: HostAttachment { view: engine.depth.view, format: DEPTH_FORMAT, extent },
+        color: HostAttachment { view: engine.color.view, format: COLOR_FORMAT, extent, samples: SINGLE },
+        depth: HostAttachment { view: engine.depth.view, format: DEPTH_FORMAT, extent, samples: SINGLE },
+        resolve: None,
         extent,
         offset: vk::Offset2D::default(),
+        sync: HostSync::Attachments,
         load: true,
     };
     let mut frames = Vec::new();
     for i in 0..options.frames {
-        let camera = camera_of(&prepared, i);
+        let camera = camera_of(&prepared, i, options.depth);
         if i > 0 {
             renderer.set_camera(camera);
             if let Some(s) = second.as_mut() {
@@ -866,7 +880,7 @@ fn render_frames(engine: &Engine, gpu: Arc<Gpu>, options: &Options) -> Result<Ru
     drop(renderer);
     drop(gpu);
     // The host's device after translucent is gone: it still draws the quad.
-    let camera = camera_of(&prepared, 0);
+    let camera = camera_of(&prepared, 0, options.depth);
     let (after_drop, _) = engine.frame(camera.projection * camera.view, &mut |_| {});
     Ok(Run { frames, after_drop, validation_messages: 0 })
 }

@@ -49,6 +49,7 @@ pub use glam;
 pub use gpu::{EnabledFeatures, Gpu, GpuError, GpuOptions, HostVulkan, RequiredFeatures, required_features};
 pub use optics::Material;
 pub use output::{OutputError, OutputSet};
+pub use render::host::{DeclaredImage, HostSync, ImageState};
 pub use render::plan::{Change, Pass, Plan};
 pub use render::renderer::{
     CameraView, FrameTimings, NonFinite, RecordedFrame, RenderError, Renderer, RendererOptions,

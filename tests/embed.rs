@@ -29,25 +29,17 @@ fn is_ground(p: &[f32]) -> bool {
     p.iter().zip(GROUND).all(|(a, b)| (a - b).abs() < 1e-6)
 }
 
-#[test]
-fn an_embedded_frame_is_clean_and_matches_the_cli_where_both_draw_the_same() {
-    let run = run(&Options::default()).expect("embedded run");
-    // The CLI's render of the same scene and view, linear.
-    let dir = common::temp_dir("embed-cli");
+/// The engine's first frame against the CLI's render of the same scene and view, where both
+/// draw the same thing: the mean difference in 8-bit display levels, and how many sphere pixels
+/// of the CLI's the engine's quad hides.
+fn against_the_cli(run: &embed::Run, name: &str) -> (f64, u64) {
+    let dir = common::temp_dir(name);
     let scene = dir.join("sphere.toml");
     std::fs::write(&scene, SPHERE_SCENE).unwrap();
     let exr = dir.join("cli.exr");
-    let out = common::translucent(
-        &[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            dir.join("cli.png").to_str().unwrap(),
-            "--exr",
-            exr.to_str().unwrap(),
-        ],
-        &[],
-    );
+    let png = dir.join("cli.png");
+    let args = ["render", scene.to_str().unwrap(), "-o", png.to_str().unwrap(), "--exr", exr.to_str().unwrap()];
+    let out = common::translucent(&args, &[]);
     assert!(out.status.success(), "{}", common::text(&out.stderr));
     let cli = image::open(&exr).unwrap().to_rgba32f().into_raw();
     let host = &run.frames[0].linear;
@@ -66,13 +58,33 @@ fn an_embedded_frame_is_clean_and_matches_the_cli_where_both_draw_the_same() {
     }
     let mean = sum as f64 / compared as f64;
     eprintln!(
-        "embed: {compared} channels compared, mean difference {mean:.4}/255; {hidden} sphere pixels hidden by the host's quad"
+        "{name}: {compared} channels compared, mean difference {mean:.4}/255; {hidden} sphere pixels hidden by the host's quad"
     );
+    (mean, hidden)
+}
+
+#[test]
+fn an_embedded_frame_is_clean_and_matches_the_cli_where_both_draw_the_same() {
+    let run = run(&Options::default()).expect("embedded run");
+    let (mean, hidden) = against_the_cli(&run, "embed-cli");
     assert!(mean <= 1.0, "mean difference {mean:.3}/255 from the CLI's render");
     assert!(hidden > 0, "the host's quad hides no part of the sphere: no depth test against the host's depth");
+    let host = &run.frames[0].linear;
     let lit = host.chunks(4).filter(|p| !is_ground(p) && p[0] > 0.05).count();
     assert!(lit > (SIZE * SIZE / 20) as usize, "only {lit} sphere pixels");
     assert!(!run.frames[0].timings.is_empty(), "timings read after the host's fence");
+}
+
+#[test]
+fn a_reversed_z_engine_matches_the_cli_and_its_quad_hides_the_sphere_as_the_standard_one_does() {
+    let reversed = run(&Options { depth: translucent::DepthTest::REVERSED, frames: 1, ..Options::default() })
+        .expect("embedded run, reversed-Z");
+    let (mean, hidden) = against_the_cli(&reversed, "embed-cli-reversed");
+    assert!(mean <= 1.0, "mean difference {mean:.3}/255 from the CLI's render");
+    let standard = run(&Options { frames: 1, ..Options::default() }).expect("embedded run");
+    let (_, standard_hidden) = against_the_cli(&standard, "embed-cli-standard");
+    assert_eq!(hidden, standard_hidden, "the quad hides another part of the sphere under reversed-Z");
+    assert!(hidden > 0, "the quad hides nothing: no depth test against the engine's reversed-Z depth");
 }
 
 #[test]

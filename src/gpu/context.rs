@@ -19,10 +19,11 @@ use std::time::Duration;
 /// owns and destroys the instance and device) or wrapped around a host's by `Gpu::from_host` (then
 /// it destroys neither).
 ///
-/// Shared as `Arc<Gpu>`: every object made from it holds a clone, so the `Gpu` drops last. Its Drop
-/// waits for the device to go idle (`vkDeviceWaitIdle`: on a host's device that is the host's
-/// work on every queue too, once, when the last `Arc` goes), frees the allocator's memory, then destroys the device and the
-/// instance when it owns them.
+/// Shared as `Arc<Gpu>`: every object made from it holds a clone, so the `Gpu` drops last.
+///
+/// **Drop calls `vkDeviceWaitIdle`**, once, when the last `Arc` goes: on a host's device that
+/// waits for the host's work on every queue too. Then it frees the allocator's memory, and
+/// destroys the device and the instance when it owns them (never a host's).
 pub struct Gpu {
     entry: ash::Entry,
     instance: ash::Instance,
@@ -145,6 +146,24 @@ impl Gpu {
     /// the device's Vulkan version (1.3), the instance's (its 1.3 commands must be loadable),
     /// the features declared in `enabled_features` and their support, and the queue family's
     /// graphics and compute capability.
+    ///
+    /// ```no_run
+    /// use translucent::ash::{self, vk};
+    /// use translucent::{EnabledFeatures, Gpu, GpuOptions, HostVulkan};
+    /// # fn engine() -> (ash::Entry, ash::Instance, vk::PhysicalDevice, ash::Device, vk::Queue, u32) {
+    /// #     unimplemented!()
+    /// # }
+    /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+    /// // The engine's own objects: its device was created from a Vulkan 1.3 instance with
+    /// // `translucent::required_features()` chained into its VkDeviceCreateInfo.
+    /// let (entry, instance, physical_device, device, queue, queue_family) = engine();
+    /// let enabled_features = EnabledFeatures::ALL;
+    /// let host = HostVulkan { entry, instance, physical_device, device, queue, queue_family, enabled_features };
+    /// // SAFETY: the engine's instance, device and queue outlive the Gpu and all made from it, and
+    /// // it enabled the features it declares.
+    /// let gpu = unsafe { Gpu::from_host(host, &GpuOptions::default()) }?;
+    /// # Ok(()) }
+    /// ```
     ///
     /// # Safety
     /// The host's instance, device and queue must outlive the returned `Gpu` and everything made

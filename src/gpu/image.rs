@@ -9,8 +9,8 @@ use gpu_allocator::MemoryLocation;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use std::sync::Arc;
 
-/// What to create: a 2D image with one mip level, one sample per texel and optimal tiling, and one
-/// view over all its layers; a builder-style value like `BufferDesc`.
+/// What to create: a 2D image with one mip level, one sample per texel unless set, and optimal
+/// tiling, and one view over all its layers; a builder-style value like `BufferDesc`.
 #[derive(Clone, Debug)]
 pub struct ImageDesc {
     /// Debug name, given to the allocator and used in error messages.
@@ -27,16 +27,32 @@ pub struct ImageDesc {
     pub layers: u32,
     /// Make the whole-image view a 2D array even with one layer (for `sampler2DArray*`).
     pub array_view: bool,
+    /// Samples per texel (a multisampled attachment); TYPE_1 unless set.
+    pub samples: vk::SampleCountFlags,
 }
 
 impl ImageDesc {
     /// One layer with a plain 2D view.
     pub fn new(name: &str, width: u32, height: u32, format: vk::Format, usage: vk::ImageUsageFlags) -> Self {
-        Self { name: name.into(), width, height, format, usage, layers: 1, array_view: false }
+        Self {
+            name: name.into(),
+            width,
+            height,
+            format,
+            usage,
+            layers: 1,
+            array_view: false,
+            samples: vk::SampleCountFlags::TYPE_1,
+        }
     }
     /// Set the number of array layers; above 1 the view is a 2D array.
     pub fn layers(mut self, layers: u32) -> Self {
         self.layers = layers;
+        self
+    }
+    /// Samples per texel (a multisampled attachment).
+    pub fn samples(mut self, samples: vk::SampleCountFlags) -> Self {
+        self.samples = samples;
         self
     }
     /// A 2D-array view whatever the layer count.
@@ -98,7 +114,7 @@ impl Image {
             .extent(vk::Extent3D { width: desc.width, height: desc.height, depth: 1 })
             .mip_levels(1)
             .array_layers(desc.layers)
-            .samples(vk::SampleCountFlags::TYPE_1)
+            .samples(desc.samples)
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(desc.usage | vk::ImageUsageFlags::TRANSFER_SRC)
             .sharing_mode(vk::SharingMode::EXCLUSIVE)

@@ -221,6 +221,8 @@ pub struct GraphicsDesc {
     /// The depth test's comparison, with a depth attachment: LESS_OR_EQUAL unless set (0 near,
     /// 1 far); a reversed-Z target's is GREATER_OR_EQUAL.
     pub depth_compare: vk::CompareOp,
+    /// Samples per pixel of the attachments (rasterizationSamples); TYPE_1 unless set.
+    pub samples: vk::SampleCountFlags,
     /// Faces to cull (counter-clockwise is front); NONE unless set.
     pub cull: vk::CullModeFlags,
     /// Constant and slope depth bias, for shadow maps.
@@ -243,6 +245,7 @@ impl GraphicsDesc {
             color_formats: Vec::new(),
             depth_format: None,
             depth_compare: vk::CompareOp::LESS_OR_EQUAL,
+            samples: vk::SampleCountFlags::TYPE_1,
             cull: vk::CullModeFlags::NONE,
             depth_bias: None,
             specialization: Vec::new(),
@@ -307,8 +310,7 @@ impl GraphicsPipeline {
         if let Some((constant, slope)) = desc.depth_bias {
             raster = raster.depth_bias_enable(true).depth_bias_constant_factor(constant).depth_bias_slope_factor(slope);
         }
-        let multisample =
-            vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+        let multisample = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(desc.samples);
         let depth = vk::PipelineDepthStencilStateCreateInfo::default()
             .depth_test_enable(desc.depth_format.is_some())
             .depth_write_enable(desc.depth_format.is_some())

@@ -11,7 +11,7 @@ pub mod gather_tree;
 pub mod gpu_scene;
 pub mod graph;
 pub mod group_gather;
-mod host;
+pub mod host;
 pub mod local_exitance;
 pub mod pass;
 pub mod plan;

@@ -9,10 +9,11 @@ use super::gather_sparse::GatherSparsePass;
 use super::gather_tree::GatherTreePass;
 use super::gpu_scene::GpuScene;
 use super::graph::{HOST_READ, Resource, Resources, read, write};
+use super::host::HostSync;
 use super::local_exitance::LocalExitancePass;
 use super::pass::{FrameInputs, RenderPass};
 use super::plan::{self, Change, Pass, Plan, Planner};
-use super::shade::{DepthConvention, DepthTest, HostTarget, ShadePass, TargetDesc};
+use super::shade::{DepthConvention, DepthTest, HostTarget, ShadeOptions, ShadePass, TargetDesc};
 use super::shadow::ShadowPass;
 use super::splat::SplatPass;
 use super::targets::{CameraTargets, FrameTargets};
@@ -93,6 +94,14 @@ pub enum RenderError {
         /// Its size.
         limit: [u32; 2],
     },
+    /// A `HostTarget` whose declared image states (`HostSync::Declared`) cannot be right.
+    #[error("the HostTarget's {which} image: {reason}")]
+    HostTargetState {
+        /// "colour" or "depth".
+        which: &'static str,
+        /// What is wrong.
+        reason: &'static str,
+    },
     /// A `HostTarget` whose render area begins left of or above its images.
     #[error("HostTarget offset ({}, {}): a render area's offset must not be negative", offset[0], offset[1])]
     HostTargetOffset {
@@ -106,6 +115,26 @@ pub enum RenderError {
         given: usize,
         /// `Renderer::MAX_FRAMES_IN_FLIGHT`.
         max: usize,
+    },
+    /// `RendererOptions::samples` this renderer cannot draw at.
+    #[error("samples {given:?}: {reason} (this device supports {supported:?})")]
+    Samples {
+        /// The count given.
+        given: vk::SampleCountFlags,
+        /// The counts the device supports for colour and depth attachments both.
+        supported: vk::SampleCountFlags,
+        /// Why it is refused.
+        reason: &'static str,
+    },
+    /// A `HostTarget` attachment of another sample count than the renderer draws at.
+    #[error("the HostTarget's {which} image has {given:?} samples, but the renderer draws at {expected:?}")]
+    HostTargetSamples {
+        /// "colour", "depth" or "resolve".
+        which: &'static str,
+        /// The attachment's samples.
+        given: vk::SampleCountFlags,
+        /// What it must have.
+        expected: vk::SampleCountFlags,
     },
     /// A `DepthTest` whose comparison does not pass nearer fragments under its convention.
     #[error(
@@ -326,17 +355,46 @@ pub struct RendererOptions {
     /// standard depth (0 near, LESS_OR_EQUAL) by default. With reversed-Z, give the renderer
     /// reversed projections (`CameraView::reversed_depth`); its first camera is reversed so.
     pub depth: DepthTest,
+    /// Samples per pixel of the host's colour and depth images (MSAA): shading rasterises at
+    /// that rate and resolves into `HostTarget::resolve` when given. TYPE_1 by default; above it,
+    /// a host target only, and a count the device supports for colour and depth attachments
+    /// (`framebufferColorSampleCounts`, `framebufferDepthSampleCounts`).
+    pub samples: vk::SampleCountFlags,
 }
 
 impl Default for RendererOptions {
     fn default() -> Self {
-        RendererOptions { frames_in_flight: Renderer::FRAMES_IN_FLIGHT, depth: DepthTest::STANDARD }
+        RendererOptions {
+            frames_in_flight: Renderer::FRAMES_IN_FLIGHT,
+            depth: DepthTest::STANDARD,
+            samples: vk::SampleCountFlags::TYPE_1,
+        }
     }
 }
 
 impl RendererOptions {
-    /// An error naming what the options get wrong.
-    fn check(&self) -> Result<(), RenderError> {
+    /// What the shading pass takes of them.
+    fn shade(&self) -> ShadeOptions {
+        ShadeOptions { depth: self.depth, samples: self.samples }
+    }
+
+    /// An error naming what the options get wrong for `target` on `gpu`.
+    fn check(&self, gpu: &Gpu, target: TargetDesc) -> Result<(), RenderError> {
+        let samples = self.samples;
+        let limits = &gpu.properties().limits;
+        let supported = limits.framebuffer_color_sample_counts & limits.framebuffer_depth_sample_counts;
+        let reason = if samples.as_raw().count_ones() != 1 {
+            Some("a sample count is one of the SampleCountFlags bits")
+        } else if !supported.contains(samples) {
+            Some("the device does not support it for both colour and depth attachments")
+        } else if samples != vk::SampleCountFlags::TYPE_1 && target == TargetDesc::Own {
+            Some("the renderer's own images are single-sampled: multisampling is for a host target")
+        } else {
+            None
+        };
+        if let Some(reason) = reason {
+            return Err(RenderError::Samples { given: samples, supported, reason });
+        }
         let max = Renderer::MAX_FRAMES_IN_FLIGHT;
         if self.frames_in_flight == 0 || self.frames_in_flight > max {
             return Err(RenderError::FramesInFlight { given: self.frames_in_flight, max });
@@ -356,12 +414,12 @@ impl RendererOptions {
 /// Renders one prepared scene: its passes over its GPU data, recording the passes each frame
 /// needs into a command buffer (the host's, or its own for `frame`).
 ///
-/// **Lifetime.** Frames recorded with `record_frame` into a host's command buffer use the
-/// renderer's pipelines, buffers and images until their submission finishes. Dropping the
-/// renderer (and `set_transform`, `bake_static_levels`, `resize`, which replace some of them)
-/// therefore first waits for the `Gpu`'s queue to go idle (`vkQueueWaitIdle`) unless every
-/// frame it recorded was seen finished: by `read_timings` succeeding on the last one, or by
-/// `frame`. So no order of safe calls destroys what a frame in flight uses; a host that does
+/// **Lifetime.** Frames recorded with `record_frame` or `record_exitance` into a host's
+/// command buffer use the renderer's pipelines, buffers and images until their submission
+/// finishes. Dropping the renderer (and `set_transform`, `bake_static_levels`, `resize`, which
+/// replace some of them) therefore first waits for the `Gpu`'s queue to go idle
+/// (`vkQueueWaitIdle`) unless every frame it recorded was seen finished: by `read_timings`
+/// succeeding on the last one (of at least one pass), or by `frame`. So no order of safe calls destroys what a frame in flight uses; a host that does
 /// not want the wait reads the last frame's timings after its fence first. A host must submit
 /// the command buffers it recorded into before dropping the renderer, or never (a buffer
 /// recorded against a dropped renderer is invalid, as after any destroyed object).
@@ -441,7 +499,7 @@ impl Renderer {
         target: TargetDesc,
         options: RendererOptions,
     ) -> Result<Renderer, RenderError> {
-        options.check()?;
+        options.check(gpu, target)?;
         check_fits(gpu, &scene)?;
         if let TargetDesc::Host { color_format, depth_format } = target {
             check_host_formats(gpu, color_format, depth_format)?;
@@ -456,7 +514,7 @@ impl Renderer {
         let camera = (target == TargetDesc::Own).then_some((scene.scene.file.camera.resolution, needs.pixel_gather));
         let targets = FrameTargets::new(gpu, settings.shadow_map_size, scene.shadow_layers, camera)?;
         let resources = Resources { scene: &buffers, targets: &targets };
-        let shade = ShadePass::new(gpu, target, &resources, needs.pixel_gather, options.depth)?;
+        let shade = ShadePass::new(gpu, target, &resources, needs.pixel_gather, options.shade())?;
         let gather = Self::gather_pass(gpu, &resources, settings.gather, needs.pixel_gather)?;
         let mut hazards = Hazards::new();
         targets.track(&mut hazards);
@@ -676,13 +734,45 @@ impl Renderer {
     /// into `cmd`, a primary command buffer the host is recording, outside any rendering. No
     /// submission and no wait: the host submits, and may read `read_timings` after its fence.
     /// `target` is the host's attachments for a `TargetDesc::Host` renderer, `None` otherwise.
+    ///
+    /// ```no_run
+    /// use translucent::ash::vk;
+    /// use translucent::{
+    ///     Gpu, HostAttachment, HostSync, HostTarget, Overrides, PreparedScene, Renderer, Scene, TargetDesc,
+    /// };
+    /// # fn frame(
+    /// #     gpu: &std::sync::Arc<Gpu>,
+    /// #     cmd: vk::CommandBuffer,
+    /// #     color_view: vk::ImageView,
+    /// #     depth_view: vk::ImageView,
+    /// # ) -> Result<(), Box<dyn std::error::Error>> {
+    /// let (color_format, depth_format) = (vk::Format::R16G16B16A16_SFLOAT, vk::Format::D32_SFLOAT);
+    /// let scene = PreparedScene::new(&Scene::builtin(), &Overrides::default())?;
+    /// let mut renderer = Renderer::with_target(gpu, scene, TargetDesc::Host { color_format, depth_format })?;
+    /// // Each frame: `cmd` is recording, outside any rendering, and the engine's images are in
+    /// // COLOR_ATTACHMENT_OPTIMAL and DEPTH_ATTACHMENT_OPTIMAL (docs/GPU.md).
+    /// let (extent, samples) = (vk::Extent2D { width: 1280, height: 720 }, vk::SampleCountFlags::TYPE_1);
+    /// let target = HostTarget {
+    ///     color: HostAttachment { view: color_view, format: color_format, extent, samples },
+    ///     depth: HostAttachment { view: depth_view, format: depth_format, extent, samples },
+    ///     resolve: None,
+    ///     extent,
+    ///     offset: vk::Offset2D::default(),
+    ///     sync: HostSync::Attachments,
+    ///     load: true,
+    /// };
+    /// let recorded = renderer.record_frame(cmd, Some(&target))?;
+    /// // ... the engine's own passes; it ends `cmd`, submits it and waits on its fence ...
+    /// let timings = renderer.read_timings(&recorded)?;
+    /// # Ok(()) }
+    /// ```
     pub fn record_frame(
         &mut self,
         cmd: vk::CommandBuffer,
         target: Option<&HostTarget>,
     ) -> Result<RecordedFrame, RenderError> {
         if let Some(t) = target {
-            super::host::check_target(&self.gpu, self.target, t)?;
+            super::host::check_target(&self.gpu, self.target, self.options.samples, t)?;
             self.follow_extent(t.extent);
         }
         let plan = self.planner.plan(&self.needs, &self.view());
@@ -753,7 +843,7 @@ impl Renderer {
             (TargetDesc::Host { .. }, None) => {
                 return Err(RenderError::MissingHostTarget);
             }
-            (_, Some(t)) => super::host::check_target(&self.gpu, self.target, t)?,
+            (_, Some(t)) => super::host::check_target(&self.gpu, self.target, self.options.samples, t)?,
             _ => {}
         }
         Ok(self.record_checked(cmd, plan, target))
@@ -844,11 +934,17 @@ impl Renderer {
         target: Option<&HostTarget>,
     ) -> Vec<Pass> {
         let layers = plan.shadow_light.map(|source| self.scene.shadow_layers_of(source));
-        if target.is_some() {
-            // The host's contract: it drew into its attachments before this frame.
+        if let Some(t) = target {
             let mut hazards = self.hazards.borrow_mut();
-            hazards.external(Resource::HostColor, Access::ColorAttachmentWrite);
-            hazards.external(Resource::HostDepth, Access::DepthAttachmentReadWrite);
+            if t.sync == HostSync::Attachments {
+                // The host's contract: it drew into its attachments before this frame.
+                hazards.external(Resource::HostColor, Access::ColorAttachmentWrite);
+                hazards.external(Resource::HostDepth, Access::DepthAttachmentReadWrite);
+            } else {
+                // The shading pass records the barriers from and to the declared states itself.
+                hazards.forget(Resource::HostColor);
+                hazards.forget(Resource::HostDepth);
+            }
         }
         let frame = self.inputs(plan, layers.as_deref(), target);
         let mut recorded = Vec::new();
@@ -1110,7 +1206,7 @@ impl Renderer {
         // Built first, then swapped in: an error leaves the renderer as it was.
         let gather = Self::gather_pass(&gpu, &resources, settings.gather, self.needs.pixel_gather)?;
         let (vertex_light, splat) = (VertexLightPass::new(&gpu, &resources)?, SplatPass::new(&gpu, &resources)?);
-        let shade = ShadePass::new(&gpu, self.target, &resources, self.needs.pixel_gather, self.options.depth)?;
+        let shade = ShadePass::new(&gpu, self.target, &resources, self.needs.pixel_gather, self.options.shade())?;
         (self.gather, self.vertex_light, self.splat, self.shade) = (gather, vertex_light, splat, shade);
         self.buffers = buffers;
         let hazards = self.hazards.get_mut();

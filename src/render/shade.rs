@@ -9,6 +9,7 @@
 //! Bindings: 0 = objects, 1 = lights, 2 = shadow maps. Push: `ShadePush`.
 
 use super::graph::{Resource, Resources, Use, overwrite, read, write};
+use super::host::HostSync;
 use super::pass::{FrameInputs, RenderPass};
 use super::records::Vertex;
 use crate::gpu::{Access, DescriptorSet, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline};
@@ -114,10 +115,12 @@ impl Default for DepthTest {
     }
 }
 
-/// A host's attachments for one frame (`TargetDesc::Host`). On entry and on exit the colour
-/// image is in COLOR_ATTACHMENT_OPTIMAL and the depth image in DEPTH_ATTACHMENT_OPTIMAL; the
-/// pass waits for earlier attachment writes, and its own writes are done at the colour-output
-/// and late-fragment-test stages, where the host's next barrier picks them up.
+/// A host's attachments for one frame (`TargetDesc::Host`). By default (`HostSync::Attachments`)
+/// on entry and on exit the colour image is in COLOR_ATTACHMENT_OPTIMAL and the depth image in
+/// DEPTH_ATTACHMENT_OPTIMAL; the pass waits for earlier attachment writes, and its own writes
+/// are done at the colour-output and late-fragment-test stages, where the host's next barrier
+/// picks them up. With `HostSync::Declared` the pass records the barriers from and to the
+/// states the host declares instead.
 ///
 /// Each attachment carries its image's format and size, because a view does not say them and
 /// Vulkan cannot be asked: `record_frame` checks them against the `TargetDesc` the pipelines
@@ -136,6 +139,14 @@ pub struct HostTarget {
     /// The render area's top-left corner in both images (`vk::Offset2D::default()`: the
     /// origin): not negative. Pixels outside the area are neither cleared nor drawn.
     pub offset: vk::Offset2D,
+    /// With multisampled attachments (`RendererOptions::samples` above 1), the single-sampled
+    /// image of the colour format that shading resolves the colour into (averaged), in
+    /// COLOR_ATTACHMENT_OPTIMAL on entry and exit like the colour image (`HostSync::Attachments`
+    /// only); `None` leaves the resolve to the host.
+    pub resolve: Option<HostAttachment>,
+    /// How the images are handed over: in the attachment layouts (`HostSync::Attachments`,
+    /// the default), or in states the host declares for entry and exit (`HostSync::Declared`).
+    pub sync: HostSync,
     /// Keep the host's colour and depth (`true`), or clear them to the scene's background and
     /// the far plane (`false`).
     pub load: bool,
@@ -150,6 +161,9 @@ pub struct HostAttachment {
     pub format: vk::Format,
     /// The image's width and height at mip level 0.
     pub extent: vk::Extent2D,
+    /// The image's samples per pixel: must be `RendererOptions::samples` for the colour and
+    /// depth images, TYPE_1 for a resolve image.
+    pub samples: vk::SampleCountFlags,
 }
 
 /// glsl/common/shade.glsl's bindings, in binding order.
@@ -166,6 +180,16 @@ pub struct ShadePass {
     pixel_gather: bool,
     /// What the depth attachment is cleared to when not loaded: the far plane.
     depth_clear: f32,
+}
+
+/// How the shading pass draws: its depth test and its samples per pixel
+/// (`RendererOptions`).
+#[derive(Clone, Copy, Debug)]
+pub struct ShadeOptions {
+    /// The depth test and convention.
+    pub depth: DepthTest,
+    /// Samples per pixel of the attachments.
+    pub samples: vk::SampleCountFlags,
 }
 
 /// A per-vertex vec4 stream (exitance, cached irradiance) at `binding`, read at `location`.
@@ -187,7 +211,7 @@ impl ShadePass {
         target: TargetDesc,
         resources: &Resources,
         pixel_gather: bool,
-        depth: DepthTest,
+        options: ShadeOptions,
     ) -> GpuResult<ShadePass> {
         let fragment = if pixel_gather { "shade_pixel.frag" } else { "shade.frag" };
         let mut desc = GraphicsDesc::new("shade.vert", Some(fragment));
@@ -201,7 +225,8 @@ impl ShadePass {
         };
         desc.color_formats = if pixel_gather { vec![color, SURFACE_FORMAT] } else { vec![color] };
         desc.depth_format = Some(depth_format);
-        desc.depth_compare = depth.compare;
+        desc.depth_compare = options.depth.compare;
+        desc.samples = options.samples;
         let bindings = resources.bind_all(&BINDINGS)?;
         let variant =
             |translucent: u32, radius: u32, directional: u32| -> GpuResult<(GraphicsPipeline, DescriptorSet)> {
@@ -213,7 +238,7 @@ impl ShadePass {
         let by_lights =
             |t, r| -> GpuResult<[(GraphicsPipeline, DescriptorSet); 2]> { Ok([variant(t, r, 0)?, variant(t, r, 1)?]) };
         let variants = [[by_lights(0, 0)?, by_lights(0, 1)?], [by_lights(1, 0)?, by_lights(1, 1)?]];
-        Ok(ShadePass { variants, pixel_gather, depth_clear: depth.far() })
+        Ok(ShadePass { variants, pixel_gather, depth_clear: options.depth.far() })
     }
 
     /// Views, depth view, render area and whether to load: the frame targets' camera images, or
@@ -267,7 +292,7 @@ impl RenderPass for ShadePass {
         let load_op = if load { vk::AttachmentLoadOp::LOAD } else { vk::AttachmentLoadOp::CLEAR };
         let [r, g, b] = frame.background;
         let clears = [[r, g, b, 1.0], [0.0; 4]];
-        let colors: Vec<_> = views
+        let mut colors: Vec<_> = views
             .iter()
             .zip(clears)
             .map(|(view, clear)| {
@@ -279,6 +304,13 @@ impl RenderPass for ShadePass {
                     .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: clear } })
             })
             .collect();
+        if let Some(resolve) = frame.target.and_then(|t| t.resolve) {
+            // A host target has one colour attachment; its samples are averaged into `resolve`.
+            colors[0] = colors[0]
+                .resolve_mode(vk::ResolveModeFlags::AVERAGE)
+                .resolve_image_view(resolve.view)
+                .resolve_image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+        }
         let depth = vk::RenderingAttachmentInfo::default()
             .image_view(depth_view)
             .image_layout(vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL)
@@ -297,6 +329,9 @@ impl RenderPass for ShadePass {
             .layer_count(1)
             .color_attachments(&colors)
             .depth_attachment(&depth);
+        if let Some(t) = frame.target {
+            super::host::record_entry(device, cmd, t);
+        }
         // SAFETY: `cmd` is recording; attachments are in the layouts the barriers above set.
         unsafe {
             device.cmd_begin_rendering(cmd, &info);
@@ -325,5 +360,8 @@ impl RenderPass for ShadePass {
             pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
         }
         unsafe { device.cmd_end_rendering(cmd) };
+        if let Some(t) = frame.target {
+            super::host::record_exit(device, cmd, t);
+        }
     }
 }

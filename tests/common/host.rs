@@ -5,7 +5,7 @@
 use ash::vk;
 use std::sync::Arc;
 use translucent::gpu::{Access, Gpu, Image, ImageBarrier, ImageDesc, aspect_of};
-use translucent::{HostAttachment, HostTarget, TargetDesc};
+use translucent::{HostAttachment, HostSync, HostTarget, TargetDesc};
 
 /// The host's formats in these tests.
 pub const COLOR: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
@@ -25,22 +25,40 @@ pub struct HostImages {
 impl HostImages {
     /// Colour (of `color_format`) and depth images of `width` x `height`.
     pub fn new(gpu: &Arc<Gpu>, width: u32, height: u32, color_format: vk::Format) -> HostImages {
-        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT;
-        let color = Image::new(gpu, &ImageDesc::new("host colour", width, height, color_format, usage)).unwrap();
-        let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT;
-        let depth = Image::new(gpu, &ImageDesc::new("host depth", width, height, DEPTH, usage)).unwrap();
+        Self::multisampled(gpu, width, height, color_format, vk::SampleCountFlags::TYPE_1)
+    }
+
+    /// As `new`, with `samples` per pixel.
+    pub fn multisampled(
+        gpu: &Arc<Gpu>,
+        width: u32,
+        height: u32,
+        color_format: vk::Format,
+        samples: vk::SampleCountFlags,
+    ) -> HostImages {
+        let image = |name, format, usage| {
+            Image::new(gpu, &ImageDesc::new(name, width, height, format, usage).samples(samples)).unwrap()
+        };
+        let color = image("host colour", color_format, vk::ImageUsageFlags::COLOR_ATTACHMENT);
+        let depth = image("host depth", DEPTH, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT);
         HostImages { color, depth }
     }
 
     /// The `HostTarget` over both images, drawing `extent` (cleared first).
     pub fn target(&self, extent: vk::Extent2D) -> HostTarget {
-        let attachment =
-            |image: &Image| HostAttachment { view: image.view(), format: image.desc().format, extent: image.extent() };
+        let attachment = |image: &Image| HostAttachment {
+            view: image.view(),
+            format: image.desc().format,
+            extent: image.extent(),
+            samples: image.desc().samples,
+        };
         HostTarget {
             color: attachment(&self.color),
             depth: attachment(&self.depth),
             extent,
             offset: vk::Offset2D::default(),
+            resolve: None,
+            sync: HostSync::Attachments,
             load: false,
         }
     }
