@@ -103,10 +103,13 @@ fn vertex_and_push_layouts() {
     assert_eq!(size_of::<Vertex>(), 24);
     assert_eq!(offset_of!(Vertex, normal), 12);
     assert_eq!(Vertex::normal_attribute().offset, 12);
-    // shade.vert/shade.frag: mat4 view_proj; vec4 eye_object; uvec4 counts.
-    assert_eq!(size_of::<ShadePush>(), 96);
+    // shade.vert/shade.frag: mat4 view_proj; vec4 eye_object; uvec4 counts; vec4
+    // albedo_roughness; vec4 material: 128 bytes, the least maxPushConstantsSize Vulkan allows.
+    assert_eq!(size_of::<ShadePush>(), 128);
     assert_eq!(offset_of!(ShadePush, eye_object), 64);
     assert_eq!(offset_of!(ShadePush, counts), 80);
+    assert_eq!(offset_of!(ShadePush, albedo_roughness), 96);
+    assert_eq!(offset_of!(ShadePush, material), 112);
     let frag = include_str!("../glsl/common/shade_push.glsl");
     assert!(frag.contains("mat4 view_proj;") && frag.contains("vec4 eye_object;") && frag.contains("uvec4 counts;"));
 }
@@ -220,7 +223,7 @@ fn push_cases() -> [PushCase; 10] {
             include_str!("../glsl/common/shade_push.glsl"),
             "ShadePush",
             size_of::<ShadePush>(),
-            &["view_proj", "eye_object", "counts"],
+            &["view_proj", "eye_object", "counts", "albedo_roughness", "material"],
         ),
     ]
 }

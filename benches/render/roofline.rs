@@ -241,7 +241,7 @@ impl Roofline {
     ) {
         let scene = renderer.buffers();
         let streams = [scene.vertices.raw(), scene.exitance.raw(), scene.environment_irradiance.raw()];
-        let push = ShadePush { view_proj: *view_proj, eye_object: [0.0; 4], counts: [0; 4] };
+        let push = ShadePush { view_proj: *view_proj, ..bytemuck::Zeroable::zeroed() };
         let draw = |cmd| {
             // SAFETY: as in `record_raster`.
             unsafe {

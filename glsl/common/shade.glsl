@@ -6,7 +6,7 @@
 // finds a texel small on screen: render::plan::SHADOW_ONE_TAP_PIXELS); the environment's directions
 // reach diffuse surfaces through the per-vertex irradiance cached by vertex_light.comp (and
 // translucent ones through the splat and gather), and add no specular lobe.
-// Bindings: 0 = objects (ObjectRecord[]), 1 = lights (Light[]), 2 = shadow maps.
+// Bindings: 0 = lights (Light[]), 1 = shadow maps; the object's material comes in the push block.
 // Compiled twice: shade.frag (vertex gather: exitance arrives interpolated from the vertices)
 // and shade_pixel.frag (PIXEL_GATHER: a second attachment receives each pixel's world position
 // and translucent object, and the HDR alpha the factor F_t / (pi T) that gather_pixel.comp
@@ -25,9 +25,8 @@ layout(location = 0) out vec4 out_radiance;
 #ifdef PIXEL_GATHER
 layout(location = 1) out vec4 out_surface;  // xyz: world position; w: object index + 1, 0 if opaque
 #endif
-layout(std430, set = 0, binding = 0) readonly buffer Objects { ObjectRecord objects[]; };
-layout(std430, set = 0, binding = 1) readonly buffer Lights { Light lights[]; };
-layout(set = 0, binding = 2) uniform sampler2DArrayShadow shadow_maps;
+layout(std430, set = 0, binding = 0) readonly buffer Lights { Light lights[]; };
+layout(set = 0, binding = 1) uniform sampler2DArrayShadow shadow_maps;
 #include "shade_push.glsl"
 
 // Specialization constants: ShadePass makes a pipeline per translucent-or-opaque and per shadow
@@ -61,24 +60,23 @@ void main() {
 #endif
         return;
     }
-    ObjectRecord o = objects[uint(push.eye_object.w)];
     vec3 n = normalize(v_normal);
     vec3 wo = normalize(push.eye_object.xyz - v_position);
     // Seen from behind (open meshes, the far side of a thin plane): shade the visible side.
     if (dot(n, wo) < 0.0) n = -n;
     float cos_o = max(dot(n, wo), 0.0);
     bool translucent = SHADE_TRANSLUCENT;
-    float eta = translucent ? o.eta : 1.5;
-    float roughness = o.albedo_roughness.w;
+    float eta = translucent ? push.material.x : 1.5;
+    float roughness = push.albedo_roughness.w;
     float alpha = max(roughness * roughness, 1e-3);
     vec3 radiance = vec3(0.0);
     float exitance_to_radiance = !translucent ? 0.0
-        : (shade_skips(SHADE_SKIP_FRESNEL) ? 1.0 : dipole_fresnel_transmittance(cos_o, eta)) * o.norm;
+        : (shade_skips(SHADE_SKIP_FRESNEL) ? 1.0 : dipole_fresnel_transmittance(cos_o, eta)) * push.material.y;
     // Irradiance transmitted into a translucent surface here, for the channels the planner
     // computes locally: the environment's part arrives per vertex (vertex_light.comp weighs it
     // by F_t for translucent objects), the key lights' is added below.
     vec3 transmitted = translucent ? v_environment : vec3(0.0);
-    if (!translucent) radiance += v_environment * (o.albedo_roughness.rgb / DIPOLE_PI);
+    if (!translucent) radiance += v_environment * (push.albedo_roughness.rgb / DIPOLE_PI);
     // The key lights come first in the buffer (scene::lights::prepare); counts.y of them.
     for (uint l = 0u; l < push.counts.y; ++l) {
         vec3 wi, irradiance;
@@ -97,16 +95,17 @@ void main() {
             float fresnel = dipole_fresnel_reflectance(max(dot(wi, h), 0.0), eta);
             radiance += lit * (fresnel * ggx_specular(n, wi, wo, alpha));
         }
-        if (!translucent) radiance += lit * (o.albedo_roughness.rgb / DIPOLE_PI * cos_i);
+        if (!translucent) radiance += lit * (push.albedo_roughness.rgb / DIPOLE_PI * cos_i);
         else transmitted += lit * (cos_i * (shade_skips(SHADE_SKIP_FRESNEL) ? 1.0 : dipole_fresnel_transmittance(cos_i, eta)));
     }
     if (translucent) {
         // Gathered channels: the exitance interpolated from the vertices (zero under the pixel
         // gather, which adds its own afterwards). Local ones: M = R_d,total E_t, the dipole
         // integral when E_t is uniform over the profile's width (render::plan).
-        vec3 gathered = object_gathered_channels(o);
+        uint local = push.counts.z;
+        vec3 gathered = vec3((local & 1u) == 0u ? 1.0 : 0.0, (local & 2u) == 0u ? 1.0 : 0.0, (local & 4u) == 0u ? 1.0 : 0.0);
         // R_d,total is the record's albedo (ObjectRecord::new), not recomputed per pixel.
-        radiance += mix(o.albedo_roughness.rgb * transmitted, v_exitance, gathered) * exitance_to_radiance;
+        radiance += mix(push.albedo_roughness.rgb * transmitted, v_exitance, gathered) * exitance_to_radiance;
     }
     // Nothing non-finite leaves this pass (the tone map counts any that would).
 #ifdef PIXEL_GATHER

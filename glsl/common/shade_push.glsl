@@ -3,13 +3,16 @@
 #ifndef SHADE_PUSH_GLSL
 #define SHADE_PUSH_GLSL
 
+// The object's material is here rather than read from its ObjectRecord: a CPU driver loads a
+// storage buffer lane by lane in a fragment shader, and push constants at fixed offsets once.
 struct ShadePush {
     mat4 view_proj;
     vec4 eye_object;        // xyz: camera position; w: object index
     uvec4 counts;           // x: light count; y: key (non-environment) lights, first in the buffer;
-                            // z: shadow filter radius (light_visibility: 0 one tap, 1 four),
-                            //    which the shaders take from SHADE_SHADOW_RADIUS instead;
+                            // z: the object's locally computed channels (ObjectRecord::local_channels);
                             // w: terms left out, to measure their cost (SHADE_SKIP_*)
+    vec4 albedo_roughness;  // the object's ObjectRecord::albedo_roughness
+    vec4 material;          // x: eta (ObjectRecord::eta); y: BSSRDF normalization (ObjectRecord::norm); zw: 0
 };
 layout(push_constant) uniform ShadePushBlock { ShadePush push; };
 

@@ -507,6 +507,11 @@ impl GpuScene {
         self.object_ranges().nth(object).expect("an object of the scene")
     }
 
+    /// Object `object`'s record as the next recorded frame uploads it.
+    pub fn object_record(&self, object: usize) -> &ObjectRecord {
+        &self.object_records[object]
+    }
+
     /// Which channels of object `object` the last recorded plan computes locally (bit c:
     /// channel c), its record's `local_channels`.
     pub fn local_channels(&self, object: usize) -> u32 {

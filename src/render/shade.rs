@@ -6,7 +6,7 @@
 //!
 //! Vertex input: binding 0 = `records::Vertex`, binding 1 = exitance, binding 2 = cached
 //! environment irradiance (vec4 per vertex each).
-//! Bindings: 0 = objects, 1 = lights, 2 = shadow maps. Push: `ShadePush`.
+//! Bindings: 0 = lights, 1 = shadow maps. Push: `ShadePush` (with the object's material).
 
 use super::graph::{Resource, Resources, Use, overwrite, read, write};
 use super::host::HostSync;
@@ -37,8 +37,14 @@ pub struct ShadePush {
     pub view_proj: [[f32; 4]; 4],
     /// xyz: camera position; w: object index.
     pub eye_object: [f32; 4],
-    /// x: light count; y: key (non-environment) lights, which come first in the buffer.
+    /// x: light count; y: key (non-environment) lights, which come first in the buffer; z: the
+    /// object's locally computed channels (`ObjectRecord::local_channels`); w: terms left out.
     pub counts: [u32; 4],
+    /// The object's `ObjectRecord::albedo_roughness`.
+    pub albedo_roughness: [f32; 4],
+    /// x: the object's `ObjectRecord::eta`; y: its `norm`; zw: 0. In the push block, not read
+    /// from the record: llvmpipe loads a storage buffer lane by lane in a fragment shader.
+    pub material: [f32; 4],
 }
 
 /// What the shading pass draws into.
@@ -167,7 +173,7 @@ pub struct HostAttachment {
 }
 
 /// glsl/common/shade.glsl's bindings, in binding order.
-const BINDINGS: [Resource; 3] = [Resource::Objects, Resource::Lights, Resource::ShadowMaps];
+const BINDINGS: [Resource; 2] = [Resource::Lights, Resource::ShadowMaps];
 
 /// The forward-shading pass: a graphics pipeline (shade.vert with shade.frag, or shade_pixel.frag
 /// for the pixel gather) and its descriptor set, drawing into the frame targets' camera images
@@ -266,7 +272,6 @@ impl RenderPass for ShadePass {
             read(Resource::Vertices, Access::VertexAttributeRead),
             read(Resource::Exitance, Access::VertexAttributeRead),
             read(Resource::EnvironmentIrradiance, Access::VertexAttributeRead),
-            read(Resource::Objects, Access::FragmentRead),
             read(Resource::Lights, Access::FragmentRead),
             read(Resource::ShadowMaps, Access::FragmentSampledRead),
         ];
@@ -342,15 +347,13 @@ impl RenderPass for ShadePass {
         let eye = frame.eye;
         for i in 0..scene.levels.len() {
             let d = scene.level(i, frame.plan.level(i)).draw;
+            let record = scene.object_record(i);
             let push = ShadePush {
                 view_proj: frame.view_proj.to_cols_array_2d(),
                 eye_object: [eye.x, eye.y, eye.z, i as f32],
-                counts: [
-                    scene.light_count,
-                    scene.key_light_count,
-                    u32::from(!frame.plan.one_tap_shadows),
-                    frame.plan.skip_terms,
-                ],
+                counts: [scene.light_count, scene.key_light_count, record.local_channels, frame.plan.skip_terms],
+                albedo_roughness: record.albedo_roughness,
+                material: [record.eta, record.norm, 0.0, 0.0],
             };
             let translucent = scene.object_range(i).eta > 0.0;
             let filter = usize::from(!frame.plan.one_tap_shadows);
