@@ -5,6 +5,7 @@
 
 pub mod bvh;
 pub mod rte;
+pub mod rte_cache;
 pub mod rte_mesh;
 pub mod tree;
 pub mod truth;
