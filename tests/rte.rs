@@ -407,3 +407,32 @@ fn sphere_reference_precision_and_the_dipoles_error_against_it() {
         }
     }
 }
+
+/// Issue 26, part 5: the half-space walk's photons that left after exactly one scattering
+/// against `optics::single_scatter::reflectance` (the closed form's integral by quadrature),
+/// index-matched and behind a boundary of 1.3, 1.5 and 0.8, isotropic and Henyey-Greenstein
+/// (`g` -0.3 and 0.6), at normal and oblique incidence, at dark and bright albedos: within 3
+/// standard errors and 1%. And the split is a split: once plus more scattered is the total.
+#[test]
+fn once_scattered_photons_match_the_single_scattering_closed_form() {
+    use translucent::optics::single_scatter::reflectance;
+    for (albedo, g, eta, cos) in [
+        (0.067, 0.0, 1.0, 1.0),
+        (0.067, 0.0, 1.3, 1.0),
+        (0.5, 0.0, 1.5, 0.5),
+        (0.9, 0.0, 0.8, 0.9),
+        (0.3, 0.6, 1.3, 1.0),
+        (0.3, -0.3, 1.3, 0.4),
+        (0.02, 0.0, 1.33, 0.2),
+    ] {
+        let medium = Medium::new(1.0 - albedo, albedo, g, eta).unwrap();
+        let budget = Budget { max_photons: 4_000_000, relative_stderr: Some(2e-3), max_seconds: None };
+        let orders = rte::half_space_by_order(&medium, cos, &budget, 3, &quiet).unwrap();
+        let single = orders.single.expect("walked");
+        let multiple = orders.multiple.expect("walked");
+        let label = format!("once scattered, albedo {albedo} g {g} eta {eta} cos {cos}");
+        assert_close(&label, &single, reflectance(albedo, g, eta, cos), 1e-2);
+        let sum = single.mean + multiple.mean;
+        assert!((sum - orders.total.mean).abs() <= 1e-12 * orders.total.mean, "{label}: {sum} vs {:?}", orders.total);
+    }
+}

@@ -169,6 +169,27 @@ mod tests {
     }
 
     #[test]
+    fn the_16_point_rule_is_within_1e_5_of_a_64_point_rule_for_g_from_minus_half_to_0_8() {
+        let mut worst = 0.0f64;
+        for g in [-0.5, -0.2, 0.0, 0.3, 0.8] {
+            for eta in [1.0 / 3.0, 0.8, 1.0, 1.3, 1.5, 3.0] {
+                for cos in [1.0, 0.7, 0.3, 0.05] {
+                    let (fine, got) = (reflectance_points(0.5, g, eta, cos, 64), reflectance(0.5, g, eta, cos));
+                    if fine == 0.0 {
+                        // Nothing enters (eta < 1 beyond the critical angle outside).
+                        assert_eq!(got, 0.0, "g {g} eta {eta} cos {cos}");
+                        continue;
+                    }
+                    let e = (got / fine - 1.0).abs();
+                    assert!(e < 1e-5, "g {g} eta {eta} cos {cos}: {e:e}");
+                    worst = worst.max(e);
+                }
+            }
+        }
+        eprintln!("16-point rule against 64 points: worst relative difference {worst:.2e}");
+    }
+
+    #[test]
     fn henyey_greenstein_integrates_to_one_and_has_mean_cosine_g() {
         let (x, w) = gauss_legendre(64);
         for g in [-0.5, 0.0, 0.3, 0.7] {

@@ -52,6 +52,10 @@ pub struct Physics {
     pub cached: bool,
     /// The budget and seed it was walked with.
     pub options: MeshOptions,
+    /// Other models against the same reference, per channel: the dipole with the
+    /// single-scattering exitance added (`reference::single`, Jensen et al. 2001's sum of the
+    /// two terms), and single scattering alone (what leaves a dark medium: nearly all of it).
+    pub alternatives: Vec<(String, VertexError)>,
 }
 
 impl Physics {
@@ -89,6 +93,17 @@ impl Physics {
         }
         let model = vertex_error_f64(&exitance, &truth.exitance);
         let noise = noise(&exitance, &stderr);
+        let single = crate::reference::single::exitance(base);
+        let sum: Vec<Vec<[f64; 3]>> = truth
+            .exitance
+            .iter()
+            .zip(&single)
+            .map(|(t, s)| t.iter().zip(s).map(|(t, s)| [0, 1, 2].map(|c| t[c] + s[c])).collect())
+            .collect();
+        let alternatives = vec![
+            ("dipole + single scattering".to_string(), vertex_error_f64(&exitance, &sum)),
+            ("single scattering alone".to_string(), vertex_error_f64(&exitance, &single)),
+        ];
         Ok(Physics {
             exitance,
             stderr,
@@ -100,6 +115,7 @@ impl Physics {
             lost,
             cached,
             options: *options,
+            alternatives,
         })
     }
 }
@@ -190,9 +206,27 @@ pub fn markdown(physics: &Physics, rows: &[Row]) -> String {
             percent(physics.noise[c])
         );
     }
+    alternatives_table(&mut out, physics);
     split_table(&mut out, rows);
     crossover_table(&mut out, rows, physics.model.rel_rms);
     out
+}
+
+/// Each model's exact exitance against the reference, per channel: RMS (bias).
+fn alternatives_table(out: &mut String, p: &Physics) {
+    let _ = writeln!(
+        out,
+        "\nThe models' exact exitance against the reference (relative RMS per vertex, mean bias in brackets; \
+         single scattering: `reference::single`, the half-space term of Jensen et al. 2001 Eq. 3 at each \
+         vertex):\n"
+    );
+    let _ = writeln!(out, "| model | r | g | b |");
+    let _ = writeln!(out, "|---|---:|---:|---:|");
+    let models = std::iter::once(("dipole", &p.model)).chain(p.alternatives.iter().map(|(n, e)| (n.as_str(), e)));
+    for (name, e) in models {
+        let cell = |c: usize| format!("{} % ({:+.1} %)", percent(e.rel_rms[c]), 100.0 * e.bias[c]);
+        let _ = writeln!(out, "| {name} | {} | {} | {} |", cell(0), cell(1), cell(2));
+    }
 }
 
 /// What the reference is, how far it got and what it cost.
