@@ -17,7 +17,7 @@ void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= push.count) return;
     vec4 p = inputs[i];
-    float cos_sq = 1.0 - (1.0 - p.w * p.w) / (p.z * p.z);
+    float cos_sq = ss_refracted_cosine_sq(p.w, p.z);
     outputs[i] = vec4(single_scatter_reflectance(p.x, p.y, p.z, p.w), ss_henyey_greenstein(p.w, p.y),
         cos_sq > 0.0 ? sqrt(cos_sq) : 0.0, 0.0);
 }

@@ -38,14 +38,20 @@ float ss_azimuthal(float mu_i, float sin_i, float mu, float g) {
     return 2.0 * sum;
 }
 
+// The squared cosine of the refracted direction inside (Snell's law; <= 0: nothing enters),
+// formed without the cancellation of 1 - sin^2 at grazing incidence.
+float ss_refracted_cosine_sq(float cos_out, float eta) {
+    return (cos_out * cos_out + (eta - 1.0) * (eta + 1.0)) / (eta * eta);
+}
+
 // Of the flux entering through the plane at incidence cosine cos_out outside, the share that
 // leaves after exactly one scattering (single_scatter::reflectance). 0 where nothing enters.
 float single_scatter_reflectance(float albedo, float g, float eta, float cos_out) {
     if (!(cos_out > 0.0 && cos_out <= 1.0)) return 0.0;
-    float cos_sq = 1.0 - (1.0 - cos_out * cos_out) / (eta * eta);
+    float cos_sq = ss_refracted_cosine_sq(cos_out, eta);
     if (cos_sq <= 0.0) return 0.0;
     float mu_i = sqrt(cos_sq);
-    float sin_i = sqrt(max(1.0 - cos_sq, 0.0));
+    float sin_i = sqrt((1.0 - cos_out) * (1.0 + cos_out)) / eta;
     float mu_c = eta > 1.0 ? sqrt(1.0 - 1.0 / (eta * eta)) : 0.0;
     float sum = 0.0;
     for (int k = 0; k < 16; ++k) {

@@ -64,7 +64,8 @@ pub fn refracted_cosine(cos_out: f64, eta: f64) -> Option<f64> {
     if !(cos_out > 0.0 && cos_out <= 1.0) {
         return None;
     }
-    let cos_sq = 1.0 - (1.0 - cos_out * cos_out) / (eta * eta);
+    // Without the cancellation of 1 - sin^2 at grazing incidence (as `fresnel` forms it).
+    let cos_sq = (cos_out * cos_out + (eta - 1.0) * (eta + 1.0)) / (eta * eta);
     (cos_sq > 0.0).then(|| cos_sq.sqrt())
 }
 
@@ -90,7 +91,7 @@ pub fn reflectance_points(albedo: f64, g: f64, eta: f64, cos_out: f64, n: usize)
 fn reflectance_with(albedo: f64, g: f64, eta: f64, cos_out: f64, rule: &(Vec<f64>, Vec<f64>)) -> f64 {
     let Some(mu_i) = refracted_cosine(cos_out, eta) else { return 0.0 };
     let mu_c = critical_cosine(eta);
-    let sin_i = (1.0 - mu_i * mu_i).max(0.0).sqrt();
+    let sin_i = ((1.0 - cos_out) * (1.0 + cos_out)).sqrt() / eta;
     let (nodes, weights) = rule;
     let mut sum = 0.0;
     for (x, w) in nodes.iter().zip(weights) {
