@@ -436,3 +436,37 @@ fn once_scattered_photons_match_the_single_scattering_closed_form() {
         assert!((sum - orders.total.mean).abs() <= 1e-12 * orders.total.mean, "{label}: {sum} vs {:?}", orders.total);
     }
 }
+
+/// Issue 26, part 4: the mesh reference is cached by content (`reference::rte_cache`). A second
+/// call reads the file the first wrote, with the same values; a file whose values were edited
+/// (its checksum no longer matches) is walked anew and gives the first walk's values again; a
+/// change of budget is another key, so another walk.
+#[test]
+fn the_mesh_reference_is_cached_by_content_and_an_edited_file_is_walked_anew() {
+    use translucent::reference::rte_cache;
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/study-tiny.toml");
+    let scene = PreparedScene::new(&Scene::load(&path).unwrap(), &Overrides::default()).unwrap();
+    let dir = std::env::temp_dir().join(format!("translucent-rte-cache-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let options = MeshOptions { budget: Budget::photons(3000), seed: 2 };
+    let (first, cached) = rte_cache::cached(&scene, &options, &dir, &quiet).unwrap();
+    assert!(!cached, "nothing was cached yet");
+    let (second, cached) = rte_cache::cached(&scene, &options, &dir, &quiet).unwrap();
+    assert!(cached && second == first, "the second call must read the first's file");
+    let file = dir.join(format!("rte-{}.json", rte_cache::content_key(&scene, &options)));
+    let text = std::fs::read_to_string(&file).unwrap();
+    let value = first.objects[0].as_ref().unwrap().exitance.iter().flatten().find(|v| **v > 0.0).unwrap();
+    let edited = text.replacen(&serde_json::to_string(value).unwrap(), "1e6", 1);
+    assert_ne!(edited, text, "the test edits a value of the file");
+    std::fs::write(&file, edited).unwrap();
+    let (third, cached) = rte_cache::cached(&scene, &options, &dir, &quiet).unwrap();
+    // The same values (the wall time of the walk aside).
+    let values = |r: &rte_cache::RteReference| {
+        let o = r.objects[0].as_ref().unwrap();
+        (o.exitance.clone(), o.stderr.clone(), o.photons)
+    };
+    assert!(!cached && values(&third) == values(&first), "an edited file must be walked anew, to the same values");
+    let other = MeshOptions { budget: Budget::photons(2000), ..options };
+    assert_ne!(rte_cache::content_key(&scene, &other), rte_cache::content_key(&scene, &options));
+    let _ = std::fs::remove_dir_all(&dir);
+}
