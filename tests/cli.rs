@@ -252,7 +252,10 @@ fn material_rte_json_splits_single_from_multiple_scattering_beside_the_closed_fo
         let (total, single, multiple) = (get("rd_total_rte"), get("rd_single_rte"), get("rd_multiple_rte"));
         assert!((single + multiple - total).abs() <= 1e-12 * total, "channel {c}: {single} + {multiple} vs {total}");
         let (r1, se) = (get("rd_single"), get("rd_single_rte_stderr"));
-        assert!((r1 - single).abs() <= (3.0 * se).min(0.01 * single), "channel {c}: R1 {r1} vs walked {single} +- {se}");
+        assert!(
+            (r1 - single).abs() <= (3.0 * se).min(0.01 * single),
+            "channel {c}: R1 {r1} vs walked {single} +- {se}"
+        );
     }
     let green = &json["channels"][1];
     assert!(green["rd_single"].as_f64().unwrap() > 0.9 * green["rd_total_rte"].as_f64().unwrap(), "{green}");

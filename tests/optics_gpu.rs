@@ -195,7 +195,8 @@ fn run_on_gpu(inputs: &[DipoleEvalInput]) -> Vec<DipoleEvalOutput> {
             .descriptor_set(&[
                 Named { name: "Inputs", binding: Binding::Buffer(&src) },
                 Named { name: "Outputs", binding: Binding::Buffer(&dst) },
-            ]).expect("descriptor set");
+            ])
+            .expect("descriptor set");
         gpu.one_shot("dipole_eval", |cmd| {
             pipeline.dispatch(cmd, &set, &count, [count, 1, 1]);
             memory_barrier(gpu.device(), cmd, &[Access::ComputeWrite], &[Access::HostRead]);
@@ -336,7 +337,8 @@ fn single_scattering_glsl_twin_matches_f64_reference() {
     let mut worst = [0.0f64; 3];
     for (p, o) in inputs.iter().zip(&outputs) {
         let [albedo, g, eta, cos] = p.map(f64::from);
-        let want = [reflectance(albedo, g, eta, cos), henyey_greenstein(cos, g), refracted_cosine(cos, eta).unwrap_or(0.0)];
+        let want =
+            [reflectance(albedo, g, eta, cos), henyey_greenstein(cos, g), refracted_cosine(cos, eta).unwrap_or(0.0)];
         for f in 0..3 {
             let got = f64::from(o[f]);
             assert!(got.is_finite(), "field {f} at {p:?}: {got}");
@@ -349,5 +351,8 @@ fn single_scattering_glsl_twin_matches_f64_reference() {
             }
         }
     }
-    eprintln!("single scattering twin: worst relative error R1 {:.2e}, phase {:.2e}, cosine {:.2e}", worst[0], worst[1], worst[2]);
+    eprintln!(
+        "single scattering twin: worst relative error R1 {:.2e}, phase {:.2e}, cosine {:.2e}",
+        worst[0], worst[1], worst[2]
+    );
 }

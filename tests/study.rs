@@ -447,7 +447,8 @@ fn study_with_physics_splits_each_rows_error_into_model_discretisation_and_total
     for pass in ["walked", "cached"] {
         let out = dir.join(format!("out-{pass}"));
         let (scene, out_s, cache_s) = (scene.to_str().unwrap(), out.to_str().unwrap(), cache.to_str().unwrap());
-        let args = ["study", scene, "-o", out_s, "--quick", "--physics", "--rte-photons", "40000", "--truth-cache", cache_s];
+        let args =
+            ["study", scene, "-o", out_s, "--quick", "--physics", "--rte-photons", "40000", "--truth-cache", cache_s];
         let run = translucent(&args, &[]);
         assert!(run.status.success(), "{pass}: {}", text(&run.stderr));
         let md = std::fs::read_to_string(out.join("study.md")).unwrap();
@@ -475,7 +476,14 @@ fn study_with_physics_splits_each_rows_error_into_model_discretisation_and_total
                 assert!(v.is_finite() && v > 0.0, "{what} {c}: {v} in {r:?}");
             }
             let bound = m[c] + d[c] * (1.0 + m[c]) + 3.0 * n[c];
-            assert!(t[c] <= bound, "channel {c}: total {} above model {} + discretisation {} + 3 noise {}", t[c], m[c], d[c], n[c]);
+            assert!(
+                t[c] <= bound,
+                "channel {c}: total {} above model {} + discretisation {} + 3 noise {}",
+                t[c],
+                m[c],
+                d[c],
+                n[c]
+            );
             // And not below what the two leave when they do not cancel exactly.
             assert!(t[c] >= (m[c] - d[c] * (1.0 + m[c])).abs() - 3.0 * n[c], "channel {c}: total {} too small", t[c]);
         }

@@ -12,8 +12,8 @@ use anyhow::{Context, bail};
 use std::fmt::Write as _;
 use std::io::Write as _;
 use translucent::optics::presets::{self, MeasuredMaterial};
-use translucent::optics::{Dipole, Material};
 use translucent::optics::single_scatter;
+use translucent::optics::{Dipole, Material};
 use translucent::reference::rte::{self, Budget, Medium, Orders, RteProgress};
 
 #[derive(clap::Args, Debug)]
@@ -164,10 +164,14 @@ fn rte_table(dipoles: &[Dipole; 3], orders: &[Orders; 3], args: &Args) -> String
     row("  more often (RTE)", orders.map(|o| walked(o.multiple)));
     let single = dipoles.each_ref().map(single_scattering);
     row("single scattering R1", single.map(fmt));
-    row("R1 vs once scattered", [0, 1, 2].map(|c| orders[c].single.map_or("-".into(), |e| difference(single[c], e.mean))));
-    row("dipole vs more often", [0, 1, 2].map(|c| {
-        orders[c].multiple.map_or("-".into(), |e| difference(dipoles[c].r_d_total(), e.mean))
-    }));
+    row(
+        "R1 vs once scattered",
+        [0, 1, 2].map(|c| orders[c].single.map_or("-".into(), |e| difference(single[c], e.mean))),
+    );
+    row(
+        "dipole vs more often",
+        [0, 1, 2].map(|c| orders[c].multiple.map_or("-".into(), |e| difference(dipoles[c].r_d_total(), e.mean))),
+    );
     row("dipole + R1 vs RTE", [0, 1, 2].map(|c| difference(dipoles[c].r_d_total() + single[c], rte[c].mean)));
     out
 }

@@ -39,9 +39,7 @@ pub fn exitance(scene: &PreparedScene) -> Vec<Vec<[f64; 3]>> {
                     for l in &scene.lights {
                         let (wi, e, dist) = light_incidence(l, p);
                         let cos_i = n.dot(wi);
-                        if cos_i <= 0.0
-                            || (l.shadow_layer.is_some() && casters.occluded(p + n * eps, wi, eps, dist))
-                        {
+                        if cos_i <= 0.0 || (l.shadow_layer.is_some() && casters.occluded(p + n * eps, wi, eps, dist)) {
                             continue;
                         }
                         let e_t = e * (cos_i * fresnel::fresnel_transmittance(cos_i, eta));
