@@ -490,3 +490,20 @@ fn study_with_physics_splits_each_rows_error_into_model_discretisation_and_total
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--physics` with a budget that budgets nothing is refused before any work, naming the flag,
+/// with a non-zero exit and no output folder.
+#[test]
+fn study_physics_refuses_an_empty_budget_naming_the_flag_and_writes_nothing() {
+    let dir = temp_dir("study-physics-bad");
+    let out = dir.join("out");
+    for (flag, value) in
+        [("--rte-stderr", "0"), ("--rte-stderr", "nan"), ("--rte-photons", "0"), ("--rte-seconds", "-1")]
+    {
+        let run = translucent(&["study", "-o", out.to_str().unwrap(), "--physics", flag, value], &[]);
+        let err = text(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{flag} {value}: {err}");
+        assert!(err.contains(flag) && !err.contains("panicked"), "{flag} {value}: {err}");
+        assert!(!out.exists(), "{flag} {value} made the output folder");
+    }
+}

@@ -74,14 +74,14 @@ pub struct Args {
     pub physics: bool,
     /// With --physics: stop the reference once its relative standard error (RMS over lit
     /// vertices over their mean, worst channel) is at most this (default 0.01)
-    #[arg(long, value_name = "REL")]
+    #[arg(long, allow_hyphen_values = true, value_name = "REL")]
     pub rte_stderr: Option<f64>,
     /// With --physics: walk at most this many photons per object (default 1000000000)
     #[arg(long, value_name = "N")]
     pub rte_photons: Option<u64>,
     /// With --physics: stop the reference after this many seconds per object (default 600; the
     /// photon count, and so the reference, then depends on the machine)
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, allow_hyphen_values = true, value_name = "SECONDS")]
     pub rte_seconds: Option<f64>,
 }
 
