@@ -407,3 +407,66 @@ fn sphere_reference_precision_and_the_dipoles_error_against_it() {
         }
     }
 }
+
+/// Issue 26, part 5: the half-space walk's photons that left after exactly one scattering
+/// against `optics::single_scatter::reflectance` (the closed form's integral by quadrature),
+/// index-matched and behind a boundary of 1.3, 1.5 and 0.8, isotropic and Henyey-Greenstein
+/// (`g` -0.3 and 0.6), at normal and oblique incidence, at dark and bright albedos: within 3
+/// standard errors and 1%. And the split is a split: once plus more scattered is the total.
+#[test]
+fn once_scattered_photons_match_the_single_scattering_closed_form() {
+    use translucent::optics::single_scatter::reflectance;
+    for (albedo, g, eta, cos) in [
+        (0.067, 0.0, 1.0, 1.0),
+        (0.067, 0.0, 1.3, 1.0),
+        (0.5, 0.0, 1.5, 0.5),
+        (0.9, 0.0, 0.8, 0.9),
+        (0.3, 0.6, 1.3, 1.0),
+        (0.3, -0.3, 1.3, 0.4),
+        (0.02, 0.0, 1.33, 0.2),
+    ] {
+        let medium = Medium::new(1.0 - albedo, albedo, g, eta).unwrap();
+        let budget = Budget { max_photons: 4_000_000, relative_stderr: Some(2e-3), max_seconds: None };
+        let orders = rte::half_space_by_order(&medium, cos, &budget, 3, &quiet).unwrap();
+        let single = orders.single.expect("walked");
+        let multiple = orders.multiple.expect("walked");
+        let label = format!("once scattered, albedo {albedo} g {g} eta {eta} cos {cos}");
+        assert_close(&label, &single, reflectance(albedo, g, eta, cos), 1e-2);
+        let sum = single.mean + multiple.mean;
+        assert!((sum - orders.total.mean).abs() <= 1e-12 * orders.total.mean, "{label}: {sum} vs {:?}", orders.total);
+    }
+}
+
+/// Issue 26, part 4: the mesh reference is cached by content (`reference::rte_cache`). A second
+/// call reads the file the first wrote, with the same values; a file whose values were edited
+/// (its checksum no longer matches) is walked anew and gives the first walk's values again; a
+/// change of budget is another key, so another walk.
+#[test]
+fn the_mesh_reference_is_cached_by_content_and_an_edited_file_is_walked_anew() {
+    use translucent::reference::rte_cache;
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/study-tiny.toml");
+    let scene = PreparedScene::new(&Scene::load(&path).unwrap(), &Overrides::default()).unwrap();
+    let dir = std::env::temp_dir().join(format!("translucent-rte-cache-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let options = MeshOptions { budget: Budget::photons(3000), seed: 2 };
+    let (first, cached) = rte_cache::cached(&scene, &options, &dir, &quiet).unwrap();
+    assert!(!cached, "nothing was cached yet");
+    let (second, cached) = rte_cache::cached(&scene, &options, &dir, &quiet).unwrap();
+    assert!(cached && second == first, "the second call must read the first's file");
+    let file = dir.join(format!("rte-{}.json", rte_cache::content_key(&scene, &options)));
+    let text = std::fs::read_to_string(&file).unwrap();
+    let value = first.objects[0].as_ref().unwrap().exitance.iter().flatten().find(|v| **v > 0.0).unwrap();
+    let edited = text.replacen(&serde_json::to_string(value).unwrap(), "1e6", 1);
+    assert_ne!(edited, text, "the test edits a value of the file");
+    std::fs::write(&file, edited).unwrap();
+    let (third, cached) = rte_cache::cached(&scene, &options, &dir, &quiet).unwrap();
+    // The same values (the wall time of the walk aside).
+    let values = |r: &rte_cache::RteReference| {
+        let o = r.objects[0].as_ref().unwrap();
+        (o.exitance.clone(), o.stderr.clone(), o.photons)
+    };
+    assert!(!cached && values(&third) == values(&first), "an edited file must be walked anew, to the same values");
+    let other = MeshOptions { budget: Budget::photons(2000), ..options };
+    assert_ne!(rte_cache::content_key(&scene, &other), rte_cache::content_key(&scene, &options));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -181,6 +181,10 @@ fn study_rejects_a_bad_sweep_selection_naming_the_flag_and_writes_nothing() {
         ("--error-image", "turk:401:hierarchical:0.1", "not in this sweep"),
         ("--configurations", "best", "expected default or sweep"),
         ("--max-error", "0", "must be 0.001 to 0.5"),
+        // The radiative-transfer reference's budget is --physics's.
+        ("--rte-photons", "1000", "only with --physics"),
+        ("--rte-stderr", "0.01", "only with --physics"),
+        ("--rte-seconds", "5", "only with --physics"),
     ] {
         let run = translucent(&["study", "-o", out.to_str().unwrap(), flag, value], &[]);
         let err = text(&run.stderr);
@@ -419,5 +423,87 @@ fn an_interrupted_study_exits_130_leaving_nothing() {
         assert!(stderr.contains("interrupted"), "{signal}: {stderr}");
         let left = |d: &Path| std::fs::read_dir(d).map_or(0, |d| d.count());
         assert_eq!((left(&out), left(&cache)), (0, 0), "{signal}: files left behind");
+    }
+}
+
+/// The `--physics` columns of a CSV row for one error, per channel.
+fn channels(row: &Row, name: &str) -> [f64; 3] {
+    ["r", "g", "b"].map(|c| row[&format!("{name}_{c}")].parse::<f64>().unwrap())
+}
+
+/// Issue 26, part 4: `study --physics` on the tiny sphere with a Monte Carlo reference of a few
+/// seconds. Every row has the model, discretisation and total errors and the reference's
+/// noise, all finite and positive; the model error is one figure per scene; the total error
+/// is within the triangle inequality's bound, `total <= model + discretisation (1 + model) +
+/// 3 noise` per channel (the RMS of a sum of relative errors, the second taken against the
+/// dipole, not the reference); study.md says where more samples stop paying; and a second run
+/// reads the reference from the cache with the same figures.
+#[test]
+fn study_with_physics_splits_each_rows_error_into_model_discretisation_and_total_consistently() {
+    let dir = temp_dir("study-physics");
+    let scene = repo_path("tests/scenes/study-tiny.toml");
+    let cache = dir.join("cache");
+    let mut csvs = Vec::new();
+    for pass in ["walked", "cached"] {
+        let out = dir.join(format!("out-{pass}"));
+        let (scene, out_s, cache_s) = (scene.to_str().unwrap(), out.to_str().unwrap(), cache.to_str().unwrap());
+        let args =
+            ["study", scene, "-o", out_s, "--quick", "--physics", "--rte-photons", "40000", "--truth-cache", cache_s];
+        let run = translucent(&args, &[]);
+        assert!(run.status.success(), "{pass}: {}", text(&run.stderr));
+        let md = std::fs::read_to_string(out.join("study.md")).unwrap();
+        assert!(md.contains("Against the physics") && md.contains("stop paying"), "{md}");
+        assert!(md.contains("40000 photons, "), "{md}");
+        assert_eq!(md.contains("when walked, read from the cache"), pass == "cached", "{pass}: {md}");
+        csvs.push(std::fs::read_to_string(out.join("study.csv")).unwrap());
+    }
+    assert_eq!(csvs[0].lines().next(), csvs[1].lines().next());
+    let model_of = |csv: &str| csv_rows(csv).iter().map(|r| channels(r, "model_rel_rms")).collect::<Vec<_>>();
+    assert_eq!(model_of(&csvs[0]), model_of(&csvs[1]), "the cached reference gave other figures");
+    let rows = csv_rows(&csvs[0]);
+    assert_eq!(rows.len(), 7);
+    let model = channels(&rows[0], "model_rel_rms");
+    for r in &rows {
+        let (m, d, t, n) = (
+            channels(r, "model_rel_rms"),
+            channels(r, "rel_rms"),
+            channels(r, "total_rel_rms"),
+            channels(r, "rte_noise"),
+        );
+        assert_eq!(m, model, "the model error is the scene's, not the row's");
+        for c in 0..3 {
+            for (what, v) in [("model", m[c]), ("discretisation", d[c]), ("total", t[c]), ("noise", n[c])] {
+                assert!(v.is_finite() && v > 0.0, "{what} {c}: {v} in {r:?}");
+            }
+            let bound = m[c] + d[c] * (1.0 + m[c]) + 3.0 * n[c];
+            assert!(
+                t[c] <= bound,
+                "channel {c}: total {} above model {} + discretisation {} + 3 noise {}",
+                t[c],
+                m[c],
+                d[c],
+                n[c]
+            );
+            // And not below what the two leave when they do not cancel exactly.
+            assert!(t[c] >= (m[c] - d[c] * (1.0 + m[c])).abs() - 3.0 * n[c], "channel {c}: total {} too small", t[c]);
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--physics` with a budget that budgets nothing is refused before any work, naming the flag,
+/// with a non-zero exit and no output folder.
+#[test]
+fn study_physics_refuses_an_empty_budget_naming_the_flag_and_writes_nothing() {
+    let dir = temp_dir("study-physics-bad");
+    let out = dir.join("out");
+    for (flag, value) in
+        [("--rte-stderr", "0"), ("--rte-stderr", "nan"), ("--rte-photons", "0"), ("--rte-seconds", "-1")]
+    {
+        let run = translucent(&["study", "-o", out.to_str().unwrap(), "--physics", flag, value], &[]);
+        let err = text(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{flag} {value}: {err}");
+        assert!(err.contains(flag) && !err.contains("panicked"), "{flag} {value}: {err}");
+        assert!(!out.exists(), "{flag} {value} made the output folder");
     }
 }

@@ -4,14 +4,17 @@
 //! - `translucent material NAME [--eta X] [--scale MM_PER_UNIT] [--json]`
 //! - `translucent material --sigma-a R,G,B --sigma-s-prime R,G,B --eta X [--scale ..] [--json]`
 //! - `... --rte [--rte-stderr REL] [--rte-photons N]`: beside each channel's `R_d,total`, the
-//!   half-space total diffuse reflectance by Monte Carlo radiative transfer (`reference::rte`).
+//!   half-space total diffuse reflectance by Monte Carlo radiative transfer (`reference::rte`),
+//!   split into what left after one scattering and after more, beside the single-scattering
+//!   closed form (`optics::single_scatter`) and the dipole with it added.
 
 use anyhow::{Context, bail};
 use std::fmt::Write as _;
 use std::io::Write as _;
 use translucent::optics::presets::{self, MeasuredMaterial};
+use translucent::optics::single_scatter;
 use translucent::optics::{Dipole, Material};
-use translucent::reference::rte::{self, Budget, Estimate, Medium, RteProgress};
+use translucent::reference::rte::{self, Budget, Medium, Orders, RteProgress};
 
 #[derive(clap::Args, Debug)]
 #[command(after_help = "Coefficients are in 1/mm; derived lengths are in scene units \
@@ -106,7 +109,7 @@ fn render(args: &Args) -> anyhow::Result<String> {
 
 /// Per channel, the half-space total diffuse reflectance by Monte Carlo (`--rte`), with a
 /// progress bar on stderr.
-fn half_space_rte(dipoles: &[Dipole; 3], args: &Args) -> anyhow::Result<[Estimate; 3]> {
+fn half_space_rte(dipoles: &[Dipole; 3], args: &Args) -> anyhow::Result<[Orders; 3]> {
     if !(args.rte_stderr.is_finite() && args.rte_stderr > 0.0) {
         bail!("--rte-stderr: {} is not a relative standard error > 0 (e.g. 0.002)", args.rte_stderr);
     }
@@ -122,14 +125,15 @@ fn half_space_rte(dipoles: &[Dipole; 3], args: &Args) -> anyhow::Result<[Estimat
             bar.set_message(format!("{channel}: relative standard error {:.2e}", p.relative_stderr));
         };
         bar.reset();
-        out.push(rte::half_space_reflectance(&Medium::reduced(d), 1.0, &budget, RTE_SEED, &progress)?);
+        out.push(rte::half_space_by_order(&Medium::reduced(d), 1.0, &budget, RTE_SEED, &progress)?);
     }
     bar.finish_and_clear();
     Ok([out[0], out[1], out[2]])
 }
 
 /// The `--rte` rows under the table.
-fn rte_table(dipoles: &[Dipole; 3], rte: &[Estimate; 3], args: &Args) -> String {
+fn rte_table(dipoles: &[Dipole; 3], orders: &[Orders; 3], args: &Args) -> String {
+    let rte = orders.map(|o| o.total);
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -145,8 +149,7 @@ fn rte_table(dipoles: &[Dipole; 3], rte: &[Estimate; 3], args: &Args) -> String 
     row("  standard error", rte.map(|e| fmt(e.stderr)));
     row("  photons", rte.map(|e| e.photons.to_string()));
     row("R_d,total (dipole)", dipoles.map(|d| fmt(d.r_d_total())));
-    let difference = |c: usize| {
-        let (d, m) = (dipoles[c].r_d_total(), rte[c].mean);
+    let difference = |d: f64, m: f64| {
         if m > 0.0 {
             format!("{:+.2}%", 100.0 * (d / m - 1.0))
         } else if d == 0.0 {
@@ -155,7 +158,21 @@ fn rte_table(dipoles: &[Dipole; 3], rte: &[Estimate; 3], args: &Args) -> String 
             "n/a".into()
         }
     };
-    row("dipole vs RTE", [0, 1, 2].map(difference));
+    row("dipole vs RTE", [0, 1, 2].map(|c| difference(dipoles[c].r_d_total(), rte[c].mean)));
+    let walked = |e: Option<rte::Estimate>| e.map_or("-".to_string(), |e| fmt(e.mean));
+    row("  once scattered (RTE)", orders.map(|o| walked(o.single)));
+    row("  more often (RTE)", orders.map(|o| walked(o.multiple)));
+    let single = dipoles.each_ref().map(single_scattering);
+    row("single scattering R1", single.map(fmt));
+    row(
+        "R1 vs once scattered",
+        [0, 1, 2].map(|c| orders[c].single.map_or("-".into(), |e| difference(single[c], e.mean))),
+    );
+    row(
+        "dipole vs more often",
+        [0, 1, 2].map(|c| orders[c].multiple.map_or("-".into(), |e| difference(dipoles[c].r_d_total(), e.mean))),
+    );
+    row("dipole + R1 vs RTE", [0, 1, 2].map(|c| difference(dipoles[c].r_d_total() + single[c], rte[c].mean)));
     out
 }
 
@@ -205,6 +222,25 @@ struct ChannelReport {
     /// `--rte`: the dipole's `R_d,total` (as `r_d_total`), beside it.
     #[serde(skip_serializing_if = "Option::is_none")]
     rd_total_dipole: Option<f64>,
+    /// `--rte`: of `rd_total_rte`, what left after exactly one scattering (absent where the
+    /// walk was not needed: no absorption or no scattering).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rd_single_rte: Option<f64>,
+    /// `--rte`: its standard error.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rd_single_rte_stderr: Option<f64>,
+    /// `--rte`: of `rd_total_rte`, what left after two or more scatterings.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rd_multiple_rte: Option<f64>,
+    /// `--rte`: the single-scattering reflectance `R1` at normal incidence
+    /// (`optics::single_scatter::reflectance`, isotropic, reduced albedo).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    rd_single: Option<f64>,
+}
+
+/// `R1` at normal incidence of the medium the walk sees (reduced albedo, isotropic).
+fn single_scattering(d: &Dipole) -> f64 {
+    single_scatter::reflectance(d.alpha_prime, 0.0, d.eta, 1.0)
 }
 
 #[derive(serde::Serialize)]
@@ -226,7 +262,7 @@ fn report<'a>(
     source: Option<&'a str>,
     scale: f64,
     dipoles: &[Dipole; 3],
-    rte: Option<&[Estimate; 3]>,
+    rte: Option<&[Orders; 3]>,
 ) -> Report<'a> {
     let channels = dipoles
         .iter()
@@ -247,10 +283,14 @@ fn report<'a>(
             r_d_total: d.r_d_total(),
             mean_free_path: d.mean_free_path(),
             diffusion_length: Some(d.diffusion_length()).filter(|l| l.is_finite()),
-            rd_total_rte: rte.map(|e| e[c].mean),
-            rd_total_rte_stderr: rte.map(|e| e[c].stderr),
-            rd_total_rte_photons: rte.map(|e| e[c].photons),
+            rd_total_rte: rte.map(|e| e[c].total.mean),
+            rd_total_rte_stderr: rte.map(|e| e[c].total.stderr),
+            rd_total_rte_photons: rte.map(|e| e[c].total.photons),
             rd_total_dipole: rte.map(|_| d.r_d_total()),
+            rd_single_rte: rte.and_then(|e| e[c].single.map(|s| s.mean)),
+            rd_single_rte_stderr: rte.and_then(|e| e[c].single.map(|s| s.stderr)),
+            rd_multiple_rte: rte.and_then(|e| e[c].multiple.map(|s| s.mean)),
+            rd_single: rte.map(|_| single_scattering(d)),
         })
         .collect();
     Report {

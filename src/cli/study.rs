@@ -7,6 +7,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use translucent::gpu::Gpu;
 use translucent::output::OutputSet;
+use translucent::reference::rte::Budget;
+use translucent::reference::rte_mesh::MeshOptions;
 use translucent::reference::truth;
 use translucent::sampling::Method;
 use translucent::scene::{GatherMode, MAX_GATHER_EPSILON, MAX_SAMPLE_COUNT, Scene};
@@ -64,6 +66,56 @@ pub struct Args {
     /// render.max_error)
     #[arg(long)]
     pub max_error: Option<f64>,
+    /// Split each row's error against the physics: the model error (the dipole's exact
+    /// integral against a Monte Carlo radiative-transfer reference walked in each mesh), the
+    /// discretisation error (the renderer against the dipole integral) and the total error (the
+    /// renderer against the reference). The reference is cached beside the truth.
+    #[arg(long)]
+    pub physics: bool,
+    /// With --physics: stop the reference once its relative standard error (RMS over lit
+    /// vertices over their mean, worst channel) is at most this (default 0.01)
+    #[arg(long, allow_hyphen_values = true, value_name = "REL")]
+    pub rte_stderr: Option<f64>,
+    /// With --physics: walk at most this many photons per object (default 1000000000)
+    #[arg(long, value_name = "N")]
+    pub rte_photons: Option<u64>,
+    /// With --physics: stop the reference after this many seconds per object (default 600; the
+    /// photon count, and so the reference, then depends on the machine)
+    #[arg(long, allow_hyphen_values = true, value_name = "SECONDS")]
+    pub rte_seconds: Option<f64>,
+}
+
+/// The seed of `--physics`'s photons: fixed, so a study is reproducible where the photon or
+/// precision budget stops it.
+const RTE_SEED: u64 = 1;
+
+/// `--physics`'s budget, or `None` without it; an `--rte-*` flag without `--physics`, or a
+/// value that budgets nothing, is an error naming the flag.
+fn physics(args: &Args) -> Result<Option<MeshOptions>> {
+    if !args.physics {
+        let given = [
+            ("--rte-stderr", args.rte_stderr.is_some()),
+            ("--rte-photons", args.rte_photons.is_some()),
+            ("--rte-seconds", args.rte_seconds.is_some()),
+        ];
+        if let Some((flag, _)) = given.into_iter().find(|g| g.1) {
+            bail!("{flag}: only with --physics (it sets the radiative-transfer reference's budget)");
+        }
+        return Ok(None);
+    }
+    let (stderr, photons, seconds) =
+        (args.rte_stderr.unwrap_or(0.01), args.rte_photons.unwrap_or(1_000_000_000), args.rte_seconds.unwrap_or(600.0));
+    if !(stderr.is_finite() && stderr > 0.0) {
+        bail!("--rte-stderr {stderr}: must be a relative standard error > 0, e.g. 0.01");
+    }
+    if photons == 0 {
+        bail!("--rte-photons 0: 0 photons estimate nothing, e.g. --rte-photons 1000000");
+    }
+    if !(seconds.is_finite() && seconds > 0.0) {
+        bail!("--rte-seconds {seconds}: must be a time > 0 in seconds, e.g. 600");
+    }
+    let budget = Budget { max_photons: photons, relative_stderr: Some(stderr), max_seconds: Some(seconds) };
+    Ok(Some(MeshOptions { budget, seed: RTE_SEED }))
 }
 
 /// `--error-image SAMPLER:COUNT[:GATHER]`, the gather written as `--gathers` writes it
@@ -213,6 +265,7 @@ fn config(args: &Args) -> Result<StudyConfig> {
         }
         config.seeds = (1..=n).collect();
     }
+    config.physics = physics(args)?;
     Ok(config)
 }
 
@@ -240,7 +293,8 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let cache = args.truth_cache.clone().unwrap_or_else(truth::default_cache_dir);
     let study = run_with_progress(&gpu, &scene, &config, &cache).map_err(with_hint)?;
 
-    let preamble = preamble(&study, &scene, &config, &device) + &reference_timing(&study);
+    let physics = study.physics.as_ref().map_or(String::new(), |p| study::physics::markdown(p, &study.rows));
+    let preamble = preamble(&study, &scene, &config, &device) + &reference_timing(&study) + &physics;
     let summaries = report::summarise(&study.rows);
     let md = report::markdown(&format!("Accuracy study: {}", scene.name), &preamble, &summaries);
     let plot = report_plot(&summaries, &scene.name)?;
@@ -250,6 +304,14 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
             Some(s) => out!("error <= {:>4}%: {} at {:.1} ms", target * 100.0, s.label(), s.frame_ms),
             None => out!("error <= {:>4}%: no configuration in the sweep", target * 100.0),
         }
+    }
+    if let Some(p) = &study.physics {
+        let pct = |v: [f64; 3]| v.map(|e| format!("{:.2}%", 100.0 * e)).join(", ");
+        out!(
+            "model error (dipole against the radiative transfer, r, g, b): {}; reference noise {}",
+            pct(p.model.rel_rms),
+            pct(p.noise)
+        );
     }
     Ok(())
 }
@@ -303,6 +365,11 @@ fn run_with_progress(gpu: &Arc<Gpu>, scene: &Scene, config: &StudyConfig, cache:
             bar.set_message(format!("exact integral, level {level}: {done}/{of} receivers"))
         }
         Event::TruthCached => bar.set_message("exact integral from the cache".to_string()),
+        Event::Rte(p) => bar.set_message(format!(
+            "radiative transfer: {} photons, {:.1} s, relative standard error {:.4}",
+            p.photons, p.seconds, p.relative_stderr
+        )),
+        Event::RteCached => bar.set_message("radiative transfer from the cache".to_string()),
         Event::Run(i, _, label) => {
             bar.set_position(i as u64);
             bar.set_message(label);

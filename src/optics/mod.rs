@@ -14,6 +14,8 @@
 //!   receiver at distance `r` in the discrete dipole sum (seed Eq. 11), so that the sum conserves
 //!   energy whatever the ratio of diffusion length to sample spacing.
 //! - [`presets`]: the measured materials of Jensen et al. 2001 and Narasimhan et al. 2006.
+//! - [`single_scatter`]: the single-scattering reflectance of a half-space (Jensen et al. 2001,
+//!   Eq. 3), the first-order term the dipole leaves out.
 //! - [`gpu`]: the std430 records shared with the shaders, mirrored with `#[repr(C)]` + bytemuck.
 
 pub mod dipole;
@@ -22,6 +24,7 @@ pub mod gpu;
 pub mod kernel;
 pub mod material;
 pub mod presets;
+pub mod single_scatter;
 
 pub use dipole::Dipole;
 pub use material::Material;

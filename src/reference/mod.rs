@@ -5,7 +5,9 @@
 
 pub mod bvh;
 pub mod rte;
+pub mod rte_cache;
 pub mod rte_mesh;
+pub mod single;
 pub mod tree;
 pub mod truth;
 

@@ -275,6 +275,31 @@ pub fn half_space_reflectance(
     seed: u64,
     progress: Progress,
 ) -> Result<Estimate, RteError> {
+    half_space_by_order(medium, cos_incidence, budget, seed, progress).map(|o| o.total)
+}
+
+/// [`half_space_reflectance`] split by the number of scatterings a photon had when it left.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Orders {
+    /// Every photon that left: [`half_space_reflectance`].
+    pub total: Estimate,
+    /// Those that left after exactly one scattering (`optics::single_scatter` is its closed
+    /// form); `None` where the total was not walked (no absorption or no scattering).
+    pub single: Option<Estimate>,
+    /// Those that left after two or more: what the dipole's diffusion models.
+    pub multiple: Option<Estimate>,
+}
+
+/// [`half_space_reflectance`] with the photons that left after one scattering tallied apart
+/// from those that left after more (the same photons: `total` is the same figure). The budget's
+/// precision target applies to the total.
+pub fn half_space_by_order(
+    medium: &Medium,
+    cos_incidence: f64,
+    budget: &Budget,
+    seed: u64,
+    progress: Progress,
+) -> Result<Orders, RteError> {
     if !(cos_incidence > 0.0 && cos_incidence <= 1.0) {
         return Err(RteError::BadIncidence(cos_incidence));
     }
@@ -286,70 +311,73 @@ pub fn half_space_reflectance(
     if sin2_t >= 1.0 {
         return Err(RteError::NothingEnters { cos: cos_incidence, eta });
     }
+    let given = |mean| Ok(Orders { total: Estimate { mean, stderr: 0.0, photons: 0 }, single: None, multiple: None });
     if medium.sigma_s == 0.0 {
         // Nothing scatters: the beam goes straight in and never turns back.
-        return Ok(Estimate { mean: 0.0, stderr: 0.0, photons: 0 });
+        return given(0.0);
     }
     if medium.sigma_a == 0.0 {
         // Nothing is absorbed and every walk in a half-space comes back to the surface, where
         // it has a chance to leave, so all of it leaves: exactly 1. (Walked, it would take for
         // ever: the time to return has no mean.)
-        return Ok(Estimate { mean: 1.0, stderr: 0.0, photons: 0 });
+        return given(1.0);
     }
     let mu0 = (1.0 - sin2_t).sqrt();
     let (albedo, g) = (medium.albedo(), medium.g);
-    // The sums of the photons' scores and of their squares, which adding chunks and measuring
-    // the precision both need.
-    let sums = std::cell::Cell::new((0.0, 0.0));
-    let mean_and_stderr = |sum: f64, sum2: f64, n: u64| {
-        let n = n as f64;
-        let mean = sum / n;
-        let var = ((sum2 / n - mean * mean) * n / (n - 1.0).max(1.0)).max(0.0);
-        (mean, (var / n).sqrt())
-    };
+    // Per order (total, single, multiple) the sums of the photons' scores and of their squares,
+    // which adding chunks and measuring the precision both need.
+    let sums = std::cell::Cell::new(([0.0; 3], [0.0; 3]));
     let photons = run_rounds(
         budget,
         HALF_SPACE_CHUNK,
         MAX_CHUNKS_PER_ROUND,
         |chunk, _, n| {
             let mut rng = chunk_rng(seed, chunk);
-            let (mut s, mut s2) = (0.0, 0.0);
+            let (mut s, mut s2) = ([0.0; 3], [0.0; 3]);
             for _ in 0..n {
-                let w = half_space_photon(&mut rng, albedo, g, eta, mu0);
-                s += w;
-                s2 += w * w;
+                let (w, scatterings) = half_space_photon(&mut rng, albedo, g, eta, mu0);
+                let k = if scatterings == 1 { 1 } else { 2 };
+                for i in [0, k] {
+                    s[i] += w;
+                    s2[i] += w * w;
+                }
             }
             (s, s2)
         },
         |(s, s2)| {
-            let (sum, sum2) = sums.get();
-            sums.set((sum + s, sum2 + s2));
+            let (mut sum, mut sum2) = sums.get();
+            (0..3).for_each(|i| (sum[i], sum2[i]) = (sum[i] + s[i], sum2[i] + s2[i]));
+            sums.set((sum, sum2));
         },
-        |n| {
-            let (sum, sum2) = sums.get();
-            let (mean, stderr) = mean_and_stderr(sum, sum2, n);
-            if mean > 0.0 { stderr / mean } else { f64::INFINITY }
-        },
+        |n| estimate(sums.get().0[0], sums.get().1[0], n).relative_stderr(),
         progress,
     );
     let (sum, sum2) = sums.get();
-    let (mean, stderr) = mean_and_stderr(sum, sum2, photons);
-    Ok(Estimate { mean, stderr, photons })
+    let [total, single, multiple] = [0, 1, 2].map(|i| estimate(sum[i], sum2[i], photons));
+    Ok(Orders { total, single: Some(single), multiple: Some(multiple) })
+}
+
+/// The mean of `n` photons' scores from their sum and sum of squares, with its standard error.
+fn estimate(sum: f64, sum2: f64, photons: u64) -> Estimate {
+    let n = photons as f64;
+    let mean = sum / n;
+    let var = ((sum2 / n - mean * mean) * n / (n - 1.0).max(1.0)).max(0.0);
+    Estimate { mean, stderr: (var / n).sqrt(), photons }
 }
 
 /// One photon's walk in the half-space `z > 0` (depth in mean free paths), starting at the
-/// surface with direction cosine `mu0` to the inward normal: its weight when it leaves.
-/// Only the depth and the direction's cosine to the normal matter, so the azimuth is drawn
-/// only to turn that cosine.
-fn half_space_photon(rng: &mut Pcg64, albedo: f64, g: f64, eta: f64, mu0: f64) -> f64 {
-    let (mut z, mut mu, mut w) = (0.0f64, mu0, 1.0);
+/// surface with direction cosine `mu0` to the inward normal: its weight when it leaves (0 if it
+/// does not) and how many times it scattered. Only the depth and the direction's cosine to the
+/// normal matter, so the azimuth is drawn only to turn that cosine.
+fn half_space_photon(rng: &mut Pcg64, albedo: f64, g: f64, eta: f64, mu0: f64) -> (f64, u32) {
+    let (mut z, mut mu, mut w, mut scatterings) = (0.0f64, mu0, 1.0, 0u32);
     loop {
         let s = -(1.0 - rng.random::<f64>()).ln();
         z += mu * s;
         if z < 0.0 {
             // At the surface going out with cosine -mu (inside over outside: 1 / eta).
             if rng.random::<f64>() >= fresnel::fresnel_reflectance(-mu, 1.0 / eta) {
-                return w;
+                return (w, scatterings);
             }
             // Specular reflection: the rest of the flight is the mirror image of its path.
             z = -z;
@@ -357,8 +385,9 @@ fn half_space_photon(rng: &mut Pcg64, albedo: f64, g: f64, eta: f64, mu0: f64) -
         }
         w = match after_collision(w, albedo, rng) {
             Some(w) => w,
-            None => return 0.0,
+            None => return (0.0, scatterings),
         };
+        scatterings += 1;
         let cos = sample_hg_cos(g, rng.random::<f64>());
         let phi = std::f64::consts::TAU * rng.random::<f64>();
         let sin = (1.0 - cos * cos).max(0.0).sqrt();

@@ -58,7 +58,7 @@ pub struct MeshOptions {
 }
 
 /// One object's radiant exitance by Monte Carlo.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ObjectExitance {
     /// Per vertex, RGB: the mean exitance over the vertex's cell (flux per area).
     pub exitance: Vec<[f64; 3]>,
@@ -68,7 +68,8 @@ pub struct ObjectExitance {
     pub photons: u64,
     /// The precision reached: per channel, the RMS standard error over the lit vertices
     /// (exitance at least `truth::LIT_FLOOR` of the brightest) over their mean exitance; the
-    /// largest of the three.
+    /// largest of the three (infinite, stored as JSON null, where a channel lights nothing).
+    #[serde(with = "super::rte_cache::infinite_as_null")]
     pub relative_stderr: f64,
     /// Walks per channel dropped because they met the surface from outside.
     pub lost: [u64; 3],

@@ -502,22 +502,30 @@ pub fn cached(
 /// `dir`, made if missing, is a folder a file can be written in (a file of its own is made and
 /// removed); otherwise what stands in the way.
 fn writable_folder(dir: &Path) -> Result<(), TruthError> {
-    let fail = |why: String| Err(TruthError::Folder { path: dir.to_path_buf(), why });
+    match folder_problem(dir) {
+        None => Ok(()),
+        Some(why) => Err(TruthError::Folder { path: dir.to_path_buf(), why }),
+    }
+}
+
+/// What keeps `dir` (made if missing) from being a folder a file can be written in, if
+/// anything: a file of its own is made and removed to find out.
+pub(crate) fn folder_problem(dir: &Path) -> Option<String> {
     if let Some(existing) = dir.ancestors().find(|a| a.exists())
         && !existing.is_dir()
     {
-        return fail(format!("{} is a file, not a folder", existing.display()));
+        return Some(format!("{} is a file, not a folder", existing.display()));
     }
     if let Err(e) = std::fs::create_dir_all(dir) {
-        return fail(format!("cannot make the folder ({e})"));
+        return Some(format!("cannot make the folder ({e})"));
     }
     let probe = dir.join(format!(".truth-probe-{}.tmp", std::process::id()));
     match std::fs::write(&probe, b"") {
         Ok(()) => {
             let _ = std::fs::remove_file(&probe);
-            Ok(())
+            None
         }
-        Err(e) => fail(format!("cannot write a file in the folder ({e})")),
+        Err(e) => Some(format!("cannot write a file in the folder ({e})")),
     }
 }
 
@@ -570,18 +578,23 @@ pub fn content_key(scene: &PreparedScene, options: &TruthOptions) -> String {
     format!("{:016x}", h.0)
 }
 
-struct Fnv(u64);
+/// FNV-1a, 64 bits: the content keys and checksums of the cached references.
+pub(crate) struct Fnv(pub(crate) u64);
 
 impl Fnv {
-    fn bytes(&mut self, bytes: &[u8]) {
+    /// The FNV-1a offset basis: an empty hash.
+    pub(crate) fn new() -> Fnv {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+    pub(crate) fn bytes(&mut self, bytes: &[u8]) {
         for &b in bytes {
             self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
         }
     }
-    fn u64(&mut self, v: u64) {
+    pub(crate) fn u64(&mut self, v: u64) {
         self.bytes(&v.to_le_bytes());
     }
-    fn f64(&mut self, v: f64) {
+    pub(crate) fn f64(&mut self, v: f64) {
         self.u64(v.to_bits());
     }
 }

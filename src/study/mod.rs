@@ -6,11 +6,15 @@
 //! measures the tone-mapped images' FLIP error, `raster` draws per-vertex error on the model.
 
 pub mod flip;
+pub mod physics;
 pub mod plot;
 pub mod raster;
 pub mod report;
 
 use crate::gpu::Gpu;
+use crate::reference::rte::RteProgress;
+use crate::reference::rte_cache::RteCacheError;
+use crate::reference::rte_mesh::MeshOptions;
 use crate::reference::truth::{self, LIT_FLOOR, Truth, TruthOptions};
 use crate::render::plan::{Change, Pass};
 use crate::render::renderer::{RenderError, Renderer};
@@ -41,6 +45,9 @@ pub struct StudyConfig {
     pub own: bool,
     /// Measure the sweep (samplers x counts x gathers x seeds).
     pub sweep: bool,
+    /// Split the error against the physics (`--physics`): the radiative-transfer reference's
+    /// budget and seed (`reference::rte_mesh`); `None` measures against the dipole alone.
+    pub physics: Option<MeshOptions>,
 }
 
 impl StudyConfig {
@@ -63,6 +70,7 @@ impl StudyConfig {
             truth: TruthOptions::default(),
             own: true,
             sweep: true,
+            physics: None,
         }
     }
 
@@ -78,6 +86,7 @@ impl StudyConfig {
             truth: TruthOptions::default(),
             own: true,
             sweep: true,
+            physics: None,
         }
     }
 
@@ -120,6 +129,8 @@ pub enum StudyError {
     Render(#[from] RenderError),
     #[error(transparent)]
     Truth(#[from] truth::TruthError),
+    #[error(transparent)]
+    Rte(#[from] RteCacheError),
     #[error("sampling {object}: {message}")]
     Sampling { object: String, message: String },
     #[error("{0}")]
@@ -140,6 +151,10 @@ pub enum Event {
     Truth(u32, usize, usize),
     /// The truth was read from the cache.
     TruthCached,
+    /// The radiative-transfer reference (`--physics`) after a round of photons.
+    Rte(RteProgress),
+    /// The radiative-transfer reference was read from the cache.
+    RteCached,
     /// A configuration starts: `(index, of, label)`.
     Run(usize, usize, String),
 }
@@ -163,14 +178,22 @@ pub struct VertexError {
 /// Per-vertex error of `estimate` against `truth`, over every object (scene order; opaque
 /// objects have all-zero truth and count for nothing). The floor is per object and channel.
 pub fn vertex_error(truth: &[Vec<[f64; 3]>], estimate: &[Vec<[f32; 3]>]) -> VertexError {
+    let estimate: Vec<Vec<[f64; 3]>> = estimate.iter().map(|o| o.iter().map(|m| m.map(f64::from)).collect()).collect();
+    vertex_error_f64(truth, &estimate)
+}
+
+/// [`vertex_error`] of an f64 estimate (the dipole truth against the radiative-transfer
+/// reference); receivers where the estimate is NaN (outside a truth's receiver subset) are
+/// left out.
+pub fn vertex_error_f64(truth: &[Vec<[f64; 3]>], estimate: &[Vec<[f64; 3]>]) -> VertexError {
     let mut out = VertexError::default();
     for c in 0..3 {
         let mut rel = Vec::new();
         for (t, e) in truth.iter().zip(estimate) {
             let floor = LIT_FLOOR * t.iter().map(|m| m[c]).fold(0.0, f64::max);
             for (tv, ev) in t.iter().zip(e) {
-                if tv[c] > 0.0 && tv[c] >= floor {
-                    rel.push((f64::from(ev[c]) - tv[c]) / tv[c]);
+                if tv[c] > 0.0 && tv[c] >= floor && !ev[c].is_nan() {
+                    rel.push((ev[c] - tv[c]) / tv[c]);
                 }
             }
         }
@@ -231,6 +254,8 @@ pub struct Study {
     pub exitance: Vec<Option<Vec<Vec<[f32; 3]>>>>,
     /// The f64 CPU reference timed on one swept configuration, beside the GPU's time for it.
     pub reference: Option<ReferenceTiming>,
+    /// With `--physics`: the radiative-transfer reference and the dipole's error against it.
+    pub physics: Option<physics::Physics>,
 }
 
 /// The GPU against the f64 CPU reference (`reference::splat` then `reference::gather`, the same
@@ -358,6 +383,10 @@ pub fn run(
     if !truth.exitance.iter().flatten().flatten().any(|&m| m > 0.0) {
         return Err(StudyError::NothingLit);
     }
+    let physics = match &config.physics {
+        Some(options) => Some(physics::Physics::measure(&base, &truth, options, truth_dir, progress)?),
+        None => None,
+    };
     let truth_image = truth_image(gpu, &base, &truth)?;
 
     let bench = Bench {
@@ -367,6 +396,7 @@ pub fn run(
         truth: &truth,
         truth_image: truth_image.as_ref(),
         scene: &scene.name,
+        physics: physics.as_ref(),
     };
     let (mut rows, mut exitances) = (Vec::new(), Vec::new());
     let total = config.runs();
@@ -378,7 +408,7 @@ pub fn run(
         exitances.push(exitance);
     }
     let reference = time_reference(&base, config, &rows)?;
-    Ok(Study { rows, truth, truth_cached, truth_image, prepared: base, exitance: exitances, reference })
+    Ok(Study { rows, truth, truth_cached, truth_image, prepared: base, exitance: exitances, reference, physics })
 }
 
 /// The truth's image: a full frame for shadows and sky, then the exact exitance shaded. A
@@ -456,6 +486,8 @@ struct Bench<'a> {
     truth_image: Option<&'a Images>,
     /// The scene's name, for the rows.
     scene: &'a str,
+    /// With `--physics`: the radiative-transfer reference, for the model and total errors.
+    physics: Option<&'a physics::Physics>,
 }
 
 impl Bench<'_> {
@@ -485,6 +517,7 @@ impl Bench<'_> {
         let pass = |p: Pass| median(timings.iter().map(|t| t.get(p).unwrap_or(0.0)).collect());
         let error = exitance.as_ref().map(|e| vertex_error(&self.truth.exitance, e));
         let nan = [f64::NAN; 3];
+        let total = self.physics.zip(exitance.as_ref()).map(|(p, e)| vertex_error(&p.exitance, e));
         let row = Row {
             scene: self.scene.to_string(),
             default: own,
@@ -504,6 +537,9 @@ impl Bench<'_> {
             p99: error.map_or(nan, |e| e.p99),
             max: error.map_or(nan, |e| e.max),
             bias: error.map_or(nan, |e| e.bias),
+            model_rel_rms: self.physics.map_or(nan, |p| p.model.rel_rms),
+            total_rel_rms: total.map_or(nan, |e| e.rel_rms),
+            rte_noise: self.physics.map_or(nan, |p| p.noise),
             image_rel_rmse: self.truth_image.map_or(f64::NAN, |t| image_rel_rmse(&t.hdr, &image.hdr)),
             flip_mean: match self.truth_image {
                 Some(t) => {

@@ -50,6 +50,17 @@ pub struct Row {
     /// The error model's prediction for this row (`sampling::density`, mean of r, g, b; NaN
     /// where it makes none: samplers other than Turk's, the pixel gather).
     pub predicted: f64,
+    /// With `--physics`, per channel: the model error, the dipole's exact integral against the
+    /// radiative-transfer reference (relative RMS per vertex; the same on every row of a scene).
+    /// NaN without.
+    pub model_rel_rms: [f64; 3],
+    /// With `--physics`, per channel: the total error, the renderer against the
+    /// radiative-transfer reference (relative RMS per vertex). NaN without, or for the pixel
+    /// gather.
+    pub total_rel_rms: [f64; 3],
+    /// With `--physics`, per channel: the reference's own noise, the RMS over lit vertices of
+    /// its relative standard error. NaN without.
+    pub rte_noise: [f64; 3],
 }
 
 /// CSV header, in column order; the single source for it, so the writer and any reader agree.
@@ -82,6 +93,15 @@ pub const COLUMNS: &[&str] = &[
     "image_rel_rmse",
     "flip_mean",
     "predicted",
+    "model_rel_rms_r",
+    "model_rel_rms_g",
+    "model_rel_rms_b",
+    "total_rel_rms_r",
+    "total_rel_rms_g",
+    "total_rel_rms_b",
+    "rte_noise_r",
+    "rte_noise_g",
+    "rte_noise_b",
 ];
 
 /// Error targets (as fractions) the report finds the fastest configuration for.
@@ -119,6 +139,9 @@ pub fn csv(rows: &[Row]) -> String {
         fields.push(row.image_rel_rmse.to_string());
         fields.push(row.flip_mean.to_string());
         fields.push(row.predicted.to_string());
+        for channels in [&row.model_rel_rms, &row.total_rel_rms, &row.rte_noise] {
+            fields.extend(channels.iter().map(f64::to_string));
+        }
         debug_assert_eq!(fields.len(), COLUMNS.len());
         out.push_str(&fields.join(","));
         out.push('\n');
@@ -193,7 +216,7 @@ impl Summary {
     }
 }
 
-fn curve_gather(gather: &str, epsilon: Option<f64>) -> String {
+pub(crate) fn curve_gather(gather: &str, epsilon: Option<f64>) -> String {
     match epsilon {
         Some(e) => format!("{gather} ε={}", param(e)),
         None => gather.to_string(),
@@ -281,7 +304,7 @@ fn predicted_against_measured(out: &mut String, summaries: &[Summary]) {
 
 /// A row's sampler as tables and curves name it: `default: turk` for the scene's own row, so it
 /// stands apart from the sweep's.
-fn sampler_label(row: &Row) -> String {
+pub(crate) fn sampler_label(row: &Row) -> String {
     if row.default { format!("default: {}", row.sampler) } else { row.sampler.clone() }
 }
 
@@ -294,7 +317,7 @@ pub fn fastest_meeting(summaries: &[Summary], target: f64) -> Option<&Summary> {
 }
 
 /// `x` to three significant digits, in plain notation for everyday magnitudes and scientific otherwise.
-fn sig3(x: f64) -> String {
+pub(crate) fn sig3(x: f64) -> String {
     if !x.is_finite() {
         return if x.is_nan() { "n/a".into() } else { x.to_string() };
     }
@@ -312,7 +335,7 @@ fn sig3(x: f64) -> String {
     }
 }
 
-fn percent(x: f64) -> String {
+pub(crate) fn percent(x: f64) -> String {
     sig3(100.0 * x)
 }
 
@@ -326,7 +349,7 @@ fn target_percent(target: f64) -> String {
     param(100.0 * target)
 }
 
-fn md_cell(s: &str) -> String {
+pub(crate) fn md_cell(s: &str) -> String {
     s.replace('|', "\\|")
 }
 
@@ -519,6 +542,9 @@ mod tests {
             flip_mean: 0.01,
             default: false,
             predicted: f64::NAN,
+            model_rel_rms: [f64::NAN; 3],
+            total_rel_rms: [f64::NAN; 3],
+            rte_noise: [f64::NAN; 3],
         }
     }
 

@@ -1,0 +1,55 @@
+//! Single scattering at the vertices, f64: the exitance of light scattered once below the
+//! surface, under the local half-space approximation (`optics::single_scatter`).
+//!
+//! At a vertex with shading normal `n`, each light that reaches it at incidence cosine `cos_i`
+//! brings `E_l cos_i F_t(cos_i, eta)` into the medium, of which `R1(cos_i)` leaves after one
+//! scattering: `M1(x) = sum_l E_l cos_i F_t(cos_i, eta) V_l(x) R1(albedo', 0, eta, cos_i)` per
+//! channel, with the reduced albedo and an isotropic phase function (the medium the
+//! radiative-transfer reference walks). Once-scattered light leaves within a few mean free
+//! paths of where it entered, so the term is local: the half-space's figure where the surface
+//! is flat and evenly lit over a few mean free paths. It is what the renderer would add to the
+//! gathered exitance per vertex for `model = dipole + single`; `study --physics` measures it
+//! against the radiative-transfer reference (docs/STUDY.md).
+
+use super::{light_incidence, occluders, ray_offset};
+use crate::optics::{fresnel, single_scatter};
+use crate::scene::build::{PreparedScene, ResolvedMaterial};
+use rayon::prelude::*;
+
+/// Per object (scene order), per vertex, RGB: the single-scattering exitance `M1` (see the
+/// module's documentation); zero for opaque objects.
+pub fn exitance(scene: &PreparedScene) -> Vec<Vec<[f64; 3]>> {
+    let casters = occluders(scene);
+    let eps = ray_offset(scene);
+    scene
+        .objects
+        .iter()
+        .map(|o| {
+            let count = o.mesh.positions().len();
+            let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else {
+                return vec![[0.0; 3]; count];
+            };
+            let eta = dipoles[0].eta;
+            (0..count)
+                .into_par_iter()
+                .map(|v| {
+                    let p = o.mesh.positions()[v].as_dvec3();
+                    let n = o.mesh.vertex_normals()[v].as_dvec3().normalize();
+                    let mut m = [0.0; 3];
+                    for l in &scene.lights {
+                        let (wi, e, dist) = light_incidence(l, p);
+                        let cos_i = n.dot(wi);
+                        if cos_i <= 0.0 || (l.shadow_layer.is_some() && casters.occluded(p + n * eps, wi, eps, dist)) {
+                            continue;
+                        }
+                        let e_t = e * (cos_i * fresnel::fresnel_transmittance(cos_i, eta));
+                        for (c, d) in dipoles.iter().enumerate() {
+                            m[c] += e_t[c] * single_scatter::reflectance(d.alpha_prime, 0.0, eta, cos_i.min(1.0));
+                        }
+                    }
+                    m
+                })
+                .collect()
+        })
+        .collect()
+}

@@ -1,0 +1,382 @@
+//! The study's error split against the physics (`study --physics`).
+//!
+//! The study measures the renderer against the exact integral of the dipole model
+//! (`reference::truth`): the discretisation error. With `--physics` it also walks the radiative
+//! transfer equation inside each translucent mesh (`reference::rte_mesh`, cached by content as
+//! `reference::rte_cache`) and measures, per channel and as a relative RMS over the vertices
+//! lit in the reference:
+//!
+//! - the model error, the dipole's exact integral against the RTE (the same for every row);
+//! - the total error, the renderer against the RTE.
+//!
+//! The reference has its own noise: a relative standard error per vertex. Against a noisy
+//! reference an RMS error reads `sqrt(e^2 + s^2)` on average, with `s` the RMS relative
+//! standard error ([`Physics::noise`]); the report prints `s` beside every figure and the
+//! model error with it taken out in quadrature (`sqrt(max(e^2 - s^2, 0))`).
+//!
+//! Past the sample count where the discretisation error falls below the model's error, more
+//! samples stop paying: the picture is then as far from the physics whatever the count.
+//! [`crossovers`] finds that count per curve and channel.
+
+use super::report::{Row, curve_gather, md_cell, percent, sampler_label};
+use super::{Event, StudyError, VertexError, vertex_error_f64};
+use crate::reference::rte_cache;
+use crate::reference::rte_mesh::MeshOptions;
+use crate::reference::truth::{LIT_FLOOR, Truth};
+use crate::scene::build::PreparedScene;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The radiative-transfer reference of a study's scene and the dipole's error against it.
+#[derive(Clone, Debug)]
+pub struct Physics {
+    /// Per object, per vertex, RGB exitance by Monte Carlo (zero for an opaque object).
+    pub exitance: Vec<Vec<[f64; 3]>>,
+    /// Its standard error, alike.
+    pub stderr: Vec<Vec<[f64; 3]>>,
+    /// The model error: the dipole truth against the reference, per channel.
+    pub model: VertexError,
+    /// Per channel, the reference's noise: the RMS over lit vertices (at least `LIT_FLOOR` of
+    /// the object's brightest) of its relative standard error.
+    pub noise: [f64; 3],
+    /// Photons walked, over every object.
+    pub photons: u64,
+    /// Wall time of the walk (when it was walked, not read), seconds, over every object.
+    pub seconds: f64,
+    /// The worst object's precision (`rte_mesh::ObjectExitance::relative_stderr`).
+    pub relative_stderr: f64,
+    /// Walks dropped because they met the surface from outside, per channel.
+    pub lost: [u64; 3],
+    /// Whether it came from the cache.
+    pub cached: bool,
+    /// The budget and seed it was walked with.
+    pub options: MeshOptions,
+    /// Other models against the same reference, per channel: the dipole with the
+    /// single-scattering exitance added (`reference::single`, Jensen et al. 2001's sum of the
+    /// two terms), and single scattering alone (what leaves a dark medium: nearly all of it).
+    pub alternatives: Vec<(String, VertexError)>,
+}
+
+impl Physics {
+    /// The reference of `base` (from the cache folder `dir` if walked before, else walked and
+    /// stored there) and the model error of `truth` against it. `progress` hears of the walk.
+    pub fn measure(
+        base: &PreparedScene,
+        truth: &Truth,
+        options: &MeshOptions,
+        dir: &Path,
+        progress: &(dyn Fn(Event) + Sync),
+    ) -> Result<Physics, StudyError> {
+        let (reference, cached) = rte_cache::cached(base, options, dir, &|p| progress(Event::Rte(p)))?;
+        if cached {
+            progress(Event::RteCached);
+        }
+        let (mut exitance, mut stderr) = (Vec::new(), Vec::new());
+        let (mut photons, mut seconds, mut relative_stderr, mut lost) = (0, 0.0, 0.0f64, [0; 3]);
+        for (o, object) in reference.objects.iter().zip(&base.objects) {
+            let zero = vec![[0.0; 3]; object.mesh.positions().len()];
+            match o {
+                Some(o) => {
+                    exitance.push(o.exitance.clone());
+                    stderr.push(o.stderr.clone());
+                    photons += o.photons;
+                    seconds += o.seconds;
+                    relative_stderr = relative_stderr.max(o.relative_stderr);
+                    (0..3).for_each(|c| lost[c] += o.lost[c]);
+                }
+                None => {
+                    exitance.push(zero.clone());
+                    stderr.push(zero);
+                }
+            }
+        }
+        let model = vertex_error_f64(&exitance, &truth.exitance);
+        let noise = noise(&exitance, &stderr);
+        let single = crate::reference::single::exitance(base);
+        let sum: Vec<Vec<[f64; 3]>> = truth
+            .exitance
+            .iter()
+            .zip(&single)
+            .map(|(t, s)| t.iter().zip(s).map(|(t, s)| [0, 1, 2].map(|c| t[c] + s[c])).collect())
+            .collect();
+        let alternatives = vec![
+            ("dipole + single scattering".to_string(), vertex_error_f64(&exitance, &sum)),
+            ("single scattering alone".to_string(), vertex_error_f64(&exitance, &single)),
+        ];
+        Ok(Physics {
+            exitance,
+            stderr,
+            model,
+            noise,
+            photons,
+            seconds,
+            relative_stderr,
+            lost,
+            cached,
+            options: *options,
+            alternatives,
+        })
+    }
+}
+
+/// Per channel, the RMS over the lit vertices of every object (at least [`LIT_FLOOR`] of the
+/// object's brightest in that channel) of the relative standard error `stderr / exitance`.
+pub fn noise(exitance: &[Vec<[f64; 3]>], stderr: &[Vec<[f64; 3]>]) -> [f64; 3] {
+    [0, 1, 2].map(|c| {
+        let (mut sum, mut n) = (0.0, 0usize);
+        for (m, s) in exitance.iter().zip(stderr) {
+            let floor = LIT_FLOOR * m.iter().map(|v| v[c]).fold(0.0, f64::max);
+            for (mv, sv) in m.iter().zip(s) {
+                if mv[c] > 0.0 && mv[c] >= floor {
+                    sum += (sv[c] / mv[c]).powi(2);
+                    n += 1;
+                }
+            }
+        }
+        if n == 0 { f64::NAN } else { (sum / n as f64).sqrt() }
+    })
+}
+
+/// An RMS error measured against a reference of RMS relative noise `noise`, with the noise
+/// taken out in quadrature: `sqrt(max(error^2 - noise^2, 0))`.
+pub fn without_noise(error: f64, noise: f64) -> f64 {
+    (error * error - noise * noise).max(0.0).sqrt()
+}
+
+/// Where one curve of the sweep (sampler and gather, every count) stops paying.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Crossover {
+    /// The curve: sampler and gather.
+    pub curve: String,
+    /// The curve's sample counts, in order.
+    pub counts: Vec<usize>,
+    /// Per channel: the smallest count of the curve from which on (at it and every larger count
+    /// swept) the discretisation error, mean over seeds, is below the model error; `None` when
+    /// even the largest count's is not.
+    pub from: [Option<usize>; 3],
+}
+
+/// [`Crossover`] of every curve of the sweep's rows (the scene's own row is no curve) against
+/// the per-channel `model` error.
+pub fn crossovers(rows: &[Row], model: [f64; 3]) -> Vec<Crossover> {
+    // curve -> count -> per-channel (sum, seeds)
+    let mut curves: BTreeMap<String, BTreeMap<usize, ([f64; 3], usize)>> = BTreeMap::new();
+    for r in rows.iter().filter(|r| !r.default && r.rel_rms.iter().all(|e| e.is_finite())) {
+        let curve = format!("{} + {}", sampler_label(r), curve_gather(&r.gather, r.epsilon));
+        let point = curves.entry(curve).or_default().entry(r.samples).or_insert(([0.0; 3], 0));
+        (0..3).for_each(|c| point.0[c] += r.rel_rms[c]);
+        point.1 += 1;
+    }
+    curves
+        .into_iter()
+        .map(|(curve, points)| {
+            let counts: Vec<usize> = points.keys().copied().collect();
+            let from = [0, 1, 2].map(|c| {
+                let mut from = None;
+                // From the largest count down, while the error stays below the model's.
+                for (&n, (sum, seeds)) in points.iter().rev() {
+                    if sum[c] / *seeds as f64 >= model[c] {
+                        break;
+                    }
+                    from = Some(n);
+                }
+                from
+            });
+            Crossover { curve, counts, from }
+        })
+        .collect()
+}
+
+/// study.md's section on the split: the reference, the model error per channel, the split per
+/// configuration and where more samples stop paying.
+pub fn markdown(physics: &Physics, rows: &[Row]) -> String {
+    let mut out = String::new();
+    reference_paragraph(&mut out, physics);
+    let _ = writeln!(out, "| channel | model error (RMS) | without the noise | model bias | reference noise |");
+    let _ = writeln!(out, "|---|---:|---:|---:|---:|");
+    for (c, name) in ["r", "g", "b"].iter().enumerate() {
+        let m = &physics.model;
+        let _ = writeln!(
+            out,
+            "| {name} | {} % | {} % | {:+.2} % | {} % |",
+            percent(m.rel_rms[c]),
+            percent(without_noise(m.rel_rms[c], physics.noise[c])),
+            100.0 * m.bias[c],
+            percent(physics.noise[c])
+        );
+    }
+    alternatives_table(&mut out, physics);
+    split_table(&mut out, rows);
+    crossover_table(&mut out, rows, physics.model.rel_rms);
+    out
+}
+
+/// Each model's exact exitance against the reference, per channel: RMS (bias).
+fn alternatives_table(out: &mut String, p: &Physics) {
+    let _ = writeln!(
+        out,
+        "\nThe models' exact exitance against the reference (relative RMS per vertex, mean bias in brackets; \
+         single scattering: `reference::single`, the half-space term of Jensen et al. 2001 Eq. 3 at each \
+         vertex):\n"
+    );
+    let _ = writeln!(out, "| model | r | g | b |");
+    let _ = writeln!(out, "|---|---:|---:|---:|");
+    let models = std::iter::once(("dipole", &p.model)).chain(p.alternatives.iter().map(|(n, e)| (n.as_str(), e)));
+    for (name, e) in models {
+        let cell = |c: usize| format!("{} % ({:+.1} %)", percent(e.rel_rms[c]), 100.0 * e.bias[c]);
+        let _ = writeln!(out, "| {name} | {} | {} | {} |", cell(0), cell(1), cell(2));
+    }
+}
+
+/// What the reference is, how far it got and what it cost.
+fn reference_paragraph(out: &mut String, p: &Physics) {
+    let b = &p.options.budget;
+    let budget = [
+        Some(format!("at most {} photons", b.max_photons)),
+        b.relative_stderr.map(|s| format!("to {s} relative standard error")),
+        b.max_seconds.map(|s| format!("at most {s} s")),
+    ]
+    .into_iter()
+    .flatten()
+    .collect::<Vec<_>>()
+    .join(", ");
+    let _ = writeln!(
+        out,
+        "\n## Against the physics: model, discretisation and total error\n\n\
+         Reference: the radiative transfer equation by Monte Carlo inside each translucent mesh \
+         (`reference::rte_mesh`: Fresnel refraction in and out at the faces, isotropic scattering with \
+         `sigma_s = sigma_s'`; budget {budget} per object, seed {}): {} photons, {:.1} s when walked{}; \
+         precision reached (RMS standard error over lit vertices / their mean, worst channel) {}, walks lost \
+         {:?}. Model error: the dipole's exact integral against it; discretisation error: the renderer \
+         against the dipole's exact integral (the study's `rel_rms`); total error: the renderer against it. \
+         Relative RMS over the vertices lit in the reference. The reference noise is the RMS of its relative \
+         standard error per vertex, which every error against it contains in quadrature: an error \
+         not well above it is noise.\n",
+        p.options.seed,
+        p.photons,
+        p.seconds,
+        if p.cached { ", read from the cache" } else { "" },
+        crate::study::report::sig3(p.relative_stderr),
+        p.lost
+    );
+}
+
+/// Per configuration (seeds averaged), the three errors per channel.
+fn split_table(out: &mut String, rows: &[Row]) {
+    let _ = writeln!(out, "\nPer configuration (mean over seeds; r, g, b in %):\n");
+    let _ = writeln!(out, "| configuration | discretisation | total |");
+    let _ = writeln!(out, "|---|---|---|");
+    let mut groups: BTreeMap<(String, usize), Vec<&Row>> = BTreeMap::new();
+    for r in rows {
+        let label = format!("{} + {}", sampler_label(r), curve_gather(&r.gather, r.epsilon));
+        groups.entry((label, r.samples)).or_default().push(r);
+    }
+    for ((label, samples), group) in groups {
+        let mean = |f: &dyn Fn(&Row) -> [f64; 3]| {
+            [0, 1, 2].map(|c| group.iter().map(|r| f(r)[c]).sum::<f64>() / group.len() as f64)
+        };
+        let fmt = |v: [f64; 3]| v.map(percent).join(", ");
+        let _ = writeln!(
+            out,
+            "| {} {samples} | {} | {} |",
+            md_cell(&label),
+            fmt(mean(&|r| r.rel_rms)),
+            fmt(mean(&|r| r.total_rel_rms))
+        );
+    }
+}
+
+/// Per curve, the sample count from which the discretisation error is below the model's.
+fn crossover_table(out: &mut String, rows: &[Row], model: [f64; 3]) {
+    let _ = writeln!(
+        out,
+        "\nWhere more samples stop paying: per curve and channel, the sample count from which on (at it and at \
+         every larger count swept) the discretisation error is below the model error ({} %, {} %, {} %). \
+         \"<= N\": already at the smallest count swept; \"none\": not within the sweep.\n",
+        percent(model[0]),
+        percent(model[1]),
+        percent(model[2])
+    );
+    let _ = writeln!(out, "| curve | counts swept | r | g | b |");
+    let _ = writeln!(out, "|---|---|---:|---:|---:|");
+    for x in crossovers(rows, model) {
+        let smallest = x.counts.first().copied();
+        let cell = |f: Option<usize>| match f {
+            None => "none".to_string(),
+            Some(n) if Some(n) == smallest => format!("<= {n}"),
+            Some(n) => n.to_string(),
+        };
+        let counts = x.counts.iter().map(usize::to_string).collect::<Vec<_>>().join(", ");
+        let _ = writeln!(
+            out,
+            "| {} | {counts} | {} | {} | {} |",
+            md_cell(&x.curve),
+            cell(x.from[0]),
+            cell(x.from[1]),
+            cell(x.from[2])
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(samples: usize, seed: u64, err: [f64; 3]) -> Row {
+        Row {
+            scene: "s".into(),
+            default: false,
+            sampler: "turk".into(),
+            samples,
+            gather: "vertex".into(),
+            epsilon: None,
+            seed,
+            sampling_ms: 1.0,
+            splat_ms: 1.0,
+            gather_ms: 1.0,
+            shade_ms: 1.0,
+            frame_ms: 3.0,
+            device_mib: 1.0,
+            rel_rms: err,
+            p99: err,
+            max: err,
+            bias: [0.0; 3],
+            image_rel_rmse: 0.0,
+            flip_mean: 0.0,
+            predicted: f64::NAN,
+            model_rel_rms: [0.01; 3],
+            total_rel_rms: err,
+            rte_noise: [0.001; 3],
+        }
+    }
+
+    #[test]
+    fn the_crossover_is_the_count_from_which_every_larger_count_stays_below_the_model_error() {
+        let rows = vec![
+            row(100, 1, [0.05, 0.005, 0.05]),
+            row(200, 1, [0.02, 0.004, 0.05]),
+            // Two seeds at 400: their mean, 0.009 for r, is below the model's 0.01.
+            row(400, 1, [0.008, 0.02, 0.05]),
+            row(400, 2, [0.010, 0.001, 0.05]),
+            row(800, 1, [0.004, 0.001, 0.05]),
+        ];
+        let x = crossovers(&rows, [0.01; 3]);
+        assert_eq!(x.len(), 1);
+        assert_eq!(x[0].counts, [100, 200, 400, 800]);
+        // g dips below at 100 and 200, rises above at 400 (mean 0.0105), so pays until 800.
+        assert_eq!(x[0].from, [Some(400), Some(800), None]);
+    }
+
+    #[test]
+    fn noise_is_the_rms_relative_standard_error_over_lit_vertices() {
+        // The third vertex is under the lit floor in every channel and left out.
+        let m = vec![vec![[1.0; 3], [2.0; 3], [1e-9; 3]]];
+        let s = vec![vec![[0.03; 3], [0.08; 3], [1.0; 3]]];
+        let n = noise(&m, &s);
+        let expected = ((0.03f64.powi(2) + 0.04f64.powi(2)) / 2.0).sqrt();
+        assert!(n.iter().all(|v| (v - expected).abs() < 1e-15), "{n:?}");
+        assert!((without_noise(0.05, 0.03) - 0.04).abs() < 1e-15);
+        assert_eq!(without_noise(0.01, 0.03), 0.0);
+    }
+}
