@@ -15,12 +15,10 @@ mod growth;
 #[path = "render/roofline.rs"]
 mod roofline;
 
-use ash::vk;
 use roofline::{Roofline, Yardsticks};
 use std::sync::Arc;
 use std::time::Instant;
-use translucent::gpu::{Binding, Buffer, BufferDesc, ComputePipeline, Gpu, GpuOptions, median};
-use translucent::render::graph::Resource;
+use translucent::gpu::{Gpu, GpuOptions, median};
 use translucent::render::plan::{Change, Pass};
 use translucent::render::renderer::Renderer;
 use translucent::sampling::Method;
@@ -97,26 +95,8 @@ fn print(title: &str, m: &Measured) {
 /// glsl/bench/gather_naive.comp over the same vertex-sample pairs, alternating the two
 /// `FRAMES` times after a warm-up: (gather ms, naive ms, pairs).
 fn gather_against_naive(gpu: &Arc<Gpu>, renderer: &mut Renderer) -> (f64, f64, f64) {
-    let naive = ComputePipeline::new(gpu, "bench/gather_naive.comp").expect("naive gather pipeline");
+    let (naive, set, _out) = roofline::naive_gather(gpu, renderer);
     let b = renderer.buffers();
-    let out = Buffer::new(
-        gpu,
-        &BufferDesc::gpu_only(
-            "naive exitance",
-            16 * b.vertex_count.max(1) as u64,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-        ),
-    )
-    .expect("buffer");
-    let set = naive
-        .descriptor_set(&[
-            Resource::Vertices.bind(Binding::Buffer(&b.vertices)),
-            Resource::Samples.bind(Binding::Buffer(&b.samples)),
-            Resource::Splat.bind(Binding::Buffer(&b.splat)),
-            Resource::Objects.bind(Binding::Buffer(&b.objects)),
-            Resource::Exitance.bind(Binding::Buffer(&out)),
-        ])
-        .expect("descriptor set");
     let receivers = b.receivers.clone();
     let pairs: f64 = receivers.iter().map(|r| r.vertex_count as f64 * r.sample_count as f64).sum();
     let mut plan = renderer.plan(Change::Everything);

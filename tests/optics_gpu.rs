@@ -182,22 +182,26 @@ const NAMES: [&str; 18] = [
 ];
 
 fn run_on_gpu(inputs: &[DipoleEvalInput]) -> Vec<DipoleEvalOutput> {
+    eval_on_gpu("dipole_eval.comp", inputs)
+}
+
+/// One invocation of `shader` (under glsl/, bindings `Inputs` and `Outputs`, push: the count) per
+/// input record, read back.
+fn eval_on_gpu<I: bytemuck::Pod, O: bytemuck::Pod>(shader: &str, inputs: &[I]) -> Vec<O> {
     with_gpu(|gpu| {
         let count = inputs.len() as u32;
-        let pipeline = ComputePipeline::new(gpu, "dipole_eval.comp").expect("dipole_eval pipeline");
-        let src = Buffer::from_slice(gpu, "dipole_eval inputs", inputs, vk::BufferUsageFlags::STORAGE_BUFFER)
-            .expect("input buffer");
-        let bytes = (inputs.len() * std::mem::size_of::<DipoleEvalOutput>()) as u64;
-        let dst =
-            Buffer::new(gpu, &BufferDesc::readback("dipole_eval outputs", bytes, vk::BufferUsageFlags::STORAGE_BUFFER))
-                .expect("output buffer");
+        let pipeline = ComputePipeline::new(gpu, shader).expect("evaluation pipeline");
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        let src = Buffer::from_slice(gpu, "evaluation inputs", inputs, usage).expect("input buffer");
+        let bytes = (inputs.len() * std::mem::size_of::<O>()) as u64;
+        let dst = Buffer::new(gpu, &BufferDesc::readback("evaluation outputs", bytes, usage)).expect("output buffer");
         let set = pipeline
             .descriptor_set(&[
                 Named { name: "Inputs", binding: Binding::Buffer(&src) },
                 Named { name: "Outputs", binding: Binding::Buffer(&dst) },
             ])
             .expect("descriptor set");
-        gpu.one_shot("dipole_eval", |cmd| {
+        gpu.one_shot(shader, |cmd| {
             pipeline.dispatch(cmd, &set, &count, [count, 1, 1]);
             memory_barrier(gpu.device(), cmd, &[Access::ComputeWrite], &[Access::HostRead]);
         })
@@ -310,30 +314,7 @@ fn single_scattering_glsl_twin_matches_f64_reference() {
             }
         }
     }
-    let outputs: Vec<[f32; 4]> = with_gpu(|gpu| {
-        let count = inputs.len() as u32;
-        let pipeline = ComputePipeline::new(gpu, "single_scatter_eval.comp").expect("pipeline");
-        let src = Buffer::from_slice(gpu, "single_scatter inputs", &inputs, vk::BufferUsageFlags::STORAGE_BUFFER)
-            .expect("input buffer");
-        let bytes = (inputs.len() * 16) as u64;
-        let dst = Buffer::new(
-            gpu,
-            &BufferDesc::readback("single_scatter outputs", bytes, vk::BufferUsageFlags::STORAGE_BUFFER),
-        )
-        .expect("output buffer");
-        let set = pipeline
-            .descriptor_set(&[
-                Named { name: "Inputs", binding: Binding::Buffer(&src) },
-                Named { name: "Outputs", binding: Binding::Buffer(&dst) },
-            ])
-            .expect("descriptor set");
-        gpu.one_shot("single_scatter_eval", |cmd| {
-            pipeline.dispatch(cmd, &set, &count, [count, 1, 1]);
-            memory_barrier(gpu.device(), cmd, &[Access::ComputeWrite], &[Access::HostRead]);
-        })
-        .expect("dispatch");
-        dst.read().expect("readback")
-    });
+    let outputs: Vec<[f32; 4]> = eval_on_gpu("single_scatter_eval.comp", &inputs);
     let mut worst = [0.0f64; 3];
     for (p, o) in inputs.iter().zip(&outputs) {
         let [albedo, g, eta, cos] = p.map(f64::from);

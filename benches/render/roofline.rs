@@ -371,7 +371,7 @@ pub fn frame_pairs(renderer: &Renderer, plan: &Plan) -> f64 {
 }
 
 /// glsl/bench/gather_naive.comp bound to `renderer`'s buffers, writing into its own.
-fn naive_gather(gpu: &Arc<Gpu>, renderer: &Renderer) -> (ComputePipeline, DescriptorSet, Buffer) {
+pub fn naive_gather(gpu: &Arc<Gpu>, renderer: &Renderer) -> (ComputePipeline, DescriptorSet, Buffer) {
     use translucent::render::graph::Resource;
     let naive = ComputePipeline::new(gpu, "bench/gather_naive.comp").expect("naive gather pipeline");
     let b = renderer.buffers();

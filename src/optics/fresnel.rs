@@ -112,7 +112,7 @@ pub fn diffuse_transmittance(eta: f64) -> f64 {
 /// Integral of `f` over `[lo, hi]` on panels `lo + (hi - lo) 2^-k`, k = 0..40, with 16-point
 /// Gauss-Legendre on each: resolves features at any scale near `lo`.
 fn graded_integral(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> f64 {
-    let (nodes, weights) = gauss_legendre_16();
+    let (nodes, weights) = super::single_scatter::gauss_legendre(16);
     let width = hi - lo;
     let mut sum = 0.0;
     let mut b = 1.0_f64;
@@ -125,34 +125,4 @@ fn graded_integral(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> f64 {
     }
     // The last sliver [lo, lo + width 2^-40] holds a negligible share of a bounded integrand.
     sum
-}
-
-/// Nodes and weights of 16-point Gauss-Legendre quadrature on [-1, 1], found by Newton's method
-/// on the Legendre polynomial P_16 (three-term recurrence) from the Chebyshev-like initial guess.
-fn gauss_legendre_16() -> ([f64; 16], [f64; 16]) {
-    const N: usize = 16;
-    let mut nodes = [0.0; N];
-    let mut weights = [0.0; N];
-    for i in 0..N {
-        let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (N as f64 + 0.5)).cos();
-        let mut dp = 1.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, x);
-            for k in 2..=N {
-                let k = k as f64;
-                let p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = N as f64 * (x * p1 - p0) / (x * x - 1.0);
-            let step = p1 / dp;
-            x -= step;
-            if step.abs() < 1e-16 {
-                break;
-            }
-        }
-        nodes[i] = x;
-        weights[i] = 2.0 / ((1.0 - x * x) * dp * dp);
-    }
-    (nodes, weights)
 }
