@@ -22,10 +22,15 @@ struct ObjectRecord {
 };
 
 // 1 in each channel whose exitance is gathered, 0 in each the planner computes locally
-// (M = R_d,total E_t at the receiver itself; GpuScene::set_local_channels).
-vec3 object_gathered_channels(ObjectRecord o) {
-    uint local = o.local_channels;
+// (M = R_d,total E_t at the receiver itself; GpuScene::set_local_channels), from the mask of
+// local channels (bit c: channel c).
+vec3 gathered_channels(uint local) {
     return vec3((local & 1u) == 0u ? 1.0 : 0.0, (local & 2u) == 0u ? 1.0 : 0.0, (local & 4u) == 0u ? 1.0 : 0.0);
+}
+
+// The same for object `o`'s record.
+vec3 object_gathered_channels(ObjectRecord o) {
+    return gathered_channels(o.local_channels);
 }
 
 struct SampleRecord {

@@ -29,9 +29,10 @@ layout(std430, set = 0, binding = 0) readonly buffer Lights { Light lights[]; };
 layout(set = 0, binding = 1) uniform sampler2DArrayShadow shadow_maps;
 #include "shade_push.glsl"
 
-// Specialization constants: ShadePass makes a pipeline per translucent-or-opaque and per shadow
-// filter, so neither is a branch at run time (a CPU driver runs both sides of a branch it cannot
-// prove uniform; the four-tap filter then cost its taps on every pixel).
+// Specialization constants: ShadePass makes a pipeline per translucent-or-opaque, per shadow
+// filter and per kind of key lights, so none is a branch at run time (a CPU driver runs both
+// sides of a branch it cannot prove uniform; the four-tap filter then cost its taps on every
+// pixel).
 layout(constant_id = 0) const bool SHADE_TRANSLUCENT = false;
 layout(constant_id = 1) const int SHADE_SHADOW_RADIUS = 0;  // light_visibility's radius: 0 one tap, 1 four
 // Every key light is directional: the point and spot lights' falloff, which would run (and read
@@ -102,8 +103,7 @@ void main() {
         // Gathered channels: the exitance interpolated from the vertices (zero under the pixel
         // gather, which adds its own afterwards). Local ones: M = R_d,total E_t, the dipole
         // integral when E_t is uniform over the profile's width (render::plan).
-        uint local = push.counts.z;
-        vec3 gathered = vec3((local & 1u) == 0u ? 1.0 : 0.0, (local & 2u) == 0u ? 1.0 : 0.0, (local & 4u) == 0u ? 1.0 : 0.0);
+        vec3 gathered = gathered_channels(push.counts.z);
         // R_d,total is the record's albedo (ObjectRecord::new), not recomputed per pixel.
         radiance += mix(push.albedo_roughness.rgb * transmitted, v_exitance, gathered) * exitance_to_radiance;
     }
