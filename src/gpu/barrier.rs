@@ -125,6 +125,37 @@ fn layout(accesses: &[Access]) -> vk::ImageLayout {
     first
 }
 
+/// One image's transition as Vulkan takes it: from layout `old` to `new`, waiting for `src`
+/// (stages, accesses) and holding back `dst`, over `range`. Every image barrier is built here
+/// (`ImageBarrier`, `Hazards::before`, a host's declared states).
+pub(crate) fn image_transition(
+    image: vk::Image,
+    range: vk::ImageSubresourceRange,
+    (old, new): (vk::ImageLayout, vk::ImageLayout),
+    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+) -> vk::ImageMemoryBarrier2<'static> {
+    vk::ImageMemoryBarrier2::default()
+        .image(image)
+        .old_layout(old)
+        .new_layout(new)
+        .src_stage_mask(src.0)
+        .src_access_mask(src.1)
+        .dst_stage_mask(dst.0)
+        .dst_access_mask(dst.1)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .subresource_range(range)
+}
+
+/// Every mip level and array layer of `aspect`.
+pub(crate) fn whole_image(aspect: vk::ImageAspectFlags) -> vk::ImageSubresourceRange {
+    vk::ImageSubresourceRange::default()
+        .aspect_mask(aspect)
+        .level_count(vk::REMAINING_MIP_LEVELS)
+        .layer_count(vk::REMAINING_ARRAY_LAYERS)
+}
+
 /// Make the `previous` accesses to any memory available and visible to the `next` ones.
 pub fn memory_barrier(device: &ash::Device, cmd: vk::CommandBuffer, previous: &[Access], next: &[Access]) {
     let (src_stage, src_access) = masks(previous);
@@ -168,24 +199,14 @@ impl<'a> ImageBarrier<'a> {
 
     /// Record it.
     pub fn record(&self, device: &ash::Device, cmd: vk::CommandBuffer) {
-        let (src_stage, src_access) = masks(self.previous);
-        let (dst_stage, dst_access) = masks(self.next);
-        let barrier = [vk::ImageMemoryBarrier2::default()
-            .image(self.image)
-            .old_layout(if self.discard { vk::ImageLayout::UNDEFINED } else { layout(self.previous) })
-            .new_layout(layout(self.next))
-            .src_stage_mask(src_stage)
-            .src_access_mask(src_access)
-            .dst_stage_mask(dst_stage)
-            .dst_access_mask(dst_access)
-            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .subresource_range(
-                vk::ImageSubresourceRange::default()
-                    .aspect_mask(self.aspect)
-                    .level_count(vk::REMAINING_MIP_LEVELS)
-                    .layer_count(vk::REMAINING_ARRAY_LAYERS),
-            )];
+        let old = if self.discard { vk::ImageLayout::UNDEFINED } else { layout(self.previous) };
+        let barrier = [image_transition(
+            self.image,
+            whole_image(self.aspect),
+            (old, layout(self.next)),
+            masks(self.previous),
+            masks(self.next),
+        )];
         // SAFETY: as for `memory_barrier`; the image is alive while the command buffer is.
         unsafe { device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&barrier)) };
     }

@@ -7,7 +7,7 @@
 //! consumers, and nothing waits on everything. The state outlives a command buffer: submissions
 //! on one queue must be submitted in the order they were recorded.
 
-use super::barrier::Access;
+use super::barrier::{Access, image_transition, whole_image};
 use ash::vk;
 use std::collections::HashMap;
 use std::hash::Hash;
@@ -149,24 +149,13 @@ impl<K: Copy + Eq + Hash + std::fmt::Debug> Hazards<K> {
             match (state.image, relayout) {
                 (Some((image, aspect)), true) => {
                     let old = if u.discard { vk::ImageLayout::UNDEFINED } else { state.layout.unwrap_or_default() };
-                    images.push(
-                        vk::ImageMemoryBarrier2::default()
-                            .image(image)
-                            .old_layout(old)
-                            .new_layout(u.access.layout())
-                            .src_stage_mask(sides.src_stage)
-                            .src_access_mask(sides.src_access)
-                            .dst_stage_mask(sides.dst_stage)
-                            .dst_access_mask(sides.dst_access)
-                            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                            .subresource_range(
-                                vk::ImageSubresourceRange::default()
-                                    .aspect_mask(aspect)
-                                    .level_count(vk::REMAINING_MIP_LEVELS)
-                                    .layer_count(vk::REMAINING_ARRAY_LAYERS),
-                            ),
-                    );
+                    images.push(image_transition(
+                        image,
+                        whole_image(aspect),
+                        (old, u.access.layout()),
+                        (sides.src_stage, sides.src_access),
+                        (sides.dst_stage, sides.dst_access),
+                    ));
                 }
                 _ if !sides.is_empty() => {
                     global.src_stage |= sides.src_stage;

@@ -25,6 +25,7 @@ pub mod shaders;
 pub use shaders::ShaderInterface;
 mod timer;
 
+pub(crate) use barrier::image_transition;
 pub use barrier::{Access, ImageBarrier, memory_barrier};
 pub use buffer::{Buffer, BufferDesc};
 pub use context::{EnabledFeatures, Gpu, HostVulkan, RequiredFeatures, required_features};

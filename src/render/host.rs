@@ -5,7 +5,7 @@
 
 use super::renderer::RenderError;
 use super::shade::{HostTarget, TargetDesc};
-use crate::gpu::{Gpu, aspect_of};
+use crate::gpu::{Gpu, aspect_of, image_transition};
 use ash::vk;
 
 /// How the host hands its attachments to the shading pass and takes them back.
@@ -152,19 +152,9 @@ fn record(
     let barriers: Vec<_> = moves
         .iter()
         .map(|&(image, aspect, from, to)| {
-            vk::ImageMemoryBarrier2::default()
-                .image(image)
-                .old_layout(from.layout)
-                .new_layout(to.layout)
-                .src_stage_mask(from.stages)
-                .src_access_mask(from.access)
-                .dst_stage_mask(to.stages)
-                .dst_access_mask(to.access)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .subresource_range(
-                    vk::ImageSubresourceRange::default().aspect_mask(aspect).level_count(1).layer_count(1),
-                )
+            // The view the host gives: mip 0, layer 0.
+            let range = vk::ImageSubresourceRange::default().aspect_mask(aspect).level_count(1).layer_count(1);
+            image_transition(image, range, (from.layout, to.layout), (from.stages, from.access), (to.stages, to.access))
         })
         .collect();
     // SAFETY: `cmd` is recording outside rendering; the host's images are alive while it is
