@@ -82,7 +82,8 @@ pub struct Roofline {
     shadow: Image,
     _output: Buffer,
     _sampler: Sampler,
-    timer: GpuTimer,
+    /// Taken out while a submission records (the recording borrows the rest), put back after.
+    timer: Option<GpuTimer>,
     /// Times per part, one entry per `run`.
     times: [Vec<f64>; 6],
 }
@@ -157,7 +158,7 @@ impl Roofline {
             shadow,
             _output: output,
             _sampler: sampler,
-            timer,
+            timer: Some(timer),
             times: Default::default(),
         }
     }
@@ -173,7 +174,7 @@ impl Roofline {
         let light = scene.light_matrices.first().copied().unwrap_or(view_proj);
         let (vertices, indices) = (scene.vertices.raw(), scene.indices.raw());
         let receivers = frame_receivers(renderer, plan);
-        let mut timer = std::mem::replace(&mut self.timer, GpuTimer::new(&self.gpu, PARTS).expect("timer"));
+        let mut timer = self.timer.take().expect("the timer is put back after each run");
         self.gpu
             .one_shot("roofline", |cmd| {
                 timer.reset(cmd);
@@ -197,7 +198,7 @@ impl Roofline {
         for (i, (_, ms)) in timer.results().expect("roofline timings").into_iter().enumerate() {
             self.times[i].push(ms);
         }
-        self.timer = timer;
+        self.timer = Some(timer);
         let start = Instant::now();
         self.gpu.one_shot("empty submission", |_| ()).expect("empty submission");
         self.times[5].push(start.elapsed().as_secs_f64() * 1e3);

@@ -355,7 +355,7 @@ impl RenderPass for ShadePass {
                 albedo_roughness: record.albedo_roughness,
                 material: [record.eta, record.norm, 0.0, 0.0],
             };
-            let translucent = scene.object_range(i).eta > 0.0;
+            let translucent = record.kind == super::records::MATERIAL_TRANSLUCENT;
             let filter = usize::from(!frame.plan.one_tap_shadows);
             let (pipeline, set) =
                 &self.variants[usize::from(translucent)][filter][usize::from(scene.key_lights_directional)];
