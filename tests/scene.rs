@@ -29,15 +29,28 @@ intensity = [1.0, 1.0, 1.0]
 fn builtin_scene_is_the_marble_bunny() {
     let scene = Scene::builtin();
     let s = &scene.file;
-    assert!(matches!(&s.objects[0].shape, Shape::Mesh { path } if path == "bunny-37k.obj"));
+    assert!(matches!(&s.objects[0].shape, Shape::Mesh { path } if path == "../bunny-37k.obj"));
     assert!(matches!(&s.objects[0].material, MaterialSpec::Translucent { preset: Some(p), .. } if p == "marble"));
     assert!(matches!(s.objects[1].material, MaterialSpec::Opaque { .. }));
     assert!(s.lights.iter().any(|l| matches!(l, Light::Environment { .. })));
     // Accurate by default: no count, the 1% error target chooses it.
     assert_eq!(s.sampling.count, None);
     assert_eq!(s.render.max_error, 0.01);
-    assert!(scene.resolve("bunny-37k.obj").is_ok());
+    assert!(scene.resolve("../bunny-37k.obj").is_ok());
     assert!(scene.resolve("missing.obj").is_err());
+}
+
+#[test]
+fn the_built_in_scene_file_loads_from_disk_as_the_binary_embeds_it() {
+    // assets/scenes/default.toml is both the embedded scene and a file a user can edit: its mesh
+    // path must resolve from its own folder as well as among the embedded assets.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/default.toml");
+    let scene = Scene::load(&path).unwrap();
+    let Shape::Mesh { path: mesh } = &scene.file.objects[0].shape else { panic!("the first object is the bunny") };
+    match scene.resolve(mesh).unwrap() {
+        translucent::scene::AssetSource::File(file) => assert!(file.is_file(), "{} is missing", file.display()),
+        translucent::scene::AssetSource::Embedded(_) => panic!("a scene read from disk resolves from disk"),
+    }
 }
 
 #[test]

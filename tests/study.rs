@@ -53,7 +53,9 @@ fn study_rows(out: &Path) -> Vec<Row> {
     assert!(rows[1..].iter().all(|r| r["configuration"] == "sweep"), "{csv}");
     // The tiny scene fixes 400 Turk samples; its own row is that, with the model's prediction.
     assert_eq!((rows[0]["sampler"].as_str(), rows[0]["samples"].as_str()), ("turk", "400"));
-    assert!(rows[0]["predicted"].parse::<f64>().unwrap() > 0.0, "{csv}");
+    for c in ["predicted_r", "predicted_g", "predicted_b"] {
+        assert!(rows[0][c].parse::<f64>().unwrap() > 0.0, "{c}: {csv}");
+    }
     for r in &rows {
         for c in COLUMNS.iter().filter(|c| **c != "epsilon") {
             assert!(!r[*c].is_empty(), "empty {c} in {r:?}");
@@ -221,7 +223,7 @@ fn an_error_target_gives_a_measured_error_within_its_bounds() {
         let [row] = &study.rows[..] else { panic!("one row: {:?}", study.rows) };
         assert!(row.default);
         let measured = row.rel_rms.iter().sum::<f64>() / 3.0;
-        eprintln!("target {target}: {} samples, predicted {:.4}, measured {measured:.4}", row.samples, row.predicted);
+        eprintln!("target {target}: {} samples, predicted {:?}, measured {:?}", row.samples, row.predicted, row.rel_rms);
         assert!(
             (target / 3.0..=1.5 * target).contains(&measured),
             "target {target}: measured {measured} outside [{}, {}]",
@@ -253,7 +255,7 @@ fn the_built_in_scene_at_its_defaults_stays_within_its_error_targets_bound() {
     let target = scene.file.render.max_error;
     let measured = row.rel_rms.iter().sum::<f64>() / 3.0;
     eprintln!(
-        "built-in scene: {} samples, {} gather, predicted {:.4}, measured {measured:.4} (r, g, b {:?})",
+        "built-in scene: {} samples, {} gather, predicted {:?}, measured {measured:.4} (r, g, b {:?})",
         row.samples, row.gather, row.predicted, row.rel_rms
     );
     assert!(study.truth.converged, "the truth did not converge: {:?}", study.truth.levels);

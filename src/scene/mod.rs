@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 pub const DEFAULT_SCENE: &str = include_str!("../../assets/scenes/default.toml");
 
 /// Assets embedded in the binary, so the default scene renders from any working directory.
-pub const EMBEDDED_ASSETS: &[(&str, &[u8])] = &[("bunny-37k.obj", include_bytes!("../../assets/bunny-37k.obj"))];
+pub const EMBEDDED_ASSETS: &[(&str, &[u8])] = &[("../bunny-37k.obj", include_bytes!("../../assets/bunny-37k.obj"))];
 
 /// Why a scene could not be read, checked or prepared. A prepared scene's errors come wrapped in
 /// [`SceneError::Context`], which says where (scene file, object, key); the cause is its

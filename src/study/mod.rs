@@ -331,18 +331,21 @@ fn configure(base: &PreparedScene, run: Configuration) -> Result<(PreparedScene,
     Ok((scene, start.elapsed().as_secs_f64() * 1e3))
 }
 
-/// The error model's prediction for `scene` as configured (mean of r, g, b, worst object):
-/// NaN where it makes none (it was fitted to Turk's samples at the vertices).
-fn predicted(scene: &PreparedScene, method: Method, gather: GatherMode) -> f64 {
+/// The error model's prediction for `scene` as configured, per channel (of the object whose
+/// worst channel is predicted worst): NaN where it makes none (it was fitted to Turk's samples
+/// at the vertices).
+fn predicted(scene: &PreparedScene, method: Method, gather: GatherMode) -> [f64; 3] {
+    let none = [f64::NAN; 3];
     if method != Method::Turk || gather == GatherMode::Pixel {
-        return f64::NAN;
+        return none;
     }
     scene
         .objects
         .iter()
         .filter_map(|o| o.density.as_ref())
-        .map(|d| d.predicted.iter().map(|c| c.error).sum::<f64>() / 3.0)
-        .fold(f64::NAN, f64::max)
+        .map(|d| d.predicted.map(|c| c.error))
+        .max_by(|a, b| report::worst(a).total_cmp(&report::worst(b)))
+        .unwrap_or(none)
 }
 
 fn images(renderer: &Renderer) -> Result<Images, StudyError> {

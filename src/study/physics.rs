@@ -344,7 +344,7 @@ mod tests {
             bias: [0.0; 3],
             image_rel_rmse: 0.0,
             flip_mean: 0.0,
-            predicted: f64::NAN,
+            predicted: [f64::NAN; 3],
             model_rel_rms: [0.01; 3],
             total_rel_rms: err,
             rte_noise: [0.001; 3],

@@ -279,6 +279,8 @@ mod tests {
             image_rel_rmse: error / 2.0,
             sampling_ms: 1.0,
             predicted: f64::NAN,
+            predicted_worst: f64::NAN,
+            error_worst: f64::NAN,
         }
     }
 
