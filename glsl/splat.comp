@@ -1,7 +1,8 @@
 #version 450
 // Irradiance splat: for every sample point, the irradiance transmitted into the medium from
 // every light: sum over lights of E_light cos(theta_i) F_t(cos theta_i, eta) V, with V from the
-// light's shadow map (one bilinear compare tap: the sharpest, closest to ray casting). Also the
+// light's shadow map (one bilinear compare tap at the sample, no normal offset: the sharpest,
+// closest to ray casting). Also the
 // sample's near-field energy per channel (dipole_near_energy), which depends only on its area and
 // material, so that the gather pays for it once per sample instead of once per pair.
 //
@@ -43,7 +44,14 @@ vec3 transmitted(uint first, uint end, vec3 p, vec3 n, float eta) {
         light_incidence(lights[l], p, wi, irradiance);
         float cos_i = dot(n, wi);
         if (cos_i <= 0.0) continue;
-        float v = light_visibility(lights[l], shadow_maps, p, n, 0);
+        // Looked up at the sample itself, without the normal offset the shading pass takes
+        // against acne: the truth casts its rays from the point (reference::ray_offset), and
+        // the offset lit samples beside the terminator of coarse meshes that a ray finds
+        // blocked (docs/STUDY.md, "Visibility in the splat"). The maps' slope-scaled depth
+        // bias still keeps lit faces free of acne.
+        Light unbiased = lights[l];
+        unbiased.spot_texel.z = 0.0;
+        float v = light_visibility(unbiased, shadow_maps, p, n, 0);
         e += irradiance * (cos_i * dipole_fresnel_transmittance(cos_i, eta) * v);
     }
     return e;
