@@ -272,6 +272,25 @@ fn plan_prints_every_change_and_its_json_has_the_documented_fields() {
 }
 
 #[test]
+fn plan_takes_an_error_target_and_a_tighter_one_places_more_samples() {
+    // The study's sphere with its count left to the target (sphere-marble.toml names no count).
+    let scene = repo_path("assets/scenes/sphere-marble.toml");
+    let count_at = |target: &str| {
+        let out = subcommand("plan", &[scene.to_str().unwrap(), "--json", "--max-error", target]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let density = &json["frames"][0]["objects"][0]["density"];
+        assert_eq!(density["target"].as_f64(), Some(target.parse().unwrap()), "{density}");
+        density["count"].as_u64().unwrap()
+    };
+    let (loose, tight) = (count_at("0.05"), count_at("0.01"));
+    assert!(tight > loose, "1% placed {tight} samples, 5% {loose}");
+    let out = subcommand("plan", &[scene.to_str().unwrap(), "--max-error", "2"]);
+    let err = text(&out.stderr);
+    assert!(!out.status.success() && err.contains("--max-error"), "{err}");
+}
+
+#[test]
 fn levels_baked_from_sky_light_are_withdrawn_when_it_is_recomputed_and_offered_once_baked_again() {
     let overrides = Overrides { samples: Some(64), resolution: Some([64, 64]), ..Overrides::default() };
     let prepared = PreparedScene::new(&Scene::builtin(), &overrides).unwrap();

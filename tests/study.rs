@@ -223,7 +223,10 @@ fn an_error_target_gives_a_measured_error_within_its_bounds() {
         let [row] = &study.rows[..] else { panic!("one row: {:?}", study.rows) };
         assert!(row.default);
         let measured = row.rel_rms.iter().sum::<f64>() / 3.0;
-        eprintln!("target {target}: {} samples, predicted {:?}, measured {:?}", row.samples, row.predicted, row.rel_rms);
+        eprintln!(
+            "target {target}: {} samples, predicted {:?}, measured {:?}",
+            row.samples, row.predicted, row.rel_rms
+        );
         assert!(
             (target / 3.0..=1.5 * target).contains(&measured),
             "target {target}: measured {measured} outside [{}, {}]",

@@ -26,6 +26,10 @@ pub struct Args {
     /// render.transport)
     #[arg(long, value_parser = super::one_of::<TransportMode>(&TransportMode::ALL.map(TransportMode::name)))]
     pub transport: Option<TransportMode>,
+    /// Relative per-vertex error against the exact dipole integral that each object's sample
+    /// count is chosen for, e.g. 0.01 for 1% (overrides render.max_error)
+    #[arg(long)]
+    pub max_error: Option<f64>,
 }
 
 pub fn run(args: &Args) -> Result<()> {
@@ -33,8 +37,13 @@ pub fn run(args: &Args) -> Result<()> {
         Some(path) => Scene::load(path)?,
         None => Scene::builtin(),
     };
-    let overrides =
-        Overrides { samples: args.samples, gather: args.gather, transport: args.transport, ..Overrides::default() };
+    let overrides = Overrides {
+        samples: args.samples,
+        gather: args.gather,
+        transport: args.transport,
+        max_error: args.max_error,
+        ..Overrides::default()
+    };
     let prepared = PreparedScene::new(&scene, &overrides)?;
     let objects = prepared.objects.len();
     let mut planner = Planner::new(objects, Change::Everything);

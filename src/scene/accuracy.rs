@@ -49,6 +49,11 @@ impl std::fmt::Display for Density {
             None => write!(f, "{} samples given (sampling.count or --samples)", self.count)?,
         }
         let [r, g, b] = self.predicted.map(|c| pct(c.error));
+        if self.target.is_some_and(|t| self.worst() > t) && self.count >= density::MAX_CHOSEN {
+            // The count stopped at the most the target may choose: say so rather than let the
+            // target read as met.
+            write!(f, " (the most a target may choose: the target is not reached)")?;
+        }
         let three = |v: [f64; 3]| format!("{:.3}, {:.3}, {:.3}", v[0], v[1], v[2]);
         write!(
             f,
@@ -124,4 +129,27 @@ pub fn choose_count(
     let count = given.unwrap_or_else(|| density::count_for(&facts, radii, max_error));
     let predicted = density::predict(&facts, radii, count);
     Some((count, Density { count, target: given.is_none().then_some(max_error), facts, predicted }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The count a target chooses on a bunny-sized surface, with its prediction.
+    fn density(target: f64) -> Density {
+        let facts = SurfaceFacts { area: 5e-3, curvature_radius: 5e-3, occlusion: 0.1 };
+        let radii = [5e-3, 3.7e-3, 2.8e-3];
+        let count = density::count_for(&facts, radii, target);
+        Density { count, target: Some(target), facts, predicted: density::predict(&facts, radii, count) }
+    }
+
+    #[test]
+    fn a_count_stopped_at_its_limit_says_the_target_is_not_reached() {
+        let capped = density(crate::scene::MIN_MAX_ERROR);
+        assert_eq!(capped.count, density::MAX_CHOSEN, "this surface must need more than the cap");
+        assert!(capped.worst() > crate::scene::MIN_MAX_ERROR);
+        assert!(capped.to_string().contains("the target is not reached"), "{capped}");
+        let met = density(0.01);
+        assert!(met.worst() <= 0.01 && !met.to_string().contains("not reached"), "{met}");
+    }
 }
