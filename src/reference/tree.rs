@@ -6,7 +6,7 @@
 use super::{near_blend, per_translucent_object};
 use crate::optics::Dipole;
 use crate::optics::kernel::{self, B_PER_SQRT_AREA};
-use crate::sampling::{NODE_ITEM, RECEIVER_GROUP_SIZE, SampleTree, TreeNode};
+use crate::sampling::{NODE_ITEM, SampleTree, TreeNode};
 use crate::scene::build::PreparedScene;
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
@@ -150,8 +150,9 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]], epsilon: f64) -> V
         let e = &irradiance[first..first + o.samples.len()];
         let power = node_power(&tree, &positions, &areas, e);
         let groups = o.receiver_groups();
-        let cuts = o.gather_cuts(&tree, &groups, epsilon);
         let mesh = o.mesh.positions();
+        let receivers: Vec<DVec3> = mesh.iter().map(|p| p.as_dvec3()).collect();
+        let cuts = o.gather_cuts(&tree, &groups, &receivers, epsilon);
         let boundary = o.mesh.boundary_distances();
         let object = TreeGather {
             tree: &tree,
@@ -168,7 +169,7 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]], epsilon: f64) -> V
             .enumerate()
             .map(|(k, &v)| {
                 let x = mesh[v as usize].as_dvec3();
-                let items = &cuts[k / RECEIVER_GROUP_SIZE];
+                let items = &cuts[k];
                 (v as usize, object.at(x, items, boundary[v as usize]))
             })
             .collect();

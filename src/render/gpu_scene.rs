@@ -331,15 +331,20 @@ impl PackedObjects {
         let groups = crate::sampling::ReceiverGroups::new(&positions);
         let (first_receiver, first_group) = (self.receiver_order.len() as u32, self.receiver_groups.len() as u32);
         self.receiver_order.extend(groups.order.iter().map(|&k| first_vertex + at.vertices[k as usize]));
-        let cuts = match at.epsilon {
-            Some(epsilon) => o.gather_cuts(at.tree, &groups, epsilon),
-            None => vec![Vec::new(); groups.bounds.len()],
-        };
-        let samples: Vec<glam::DVec3> = o.samples.iter().map(|s| s.position.as_dvec3()).collect();
-        let areas: Vec<f64> = o.samples.iter().map(|s| s.area).collect();
-        for (&group, items) in groups.bounds.iter().zip(&cuts) {
-            let blend = at.sparse.then(|| at.tree.within_reach(group, &samples, &areas, NEAR_BLEND_RADIUS));
-            self.group(group, items, blend.as_deref(), [first_node, first_sample]);
+        let first = [first_node, first_sample];
+        if let Some(epsilon) = at.epsilon {
+            // The hierarchical gather: one record per receiver, in group order, with its own cut.
+            let cuts = o.gather_cuts(at.tree, &groups, &positions, epsilon);
+            for (&k, items) in groups.order.iter().zip(&cuts) {
+                self.group((positions[k as usize].as_vec3().to_array(), 0.0), items, None, first);
+            }
+        } else {
+            let samples: Vec<glam::DVec3> = o.samples.iter().map(|s| s.position.as_dvec3()).collect();
+            let areas: Vec<f64> = o.samples.iter().map(|s| s.area).collect();
+            for &group in &groups.bounds {
+                let blend = at.sparse.then(|| at.tree.within_reach(group, &samples, &areas, NEAR_BLEND_RADIUS));
+                self.group(group, &[], blend.as_deref(), first);
+            }
         }
         Receiver {
             object: i as u32,

@@ -1,8 +1,9 @@
 //! The shape the two two-stage gathers share (`gather_tree`, `gather_sparse`): stage 0 runs
 //! over something of each object the plan gathers (its hierarchy's nodes, or its samples) into
-//! a buffer stage 1 reads; stage 1 runs one workgroup per receiver group
-//! (`sampling::ReceiverGroups`, `RECEIVER_GROUP_SIZE` vertices) of the same objects, into the
-//! per-vertex exitance. Both stages run over the plan's receivers only: an object the plan does
+//! a buffer stage 1 reads; stage 1 runs one invocation per receiver, one workgroup per receiver
+//! group (`sampling::ReceiverGroups`, `RECEIVER_GROUP_SIZE` vertices) of the same objects, into
+//! the per-vertex exitance (the sparse gather's lists are per group, the hierarchical one's per
+//! receiver). Both stages run over the plan's receivers only: an object the plan does
 //! not gather this frame has no fresh stage-0 output, and its exitance must stay as it was.
 
 use super::gpu_scene::Receiver;

@@ -90,22 +90,30 @@ impl PreparedObject {
         }
     }
 
-    /// The hierarchical gather's items for each receiver group at accuracy `epsilon`
-    /// (`sampling::SampleTree::cut`, nodes dropped by `optics::kernel::negligible_cluster`);
-    /// empty lists for an opaque object.
+    /// The hierarchical gather's items for each receiver, in `groups.order` (receivers at
+    /// `positions`), at accuracy `epsilon`: each receiver's own cut (`sampling::SampleTree::cut`
+    /// about its point, nodes dropped by `optics::kernel::negligible_cluster`); empty lists for
+    /// an opaque object. Its own, not its group's: a group's cut lists one by one every sample
+    /// within reach of any of its receivers, which on a coarse level of detail is three times
+    /// what one receiver needs (docs/STUDY.md, "What a group's list costs").
     pub fn gather_cuts(
         &self,
         tree: &sampling::SampleTree,
         groups: &sampling::ReceiverGroups,
+        positions: &[glam::DVec3],
         epsilon: f64,
     ) -> Vec<Vec<u32>> {
         use rayon::prelude::*;
         let ResolvedMaterial::Translucent { dipoles, .. } = &self.material else {
-            return vec![Vec::new(); groups.bounds.len()];
+            return vec![Vec::new(); groups.order.len()];
         };
         let negligible =
             |n: &sampling::TreeNode, dist: f64| crate::optics::kernel::negligible_cluster(dipoles, n.area as f64, dist);
-        groups.bounds.par_iter().map(|&g| tree.cut(g, epsilon, negligible)).collect()
+        groups
+            .order
+            .par_iter()
+            .map(|&k| tree.cut((positions[k as usize].as_vec3().to_array(), 0.0), epsilon, negligible))
+            .collect()
     }
 
     /// Its vertices as the hierarchical gather groups them (`sampling::ReceiverGroups`).
