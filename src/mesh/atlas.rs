@@ -30,9 +30,20 @@ pub const MIN_RESOLUTION: u32 = 16;
 /// 16 MiB.
 pub const MAX_RESOLUTION: u32 = 2048;
 
-/// The texture gather's local window: the `(2h + 1)^2` texels around a receiver's own texel,
-/// `h` this many, are summed exactly (`render::gather_texture`).
-pub const TEXTURE_LOCAL_RADIUS: u32 = 3;
+/// The texture gather's local window: the `(2h + 1)^2` texels around a receiver's own texel are
+/// summed exactly (`render::gather_texture`); `h` covers [`WINDOW_PROFILE_RADII`] RMS radii of
+/// the widest channel's profile, from 1 to this many texels.
+pub const MAX_WINDOW_RADIUS: u32 = 8;
+/// The local window reaches this many RMS profile radii (`optics::Dipole::profile_radius`).
+pub const WINDOW_PROFILE_RADII: f64 = 6.0;
+
+/// The local window's half-width `h` in texels for an atlas of `scale` texels per unit and a
+/// widest RMS profile radius of `profile_radius` units (infinite without absorption): enough
+/// texels for [`WINDOW_PROFILE_RADII`] of it, 1 to [`MAX_WINDOW_RADIUS`].
+pub fn window_radius(scale: f64, profile_radius: f64) -> u32 {
+    let h = (WINDOW_PROFILE_RADII * profile_radius * scale).ceil();
+    if h.is_nan() { MAX_WINDOW_RADIUS } else { h.clamp(1.0, f64::from(MAX_WINDOW_RADIUS)) as u32 }
+}
 
 /// The depth of the 4-ary sum tree over `texels` leaves: the least `L` with `4^L >= texels`. Its
 /// nodes above the leaves number `(4^L - 1) / 3` ([`tree_nodes`]).
@@ -82,6 +93,8 @@ pub struct Atlas {
     pub vertex_texel: Vec<[u32; 2]>,
     /// How many charts the mesh was cut into.
     pub charts: usize,
+    /// Texels per scene unit (one for all charts).
+    pub scale: f64,
 }
 
 /// Why a mesh got no atlas.
@@ -142,7 +155,7 @@ impl Atlas {
             }
         }
         let vertex_texel = vertex_texel.into_iter().map(Option::unwrap_or_default).collect();
-        Ok(Atlas { resolution, texels, index, vertex_texel, charts: charts.len() })
+        Ok(Atlas { resolution, texels, index, vertex_texel, charts: charts.len(), scale })
     }
 
     /// The texel at column `x`, row `y`, if one carries surface there.

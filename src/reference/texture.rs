@@ -8,7 +8,7 @@
 //! field blended over the window: what the mean over many seeds approaches.
 
 use super::{near_blend, near_kept, per_translucent_object};
-use crate::mesh::atlas::{Atlas, TEXTURE_LOCAL_RADIUS, tree_levels, tree_nodes};
+use crate::mesh::atlas::{Atlas, tree_levels, tree_nodes};
 use crate::optics::Dipole;
 use crate::optics::kernel;
 use crate::scene::build::{PreparedObject, PreparedScene};
@@ -49,7 +49,9 @@ impl PowerTree {
         for d in (0..levels as usize).rev() {
             let below = if d + 1 < levels as usize { &nodes[d + 1] } else { &leaves };
             let child = |c: usize| below.get(c).copied().unwrap_or(0.0);
-            nodes[d] = (0..1usize << (2 * d)).map(|i| ((child(4 * i) + child(4 * i + 1)) + child(4 * i + 2)) + child(4 * i + 3)).collect();
+            nodes[d] = (0..1usize << (2 * d))
+                .map(|i| ((child(4 * i) + child(4 * i + 1)) + child(4 * i + 2)) + child(4 * i + 3))
+                .collect();
         }
         debug_assert_eq!(nodes.iter().map(Vec::len).sum::<usize>(), tree_nodes(levels));
         PowerTree { levels, nodes, leaves }
@@ -68,7 +70,7 @@ impl PowerTree {
         for d in 0..self.levels {
             let w = [0, 1, 2, 3].map(|j| self.child(d as usize, node, j));
             let total = ((w[0] + w[1]) + w[2]) + w[3];
-            if !(total > 0.0) {
+            if total.is_nan() || total <= 0.0 {
                 return None;
             }
             let t = u(d) * total;
@@ -101,6 +103,8 @@ struct TextureGather<'a> {
     e: Vec<[f64; 3]>,
     radii: [f64; 3],
     tree: PowerTree,
+    /// The local window's half-width in texels.
+    h: u32,
 }
 
 impl<'a> TextureGather<'a> {
@@ -116,6 +120,7 @@ impl<'a> TextureGather<'a> {
             e: e32.iter().map(|e| e.map(f64::from)).collect(),
             radii: o.near_blend_radii(),
             tree: PowerTree::new(&e32, &a32),
+            h: o.window_radius().unwrap_or(1),
         }
     }
 
@@ -125,13 +130,13 @@ impl<'a> TextureGather<'a> {
     }
 
     fn in_window(&self, own: [u32; 2], at: [u32; 2]) -> bool {
-        own[0].abs_diff(at[0]) <= TEXTURE_LOCAL_RADIUS && own[1].abs_diff(at[1]) <= TEXTURE_LOCAL_RADIUS
+        own[0].abs_diff(at[0]) <= self.h && own[1].abs_diff(at[1]) <= self.h
     }
 
     /// The local term at vertex `v` (position `x`): far sum and blended near field over the
     /// window, times the share kept beside open boundaries `boundary` away.
     fn local(&self, x: DVec3, own: [u32; 2], boundary: [f32; 2]) -> [f64; 3] {
-        let (h, side) = (TEXTURE_LOCAL_RADIUS as i64, i64::from(self.atlas.resolution));
+        let (h, side) = (i64::from(self.h), i64::from(self.atlas.resolution));
         let (mut far, mut near) = ([0.0; 3], Vec::new());
         for y in (i64::from(own[1]) - h..=i64::from(own[1]) + h).filter(|y| (0..side).contains(y)) {
             for tx in (i64::from(own[0]) - h..=i64::from(own[0]) + h).filter(|x| (0..side).contains(x)) {
@@ -141,7 +146,11 @@ impl<'a> TextureGather<'a> {
                 (0..3).for_each(|c| far[c] += f[c]);
                 let b = kernel::B_PER_SQRT_AREA * self.areas[i].sqrt();
                 let e = self.e[i];
-                near.push((self.positions[i], self.areas[i], [0, 1, 2].map(|c| e[c] * kernel::near_energy(&self.dipoles[c], b))));
+                near.push((
+                    self.positions[i],
+                    self.areas[i],
+                    [0, 1, 2].map(|c| e[c] * kernel::near_energy(&self.dipoles[c], b)),
+                ));
             }
         }
         let (blended, mean_area) = near_blend(x, &near, self.radii);

@@ -6,7 +6,8 @@
 //! texel's transmitted irradiance `E_i` with the same shadow maps as for any sample. The dipole
 //! sum at a receiver `x` (seed Eq. 11 with the near field of `optics::kernel`) over the texels,
 //! `M(x) = sum_i E_i A_i K(x, x_i) + near(x)`, is split by a window `W(x)` of
-//! `(2h + 1)^2` texels around the receiver's own texel (`h` = [`TEXTURE_LOCAL_RADIUS`]):
+//! `(2h + 1)^2` texels around the receiver's own texel (`h` covers six times the widest channel's RMS
+//! profile radius, at most 8 texels: `mesh::atlas::window_radius`):
 //!
 //! `M(x) = [sum_{i in W} E_i A_i K_i + near over W]  +  sum_{i not in W} E_i A_i K_i`.
 //!
@@ -35,7 +36,6 @@
 use super::graph::{Resource, Resources, Use, compute_uses, read, write};
 use super::pass::{FrameInputs, RenderPass};
 use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuResult};
-pub use crate::mesh::atlas::TEXTURE_LOCAL_RADIUS;
 use ash::vk;
 use std::sync::Arc;
 
@@ -109,8 +109,17 @@ impl RenderPass for GatherTexturePass {
     }
 
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        let step = [read(Resource::TexturePyramid, Access::ComputeRead), write(Resource::TexturePyramid, Access::ComputeWrite)];
-        let planned = || frame.scene.receivers.iter().filter(|r| frame.plan.gathers(r.object as usize));
+        let step = [
+            read(Resource::TexturePyramid, Access::ComputeRead),
+            write(Resource::TexturePyramid, Access::ComputeWrite),
+        ];
+        // An object without an atlas (a scene prepared for another gather) keeps its exitance.
+        let planned = || {
+            let receivers = frame.scene.receivers.iter();
+            receivers.filter(|r| {
+                frame.plan.gathers(r.object as usize) && frame.scene.textures[r.object as usize].resolution > 0
+            })
+        };
         let push_of = |object: u32| {
             let t = frame.scene.textures[object as usize];
             GatherTexturePush {
@@ -120,7 +129,7 @@ impl RenderPass for GatherTexturePass {
                 first_index: t.first_index,
                 resolution: t.resolution,
                 samples: self.samples,
-                radius: TEXTURE_LOCAL_RADIUS,
+                radius: t.radius,
                 ..GatherTexturePush::default()
             }
         };

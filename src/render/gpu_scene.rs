@@ -68,6 +68,8 @@ pub struct TextureRange {
     pub first_index: u32,
     /// Its atlas's texels per side.
     pub resolution: u32,
+    /// Its local window's half-width in texels (`PreparedObject::window_radius`).
+    pub radius: u32,
 }
 
 /// Where one object's vertices and samples lie in the shared buffers (every object, opaque ones
@@ -337,6 +339,7 @@ impl PackedObjects {
             first_node: self.pyramid_nodes as u32,
             first_index: self.texel_index.len() as u32,
             resolution: atlas.resolution,
+            radius: o.window_radius().unwrap_or(1),
         });
         self.texel_index.extend(&atlas.index);
         self.pyramid_nodes += crate::mesh::atlas::tree_nodes(levels);

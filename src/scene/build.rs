@@ -111,6 +111,16 @@ impl PreparedObject {
         groups.bounds.par_iter().map(|&g| tree.cut(g, epsilon, negligible)).collect()
     }
 
+    /// The texture gather's local window half-width in texels (`mesh::atlas::window_radius`
+    /// for its atlas and its widest channel's profile); `None` without an atlas.
+    pub fn window_radius(&self) -> Option<u32> {
+        let (Some(atlas), ResolvedMaterial::Translucent { dipoles, .. }) = (&self.atlas, &self.material) else {
+            return None;
+        };
+        let widest = dipoles.iter().map(|d| d.profile_radius()).fold(0.0, f64::max);
+        Some(crate::mesh::atlas::window_radius(atlas.scale, widest))
+    }
+
     /// Its vertices as the hierarchical gather groups them (`sampling::ReceiverGroups`).
     pub fn receiver_groups(&self) -> sampling::ReceiverGroups {
         let positions: Vec<glam::DVec3> = self.mesh.positions().iter().map(|p| p.as_dvec3()).collect();
@@ -381,8 +391,9 @@ fn sample_objects(scene: &Scene, objects: &mut [PreparedObject], only: Option<us
     for (i, o) in objects.iter_mut().enumerate().filter(|(i, _)| only.is_none_or(|j| j == *i)) {
         let facts = super::accuracy::surface_facts(o, &occluders, eps);
         if file.render.gather == GatherMode::Texture && matches!(o.material, ResolvedMaterial::Translucent { .. }) {
-            let atlas = crate::mesh::atlas::Atlas::new(&o.mesh, file.render.texture_resolution)
-                .map_err(|e| SceneError::Flag(format!("{}: object[{i}] ({}): texture atlas: {e}", scene.name, o.name)))?;
+            let atlas = crate::mesh::atlas::Atlas::new(&o.mesh, file.render.texture_resolution).map_err(|e| {
+                SceneError::Flag(format!("{}: object[{i}] ({}): texture atlas: {e}", scene.name, o.name))
+            })?;
             o.samples = atlas.texels.iter().map(texel_sample).collect();
             let count = Some(o.samples.len());
             o.density = super::accuracy::choose_count(o, facts, count, file.render.max_error).map(|(_, d)| d);

@@ -387,10 +387,9 @@ impl GatherMode {
 impl std::str::FromStr for GatherMode {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        GatherMode::ALL
-            .into_iter()
-            .find(|m| m.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| format!("unknown gather mode `{s}` (expected vertex, pixel, sparse, hierarchical or texture)"))
+        GatherMode::ALL.into_iter().find(|m| m.name().eq_ignore_ascii_case(s)).ok_or_else(|| {
+            format!("unknown gather mode `{s}` (expected vertex, pixel, sparse, hierarchical or texture)")
+        })
     }
 }
 
