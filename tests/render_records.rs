@@ -154,6 +154,22 @@ fn splat_and_vertex_records_match_glsl() {
 type PushCase = (&'static str, &'static str, &'static str, usize, &'static [&'static str]);
 
 /// Every pass's push block, as `push_blocks_match_glsl_and_spirv` checks them.
+/// `GatherTexturePush`'s fields, in order.
+const TEXTURE_PUSH_FIELDS: [&str; 12] = [
+    "object",
+    "stage",
+    "depth",
+    "levels",
+    "first_node",
+    "first_index",
+    "resolution",
+    "samples",
+    "radius",
+    "seed",
+    "first_entry",
+    "receiver_count",
+];
+
 fn push_cases() -> [PushCase; 11] {
     [
         (
@@ -203,20 +219,7 @@ fn push_cases() -> [PushCase; 11] {
             include_str!("../glsl/gather_texture.comp"),
             "GatherTexturePush",
             size_of::<GatherTexturePush>(),
-            &[
-                "object",
-                "stage",
-                "depth",
-                "levels",
-                "first_node",
-                "first_index",
-                "resolution",
-                "samples",
-                "radius",
-                "seed",
-                "first_entry",
-                "receiver_count",
-            ],
+            &TEXTURE_PUSH_FIELDS,
         ),
         (
             "gather_pixel.comp",
