@@ -111,6 +111,18 @@ impl PreparedObject {
         groups.bounds.par_iter().map(|&g| tree.cut(g, epsilon, negligible)).collect()
     }
 
+    /// Make the texels of an atlas of its mesh at `resolution` its samples (the texture
+    /// gather's; `mesh::atlas`), its density judged for their count.
+    pub fn place_texels(&mut self, resolution: u32) -> Result<(), crate::mesh::atlas::AtlasError> {
+        let atlas = crate::mesh::atlas::Atlas::new(&self.mesh, resolution)?;
+        self.samples = atlas.texels.iter().map(texel_sample).collect();
+        if let ResolvedMaterial::Translucent { dipoles, .. } = &self.material {
+            self.density = self.density.as_ref().map(|d| d.given(dipoles, self.samples.len()));
+        }
+        self.atlas = Some(std::sync::Arc::new(atlas));
+        Ok(())
+    }
+
     /// The texture gather's local window half-width in texels (`mesh::atlas::window_radius`
     /// for its atlas and its widest channel's profile); `None` without an atlas.
     pub fn window_radius(&self) -> Option<u32> {
