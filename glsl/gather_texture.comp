@@ -89,11 +89,18 @@ float child_power(uint d, uint i, uint j, uint first_sample, uint sample_count) 
     return leaf_power(c, first_sample, sample_count);
 }
 
+// The four children's powers, written out rather than looped: llvmpipe ends any loop after
+// 65,535 iterations counted over the whole invocation, and a loop over the children inside the
+// depth loop inside the sample loop passed that at 4,096 samples (a silent, wrong result).
+vec4 children(uint d, uint i, uint first_sample, uint sample_count) {
+    return vec4(child_power(d, i, 0u, first_sample, sample_count), child_power(d, i, 1u, first_sample, sample_count),
+                child_power(d, i, 2u, first_sample, sample_count), child_power(d, i, 3u, first_sample, sample_count));
+}
+
 void build(ObjectRecord o) {
     uint i = gl_GlobalInvocationID.x;
     if (i >= (1u << (2u * push.depth))) return;
-    vec4 w;
-    for (uint j = 0u; j < 4u; ++j) w[j] = child_power(push.depth, i, j, o.ranges.z, o.ranges.w);
+    vec4 w = children(push.depth, i, o.ranges.z, o.ranges.w);
     precise float total = ((w.x + w.y) + w.z) + w.w;
     pyramid[push.first_node + depth_offset(push.depth) + i] = total;
 }
@@ -104,8 +111,7 @@ uint draw(uint vertex, uint k, uint first_sample, uint sample_count, out float p
     uint node = 0u;
     p = 1.0;
     for (uint d = 0u; d < push.levels; ++d) {
-        vec4 w;
-        for (uint j = 0u; j < 4u; ++j) w[j] = child_power(d, node, j, first_sample, sample_count);
+        vec4 w = children(d, node, first_sample, sample_count);
         precise float total = ((w.x + w.y) + w.z) + w.w;
         if (!(total > 0.0)) {
             p = 0.0;
@@ -115,8 +121,11 @@ uint draw(uint vertex, uint k, uint first_sample, uint sample_count, out float p
         precise float c1 = w.x + w.y;
         precise float c2 = c1 + w.z;
         uint j = t < w.x ? 0u : (t < c1 ? 1u : (t < c2 ? 2u : 3u));
-        // Rounding can land on a child without power: the last one with power instead.
-        while (w[j] <= 0.0 && j > 0u) --j;
+        // Rounding can land on a child without power: the last one with power before it
+        // instead (written out: no loop, see children()).
+        if (w[j] <= 0.0 && j == 3u) j = 2u;
+        if (w[j] <= 0.0 && j == 2u) j = 1u;
+        if (w[j] <= 0.0 && j == 1u) j = 0u;
         p *= w[j] / total;
         node = 4u * node + j;
     }
