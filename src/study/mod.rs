@@ -366,7 +366,7 @@ fn configure_texture(
 /// The error model's prediction for `scene` as configured (mean of r, g, b, worst object):
 /// NaN where it makes none (it was fitted to Turk's samples at the vertices).
 fn predicted(scene: &PreparedScene, method: Method, gather: GatherMode) -> f64 {
-    if method != Method::Turk || gather == GatherMode::Pixel {
+    if method != Method::Turk || matches!(gather, GatherMode::Pixel | GatherMode::Texture) {
         return f64::NAN;
     }
     scene
