@@ -159,7 +159,10 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         gpu.info().name,
         prepared.vertex_count(),
         prepared.sample_count(),
-        prepared.scene.file.sampling.method,
+        match prepared.scene.file.render.gather {
+            GatherMode::Texture => "atlas texels".to_string(),
+            _ => prepared.scene.file.sampling.method.to_string(),
+        },
         prepared.lights.len(),
         prepared.shadow_layers
     );
