@@ -171,6 +171,26 @@ fn a_static_scene_gives_the_same_exitance_every_frame() {
     });
 }
 
+/// What fixing the random numbers saves: the same receivers with another seed (what a new
+/// seed every frame would show from one frame to the next), default scene at the texture
+/// gather's defaults (atlas 256, 64 draws), in the f64 twin.
+#[test]
+fn another_seed_would_change_the_exitance_by_the_draws_noise() {
+    let samples = translucent::scene::DEFAULT_TEXTURE_SAMPLES;
+    let prepared = builtin(&texture(translucent::scene::DEFAULT_TEXTURE_RESOLUTION, samples));
+    let irradiance = reference::splat(&prepared, &reference::occluders(&prepared));
+    let a = reference::texture::gather(&prepared, &irradiance, samples, 0);
+    let b = reference::texture::gather(&prepared, &irradiance, samples, 1);
+    let (_, rms, _) = compare(&b[0], &a[0]);
+    let median = median_error(&b[0], &a[0]);
+    eprintln!(
+        "seed 0 against seed 1 (a new seed per frame): per-vertex relative difference RMS {:.1}%, median {:.2}%",
+        100.0 * rms,
+        100.0 * median
+    );
+    assert!(median > 1e-3, "the draws should depend on the seed: {median}");
+}
+
 #[test]
 fn bad_texture_settings_are_errors_naming_them() {
     let dir = temp_dir("texture");
