@@ -166,7 +166,7 @@ intensity = [40.0, 40.0, 40.0]
 
 #[test]
 fn every_gather_and_frame_change_is_clean_under_synchronisation_validation() {
-    for gather in ["vertex", "sparse", "hierarchical", "pixel"] {
+    for gather in ["vertex", "sparse", "hierarchical", "pixel", "texture"] {
         let messages = with_sync_gpu(|gpu| {
             let extra = format!("[render]\ngather = \"{gather}\"\n{CASTER}");
             let mut renderer = Renderer::new(gpu, plane(&extra)).unwrap();

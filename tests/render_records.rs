@@ -7,6 +7,7 @@ use translucent::gpu::ShaderInterface;
 use translucent::render::gather::GatherPush;
 use translucent::render::gather_pixel::GatherPixelPush;
 use translucent::render::gather_sparse::GatherSparsePush;
+use translucent::render::gather_texture::GatherTexturePush;
 use translucent::render::gather_tree::GatherTreePush;
 use translucent::render::local_exitance::LocalExitancePush;
 use translucent::render::records::{
@@ -153,7 +154,23 @@ fn splat_and_vertex_records_match_glsl() {
 type PushCase = (&'static str, &'static str, &'static str, usize, &'static [&'static str]);
 
 /// Every pass's push block, as `push_blocks_match_glsl_and_spirv` checks them.
-fn push_cases() -> [PushCase; 10] {
+/// `GatherTexturePush`'s fields, in order.
+const TEXTURE_PUSH_FIELDS: [&str; 12] = [
+    "object",
+    "stage",
+    "depth",
+    "levels",
+    "first_node",
+    "first_index",
+    "resolution",
+    "samples",
+    "radius",
+    "seed",
+    "first_entry",
+    "receiver_count",
+];
+
+fn push_cases() -> [PushCase; 11] {
     [
         (
             "splat.comp",
@@ -196,6 +213,13 @@ fn push_cases() -> [PushCase; 10] {
             "GatherTreePush",
             size_of::<GatherTreePush>(),
             &["object", "stage", "first_node", "node_count", "first_receiver", "first_group", "receiver_count"],
+        ),
+        (
+            "gather_texture.comp",
+            include_str!("../glsl/gather_texture.comp"),
+            "GatherTexturePush",
+            size_of::<GatherTexturePush>(),
+            &TEXTURE_PUSH_FIELDS,
         ),
         (
             "gather_pixel.comp",

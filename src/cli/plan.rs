@@ -52,8 +52,13 @@ pub fn run(args: &Args) -> Result<()> {
     // The first frame computes everything; every other change follows a frame that did, at the
     // levels of detail it chose (a fresh scene has no levels baked from sky light to withdraw).
     let first = planner.plan(&needs, &view);
-    planner
-        .recorded(&first, matches!(prepared.scene.file.render.gather, GatherMode::Vertex | GatherMode::Hierarchical));
+    planner.recorded(
+        &first,
+        matches!(
+            prepared.scene.file.render.gather,
+            GatherMode::Vertex | GatherMode::Hierarchical | GatherMode::Texture
+        ),
+    );
     let frames: Vec<(Change, plan::Plan)> = Change::all(prepared.scene.file.lights.len(), objects)
         .into_iter()
         .map(|change| {

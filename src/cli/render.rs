@@ -42,6 +42,14 @@ pub struct Args {
     /// sum, larger is faster and coarser (overrides render.gather_epsilon)
     #[arg(long, value_name = "EPSILON", allow_negative_numbers = true)]
     pub gather_epsilon: Option<f32>,
+    /// The texture gather's importance-sampled texels per receiver, 0 to 4096 (overrides
+    /// render.texture_samples)
+    #[arg(long, value_name = "N")]
+    pub texture_samples: Option<u32>,
+    /// The texture gather's atlas resolution in texels per side, 16 to 2048 (overrides
+    /// render.texture_resolution)
+    #[arg(long, value_name = "TEXELS")]
+    pub texture_resolution: Option<u32>,
     /// Image size WIDTHxHEIGHT (overrides the scene)
     #[arg(long, value_parser = parse_resolution)]
     pub resolution: Option<[u32; 2]>,
@@ -100,6 +108,8 @@ impl Default for Args {
             sampler: None,
             gather: None,
             gather_epsilon: None,
+            texture_samples: None,
+            texture_resolution: None,
             resolution: None,
             frames: 1,
             moving: Moving::Light,
@@ -149,7 +159,10 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         gpu.info().name,
         prepared.vertex_count(),
         prepared.sample_count(),
-        prepared.scene.file.sampling.method,
+        match prepared.scene.file.render.gather {
+            GatherMode::Texture => "atlas texels".to_string(),
+            _ => prepared.scene.file.sampling.method.to_string(),
+        },
         prepared.lights.len(),
         prepared.shadow_layers
     );
@@ -190,6 +203,8 @@ fn prepare(args: &Args) -> Result<PreparedScene> {
         sampler: args.sampler,
         gather: args.gather,
         gather_epsilon: args.gather_epsilon,
+        texture_samples: args.texture_samples,
+        texture_resolution: args.texture_resolution,
         resolution: args.resolution,
         transport: args.transport,
         // Exported exitance is every vertex's.

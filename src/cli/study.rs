@@ -33,8 +33,10 @@ pub struct Args {
     /// Only these sample counts, comma-separated (default: 100 to 6400, doubling)
     #[arg(long, value_delimiter = ',', value_name = "N,...")]
     pub counts: Vec<usize>,
-    /// Only these gathers, comma-separated: vertex, sparse, pixel, hierarchical:EPSILON
-    /// (default: the first three and hierarchical at 0.3, 0.1 and 0.03)
+    /// Only these gathers, comma-separated: vertex, sparse, pixel, hierarchical:EPSILON,
+    /// texture[:ATLAS] (default: the first three, hierarchical at 0.3, 0.1 and 0.03, texture at
+    /// 128, 256 and 512; the texture gather takes each count as its draws per receiver, first
+    /// sampler and seed only)
     #[arg(long, value_delimiter = ',', value_name = "GATHER,...")]
     pub gathers: Vec<String>,
     /// Also draw per-vertex relative error on the model for one configuration,
@@ -176,7 +178,18 @@ fn parse_gather(spec: &str) -> Result<Gather> {
             }
             Ok((mode, Some(eps)))
         }
-        (_, Some(_)) => bail!("--gathers {spec:?}: only the hierarchical gather takes an epsilon"),
+        (GatherMode::Texture, Some(r)) => {
+            let resolution: u32 =
+                r.parse().with_context(|| format!("--gathers {spec:?}: {r:?} is not a whole number"))?;
+            let (lo, hi) = (translucent::mesh::atlas::MIN_RESOLUTION, translucent::mesh::atlas::MAX_RESOLUTION);
+            if !(lo..=hi).contains(&resolution) {
+                bail!("--gathers {spec:?}: the atlas resolution must be {lo} to {hi}");
+            }
+            Ok((mode, Some(resolution as f32)))
+        }
+        (_, Some(_)) => bail!(
+            "--gathers {spec:?}: only the hierarchical gather (epsilon) and the texture gather (atlas resolution) take a parameter"
+        ),
         (_, None) => Ok((mode, None)),
     }
 }

@@ -8,6 +8,7 @@
 //! vertices, then derive topology and geometry. What the pipeline changed or found is kept in a
 //! [`MeshReport`].
 
+pub mod atlas;
 mod boundary;
 mod curvature;
 mod lod;

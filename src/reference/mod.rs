@@ -8,6 +8,7 @@ pub mod rte;
 pub mod rte_cache;
 pub mod rte_mesh;
 pub mod single;
+pub mod texture;
 pub mod tree;
 pub mod truth;
 

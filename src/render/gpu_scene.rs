@@ -56,6 +56,22 @@ pub struct Receiver {
     pub first_group: u32,
 }
 
+/// Where one object's atlas and sum tree lie, for the texture gather (all zero for an object
+/// without an atlas).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TextureRange {
+    /// The depth of its sum tree (`mesh::atlas::tree_levels` of its texels).
+    pub levels: u32,
+    /// Its root in `GpuScene::texture_pyramid`.
+    pub first_node: u32,
+    /// Its index map's first entry in `GpuScene::texel_index`.
+    pub first_index: u32,
+    /// Its atlas's texels per side.
+    pub resolution: u32,
+    /// Its local window's half-width in texels (`PreparedObject::window_radius`).
+    pub radius: u32,
+}
+
 /// Where one object's vertices and samples lie in the shared buffers (every object, opaque ones
 /// included): what per-object dispatches cover.
 #[derive(Clone, Copy, Debug)]
@@ -138,6 +154,18 @@ pub struct GpuScene {
     /// map spanning the casters' bounding sphere), so the full-detail surface the splat and
     /// shading look up from never falls behind a simplified caster (self-shadowing).
     pub casters: Vec<(usize, usize)>,
+    /// Per sample (u32), its atlas texel `x | y << 16` (0 for samples of objects without an
+    /// atlas).
+    pub texel_coords: Buffer,
+    /// Every atlas's index map, objects one after another (`TextureRange::first_index`):
+    /// per texel, row by row, its object-relative sample or `mesh::atlas::NO_TEXEL`.
+    pub texel_index: Buffer,
+    /// Per vertex (u32), its atlas texel `x | y << 16` (0 on objects without an atlas).
+    pub vertex_texel: Buffer,
+    /// Per node of every atlas's sum tree (f32), written by the texture gather's stage 0.
+    pub texture_pyramid: Buffer,
+    /// Per object, in scene order: its atlas and sum tree's place (`TextureRange`).
+    pub textures: Vec<TextureRange>,
     /// Per level of detail of every object, one after another: the object-relative indices of
     /// the vertices it uses, ascending (`LevelRange::first_entry`).
     pub level_vertices: Buffer,
@@ -254,6 +282,11 @@ struct PackedObjects {
     receiver_groups: Vec<ReceiverGroupRecord>,
     group_items: Vec<u32>,
     blend_items: Vec<u32>,
+    texel_coords: Vec<u32>,
+    texel_index: Vec<u32>,
+    vertex_texel: Vec<u32>,
+    pyramid_nodes: usize,
+    textures: Vec<TextureRange>,
 }
 
 impl PackedObjects {
@@ -285,6 +318,31 @@ impl PackedObjects {
         self.samples.extend(o.samples.iter().map(|s| SampleRecord::new(s, i)));
         let ranges = [first_vertex, positions.len() as u32, first_sample, o.samples.len() as u32];
         self.objects.push(ObjectRecord::new(o, ranges));
+        self.atlas(o);
+    }
+
+    /// Object `o`'s atlas, when it has one: its texels' and vertices' coordinates, its index
+    /// map and its sum tree's place; zeros otherwise.
+    fn atlas(&mut self, o: &crate::scene::build::PreparedObject) {
+        let pack = |[x, y]: [u32; 2]| x | (y << 16);
+        let Some(atlas) = &o.atlas else {
+            self.texel_coords.extend(std::iter::repeat_n(0, o.samples.len()));
+            self.vertex_texel.extend(std::iter::repeat_n(0, o.mesh.positions().len()));
+            self.textures.push(TextureRange::default());
+            return;
+        };
+        self.texel_coords.extend(atlas.texels.iter().map(|t| pack(t.coord)));
+        self.vertex_texel.extend(atlas.vertex_texel.iter().map(|&c| pack(c)));
+        let levels = crate::mesh::atlas::tree_levels(atlas.texels.len());
+        self.textures.push(TextureRange {
+            levels,
+            first_node: self.pyramid_nodes as u32,
+            first_index: self.texel_index.len() as u32,
+            resolution: atlas.resolution,
+            radius: o.window_radius().unwrap_or(1),
+        });
+        self.texel_index.extend(&atlas.index);
+        self.pyramid_nodes += crate::mesh::atlas::tree_nodes(levels);
     }
 
     /// Translucent object `i`'s hierarchy, receiver groups and their item lists; `first` is its
@@ -439,6 +497,11 @@ impl GpuScene {
             node_power: sized("node power", std::mem::size_of::<NodePowerRecord>(), p.tree_nodes.len())?,
             lights: sized("lights", std::mem::size_of::<LightGpu>(), scene.lights.len())?,
             level_vertices: upload(gpu, "level vertices", &l.level_vertices, none)?,
+            texel_coords: upload(gpu, "texel coordinates", &p.texel_coords, none)?,
+            texel_index: upload(gpu, "texel index", &p.texel_index, none)?,
+            vertex_texel: upload(gpu, "vertex texel", &p.vertex_texel, none)?,
+            texture_pyramid: sized("texture pyramid", std::mem::size_of::<f32>(), p.pyramid_nodes)?,
+            textures: p.textures,
             levels: l.levels,
             casters: l.casters,
             light_matrices: Vec::new(),

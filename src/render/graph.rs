@@ -56,6 +56,15 @@ pub enum Resource {
     BlendItems,
     /// Each level of detail's vertices (`GpuScene::level_vertices`).
     LevelVertices,
+    /// Per sample, its atlas texel (x | y << 16) under the texture gather
+    /// (`GpuScene::texel_coords`).
+    TexelCoords,
+    /// Per atlas texel of every texture-gathered object, its sample (`GpuScene::texel_index`).
+    TexelIndex,
+    /// Per vertex, its atlas texel (x | y << 16) under the texture gather (`GpuScene::vertex_texel`).
+    VertexTexel,
+    /// The texture gather's sum trees of texel power, its stage 0 (`GpuScene::texture_pyramid`).
+    TexturePyramid,
     /// Exitance at the samples, the sparse gather's stage 0 (owned by `GatherSparsePass`).
     SampleExitance,
     /// The shadow-map array (`FrameTargets::shadow_maps`).
@@ -100,6 +109,10 @@ impl Resource {
             BlendItems => "BlendItems",
             LevelVertices => "LevelVertices",
             SampleExitance => "SampleExitance",
+            TexelCoords => "TexelCoords",
+            TexelIndex => "TexelIndex",
+            VertexTexel => "VertexTexel",
+            TexturePyramid => "TexturePyramid",
             ShadowMaps => "shadow_maps",
             Hdr => "hdr",
             Surface => "surface",
@@ -128,7 +141,7 @@ pub const HOST_READ: [Resource; 5] = [
 ];
 
 /// Every resource that is a `GpuScene` buffer (`Resources::buffer`).
-pub const SCENE_BUFFERS: [Resource; 18] = [
+pub const SCENE_BUFFERS: [Resource; 22] = [
     Resource::Vertices,
     Resource::Objects,
     Resource::Lights,
@@ -147,6 +160,10 @@ pub const SCENE_BUFFERS: [Resource; 18] = [
     Resource::GroupItems,
     Resource::BlendItems,
     Resource::LevelVertices,
+    Resource::TexelCoords,
+    Resource::TexelIndex,
+    Resource::VertexTexel,
+    Resource::TexturePyramid,
 ];
 
 /// One declared access of a pass (`gpu::Use` over `Resource`).
@@ -215,6 +232,10 @@ impl<'a> Resources<'a> {
             GroupItems => &s.group_items,
             BlendItems => &s.blend_items,
             LevelVertices => &s.level_vertices,
+            TexelCoords => &s.texel_coords,
+            TexelIndex => &s.texel_index,
+            VertexTexel => &s.vertex_texel,
+            TexturePyramid => &s.texture_pyramid,
             _ => return None,
         })
     }

@@ -7,6 +7,7 @@ pub mod edit;
 pub mod gather;
 pub mod gather_pixel;
 pub mod gather_sparse;
+pub mod gather_texture;
 pub mod gather_tree;
 pub mod gpu_scene;
 pub mod graph;

@@ -6,6 +6,7 @@ use super::edit::SceneEdit;
 use super::gather::GatherPass;
 use super::gather_pixel::GatherPixelPass;
 use super::gather_sparse::GatherSparsePass;
+use super::gather_texture::GatherTexturePass;
 use super::gather_tree::GatherTreePass;
 use super::gpu_scene::GpuScene;
 use super::graph::{HOST_READ, Resource, Resources, read, write};
@@ -515,7 +516,7 @@ impl Renderer {
         let targets = FrameTargets::new(gpu, settings.shadow_map_size, scene.shadow_layers, camera)?;
         let resources = Resources { scene: &buffers, targets: &targets };
         let shade = ShadePass::new(gpu, target, &resources, needs.pixel_gather, options.shade())?;
-        let gather = Self::gather_pass(gpu, &resources, settings.gather, needs.pixel_gather)?;
+        let gather = Self::gather_pass(gpu, &resources, settings, needs.pixel_gather)?;
         let mut hazards = Hazards::new();
         targets.track(&mut hazards);
         // Timing is optional: a queue without timestamps still renders.
@@ -558,13 +559,14 @@ impl Renderer {
     fn gather_pass(
         gpu: &Arc<Gpu>,
         resources: &Resources,
-        mode: GatherMode,
+        settings: &crate::scene::RenderSettings,
         pixel: bool,
     ) -> Result<Box<dyn RenderPass>, RenderError> {
-        Ok(match mode {
+        Ok(match settings.gather {
             _ if pixel => Box::new(GatherPixelPass::new(gpu, resources)?),
             GatherMode::Sparse => Box::new(GatherSparsePass::new(gpu, resources)?),
             GatherMode::Hierarchical => Box::new(GatherTreePass::new(gpu, resources)?),
+            GatherMode::Texture => Box::new(GatherTexturePass::new(gpu, resources, settings.texture_samples)?),
             _ => Box::new(GatherPass::new(gpu, resources)?),
         })
     }
@@ -877,7 +879,10 @@ impl Renderer {
         // Only the vertex gather works at a level's vertices; the others reach every vertex.
         self.planner.recorded(
             plan,
-            matches!(self.scene.scene.file.render.gather, GatherMode::Vertex | GatherMode::Hierarchical),
+            matches!(
+                self.scene.scene.file.render.gather,
+                GatherMode::Vertex | GatherMode::Hierarchical | GatherMode::Texture
+            ),
         );
         // A frame that recomputed the sky light withdraws the levels baked from it.
         if self.planner.baked_levels() != baked {
@@ -1204,7 +1209,7 @@ impl Renderer {
         let resources = Resources { scene: &buffers, targets: &self.targets };
         let settings = &self.scene.scene.file.render;
         // Built first, then swapped in: an error leaves the renderer as it was.
-        let gather = Self::gather_pass(&gpu, &resources, settings.gather, self.needs.pixel_gather)?;
+        let gather = Self::gather_pass(&gpu, &resources, settings, self.needs.pixel_gather)?;
         let (vertex_light, splat) = (VertexLightPass::new(&gpu, &resources)?, SplatPass::new(&gpu, &resources)?);
         let shade = ShadePass::new(&gpu, self.target, &resources, self.needs.pixel_gather, self.options.shade())?;
         (self.gather, self.vertex_light, self.splat, self.shade) = (gather, vertex_light, splat, shade);

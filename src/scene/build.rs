@@ -63,6 +63,9 @@ pub struct PreparedObject {
     /// `render.level_of_detail` is off or the object's shading rests on per-vertex data the
     /// simplifier cannot see (`lod_allowed`).
     pub levels: Vec<crate::mesh::LodLevel>,
+    /// The texture gather's atlas of its mesh, whose texels are then its samples (translucent
+    /// objects of a scene with `render.gather = "texture"` only).
+    pub atlas: Option<std::sync::Arc<crate::mesh::atlas::Atlas>>,
 }
 
 impl PreparedObject {
@@ -114,6 +117,28 @@ impl PreparedObject {
             .par_iter()
             .map(|&k| tree.cut((positions[k as usize].as_vec3().to_array(), 0.0), epsilon, negligible))
             .collect()
+    }
+
+    /// Make the texels of an atlas of its mesh at `resolution` its samples (the texture
+    /// gather's; `mesh::atlas`), its density judged for their count.
+    pub fn place_texels(&mut self, resolution: u32) -> Result<(), crate::mesh::atlas::AtlasError> {
+        let atlas = crate::mesh::atlas::Atlas::new(&self.mesh, resolution)?;
+        self.samples = atlas.texels.iter().map(texel_sample).collect();
+        if let ResolvedMaterial::Translucent { dipoles, .. } = &self.material {
+            self.density = self.density.as_ref().map(|d| d.given(dipoles, self.samples.len()));
+        }
+        self.atlas = Some(std::sync::Arc::new(atlas));
+        Ok(())
+    }
+
+    /// The texture gather's local window half-width in texels (`mesh::atlas::window_radius`
+    /// for its atlas and its widest channel's profile); `None` without an atlas.
+    pub fn window_radius(&self) -> Option<u32> {
+        let (Some(atlas), ResolvedMaterial::Translucent { dipoles, .. }) = (&self.atlas, &self.material) else {
+            return None;
+        };
+        let widest = dipoles.iter().map(|d| d.profile_radius()).fold(0.0, f64::max);
+        Some(crate::mesh::atlas::window_radius(atlas.scale, widest))
     }
 
     /// Its vertices as the hierarchical gather groups them (`sampling::ReceiverGroups`).
@@ -175,6 +200,10 @@ pub struct Overrides {
     /// `--max-error`: replaces `render.max_error` ([`crate::scene::MIN_MAX_ERROR`] to
     /// [`crate::scene::MAX_MAX_ERROR`]).
     pub max_error: Option<f64>,
+    /// `--texture-samples`: replaces `render.texture_samples`.
+    pub texture_samples: Option<u32>,
+    /// `--texture-resolution`: replaces `render.texture_resolution`.
+    pub texture_resolution: Option<u32>,
 }
 
 impl PreparedScene {
@@ -325,6 +354,16 @@ fn apply_overrides(scene: &mut Scene, overrides: &Overrides) -> Result<(), Scene
     if let Some(t) = overrides.transport {
         scene.file.render.transport = t;
     }
+    let render = &mut scene.file.render;
+    render.texture_samples = overrides.texture_samples.unwrap_or(render.texture_samples);
+    render.texture_resolution = overrides.texture_resolution.unwrap_or(render.texture_resolution);
+    crate::scene::check_texture(
+        "--texture-samples",
+        "--texture-resolution",
+        render.texture_samples,
+        render.texture_resolution,
+    )
+    .map_err(|(flag, message)| SceneError::Flag(format!("{flag} {message}")))?;
     if let Some(l) = overrides.level_of_detail {
         scene.file.render.level_of_detail = l;
     }
@@ -357,6 +396,7 @@ fn prepare_object(scene: &Scene, i: usize, environment_lit: bool) -> Result<Prep
         samples: Vec::new(),
         density: None,
         levels,
+        atlas: None,
     })
 }
 
@@ -370,6 +410,16 @@ fn sample_objects(scene: &Scene, objects: &mut [PreparedObject], only: Option<us
     let file = &scene.file;
     for (i, o) in objects.iter_mut().enumerate().filter(|(i, _)| only.is_none_or(|j| j == *i)) {
         let facts = super::accuracy::surface_facts(o, &occluders, eps);
+        if file.render.gather == GatherMode::Texture && matches!(o.material, ResolvedMaterial::Translucent { .. }) {
+            let atlas = crate::mesh::atlas::Atlas::new(&o.mesh, file.render.texture_resolution).map_err(|e| {
+                SceneError::Flag(format!("{}: object[{i}] ({}): texture atlas: {e}", scene.name, o.name))
+            })?;
+            o.samples = atlas.texels.iter().map(texel_sample).collect();
+            let count = Some(o.samples.len());
+            o.density = super::accuracy::choose_count(o, facts, count, file.render.max_error).map(|(_, d)| d);
+            o.atlas = Some(std::sync::Arc::new(atlas));
+            continue;
+        }
         let Some((count, density)) =
             super::accuracy::choose_count(o, facts, file.sampling.count, file.render.max_error)
         else {
@@ -383,6 +433,18 @@ fn sample_objects(scene: &Scene, objects: &mut [PreparedObject], only: Option<us
         o.density = Some(density);
     }
     Ok(())
+}
+
+/// A texel of the texture gather's atlas as a sample point (`mesh::atlas`: it carries the area
+/// of the surface it stands for).
+fn texel_sample(t: &crate::mesh::atlas::Texel) -> SamplePoint {
+    SamplePoint {
+        position: t.position,
+        normal: t.normal,
+        triangle: t.triangle,
+        barycentric: t.barycentric.map(|b| b as f32),
+        area: t.area,
+    }
 }
 
 /// The gather a scene leaves to the sample count: the hierarchical one, at

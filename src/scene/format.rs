@@ -321,6 +321,29 @@ pub struct RenderSettings {
     /// overrides it.
     #[serde(default = "max_error")]
     pub max_error: f64,
+    /// The texture gather's importance-sampled texels per receiver (default
+    /// [`DEFAULT_TEXTURE_SAMPLES`]; 0 to [`MAX_TEXTURE_SAMPLES`]; 0 keeps the local term alone).
+    #[serde(default = "texture_samples")]
+    pub texture_samples: u32,
+    /// The texture gather's atlas resolution, texels per side (default
+    /// [`DEFAULT_TEXTURE_RESOLUTION`]; `mesh::atlas::MIN_RESOLUTION` to
+    /// `mesh::atlas::MAX_RESOLUTION`).
+    #[serde(default = "texture_resolution")]
+    pub texture_resolution: u32,
+}
+
+/// `render.texture_samples` when a scene names none (docs/STUDY.md, "The texture-space gather").
+pub const DEFAULT_TEXTURE_SAMPLES: u32 = 64;
+/// The most importance-sampled texels per receiver.
+pub const MAX_TEXTURE_SAMPLES: u32 = 4096;
+/// `render.texture_resolution` when a scene names none.
+pub const DEFAULT_TEXTURE_RESOLUTION: u32 = 256;
+
+fn texture_samples() -> u32 {
+    DEFAULT_TEXTURE_SAMPLES
+}
+fn texture_resolution() -> u32 {
+    DEFAULT_TEXTURE_RESOLUTION
 }
 
 /// Where exitance is gathered: `render.gather` in a scene, `--gather` on the command line.
@@ -338,12 +361,16 @@ pub enum GatherMode {
     /// At every mesh vertex, far clusters of samples standing in for their members
     /// (`render.gather_epsilon`)
     Hierarchical,
+    /// At every mesh vertex from a texture atlas of the surface: its texels' neighbourhood
+    /// summed, the rest importance-sampled by transmitted power (after Chang et al. 2008;
+    /// `render.texture_samples`, `render.texture_resolution`)
+    Texture,
 }
 
 impl GatherMode {
     /// Every gather mode: what `--gather` accepts and what parsing a name tries.
-    pub const ALL: [GatherMode; 4] =
-        [GatherMode::Vertex, GatherMode::Pixel, GatherMode::Sparse, GatherMode::Hierarchical];
+    pub const ALL: [GatherMode; 5] =
+        [GatherMode::Vertex, GatherMode::Pixel, GatherMode::Sparse, GatherMode::Hierarchical, GatherMode::Texture];
 
     /// The lowercase name used in scene files and on the command line.
     pub fn name(self) -> &'static str {
@@ -352,6 +379,7 @@ impl GatherMode {
             GatherMode::Pixel => "pixel",
             GatherMode::Sparse => "sparse",
             GatherMode::Hierarchical => "hierarchical",
+            GatherMode::Texture => "texture",
         }
     }
 }
@@ -359,10 +387,9 @@ impl GatherMode {
 impl std::str::FromStr for GatherMode {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        GatherMode::ALL
-            .into_iter()
-            .find(|m| m.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| format!("unknown gather mode `{s}` (expected vertex, pixel, sparse or hierarchical)"))
+        GatherMode::ALL.into_iter().find(|m| m.name().eq_ignore_ascii_case(s)).ok_or_else(|| {
+            format!("unknown gather mode `{s}` (expected vertex, pixel, sparse, hierarchical or texture)")
+        })
     }
 }
 
@@ -429,6 +456,8 @@ impl Default for RenderSettings {
             background: None,
             level_of_detail: true,
             max_error: DEFAULT_MAX_ERROR,
+            texture_samples: DEFAULT_TEXTURE_SAMPLES,
+            texture_resolution: DEFAULT_TEXTURE_RESOLUTION,
         }
     }
 }

@@ -49,6 +49,10 @@ pub enum SceneError {
     /// `--gather-epsilon` outside its range.
     #[error("--gather-epsilon {0} must be 0 to {MAX_GATHER_EPSILON} (as for render.gather_epsilon)")]
     GatherEpsilon(f32),
+    /// A command-line setting outside its range, or what it asks for impossible: the message
+    /// names the flag.
+    #[error("{0}")]
+    Flag(String),
     /// `--max-error` outside its range.
     #[error("--max-error {0} must be {MIN_MAX_ERROR} to {MAX_MAX_ERROR} (as for render.max_error; 0.01 is 1%)")]
     MaxError(f64),
@@ -433,7 +437,21 @@ fn check_render(r: &RenderSettings) -> Check {
         return Err(("render.shadow_map_size".into(), format!("{} must be 16 to 8192", r.shadow_map_size)));
     }
     non_negative("render.background", &r.background.unwrap_or_default())?;
+    check_texture("render.texture_samples", "render.texture_resolution", r.texture_samples, r.texture_resolution)?;
     check_max_error("render.max_error", r.max_error)
+}
+
+/// The texture gather's sample count (0 to [`format::MAX_TEXTURE_SAMPLES`]) and atlas
+/// resolution (`mesh::atlas::MIN_RESOLUTION` to `MAX_RESOLUTION`), under the keys or flags named.
+pub fn check_texture(samples_key: &str, resolution_key: &str, samples: u32, resolution: u32) -> Check {
+    use crate::mesh::atlas::{MAX_RESOLUTION, MIN_RESOLUTION};
+    if samples > format::MAX_TEXTURE_SAMPLES {
+        return Err((samples_key.into(), format!("{samples} must be 0 to {}", format::MAX_TEXTURE_SAMPLES)));
+    }
+    if !(MIN_RESOLUTION..=MAX_RESOLUTION).contains(&resolution) {
+        return Err((resolution_key.into(), format!("{resolution} must be {MIN_RESOLUTION} to {MAX_RESOLUTION}")));
+    }
+    Ok(())
 }
 
 /// A relative error target (`render.max_error`, `--max-error`) within

@@ -32,7 +32,11 @@ pub struct StudyConfig {
     pub samplers: Vec<Method>,
     /// Sample counts per object.
     pub counts: Vec<usize>,
-    /// Gathers, with the hierarchical gather's epsilon where it applies.
+    /// Gathers, with the hierarchical gather's epsilon or the texture gather's atlas
+    /// resolution (texels per side) where they apply. The texture gather takes each count as
+    /// its draws per receiver (`render.texture_samples`, counts above its limit skipped), with
+    /// the first sampler and seed only: its samples are the atlas's texels and its random
+    /// numbers are fixed.
     pub gathers: Vec<(GatherMode, Option<f32>)>,
     /// Seeds (each replaces `sampling.seed`).
     pub seeds: Vec<u64>,
@@ -64,6 +68,9 @@ impl StudyConfig {
                 (GatherMode::Hierarchical, Some(0.3)),
                 (GatherMode::Hierarchical, Some(0.1)),
                 (GatherMode::Hierarchical, Some(0.03)),
+                (GatherMode::Texture, Some(128.0)),
+                (GatherMode::Texture, Some(256.0)),
+                (GatherMode::Texture, Some(512.0)),
             ],
             seeds: vec![1, 2, 3],
             frames: 5,
@@ -92,12 +99,7 @@ impl StudyConfig {
 
     /// Configurations times seeds, and the scene's own row.
     pub fn runs(&self) -> usize {
-        let sweep = if self.sweep {
-            self.samplers.len() * self.counts.len() * self.gathers.len() * self.seeds.len()
-        } else {
-            0
-        };
-        sweep + usize::from(self.own)
+        self.configurations().len() + usize::from(self.own)
     }
 
     /// The sweep's configurations, in order.
@@ -110,6 +112,11 @@ impl StudyConfig {
             for &count in &self.counts {
                 for &seed in &self.seeds {
                     for &gather in &self.gathers {
+                        let texture = gather.0 == GatherMode::Texture;
+                        let first = Some(&method) == self.samplers.first() && Some(&seed) == self.seeds.first();
+                        if texture && !(first && count <= crate::scene::MAX_TEXTURE_SAMPLES as usize) {
+                            continue;
+                        }
                         out.push(Configuration { method, count, seed, gather, own: false });
                     }
                 }
@@ -310,6 +317,9 @@ fn configure(base: &PreparedScene, run: Configuration) -> Result<(PreparedScene,
         file.render.gather_epsilon = e;
     }
     file.render.transport = TransportMode::Gather;
+    if gather.0 == GatherMode::Texture && !own {
+        return configure_texture(scene, count, gather.1);
+    }
     if own {
         // The samples as the scene's error target placed them (their time is the scene's).
         return Ok((scene, f64::NAN));
@@ -331,12 +341,34 @@ fn configure(base: &PreparedScene, run: Configuration) -> Result<(PreparedScene,
     Ok((scene, start.elapsed().as_secs_f64() * 1e3))
 }
 
+/// `scene` with the texture gather: `count` draws per receiver, every translucent object's
+/// samples the texels of its atlas at `resolution` (default `render.texture_resolution`), and
+/// the time the atlases took.
+fn configure_texture(
+    mut scene: PreparedScene,
+    count: usize,
+    resolution: Option<f32>,
+) -> Result<(PreparedScene, f64), StudyError> {
+    let render = &mut scene.scene.file.render;
+    render.texture_samples = count as u32;
+    render.texture_resolution = resolution.map_or(render.texture_resolution, |r| r as u32);
+    let resolution = render.texture_resolution;
+    let start = std::time::Instant::now();
+    for o in &mut scene.objects {
+        if matches!(o.material, ResolvedMaterial::Translucent { .. }) {
+            o.place_texels(resolution)
+                .map_err(|e| StudyError::Sampling { object: o.name.clone(), message: e.to_string() })?;
+        }
+    }
+    Ok((scene, start.elapsed().as_secs_f64() * 1e3))
+}
+
 /// The error model's prediction for `scene` as configured, per channel (of the object whose
 /// worst channel is predicted worst): NaN where it makes none (it was fitted to Turk's samples
 /// at the vertices).
 fn predicted(scene: &PreparedScene, method: Method, gather: GatherMode) -> [f64; 3] {
     let none = [f64::NAN; 3];
-    if method != Method::Turk || gather == GatherMode::Pixel {
+    if method != Method::Turk || matches!(gather, GatherMode::Pixel | GatherMode::Texture) {
         return none;
     }
     scene
@@ -472,7 +504,10 @@ impl Configuration {
             self.method,
             self.count,
             self.gather.0.name(),
-            self.gather.1.map_or(String::new(), |e| format!(" eps {e}")),
+            self.gather.1.map_or(String::new(), |e| match self.gather.0 {
+                GatherMode::Texture => format!(" atlas {e}"),
+                _ => format!(" eps {e}"),
+            }),
             self.seed
         )
     }
@@ -525,7 +560,7 @@ impl Bench<'_> {
             scene: self.scene.to_string(),
             default: own,
             predicted,
-            sampler: method.name().to_string(),
+            sampler: if gather.0 == GatherMode::Texture { "atlas" } else { method.name() }.to_string(),
             samples: count,
             gather: gather.0.name().to_string(),
             epsilon: gather.1.map(f64::from),

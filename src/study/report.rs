@@ -231,6 +231,8 @@ impl Summary {
 
 pub(crate) fn curve_gather(gather: &str, epsilon: Option<f64>) -> String {
     match epsilon {
+        // The texture gather's parameter is its atlas's resolution.
+        Some(r) if gather == "texture" => format!("texture {}²", param(r)),
         Some(e) => format!("{gather} ε={}", param(e)),
         None => gather.to_string(),
     }

@@ -1,0 +1,389 @@
+//! A texture atlas of a mesh and its texels baked as surface samples, for the texture-space
+//! gather (`render.gather = "texture"`, after Chang, Lin, Ho, Huang and Chuang 2008, who gather
+//! from the irradiance stored in a texture of the surface).
+//!
+//! Charts: triangles grown across shared edges while their face normal stays within
+//! [`CHART_COS`] of the chart's first triangle, each chart projected orthographically onto the
+//! plane of that normal (so no triangle of a chart is flipped in the projection), in scene units.
+//! Packing: the charts' rectangles on shelves, tallest first, one texel of padding on each side,
+//! at one scale for all (texels per scene unit), the largest of a geometric sequence that fits.
+//! Why our own and not xatlas: the `xatlas-rs` 0.1.3 crate's bindings were generated on Windows
+//! and link against MSVC-mangled names (`?Create@xatlas@@...`), which no Linux build resolves
+//! (docs/STUDY.md, "The texture-space gather").
+//!
+//! Baking: each texel whose centre a chart triangle covers is a sample at that point (position,
+//! interpolated normal); a triangle's area is shared equally by the texels it covers, and a
+//! triangle that covers no texel centre gives its area to the texel under its centroid. So the
+//! texels' areas sum to the mesh's area exactly, at any resolution.
+
+use super::{Mesh, NO_NEIGHBOUR};
+use glam::{DVec2, DVec3, Vec3};
+
+/// A chart keeps growing into a neighbouring triangle while the cosine between its face normal
+/// and the chart's first normal is above this (about 53 degrees).
+pub const CHART_COS: f64 = 0.6;
+/// What [`Atlas::index`] holds where no texel is.
+pub const NO_TEXEL: u32 = u32::MAX;
+/// The smallest and largest atlas resolution (texels per side).
+pub const MIN_RESOLUTION: u32 = 16;
+/// See [`MIN_RESOLUTION`]; 2,048 keeps every texel coordinate in 16 bits and the index map at
+/// 16 MiB.
+pub const MAX_RESOLUTION: u32 = 2048;
+
+/// The texture gather's local window: the `(2h + 1)^2` texels around a receiver's own texel are
+/// summed exactly (`render::gather_texture`); `h` covers [`WINDOW_PROFILE_RADII`] RMS radii of
+/// the widest channel's profile, from 1 to this many texels.
+pub const MAX_WINDOW_RADIUS: u32 = 8;
+/// The local window reaches this many RMS profile radii (`optics::Dipole::profile_radius`).
+pub const WINDOW_PROFILE_RADII: f64 = 6.0;
+
+/// The local window's half-width `h` in texels for an atlas of `scale` texels per unit and a
+/// widest RMS profile radius of `profile_radius` units (infinite without absorption): enough
+/// texels for [`WINDOW_PROFILE_RADII`] of it, 1 to [`MAX_WINDOW_RADIUS`].
+pub fn window_radius(scale: f64, profile_radius: f64) -> u32 {
+    let h = (WINDOW_PROFILE_RADII * profile_radius * scale).ceil();
+    if h.is_nan() { MAX_WINDOW_RADIUS } else { h.clamp(1.0, f64::from(MAX_WINDOW_RADIUS)) as u32 }
+}
+
+/// The depth of the 4-ary sum tree over `texels` leaves: the least `L` with `4^L >= texels`. Its
+/// nodes above the leaves number `(4^L - 1) / 3` ([`tree_nodes`]).
+pub fn tree_levels(texels: usize) -> u32 {
+    let mut levels = 0;
+    while (1usize << (2 * levels)) < texels {
+        levels += 1;
+    }
+    levels
+}
+
+/// Nodes above the leaves of a 4-ary sum tree of depth `levels`: `(4^levels - 1) / 3`.
+pub fn tree_nodes(levels: u32) -> usize {
+    ((1usize << (2 * levels)) - 1) / 3
+}
+
+/// One texel that carries surface: a sample of the texture-space gather.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Texel {
+    /// The surface point at its centre (or the centroid of the small triangle it stands for).
+    pub position: Vec3,
+    /// The unit shading normal there.
+    pub normal: Vec3,
+    /// The surface area it stands for.
+    pub area: f64,
+    /// Its column and row in the atlas.
+    pub coord: [u32; 2],
+    /// The triangle it lies on, and its barycentric coordinates there.
+    pub triangle: u32,
+    /// Weights of the triangle's corners.
+    pub barycentric: [f64; 3],
+}
+
+/// A mesh's atlas with its texels baked.
+#[derive(Clone, Debug)]
+pub struct Atlas {
+    /// Texels per side.
+    pub resolution: u32,
+    /// The texels that carry surface, in Morton (Z) order of their coordinates: what the
+    /// texture gather's sum tree is built over (its nodes are then compact squares of texels).
+    pub texels: Vec<Texel>,
+    /// `resolution^2` entries, row by row: the index in `texels` of the texel there, or
+    /// [`NO_TEXEL`].
+    pub index: Vec<u32>,
+    /// Per mesh vertex, its texel (column, row): where it lies in the chart of its first
+    /// triangle, clamped into the atlas.
+    pub vertex_texel: Vec<[u32; 2]>,
+    /// How many charts the mesh was cut into.
+    pub charts: usize,
+    /// Texels per scene unit (one for all charts).
+    pub scale: f64,
+}
+
+/// Why a mesh got no atlas.
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum AtlasError {
+    /// The resolution is outside [`MIN_RESOLUTION`] to [`MAX_RESOLUTION`].
+    #[error("atlas resolution {0} must be {MIN_RESOLUTION} to {MAX_RESOLUTION}")]
+    Resolution(u32),
+    /// Even at one texel per chart the charts do not fit.
+    #[error("{charts} charts do not fit an atlas of {resolution}x{resolution} texels: raise the resolution")]
+    TooManyCharts {
+        /// The mesh's charts.
+        charts: usize,
+        /// The atlas's resolution.
+        resolution: u32,
+    },
+}
+
+/// One chart: its triangles, its projection plane and its place in the atlas.
+struct Chart {
+    triangles: Vec<usize>,
+    origin: DVec3,
+    axes: [DVec3; 2],
+    /// The projection's bounding box in scene units (min, max).
+    bounds: (DVec2, DVec2),
+    /// Where its bounding box's minimum lands in the atlas, in texels.
+    offset: DVec2,
+}
+
+impl Chart {
+    /// Atlas coordinates (texels) of point `p` at `scale` texels per unit.
+    fn uv(&self, p: DVec3, scale: f64) -> DVec2 {
+        let d = p - self.origin;
+        let q = DVec2::new(d.dot(self.axes[0]), d.dot(self.axes[1]));
+        self.offset + (q - self.bounds.0) * scale
+    }
+}
+
+impl Atlas {
+    /// Cut `mesh` into charts, pack them into `resolution^2` texels and bake the texels.
+    pub fn new(mesh: &Mesh, resolution: u32) -> Result<Atlas, AtlasError> {
+        if !(MIN_RESOLUTION..=MAX_RESOLUTION).contains(&resolution) {
+            return Err(AtlasError::Resolution(resolution));
+        }
+        let mut charts = grow_charts(mesh);
+        let scale = pack(&mut charts, mesh.total_area(), resolution)?;
+        let (texels, index) = bake(mesh, &charts, scale, resolution);
+        let mut vertex_texel = vec![None; mesh.positions().len()];
+        for chart in &charts {
+            for &t in &chart.triangles {
+                for v in mesh.triangles()[t] {
+                    let slot = &mut vertex_texel[v as usize];
+                    if slot.is_none() {
+                        let uv = chart.uv(mesh.positions()[v as usize].as_dvec3(), scale);
+                        *slot = Some(texel_of(uv, resolution));
+                    }
+                }
+            }
+        }
+        let vertex_texel = vertex_texel.into_iter().map(Option::unwrap_or_default).collect();
+        Ok(Atlas { resolution, texels, index, vertex_texel, charts: charts.len(), scale })
+    }
+
+    /// The texel at column `x`, row `y`, if one carries surface there.
+    pub fn texel_at(&self, x: u32, y: u32) -> Option<u32> {
+        let i = self.index[(y * self.resolution + x) as usize];
+        (i != NO_TEXEL).then_some(i)
+    }
+}
+
+/// The texel holding atlas point `uv`, clamped into the atlas.
+fn texel_of(uv: DVec2, resolution: u32) -> [u32; 2] {
+    let max = f64::from(resolution - 1);
+    [uv.x.floor().clamp(0.0, max) as u32, uv.y.floor().clamp(0.0, max) as u32]
+}
+
+/// Charts by growing across edges from each triangle not yet taken, in triangle order, while the
+/// face normal stays within [`CHART_COS`] of the seed's.
+fn grow_charts(mesh: &Mesh) -> Vec<Chart> {
+    let normals = mesh.face_normals();
+    let mut taken = vec![false; mesh.triangles().len()];
+    let mut charts = Vec::new();
+    for seed in 0..taken.len() {
+        if taken[seed] {
+            continue;
+        }
+        let axis = normals[seed].as_dvec3();
+        taken[seed] = true;
+        let mut triangles = vec![seed];
+        let mut next = 0;
+        while next < triangles.len() {
+            let t = triangles[next];
+            next += 1;
+            for n in mesh.neighbours()[t] {
+                if n != NO_NEIGHBOUR && !taken[n as usize] && normals[n as usize].as_dvec3().dot(axis) > CHART_COS {
+                    taken[n as usize] = true;
+                    triangles.push(n as usize);
+                }
+            }
+        }
+        let axes = axis.any_orthonormal_pair();
+        let origin = mesh.corners(seed)[0];
+        let project = |p: DVec3| DVec2::new((p - origin).dot(axes.0), (p - origin).dot(axes.1));
+        let mut bounds = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for &t in &triangles {
+            for p in mesh.corners(t) {
+                bounds = (bounds.0.min(project(p)), bounds.1.max(project(p)));
+            }
+        }
+        charts.push(Chart { triangles, origin, axes: [axes.0, axes.1], bounds, offset: DVec2::ZERO });
+    }
+    charts
+}
+
+/// Place the charts on shelves at the largest scale (texels per unit) of the sequence starting
+/// where they would cover 60% of the atlas and shrinking by 10% a step that fits; each chart's
+/// `offset` is set. An error when even the smallest scale does not fit.
+fn pack(charts: &mut [Chart], area: f64, resolution: u32) -> Result<f64, AtlasError> {
+    let side = f64::from(resolution);
+    let mut scale = (0.6 * side * side / area.max(f64::MIN_POSITIVE)).sqrt();
+    let mut order: Vec<usize> = (0..charts.len()).collect();
+    let extent = |c: &Chart| c.bounds.1 - c.bounds.0;
+    order.sort_by(|&a, &b| extent(&charts[b]).y.total_cmp(&extent(&charts[a]).y));
+    for _ in 0..400 {
+        if let Some(offsets) = shelves(charts, &order, scale, side) {
+            for (c, o) in charts.iter_mut().zip(offsets) {
+                c.offset = o;
+            }
+            return Ok(scale);
+        }
+        scale *= 0.9;
+    }
+    Err(AtlasError::TooManyCharts { charts: charts.len(), resolution })
+}
+
+/// Shelf packing of `charts` in `order` at `scale`: each chart's offset (its bounding box's
+/// minimum, one texel inside its padded cell), or `None` when they overflow `side`.
+fn shelves(charts: &[Chart], order: &[usize], scale: f64, side: f64) -> Option<Vec<DVec2>> {
+    let mut offsets = vec![DVec2::ZERO; charts.len()];
+    let (mut x, mut y, mut shelf) = (0.0, 0.0, 0.0f64);
+    for &i in order {
+        let e = (charts[i].bounds.1 - charts[i].bounds.0) * scale;
+        let (w, h) = ((e.x + 1.0).ceil() + 2.0, (e.y + 1.0).ceil() + 2.0);
+        if w > side {
+            return None;
+        }
+        if x + w > side {
+            (x, y, shelf) = (0.0, y + shelf, 0.0);
+        }
+        if y + h > side {
+            return None;
+        }
+        offsets[i] = DVec2::new(x + 1.0, y + 1.0);
+        x += w;
+        shelf = shelf.max(h);
+    }
+    Some(offsets)
+}
+
+/// The texels every chart triangle covers (see the module's doc), in Morton order, and the
+/// index map.
+fn bake(mesh: &Mesh, charts: &[Chart], scale: f64, resolution: u32) -> (Vec<Texel>, Vec<u32>) {
+    let mut index = vec![NO_TEXEL; (resolution * resolution) as usize];
+    let mut texels: Vec<Texel> = Vec::new();
+    for chart in charts {
+        for &t in &chart.triangles {
+            let uv = mesh.corners(t).map(|p| chart.uv(p, scale));
+            let covered = cover(&uv, resolution, &mut index, texels.len() as u32);
+            let area = mesh.triangle_areas()[t];
+            if covered.is_empty() {
+                let centroid = (uv[0] + uv[1] + uv[2]) / 3.0;
+                let [x, y] = texel_of(centroid, resolution);
+                let slot = &mut index[(y * resolution + x) as usize];
+                if *slot == NO_TEXEL {
+                    *slot = texels.len() as u32;
+                    texels.push(texel(mesh, t, [1.0 / 3.0; 3], [x, y], 0.0));
+                }
+                texels[*slot as usize].area += area;
+                continue;
+            }
+            let share = area / covered.len() as f64;
+            for ([x, y], bary) in covered {
+                texels.push(texel(mesh, t, bary, [x, y], share));
+            }
+        }
+    }
+    let mut order: Vec<u32> = (0..texels.len() as u32).collect();
+    order.sort_by_key(|&i| morton(texels[i as usize].coord));
+    let texels: Vec<Texel> = order.iter().map(|&i| texels[i as usize]).collect();
+    index.fill(NO_TEXEL);
+    for (i, t) in texels.iter().enumerate() {
+        index[(t.coord[1] * resolution + t.coord[0]) as usize] = i as u32;
+    }
+    (texels, index)
+}
+
+fn texel(mesh: &Mesh, t: usize, barycentric: [f64; 3], coord: [u32; 2], area: f64) -> Texel {
+    Texel {
+        position: mesh.point(t, barycentric).as_vec3(),
+        normal: mesh.normal_at(t, barycentric),
+        area,
+        coord,
+        triangle: t as u32,
+        barycentric,
+    }
+}
+
+/// The texel centres inside the triangle `uv` (atlas coordinates) not yet taken, each claimed in
+/// `index` for the texel numbered `next` on, with their barycentric coordinates.
+fn cover(uv: &[DVec2; 3], resolution: u32, index: &mut [u32], next: u32) -> Vec<([u32; 2], [f64; 3])> {
+    let lo = uv[0].min(uv[1]).min(uv[2]);
+    let hi = uv[0].max(uv[1]).max(uv[2]);
+    let max = f64::from(resolution - 1);
+    let span = |a: f64, b: f64| (a - 0.5).ceil().clamp(0.0, max) as u32..=(b - 0.5).floor().clamp(0.0, max) as u32;
+    let d = (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]);
+    let mut covered = Vec::new();
+    if d.abs() < 1e-300 {
+        return covered;
+    }
+    for y in span(lo.y, hi.y) {
+        for x in span(lo.x, hi.x) {
+            let p = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let b1 = (p - uv[0]).perp_dot(uv[2] - uv[0]) / d;
+            let b2 = (uv[1] - uv[0]).perp_dot(p - uv[0]) / d;
+            let b0 = 1.0 - b1 - b2;
+            let slot = &mut index[(y * resolution + x) as usize];
+            if b0 >= 0.0 && b1 >= 0.0 && b2 >= 0.0 && *slot == NO_TEXEL {
+                *slot = next + covered.len() as u32;
+                covered.push(([x, y], [b0, b1, b2]));
+            }
+        }
+    }
+    covered
+}
+
+/// The Morton (Z-order) key of a texel: its column's and row's bits interleaved.
+pub fn morton([x, y]: [u32; 2]) -> u64 {
+    let spread = |v: u32| {
+        let mut v = u64::from(v) & 0xffff_ffff;
+        v = (v | (v << 16)) & 0x0000_ffff_0000_ffff;
+        v = (v | (v << 8)) & 0x00ff_00ff_00ff_00ff;
+        v = (v | (v << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
+        v = (v | (v << 2)) & 0x3333_3333_3333_3333;
+        (v | (v << 1)) & 0x5555_5555_5555_5555
+    };
+    spread(x) | (spread(y) << 1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(n: u32) -> Mesh {
+        crate::scene::build::plane(1.0, n).unwrap()
+    }
+
+    #[test]
+    fn texel_areas_sum_to_the_mesh_area_at_any_resolution() {
+        let sphere = crate::scene::build::sphere(1.0, 24).unwrap();
+        for mesh in [square(8), sphere] {
+            for resolution in [16, 64, 256] {
+                let atlas = Atlas::new(&mesh, resolution).unwrap();
+                let sum: f64 = atlas.texels.iter().map(|t| t.area).sum();
+                assert!((sum - mesh.total_area()).abs() < 1e-9 * mesh.total_area(), "{resolution}: {sum}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_plane_is_one_chart_with_equal_texels() {
+        let atlas = Atlas::new(&square(8), 64).unwrap();
+        assert_eq!(atlas.charts, 1);
+        let areas: Vec<f64> = atlas.texels.iter().map(|t| t.area).collect();
+        let mean = areas.iter().sum::<f64>() / areas.len() as f64;
+        // Every triangle covers about the same number of texel centres.
+        assert!(areas.iter().all(|a| (a / mean - 1.0).abs() < 0.5), "{mean}");
+    }
+
+    #[test]
+    fn the_index_map_and_the_texels_agree() {
+        let atlas = Atlas::new(&crate::scene::build::sphere(1.0, 16).unwrap(), 64).unwrap();
+        for (i, t) in atlas.texels.iter().enumerate() {
+            assert_eq!(atlas.texel_at(t.coord[0], t.coord[1]), Some(i as u32));
+        }
+        assert!(atlas.texels.windows(2).all(|w| morton(w[0].coord) < morton(w[1].coord)));
+    }
+
+    #[test]
+    fn a_resolution_out_of_range_is_an_error() {
+        assert_eq!(Atlas::new(&square(2), 8).unwrap_err(), AtlasError::Resolution(8));
+    }
+}
