@@ -250,3 +250,20 @@ fn an_environment_scale_that_overflows_its_lights_names_the_key() {
     assert!(e.contains("light[1].scale") && e.contains("not finite"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn the_chosen_gathers_epsilon_follows_the_error_target() {
+    use translucent::scene::{ACCURATE_GATHER_EPSILON, DEFAULT_MAX_ERROR, accurate_gather_epsilon};
+    assert_eq!(accurate_gather_epsilon(DEFAULT_MAX_ERROR), ACCURATE_GATHER_EPSILON);
+    // Tighter targets cluster less; loose ones are capped.
+    assert!(accurate_gather_epsilon(0.003) < accurate_gather_epsilon(0.01));
+    assert!(accurate_gather_epsilon(0.5) <= 2.0);
+    // A scene that names no gather and no epsilon gets the one its target asks for.
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/sphere-ketchup.toml");
+    let scene = Scene::load(&path).unwrap();
+    let overrides = translucent::scene::build::Overrides { max_error: Some(0.003), ..Default::default() };
+    let prepared = translucent::scene::build::PreparedScene::new(&scene, &overrides).unwrap();
+    let render = &prepared.scene.file.render;
+    assert_eq!(render.gather, GatherMode::Hierarchical, "ketchup at 0.3% places over 1,600 samples");
+    assert_eq!(render.gather_epsilon, accurate_gather_epsilon(0.003));
+}

@@ -448,7 +448,7 @@ fn texel_sample(t: &crate::mesh::atlas::Texel) -> SamplePoint {
 }
 
 /// The gather a scene leaves to the sample count: the hierarchical one, at
-/// [`super::ACCURATE_GATHER_EPSILON`] unless the scene or the command line gives an epsilon,
+/// [`super::accurate_gather_epsilon`] of its error target unless the scene or the command line gives an epsilon,
 /// when an object has more than [`super::AUTO_HIERARCHICAL_COUNT`] samples.
 fn choose_gather(scene: &mut Scene, objects: &[PreparedObject], overrides: &Overrides) {
     let render = &mut scene.file.render;
@@ -468,7 +468,8 @@ pub fn own_gather(render: &super::RenderSettings, objects: &[PreparedObject]) ->
     let many = objects.iter().any(|o| o.samples.len() > super::AUTO_HIERARCHICAL_COUNT);
     let gather = render.gather_given.unwrap_or(if many { GatherMode::Hierarchical } else { GatherMode::Vertex });
     let chosen = render.gather_given.is_none() && gather == GatherMode::Hierarchical;
-    let fallback = if chosen { super::ACCURATE_GATHER_EPSILON } else { super::DEFAULT_GATHER_EPSILON };
+    let fallback =
+        if chosen { super::accurate_gather_epsilon(render.max_error) } else { super::DEFAULT_GATHER_EPSILON };
     (gather, render.gather_epsilon_given.unwrap_or(fallback))
 }
 

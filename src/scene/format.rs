@@ -469,9 +469,20 @@ impl Default for RenderSettings {
 /// 0.16% RMS from the flat gather (2 gave 0.57%, 1 kept the RMS but moved skim milk's red on a
 /// lit plane by 1.2e-3 from the flat sum; `tests/hierarchy.rs` holds 0.5% and 1e-3).
 pub const DEFAULT_GATHER_EPSILON: f32 = 0.5;
-/// `render.gather_epsilon` when the gather is chosen with the sample count: the study's rows at
-/// 0.3 match the flat sum's error at every count (docs/STUDY.md), where 4 adds about 0.5%.
+/// `render.gather_epsilon` when the gather is chosen with the sample count, at the default
+/// target: [`accurate_gather_epsilon`] of [`DEFAULT_MAX_ERROR`].
 pub const ACCURATE_GATHER_EPSILON: f32 = 0.3;
+/// [`accurate_gather_epsilon`]'s slope: epsilon per unit of `render.max_error`.
+pub const ACCURATE_EPSILON_PER_ERROR: f64 = 30.0;
+
+/// `render.gather_epsilon` when the gather is chosen with the sample count for the target
+/// `max_error`: `30 max_error`, at most 2. The clusters' own error must stay a small part of the
+/// target: with each receiver's own cut, 0.3 adds 0.01 to 0.03 points at a 1% target on the
+/// built-in scene, but 0.1 to 0.3 points at 0.3% on the spheres (docs/STUDY.md, "What a
+/// group's list costs, and a list per receiver").
+pub fn accurate_gather_epsilon(max_error: f64) -> f32 {
+    (ACCURATE_EPSILON_PER_ERROR * max_error).clamp(0.0, 2.0) as f32
+}
 /// Above this many samples on an object, a gather the scene does not name is the hierarchical
 /// one: the flat sum's cost grows with samples times receivers.
 pub const AUTO_HIERARCHICAL_COUNT: usize = 1600;
