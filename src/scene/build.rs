@@ -411,13 +411,11 @@ fn sample_objects(scene: &Scene, objects: &mut [PreparedObject], only: Option<us
     for (i, o) in objects.iter_mut().enumerate().filter(|(i, _)| only.is_none_or(|j| j == *i)) {
         let facts = super::accuracy::surface_facts(o, &occluders, eps);
         if file.render.gather == GatherMode::Texture && matches!(o.material, ResolvedMaterial::Translucent { .. }) {
-            let atlas = crate::mesh::atlas::Atlas::new(&o.mesh, file.render.texture_resolution).map_err(|e| {
+            o.place_texels(file.render.texture_resolution).map_err(|e| {
                 SceneError::Flag(format!("{}: object[{i}] ({}): texture atlas: {e}", scene.name, o.name))
             })?;
-            o.samples = atlas.texels.iter().map(texel_sample).collect();
             let count = Some(o.samples.len());
             o.density = super::accuracy::choose_count(o, facts, count, file.render.max_error).map(|(_, d)| d);
-            o.atlas = Some(std::sync::Arc::new(atlas));
             continue;
         }
         let Some((count, density)) =
