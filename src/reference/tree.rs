@@ -169,7 +169,7 @@ pub fn gather(scene: &PreparedScene, irradiance: &[[f64; 3]], epsilon: f64) -> V
             .enumerate()
             .map(|(k, &v)| {
                 let x = mesh[v as usize].as_dvec3();
-                let items = &cuts[k];
+                let items = cuts.of(k);
                 (v as usize, object.at(x, items, boundary[v as usize]))
             })
             .collect();

@@ -393,8 +393,8 @@ impl PackedObjects {
         if let Some(epsilon) = at.epsilon {
             // The hierarchical gather: one record per receiver, in group order, with its own cut.
             let cuts = o.gather_cuts(at.tree, &groups, &positions, epsilon);
-            for (&k, items) in groups.order.iter().zip(&cuts) {
-                self.group((positions[k as usize].as_vec3().to_array(), 0.0), items, None, first);
+            for (n, &k) in groups.order.iter().enumerate() {
+                self.group((positions[k as usize].as_vec3().to_array(), 0.0), cuts.of(n), None, first);
             }
         } else {
             let samples: Vec<glam::DVec3> = o.samples.iter().map(|s| s.position.as_dvec3()).collect();

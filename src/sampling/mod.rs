@@ -33,7 +33,7 @@ pub use feature::FeatureParams;
 pub use hash::SpatialHash;
 pub use poisson::PoissonParams;
 pub use stats::{SampleStats, nearest_neighbour_distances};
-pub use tree::{NODE_ITEM, RECEIVER_GROUP_SIZE, ReceiverGroups, SampleTree, TreeNode};
+pub use tree::{Cuts, NODE_ITEM, RECEIVER_GROUP_SIZE, ReceiverGroups, SampleTree, TreeNode};
 pub use turk::TurkParams;
 pub use walk::SurfacePoint;
 pub use weights::WeightParams;

@@ -139,8 +139,21 @@ impl SampleTree {
     ///
     /// `epsilon = 0` takes every sample: the flat sum.
     pub fn cut(&self, group: ([f32; 3], f32), epsilon: f64, negligible: impl Fn(&TreeNode, f64) -> bool) -> Vec<u32> {
-        let (center, radius) = (glam::Vec3::from(group.0).as_dvec3(), group.1 as f64);
         let mut items = Vec::new();
+        self.cut_into(group, epsilon, negligible, &mut items);
+        items
+    }
+
+    /// [`Self::cut`], appended to `items`: many cuts share one buffer instead of an allocation
+    /// each, which the allocator's locks made costly on every thread at once.
+    pub fn cut_into(
+        &self,
+        group: ([f32; 3], f32),
+        epsilon: f64,
+        negligible: impl Fn(&TreeNode, f64) -> bool,
+        items: &mut Vec<u32>,
+    ) {
+        let (center, radius) = (glam::Vec3::from(group.0).as_dvec3(), group.1 as f64);
         let mut i = 0;
         while i < self.nodes.len() {
             let n = &self.nodes[i];
@@ -158,7 +171,60 @@ impl SampleTree {
                 i += 1;
             }
         }
-        items
+    }
+}
+
+/// Many receivers' cuts ([`SampleTree::cut`]) in one buffer, in receiver order.
+#[derive(Clone, Debug, Default)]
+pub struct Cuts {
+    items: Vec<u32>,
+    /// Where each receiver's items end in `items`.
+    ends: Vec<usize>,
+}
+
+impl Cuts {
+    /// Cuts for receivers `0..count`, made by `cut(k, buffer)` appending receiver k's items,
+    /// chunks of receivers in parallel and joined in order (the same on any thread count).
+    pub fn build(count: usize, cut: impl Fn(usize, &mut Vec<u32>) + Sync) -> Cuts {
+        use rayon::prelude::*;
+        const CHUNK: usize = 256;
+        let chunks: Vec<Cuts> = (0..count.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let mut part = Cuts::default();
+                for k in c * CHUNK..((c + 1) * CHUNK).min(count) {
+                    cut(k, &mut part.items);
+                    part.ends.push(part.items.len());
+                }
+                part
+            })
+            .collect();
+        let mut all = Cuts {
+            items: Vec::with_capacity(chunks.iter().map(|c| c.items.len()).sum()),
+            ends: Vec::with_capacity(count),
+        };
+        for part in chunks {
+            let base = all.items.len();
+            all.items.extend_from_slice(&part.items);
+            all.ends.extend(part.ends.iter().map(|e| base + e));
+        }
+        all
+    }
+
+    /// Receiver `k`'s items.
+    pub fn of(&self, k: usize) -> &[u32] {
+        let start = if k == 0 { 0 } else { self.ends[k - 1] };
+        &self.items[start..self.ends[k]]
+    }
+
+    /// The number of receivers.
+    pub fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    /// Whether there are no receivers.
+    pub fn is_empty(&self) -> bool {
+        self.ends.is_empty()
     }
 }
 

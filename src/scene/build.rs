@@ -105,18 +105,16 @@ impl PreparedObject {
         groups: &sampling::ReceiverGroups,
         positions: &[glam::DVec3],
         epsilon: f64,
-    ) -> Vec<Vec<u32>> {
-        use rayon::prelude::*;
+    ) -> sampling::Cuts {
         let ResolvedMaterial::Translucent { dipoles, .. } = &self.material else {
-            return vec![Vec::new(); groups.order.len()];
+            return sampling::Cuts::build(groups.order.len(), |_, _| {});
         };
         let negligible =
             |n: &sampling::TreeNode, dist: f64| crate::optics::kernel::negligible_cluster(dipoles, n.area as f64, dist);
-        groups
-            .order
-            .par_iter()
-            .map(|&k| tree.cut((positions[k as usize].as_vec3().to_array(), 0.0), epsilon, negligible))
-            .collect()
+        sampling::Cuts::build(groups.order.len(), |k, items| {
+            let at = positions[groups.order[k] as usize].as_vec3().to_array();
+            tree.cut_into((at, 0.0), epsilon, negligible, items)
+        })
     }
 
     /// Make the texels of an atlas of its mesh at `resolution` its samples (the texture
