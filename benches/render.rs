@@ -613,12 +613,20 @@ fn frames(gpu: &Arc<Gpu>, prepared: PreparedScene) {
         &measure(&mut renderer, Change::Light(0)),
     );
     print("only the camera moves (shade, tone map):", &measure(&mut renderer, Change::Camera));
+    // The allocator counts the device's whole use: the renderer's own is read before the
+    // yardsticks allocate their targets.
+    let own = renderer.device_memory();
     let mut roof = Roofline::new(gpu, &renderer);
     for (title, change) in [("key light moving", Change::Light(0)), ("camera moving", Change::Camera)] {
         let (passes, yard, pairs) = against_roofline(&mut renderer, &mut roof, change);
         print_roofline(title, &passes, &yard, pairs, change);
     }
-    println!("device memory in use: {:.1} MiB", renderer.device_memory() as f64 / (1 << 20) as f64);
+    let mib = |bytes: u64| bytes as f64 / (1 << 20) as f64;
+    println!(
+        "device memory in use: {:.1} MiB by the renderer, {:.1} MiB with the yardsticks' targets",
+        mib(own),
+        mib(renderer.device_memory())
+    );
     let (ours, naive, pairs) = gather_against_naive(gpu, &mut renderer);
     println!(
         "\nFlat vertex gather against a naive point-kernel shader (glsl/bench/gather_naive.comp), same {:.1}M \
@@ -790,6 +798,15 @@ fn print_roofline(title: &str, passes: &[(String, f64)], yard: &Yardsticks, pair
     println!(
         "  (the raster yardstick with the shading pass's vertex stage and its four interpolants read: {:.2} ms)",
         yard.raster_inputs
+    );
+    let shade = passes.iter().find(|(n, _)| n == "shade").map_or(0.0, |p| p.1);
+    println!(
+        "  (deferred: a G-buffer of those interpolants {:.2} ms + the shading arithmetic in compute over its \
+         pixels {:.2} ms = {:.2} ms, {:.2}x the shade pass)",
+        yard.gbuffer,
+        yard.shade_compute,
+        yard.gbuffer + yard.shade_compute,
+        (yard.gbuffer + yard.shade_compute) / shade
     );
     let roof = if light { yard.light() } else { yard.camera() };
     println!("  {:<8} {:>10.2} {:>13.2}", "submit", 0.0, yard.submit);

@@ -11,6 +11,11 @@
 //!   (glsl/bench/tonemap_minimal.comp);
 //! - submission: an empty command buffer, submitted and waited for.
 //!
+//! Not part of the roofline, beside it: deferred shading, the same drawn geometry into a G-buffer
+//! of the shading pass's four interpolants (glsl/bench/raster_gbuffer.frag), then the shading
+//! pass's own arithmetic over its pixels in a compute pass (glsl/bench/shade_compute.comp), which
+//! says whether llvmpipe shades cheaper in full SIMD lanes than in fragment blocks.
+//!
 //! The naive gather (glsl/bench/gather_naive.comp) is the gather's yardstick, measured in
 //! render.rs. Each part here is timed by timestamps inside one submission, as the frame is.
 
@@ -32,8 +37,8 @@ const CAMERA_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
 const SHADOW_DEPTH: vk::Format = vk::Format::D16_UNORM;
 
 /// Timed parts per submission: raster, shadow, tone map, gather, raster with the shading pass's
-/// inputs.
-const PARTS: u32 = 5;
+/// inputs, the G-buffer and the compute shading over it.
+const PARTS: u32 = 7;
 
 /// Median milliseconds of each yardstick part.
 #[derive(Clone, Copy, Debug, Default)]
@@ -52,6 +57,11 @@ pub struct Yardsticks {
     pub raster_inputs: f64,
     /// An empty submission, wall time from submission to fence.
     pub submit: f64,
+    /// Not part of the roofline: deferred shading's G-buffer raster (the shading pass's vertex
+    /// stage, its four interpolants written to four RGBA32F targets).
+    pub gbuffer: f64,
+    /// Not part of the roofline: the shading pass's arithmetic over the G-buffer in compute.
+    pub shade_compute: f64,
 }
 
 impl Yardsticks {
@@ -85,7 +95,18 @@ pub struct Roofline {
     /// Taken out while a submission records (the recording borrows the rest), put back after.
     timer: Option<GpuTimer>,
     /// Times per part, one entry per `run`.
-    times: [Vec<f64>; 6],
+    times: [Vec<f64>; 8],
+    deferred: Deferred,
+}
+
+/// Deferred shading's G-buffer, its raster pipeline, and the compute shading over it.
+struct Deferred {
+    raster: GraphicsPipeline,
+    targets: Vec<Image>,
+    shade: ComputePipeline,
+    set: DescriptorSet,
+    out: Image,
+    _samplers: [Sampler; 2],
 }
 
 fn attachment(view: vk::ImageView, layout: vk::ImageLayout, depth: bool) -> vk::RenderingAttachmentInfo<'static> {
@@ -112,7 +133,15 @@ impl Roofline {
             |name, w, h, format, usage| Image::new(gpu, &ImageDesc::new(name, w, h, format, usage)).expect(name);
         let colour = image("roofline colour", width, height, HDR_FORMAT, U::COLOR_ATTACHMENT | U::SAMPLED);
         let camera_depth = image("roofline depth", width, height, CAMERA_DEPTH, U::DEPTH_STENCIL_ATTACHMENT);
-        let shadow = image("roofline shadow", map, map, SHADOW_DEPTH, U::DEPTH_STENCIL_ATTACHMENT);
+        // An array view of its one layer, so that the deferred yardstick samples it as the
+        // shading pass samples its maps (sampler2DArrayShadow).
+        let shadow = Image::new(gpu, &{
+            let mut d =
+                ImageDesc::new("roofline shadow", map, map, SHADOW_DEPTH, U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED);
+            d.array_view = true;
+            d
+        })
+        .expect("roofline shadow");
         let mut desc = GraphicsDesc::new("bench/raster_trivial.vert", Some("bench/raster_trivial.frag"));
         desc.vertex_bindings = vec![Vertex::binding()];
         desc.vertex_attributes = vec![Vertex::position_attribute(), Vertex::normal_attribute()];
@@ -143,6 +172,7 @@ impl Roofline {
             .expect("tone-map set");
         let (naive, naive_set, naive_out) = naive_gather(gpu, renderer);
         let timer = GpuTimer::new(gpu, PARTS).expect("timer");
+        let deferred = Deferred::new(gpu, renderer, &shadow);
         Roofline {
             gpu: gpu.clone(),
             raster,
@@ -160,6 +190,7 @@ impl Roofline {
             _sampler: sampler,
             timer: Some(timer),
             times: Default::default(),
+            deferred,
         }
     }
 
@@ -193,10 +224,16 @@ impl Roofline {
                 timer.begin(cmd, "inputs");
                 self.record_inputs(cmd, renderer, &draws, &view_proj);
                 timer.end(cmd);
+                timer.begin(cmd, "gbuffer");
+                self.deferred.record_gbuffer((&self.gpu, cmd, &self.camera_depth), renderer, &draws, &view_proj);
+                timer.end(cmd);
+                timer.begin(cmd, "shade compute");
+                self.deferred.record_shading((&self.gpu, cmd, &self.shadow), renderer, &view_proj);
+                timer.end(cmd);
             })
             .expect("roofline submission");
         for (i, (_, ms)) in timer.results().expect("roofline timings").into_iter().enumerate() {
-            self.times[i].push(ms);
+            self.times[if i < 5 { i } else { i + 1 }].push(ms);
         }
         self.timer = Some(timer);
         let start = Instant::now();
@@ -207,7 +244,16 @@ impl Roofline {
     /// The medians of every `run` so far.
     pub fn yardsticks(&self) -> Yardsticks {
         let m = |i: usize| median(&mut self.times[i].clone());
-        Yardsticks { raster: m(0), shadow: m(1), tonemap: m(2), gather: m(3), raster_inputs: m(4), submit: m(5) }
+        Yardsticks {
+            raster: m(0),
+            shadow: m(1),
+            tonemap: m(2),
+            gather: m(3),
+            raster_inputs: m(4),
+            submit: m(5),
+            gbuffer: m(6),
+            shade_compute: m(7),
+        }
     }
 
     fn record_raster(
@@ -394,6 +440,13 @@ pub fn naive_gather(gpu: &Arc<Gpu>, renderer: &Renderer) -> (ComputePipeline, De
 /// shade.vert (the shading pass's vertex stage and three streams) with
 /// glsl/bench/raster_inputs.frag, into the same targets as the raster yardstick.
 fn inputs_pipeline(gpu: &Arc<Gpu>) -> GraphicsPipeline {
+    let mut desc = inputs_desc("bench/raster_inputs.frag");
+    desc.color_formats = vec![HDR_FORMAT];
+    GraphicsPipeline::new(gpu, &desc).expect("inputs raster pipeline")
+}
+
+/// shade.vert with its three streams, `fragment` after it, camera depth; colour formats unset.
+fn inputs_desc(fragment: &str) -> GraphicsDesc {
     let stream = |binding: u32, location: u32| {
         (
             vk::VertexInputBindingDescription { binding, stride: 16, input_rate: vk::VertexInputRate::VERTEX },
@@ -406,10 +459,146 @@ fn inputs_pipeline(gpu: &Arc<Gpu>) -> GraphicsPipeline {
         )
     };
     let (exitance, environment) = (stream(1, 2), stream(2, 3));
-    let mut desc = GraphicsDesc::new("shade.vert", Some("bench/raster_inputs.frag"));
+    let mut desc = GraphicsDesc::new("shade.vert", Some(fragment));
     desc.vertex_bindings = vec![Vertex::binding(), exitance.0, environment.0];
     desc.vertex_attributes = vec![Vertex::position_attribute(), Vertex::normal_attribute(), exitance.1, environment.1];
-    desc.color_formats = vec![HDR_FORMAT];
     desc.depth_format = Some(CAMERA_DEPTH);
-    GraphicsPipeline::new(gpu, &desc).expect("inputs raster pipeline")
+    desc
+}
+
+impl Deferred {
+    /// The G-buffer (four RGBA32F targets of the camera's size), its pipeline, and the compute
+    /// shading bound to `renderer`'s lights and the roofline's own shadow map (`shadow`).
+    fn new(gpu: &Arc<Gpu>, renderer: &Renderer, shadow: &Image) -> Deferred {
+        use vk::ImageUsageFlags as U;
+        let [width, height] = renderer.scene().scene.file.camera.resolution;
+        let format = vk::Format::R32G32B32A32_SFLOAT;
+        let targets: Vec<Image> = ["g position", "g normal", "g exitance", "g environment"]
+            .iter()
+            .map(|name| {
+                let desc = ImageDesc::new(name, width, height, format, U::COLOR_ATTACHMENT | U::SAMPLED);
+                Image::new(gpu, &desc).expect(name)
+            })
+            .collect();
+        let out = Image::new(gpu, &ImageDesc::new("deferred radiance", width, height, format, U::STORAGE))
+            .expect("deferred radiance");
+        let mut desc = inputs_desc("bench/raster_gbuffer.frag");
+        desc.color_formats = vec![format; 4];
+        let raster = GraphicsPipeline::new(gpu, &desc).expect("G-buffer pipeline");
+        let shade = ComputePipeline::new(gpu, "bench/shade_compute.comp").expect("compute shading");
+        let samplers = [
+            Sampler::shadow(gpu, SHADOW_DEPTH).expect("shadow sampler"),
+            Sampler::new(gpu, vk::Filter::NEAREST).expect("sampler"),
+        ];
+        let sampled = |image: &Image, sampler: &Sampler| Binding::Image {
+            view: image.view(),
+            layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            sampler: sampler.raw(),
+        };
+        let names = ["g_position", "g_normal", "g_exitance", "g_environment"];
+        let mut bindings = vec![
+            Named { name: "Lights", binding: Binding::Buffer(&renderer.buffers().lights) },
+            Named { name: "shadow_maps", binding: sampled(shadow, &samplers[0]) },
+        ];
+        bindings.extend(names.iter().zip(&targets).map(|(&name, t)| Named { name, binding: sampled(t, &samplers[1]) }));
+        let storage =
+            Binding::Image { view: out.view(), layout: vk::ImageLayout::GENERAL, sampler: vk::Sampler::null() };
+        bindings.push(Named { name: "radiance_out", binding: storage });
+        let set = shade.descriptor_set(&bindings).expect("compute shading set");
+        Deferred { raster, targets, shade, set, out, _samplers: samplers }
+    }
+
+    /// The drawn geometry through the shading pass's vertex stage into the G-buffer.
+    fn record_gbuffer(
+        &self,
+        (gpu, cmd, depth): (&Gpu, vk::CommandBuffer, &Image),
+        renderer: &Renderer,
+        draws: &[translucent::render::gpu_scene::DrawRange],
+        view_proj: &[[f32; 4]; 4],
+    ) {
+        let device = gpu.device();
+        ImageBarrier::new(
+            depth.raw(),
+            vk::ImageAspectFlags::DEPTH,
+            &[Access::Nothing],
+            &[Access::DepthAttachmentReadWrite],
+        )
+        .discard(true)
+        .record(device, cmd);
+        for t in &self.targets {
+            ImageBarrier::new(
+                t.raw(),
+                vk::ImageAspectFlags::COLOR,
+                &[Access::Nothing],
+                &[Access::ColorAttachmentWrite],
+            )
+            .discard(true)
+            .record(device, cmd);
+        }
+        // Cleared to zero: a position's w of 0 marks a pixel no surface covers.
+        let zero = vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } };
+        let colours: Vec<_> = self
+            .targets
+            .iter()
+            .map(|t| attachment(t.view(), vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, false).clear_value(zero))
+            .collect();
+        // The depth image is the roofline's; its parts run one after another in one submission.
+        let depth = attachment(depth.view(), vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL, true);
+        let extent = self.targets[0].extent();
+        let scene = renderer.buffers();
+        let streams = [scene.vertices.raw(), scene.exitance.raw(), scene.environment_irradiance.raw()];
+        let push = ShadePush { view_proj: *view_proj, ..bytemuck::Zeroable::zeroed() };
+        let info = vk::RenderingInfo::default()
+            .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent })
+            .layer_count(1)
+            .color_attachments(&colours)
+            .depth_attachment(&depth);
+        // SAFETY: `cmd` is recording; the targets are in the layout the barriers set, and the
+        // buffers outlive the submission.
+        unsafe {
+            device.cmd_begin_rendering(cmd, &info);
+            device.cmd_bind_vertex_buffers(cmd, 0, &streams, &[0, 0, 0]);
+            device.cmd_bind_index_buffer(cmd, scene.indices.raw(), 0, vk::IndexType::UINT32);
+        }
+        self.raster.bind(cmd, None, &push, extent);
+        for d in draws {
+            self.raster.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
+        }
+        unsafe { device.cmd_end_rendering(cmd) };
+        for t in &self.targets {
+            let (from, to) = ([Access::ColorAttachmentWrite], [Access::ComputeSampledRead]);
+            ImageBarrier::new(t.raw(), vk::ImageAspectFlags::COLOR, &from, &to).record(device, cmd);
+        }
+    }
+
+    /// The shading pass's arithmetic over every pixel of the G-buffer, as the first translucent
+    /// object's pipeline shades it, with the shadow map the roofline drew just before.
+    fn record_shading(
+        &self,
+        (gpu, cmd, shadow): (&Gpu, vk::CommandBuffer, &Image),
+        renderer: &Renderer,
+        view_proj: &[[f32; 4]; 4],
+    ) {
+        let device = gpu.device();
+        let (drawn, read) = ([Access::DepthAttachmentReadWrite], [Access::ComputeSampledRead]);
+        ImageBarrier::new(shadow.raw(), vk::ImageAspectFlags::DEPTH, &drawn, &read).record(device, cmd);
+        let scene = renderer.buffers();
+        let eye = renderer.camera().eye;
+        let object = (0..scene.levels.len())
+            .find(|&i| scene.object_record(i).kind == translucent::render::records::MATERIAL_TRANSLUCENT)
+            .unwrap_or(0);
+        let record = scene.object_record(object);
+        let push = ShadePush {
+            view_proj: *view_proj,
+            eye_object: [eye.x, eye.y, eye.z, object as f32],
+            counts: [scene.light_count, scene.key_light_count, record.local_channels, 0],
+            albedo_roughness: record.albedo_roughness,
+            material: [record.eta, record.norm, 0.0, 0.0],
+        };
+        ImageBarrier::new(self.out.raw(), vk::ImageAspectFlags::COLOR, &[Access::Nothing], &[Access::ComputeWrite])
+            .discard(true)
+            .record(device, cmd);
+        let extent = self.out.extent();
+        self.shade.dispatch(cmd, &self.set, &push, [extent.width, extent.height, 1]);
+    }
 }

@@ -17,6 +17,9 @@
 #include "lights.glsl"
 #include "scene.glsl"
 
+// SHADE_COMPUTE (the benchmark's shading over a G-buffer, glsl/bench/shade_compute.comp) takes
+// shade_radiance alone: it declares its own inputs and the three constants below.
+#ifndef SHADE_COMPUTE
 layout(location = 0) in vec3 v_position;
 layout(location = 1) in vec3 v_normal;
 layout(location = 2) in vec3 v_exitance;
@@ -25,9 +28,6 @@ layout(location = 0) out vec4 out_radiance;
 #ifdef PIXEL_GATHER
 layout(location = 1) out vec4 out_surface;  // xyz: world position; w: object index + 1, 0 if opaque
 #endif
-layout(std430, set = 0, binding = 0) readonly buffer Lights { Light lights[]; };
-layout(set = 0, binding = 1) uniform sampler2DArrayShadow shadow_maps;
-#include "shade_push.glsl"
 
 // Specialization constants: ShadePass makes a pipeline per translucent-or-opaque, per shadow
 // filter and per kind of key lights, so none is a branch at run time (a CPU driver runs both
@@ -38,6 +38,10 @@ layout(constant_id = 1) const int SHADE_SHADOW_RADIUS = 0;  // light_visibility'
 // Every key light is directional: the point and spot lights' falloff, which would run (and read
 // its light fields) for every pixel whatever the light, is left out.
 layout(constant_id = 2) const bool SHADE_DIRECTIONAL_KEYS = false;
+#endif
+layout(std430, set = 0, binding = 0) readonly buffer Lights { Light lights[]; };
+layout(set = 0, binding = 1) uniform sampler2DArrayShadow shadow_maps;
+#include "shade_push.glsl"
 
 // GGX / Trowbridge-Reitz microfacet specular (Walter et al. 2007) with the height-correlated
 // Smith visibility term (Heitz 2014); returns f_s cos(theta_i) without the Fresnel factor.
@@ -53,14 +57,10 @@ float ggx_specular(vec3 n, vec3 wi, vec3 wo, float alpha) {
     return D * V * ni;
 }
 
-void main() {
-    if (shade_skips(SHADE_SKIP_ALL)) {
-        out_radiance = vec4(v_exitance + v_environment, 1.0);
-#ifdef PIXEL_GATHER
-        out_surface = vec4(0.0);
-#endif
-        return;
-    }
+// Linear radiance towards the eye from the surface point `position` with interpolated normal
+// `normal`, gathered exitance `exitance` and environment irradiance `environment` (the vertex
+// stage's four interpolants); `exitance_to_radiance` receives F_t(cos theta_o) / (pi T).
+vec3 shade_radiance(vec3 v_position, vec3 v_normal, vec3 v_exitance, vec3 v_environment, out float exitance_to_radiance) {
     vec3 n = normalize(v_normal);
     vec3 wo = normalize(push.eye_object.xyz - v_position);
     // Seen from behind (open meshes, the far side of a thin plane): shade the visible side.
@@ -71,7 +71,7 @@ void main() {
     float roughness = push.albedo_roughness.w;
     float alpha = max(roughness * roughness, 1e-3);
     vec3 radiance = vec3(0.0);
-    float exitance_to_radiance = !translucent ? 0.0
+    exitance_to_radiance = !translucent ? 0.0
         : (shade_skips(SHADE_SKIP_FRESNEL) ? 1.0 : dipole_fresnel_transmittance(cos_o, eta)) * push.material.y;
     // Irradiance transmitted into a translucent surface here, for the channels the planner
     // computes locally: the environment's part arrives per vertex (vertex_light.comp weighs it
@@ -107,13 +107,28 @@ void main() {
         // R_d,total is the record's albedo (ObjectRecord::new), not recomputed per pixel.
         radiance += mix(push.albedo_roughness.rgb * transmitted, v_exitance, gathered) * exitance_to_radiance;
     }
+    return radiance;
+}
+
+#ifndef SHADE_COMPUTE
+void main() {
+    if (shade_skips(SHADE_SKIP_ALL)) {
+        out_radiance = vec4(v_exitance + v_environment, 1.0);
+#ifdef PIXEL_GATHER
+        out_surface = vec4(0.0);
+#endif
+        return;
+    }
+    float exitance_to_radiance;
+    vec3 radiance = shade_radiance(v_position, v_normal, v_exitance, v_environment, exitance_to_radiance);
     // Nothing non-finite leaves this pass (the tone map counts any that would).
 #ifdef PIXEL_GATHER
     out_radiance = vec4(radiance, exitance_to_radiance);
-    out_surface = vec4(v_position, translucent ? push.eye_object.w + 1.0 : 0.0);
+    out_surface = vec4(v_position, SHADE_TRANSLUCENT ? push.eye_object.w + 1.0 : 0.0);
 #else
     out_radiance = vec4(radiance, 1.0);
 #endif
 }
+#endif
 
 #endif
