@@ -9,7 +9,8 @@
 // The environment's directions (lights key_light_count..light_count) rarely change while a key
 // light moves every frame, so their part is kept per sample (SplatEnvironment): a frame after a
 // key light moved reads it back and loops over the key lights alone. The sum is taken in the same
-// order either way (key lights + environment), so the kept splat equals a full one bit for bit.
+// order either way (key lights + environment), so the kept splat equals a full one bit for bit;
+// the near energy, written with the environment's part, is kept with it.
 //
 // Bindings: 0 = samples (SampleRecord[], read), 1 = objects (ObjectRecord[], read),
 // 2 = lights (Light[], read), 3 = shadow maps (sampler2DArrayShadow),
@@ -73,6 +74,13 @@ void main() {
     }
     vec3 e = transmitted(0u, push.key_light_count, p, n, o.eta) + environment;
     float area = s.position_area.w;
+    if (push.environment_kept != 0u) {
+        // The near energy depends on the sample's area and material alone, and whatever
+        // changes those also splats the environment anew: it is the one written before, and
+        // six Taylor remainders a sample (30 exponentials) are left out of a key light's frame.
+        splat[i].irradiance_area = vec4(e, area);
+        return;
+    }
     float b = DIPOLE_B_PER_SQRT_AREA * sqrt(area);
     vec3 near_energy;
     for (int c = 0; c < 3; ++c) {
