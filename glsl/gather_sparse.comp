@@ -47,6 +47,8 @@ struct GatherSparsePush {
     uint first_receiver;    // its first entry in receiver_order
     uint first_group;       // its first group in receiver_groups
     uint receiver_count;    // receivers at the level of detail gathered (stage 1's threads)
+    uint first_listed;      // unused here (the hierarchical gather's stage 0 lists its nodes)
+    uint listed_count;
 };
 layout(push_constant) uniform GatherSparsePushBlock { GatherSparsePush push; };
 

@@ -8,7 +8,9 @@
 // `stage`):
 //   0: per node of the object's hierarchy, its transmitted power sum E_i A_i per channel, its
 //      power-weighted centroid and the power-weighted covariance of its members about it, from
-//      this frame's splat;
+//      this frame's splat: a leaf from its samples, an inner node from its two children's
+//      (the parallel-axis theorem), one height of the hierarchy per dispatch, leaves first
+//      (GpuScene::node_heights), so each sample is read once rather than once per ancestor;
 //   1: one invocation per vertex (in group order, receiver_order, so that the 8 lanes of a
 //      workgroup walk similar lists), summing its own items straight from their buffers: first
 //      its nodes, each its power times the cluster kernel (dipole_r_d_far_cluster_sq: R_far at
@@ -53,13 +55,41 @@ struct GatherTreePush {
     uint first_receiver;    // its first entry in receiver_order
     uint first_group;       // its first receiver's record in receiver_groups
     uint receiver_count;    // receivers at the level of detail gathered (stage 1's threads)
+    uint first_listed;      // stage 0: this dispatch's nodes, tree_order[first_listed + k]
+    uint listed_count;      // stage 0: their count (one height of the hierarchy)
 };
 layout(push_constant) uniform GatherTreePushBlock { GatherTreePush push; };
 
 #include "tree.glsl"
 
+// Node i from its children l and r (already aggregated): powers add; the centroid is the
+// weighted mean of theirs; the covariance about it is each child's plus the outer product of its
+// centroid's offset (the parallel-axis theorem), weighted. Offsets are taken from the node's
+// centre, as a leaf's are, so that far-off objects keep their digits.
+void combine(uint i, uint l, uint r) {
+    vec3 center = tree_nodes[i].center_radius.xyz;
+    NodePowerRecord a = node_power[l], b = node_power[r];
+    float wa = a.mean_weight.w, wb = b.mean_weight.w, w = wa + wb;
+    vec3 power = a.power.rgb + b.power.rgb;
+    if (!(w > 0.0)) {
+        node_power[i] = NodePowerRecord(vec4(power, 0.0), vec4(center, 0.0), vec4(0.0), vec4(0.0));
+        return;
+    }
+    vec3 ya = a.mean_weight.xyz - center, yb = b.mean_weight.xyz - center;
+    vec3 m = (wa * ya + wb * yb) / w;
+    vec3 da = ya - m, db = yb - m;
+    vec3 diag = (wa * (a.cov_diag.xyz + da * da) + wb * (b.cov_diag.xyz + db * db)) / w;
+    vec3 off = (wa * (a.cov_off.xyz + vec3(da.x * da.y, da.x * da.z, da.y * da.z))
+                + wb * (b.cov_off.xyz + vec3(db.x * db.y, db.x * db.z, db.y * db.z))) / w;
+    node_power[i] = NodePowerRecord(vec4(power, 0.0), vec4(center + m, w), vec4(max(diag, vec3(0.0)), 0.0), vec4(off, 0.0));
+}
+
 void aggregate(uint i) {
     TreeNodeRecord n = tree_nodes[i];
+    if (n.range_skip.w == 0u) {
+        combine(i, i + 1u, tree_nodes[i + 1u].range_skip.z);
+        return;
+    }
     vec3 center = n.center_radius.xyz;
     vec3 power = vec3(0.0), offset = vec3(0.0), diag = vec3(0.0), off = vec3(0.0);
     float weight = 0.0;
@@ -86,7 +116,7 @@ void aggregate(uint i) {
 void main() {
     uint k = gl_GlobalInvocationID.x;
     if (push.stage == 0u) {
-        if (k < push.node_count) aggregate(push.first_node + k);
+        if (k < push.listed_count) aggregate(tree_order[push.first_listed + k]);
         return;
     }
     ObjectRecord o = objects[push.object];

@@ -155,6 +155,19 @@ type PushCase = (&'static str, &'static str, &'static str, usize, &'static [&'st
 
 /// Every pass's push block, as `push_blocks_match_glsl_and_spirv` checks them.
 /// `GatherTexturePush`'s fields, in order.
+/// The two-stage gathers' push block (`GroupGatherPush`), the same in both shaders.
+const GROUP_GATHER_PUSH_FIELDS: [&str; 9] = [
+    "object",
+    "stage",
+    "first_node",
+    "node_count",
+    "first_receiver",
+    "first_group",
+    "receiver_count",
+    "first_listed",
+    "listed_count",
+];
+
 const TEXTURE_PUSH_FIELDS: [&str; 12] = [
     "object",
     "stage",
@@ -205,14 +218,14 @@ fn push_cases() -> [PushCase; 11] {
             include_str!("../glsl/gather_sparse.comp"),
             "GatherSparsePush",
             size_of::<GatherSparsePush>(),
-            &["object", "stage", "first_node", "node_count", "first_receiver", "first_group", "receiver_count"],
+            &GROUP_GATHER_PUSH_FIELDS,
         ),
         (
             "gather_tree.comp",
             include_str!("../glsl/gather_tree.comp"),
             "GatherTreePush",
             size_of::<GatherTreePush>(),
-            &["object", "stage", "first_node", "node_count", "first_receiver", "first_group", "receiver_count"],
+            &GROUP_GATHER_PUSH_FIELDS,
         ),
         (
             "gather_texture.comp",

@@ -12,7 +12,7 @@
 //! Bindings: `BINDINGS`, in binding order. Push: `GatherSparsePush`.
 
 use super::graph::{Resource, Resources, Use, compute_uses};
-use super::group_gather::GroupGather;
+use super::group_gather::{GroupGather, Stage0};
 use super::pass::{FrameInputs, RenderPass};
 use crate::gpu::{Binding, Buffer, BufferDesc, ComputePipeline, Gpu, GpuResult};
 use ash::vk;
@@ -57,7 +57,7 @@ impl GatherSparsePass {
         bindings.push(Resource::SampleExitance.bind(Binding::Buffer(&sample_exitance)));
         bindings.extend(resources.bind_all(&BINDINGS[5..])?);
         let set = pipeline.descriptor_set(&bindings)?;
-        let stages = GroupGather::new(pipeline, set, Resource::SampleExitance, |r| r.sample_count);
+        let stages = GroupGather::new(pipeline, set, Resource::SampleExitance, Stage0::Threads(|r| r.sample_count));
         Ok(GatherSparsePass { stages, _sample_exitance: sample_exitance })
     }
 }

@@ -12,7 +12,7 @@
 //! Bindings: `BINDINGS`, in binding order. Push: `GatherTreePush`.
 
 use super::graph::{Resource, Resources, Use, compute_uses};
-use super::group_gather::GroupGather;
+use super::group_gather::{GroupGather, Stage0};
 use super::pass::{FrameInputs, RenderPass};
 use crate::gpu::{ComputePipeline, Gpu, GpuResult};
 use ash::vk;
@@ -50,7 +50,7 @@ impl GatherTreePass {
     pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<GatherTreePass> {
         let pipeline = ComputePipeline::new(gpu, "gather_tree.comp")?;
         let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
-        Ok(GatherTreePass { stages: GroupGather::new(pipeline, set, Resource::NodePower, |r| r.node_count) })
+        Ok(GatherTreePass { stages: GroupGather::new(pipeline, set, Resource::NodePower, Stage0::ByHeight) })
     }
 }
 

@@ -125,7 +125,8 @@ pub struct GpuScene {
     /// (`sampling::SampleTree`), objects one after another (`Receiver::first_node`).
     pub tree_nodes: Buffer,
     /// Sample indices (u32, absolute) in the hierarchies' leaf order: node `n`'s samples are
-    /// `tree_order[n.first .. n.first + n.count]`.
+    /// `tree_order[n.first .. n.first + n.count]`. After each object's samples, its nodes
+    /// (absolute) grouped by height (`node_heights`).
     pub tree_order: Buffer,
     /// `NodePowerRecord` per node, written by the hierarchical gather's stage 0.
     pub node_power: Buffer,
@@ -177,6 +178,10 @@ pub struct GpuScene {
     /// detail (level 1 first): the level's vertices grouped and cut anew, so that a frame
     /// drawing a coarse level gathers at its vertices only. Empty for other gathers.
     pub coarser_receivers: Vec<Vec<Receiver>>,
+    /// Per entry of `receivers`, its hierarchy's nodes by height, leaves first
+    /// (`sampling::SampleTree::by_height`): each height's first entry in `tree_order` and its
+    /// node count. The hierarchical gather's stage 0 aggregates them one height at a time.
+    pub node_heights: Vec<Vec<[u32; 2]>>,
     /// Vertices of all objects together.
     pub vertex_count: u32,
     /// Sample points of all objects together.
@@ -276,6 +281,7 @@ struct PackedObjects {
     vertex_boundary: Vec<[f32; 2]>,
     receivers: Vec<Receiver>,
     coarser_receivers: Vec<Vec<Receiver>>,
+    node_heights: Vec<Vec<[u32; 2]>>,
     tree_nodes: Vec<TreeNodeRecord>,
     tree_order: Vec<u32>,
     receiver_order: Vec<u32>,
@@ -355,6 +361,12 @@ impl PackedObjects {
         let (first_node, first_entry) = (self.tree_nodes.len() as u32, self.tree_order.len() as u32);
         self.tree_nodes.extend(tree.nodes.iter().map(|n| TreeNodeRecord::new(n, first_node, first_entry)));
         self.tree_order.extend(tree.order.iter().map(|k| first_sample + k));
+        let mut heights = Vec::new();
+        for nodes in tree.by_height() {
+            heights.push([self.tree_order.len() as u32, nodes.len() as u32]);
+            self.tree_order.extend(nodes.iter().map(|n| first_node + n));
+        }
+        self.node_heights.push(heights);
         let hierarchical = render.gather == crate::scene::GatherMode::Hierarchical;
         let epsilon = hierarchical.then_some(render.gather_epsilon as f64);
         let sparse = render.gather == crate::scene::GatherMode::Sparse;
@@ -507,6 +519,7 @@ impl GpuScene {
             light_matrices: Vec::new(),
             receivers: p.receivers,
             coarser_receivers: p.coarser_receivers,
+            node_heights: p.node_heights,
             vertex_count: p.vertices.len() as u32,
             sample_count: p.samples.len() as u32,
             light_count: scene.lights.len() as u32,

@@ -7,7 +7,7 @@
 //! not gather this frame has no fresh stage-0 output, and its exitance must stay as it was.
 
 use super::gpu_scene::Receiver;
-use super::graph::{Resource, read};
+use super::graph::{Resource, read, write};
 use super::pass::FrameInputs;
 use crate::gpu::{Access, ComputePipeline, DescriptorSet};
 use ash::vk;
@@ -31,6 +31,11 @@ pub struct GroupGatherPush {
     pub first_group: u32,
     /// Receivers at the level of detail gathered: stage 1's threads.
     pub receiver_count: u32,
+    /// Stage 0 of the hierarchical gather: the first entry in `GpuScene::tree_order` of the
+    /// nodes this dispatch aggregates (one height of the hierarchy); 0 otherwise.
+    pub first_listed: u32,
+    /// Their count: the dispatch's threads.
+    pub listed_count: u32,
 }
 
 impl GroupGatherPush {
@@ -44,8 +49,20 @@ impl GroupGatherPush {
             first_receiver: receiver.first_receiver,
             first_group: receiver.first_group,
             receiver_count: receiver.vertex_count,
+            first_listed: 0,
+            listed_count: 0,
         }
     }
+}
+
+/// What a two-stage gather's stage 0 runs over.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Stage0 {
+    /// One dispatch per object, this many threads (its samples).
+    Threads(fn(&Receiver) -> u32),
+    /// The object's hierarchy one height at a time, leaves first (`GpuScene::node_heights`),
+    /// each dispatch reading what the ones before it wrote.
+    ByHeight,
 }
 
 /// A two-stage gather's pipeline, its set, and what its stage 0 writes for stage 1.
@@ -54,26 +71,20 @@ pub(super) struct GroupGather {
     pub set: DescriptorSet,
     /// Stage 0's output, read by stage 1.
     pub handoff: Resource,
-    /// Stage 0's threads for a receiver: its nodes or its samples.
-    pub stage0_threads: fn(&Receiver) -> u32,
+    pub stage0: Stage0,
 }
 
 impl GroupGather {
     /// `pipeline` must have `RECEIVER_GROUP_SIZE` as its local size: its workgroups are
     /// receiver groups.
-    pub fn new(
-        pipeline: ComputePipeline,
-        set: DescriptorSet,
-        handoff: Resource,
-        stage0_threads: fn(&Receiver) -> u32,
-    ) -> GroupGather {
+    pub fn new(pipeline: ComputePipeline, set: DescriptorSet, handoff: Resource, stage0: Stage0) -> GroupGather {
         let n = crate::sampling::RECEIVER_GROUP_SIZE as u32;
         assert!(
             pipeline.groups([n, 1, 1]) == [1, 1, 1] && pipeline.groups([n + 1, 1, 1]) == [2, 1, 1],
             "{}: local size is not RECEIVER_GROUP_SIZE",
             pipeline.name()
         );
-        GroupGather { pipeline, set, handoff, stage0_threads }
+        GroupGather { pipeline, set, handoff, stage0 }
     }
 
     /// Stage 0 over the plan's receivers, the hand-off barrier, stage 1 over the same receivers
@@ -82,14 +93,32 @@ impl GroupGather {
     pub fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         let planned =
             || frame.scene.receivers.iter().enumerate().filter(|(_, r)| frame.plan.gathers(r.object as usize));
-        for (_, r) in planned() {
-            let threads = (self.stage0_threads)(r);
-            self.pipeline.dispatch(cmd, &self.set, &GroupGatherPush::new(r, 0), [threads, 1, 1]);
+        for (j, r) in planned() {
+            self.record_stage0(cmd, frame, j, r);
         }
         frame.before(cmd, &[read(self.handoff, Access::ComputeRead)]);
         for (j, r) in planned() {
             let at = frame.scene.receiver_at(j, frame.plan.level(r.object as usize));
             self.pipeline.dispatch(cmd, &self.set, &GroupGatherPush::new(at, 1), [at.vertex_count, 1, 1]);
+        }
+    }
+
+    /// Stage 0 for entry `j` of the scene's receivers, `r`.
+    fn record_stage0(&self, cmd: vk::CommandBuffer, frame: &FrameInputs, j: usize, r: &Receiver) {
+        match self.stage0 {
+            Stage0::Threads(threads) => {
+                self.pipeline.dispatch(cmd, &self.set, &GroupGatherPush::new(r, 0), [threads(r), 1, 1]);
+            }
+            Stage0::ByHeight => {
+                for (h, &[first_listed, listed_count]) in frame.scene.node_heights[j].iter().enumerate() {
+                    if h > 0 {
+                        // This height reads the nodes the heights before it wrote.
+                        frame.before(cmd, &[write(self.handoff, Access::ComputeReadWrite)]);
+                    }
+                    let push = GroupGatherPush { first_listed, listed_count, ..GroupGatherPush::new(r, 0) };
+                    self.pipeline.dispatch(cmd, &self.set, &push, [listed_count, 1, 1]);
+                }
+            }
         }
     }
 }

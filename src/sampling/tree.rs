@@ -229,6 +229,28 @@ impl Cuts {
 }
 
 impl SampleTree {
+    /// The nodes grouped by height, leaves first: every inner node's two children (`i + 1` and
+    /// that child's `skip`) lie in earlier groups, so the groups can be aggregated one after
+    /// another, each node from its children, in as many steps as the tree is high. Each group
+    /// in index order.
+    pub fn by_height(&self) -> Vec<Vec<u32>> {
+        let mut height = vec![0usize; self.nodes.len()];
+        // Depth first: children come after their parent, so a reverse sweep meets them first.
+        for i in (0..self.nodes.len()).rev() {
+            if !self.nodes[i].leaf {
+                let (left, right) = (i + 1, self.nodes[i + 1].skip as usize);
+                height[i] = 1 + height[left].max(height[right]);
+            }
+        }
+        let mut groups = vec![Vec::new(); height.iter().max().map_or(0, |h| h + 1)];
+        for (i, &h) in height.iter().enumerate() {
+            groups[h].push(i as u32);
+        }
+        groups
+    }
+}
+
+impl SampleTree {
     /// The samples whose near-field blend radius (`blend_radius sqrt(dA)`, at most the tree's
     /// own; positions and areas in the object's sample order) reaches into the sphere `group`:
     /// every sample that can give a receiver of the group a Shepard weight, found by walking only
@@ -321,6 +343,34 @@ fn sphere(points: &[DVec3]) -> ([f32; 3], f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn by_height_lists_every_node_once_after_both_its_children() {
+        let (positions, areas) = points(1000);
+        let t = SampleTree::new(&positions, &areas, BLEND);
+        let groups = t.by_height();
+        let mut group_of = vec![usize::MAX; t.nodes.len()];
+        for (g, nodes) in groups.iter().enumerate() {
+            for &n in nodes {
+                assert_eq!(group_of[n as usize], usize::MAX, "node {n} listed twice");
+                group_of[n as usize] = g;
+            }
+        }
+        assert!(group_of.iter().all(|&g| g != usize::MAX), "every node listed");
+        for (i, n) in t.nodes.iter().enumerate() {
+            assert_eq!(n.leaf, group_of[i] == 0, "node {i}: leaves first, and only leaves");
+            if !n.leaf {
+                let (left, right) = (i + 1, t.nodes[i + 1].skip as usize);
+                assert!(right < n.skip as usize && left < right, "node {i}: two children inside its subtree");
+                assert!(group_of[left] < group_of[i] && group_of[right] < group_of[i], "node {i}");
+                assert_eq!(
+                    t.nodes[left].count + t.nodes[right].count,
+                    n.count,
+                    "node {i}: the children hold its samples"
+                );
+            }
+        }
+    }
 
     const BLEND: f64 = 1.5;
 
