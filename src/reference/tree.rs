@@ -25,7 +25,8 @@ pub struct NodePower {
 }
 
 /// Stage 0: every node's power and centroid, from per-sample transmitted irradiance `e` and
-/// the samples' positions and areas (the object's own sample order).
+/// the samples' positions and areas (the object's own sample order). Each node straight from its
+/// members, where the GPU combines two children's (the same sums, in another order).
 pub fn node_power(tree: &SampleTree, positions: &[DVec3], areas: &[f64], e: &[[f64; 3]]) -> Vec<NodePower> {
     tree.nodes
         .iter()

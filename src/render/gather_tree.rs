@@ -2,7 +2,7 @@
 //! the vertex gather's dipole sum with far clusters of samples standing in for their members
 //! (after Jensen and Buhler 2002). Per translucent object the plan gathers, stage 0 aggregates
 //! each node of its sample hierarchy (`sampling::SampleTree`) from this frame's splat into the
-//! node power, then stage 1 sums, for every vertex, its own list of samples and nodes (the cut
+//! node power, bottom-up, one height per dispatch (`group_gather::Stage0::ByHeight`), then stage 1 sums, for every vertex, its own list of samples and nodes (the cut
 //! `sampling::SampleTree::cut` chose about that vertex, built once in `GpuScene::new`; one
 //! record per receiver in `receiver_groups`, in group order so that neighbouring lanes walk
 //! similar lists). The two stages' shape is `group_gather`'s. `render.gather_epsilon` is the
