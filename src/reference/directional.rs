@@ -37,6 +37,10 @@ use crate::scene::build::{PreparedScene, ResolvedMaterial};
 use glam::DVec3;
 use rayon::prelude::*;
 
+/// A kernel in place of the directional dipole's: `(channel, x_i, n_i, w_12, x_o, n_o)` to the
+/// exitance per unit entering flux.
+pub type Kernel = dyn Fn(usize, DVec3, DVec3, DVec3, DVec3, DVec3) -> f64 + Sync;
+
 /// The fineness [`exitance`] integrates at.
 pub const FINENESS: f64 = 0.4;
 /// Pieces further than this many diffusion lengths from the receiver are left out (`e^-30`).
@@ -60,7 +64,7 @@ pub fn exitance_with(
     diffusion: Diffusion,
     strength: Strength,
     fineness: f64,
-    kernel: Option<&(dyn Fn(usize, DVec3, DVec3, DVec3, DVec3, DVec3) -> f64 + Sync)>,
+    kernel: Option<&Kernel>,
 ) -> Vec<Vec<[f64; 3]>> {
     let casters = occluders(scene);
     let eps = ray_offset(scene);

@@ -175,6 +175,9 @@ pub fn light_cosines(base: &PreparedScene) -> Vec<Vec<f64>> {
         .collect()
 }
 
+/// One object's exitance per vertex.
+type Exitance = Vec<[f64; 3]>;
+
 /// [`vertex_error_f64`] of `estimate` against `reference` per band of [`BANDS`]: the lit floor
 /// is the object's, as over all vertices; each band keeps the vertices whose cosine is in it.
 pub fn band_errors(reference: &[Vec<[f64; 3]>], estimate: &[Vec<[f64; 3]>], cosines: &[Vec<f64>]) -> Vec<VertexError> {
@@ -183,7 +186,7 @@ pub fn band_errors(reference: &[Vec<[f64; 3]>], estimate: &[Vec<[f64; 3]>], cosi
         .map(|&(lo, hi, _)| {
             // Outside the band the reference reads 0 (unlit, so left out); the floor is kept
             // by a copy of the brightest vertex placed where no estimate is compared.
-            let (r, e): (Vec<Vec<[f64; 3]>>, Vec<Vec<[f64; 3]>>) = reference
+            let (r, e): (Vec<Exitance>, Vec<Exitance>) = reference
                 .iter()
                 .zip(estimate)
                 .zip(cosines)
