@@ -168,8 +168,16 @@ impl DirectionalDipole {
 
     /// Radiant exitance at `x_o` (outward normal `n_o`) per unit flux entering at `x_i`
     /// (outward normal `n_i`) and travelling inside along the unit direction `w_12`: the real
-    /// source minus the virtual one, clamped at 0. Units: 1 / area.
+    /// source minus the virtual one ([`Self::sources`]), clamped at 0, times the strength.
+    /// Units: 1 / area.
     pub fn exitance_per_flux(&self, x_i: DVec3, n_i: DVec3, w_12: DVec3, x_o: DVec3, n_o: DVec3) -> f64 {
+        let (real, virtual_) = self.sources(x_i, n_i, w_12, x_o, n_o);
+        self.strength * (real - virtual_).max(0.0)
+    }
+
+    /// The real and the virtual source's terms of [`Self::exitance_per_flux`], unclamped and
+    /// without the strength.
+    pub fn sources(&self, x_i: DVec3, n_i: DVec3, w_12: DVec3, x_o: DVec3, n_o: DVec3) -> (f64, f64) {
         let x = x_o - x_i;
         let r2 = x.length_squared();
         let r = r2.sqrt();
@@ -190,9 +198,7 @@ impl DirectionalDipole {
         let x_v = x_i + n_star * (2.0 * self.A * self.d_e);
         let w_v = w_12 - n_star * (2.0 * w_12.dot(n_star));
         let xv = x_o - x_v;
-        let real = self.source(x, w_12, d_r, n_o);
-        let virtual_ = self.source(xv, w_v, xv.length(), n_o);
-        self.strength * (real - virtual_).max(0.0)
+        (self.source(x, w_12, d_r, n_o), self.source(xv, w_v, xv.length(), n_o))
     }
 
     /// The paper's `S_d(x_i, w_i; x_o)`: [`Self::exitance_per_flux`] over
