@@ -9,6 +9,11 @@
 //! - the model error, the dipole's exact integral against the RTE (the same for every row);
 //! - the total error, the renderer against the RTE.
 //!
+//! Beside the dipole it measures other models' exact exitance against the same reference
+//! ([`Physics::alternatives`]: single scattering added or alone, and the directional dipole of
+//! Frisvad et al. 2014 in three variants), and every model's error per band of incidence at the
+//! vertex ([`Physics::bands`], [`BANDS`]).
+//!
 //! The reference has its own noise: a relative standard error per vertex. Against a noisy
 //! reference an RMS error reads `sqrt(e^2 + s^2)` on average, with `s` the RMS relative
 //! standard error ([`Physics::noise`]); the report prints `s` beside every figure and the
