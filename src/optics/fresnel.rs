@@ -102,6 +102,21 @@ pub fn fresnel_moment1(eta: f64) -> f64 {
     tir + graded_integral(f, mu_c, 1.0)
 }
 
+/// Second Fresnel moment `FM2(eta) = integral_0^1 F_r(mu, eta) mu^2 dmu`, the weight of the
+/// net-flux term of a diffusion radiance crossing the interface (d'Eon and Irving 2011's `C_2`;
+/// the directional dipole's `C_E = (1 - 3 FM2) / 2`, `optics::directional_dipole`). Computed
+/// as [`fresnel_moment1`] is; under total internal reflection `[0, mu_c]` contributes
+/// `mu_c^3 / 3`.
+pub fn fresnel_moment2(eta: f64) -> f64 {
+    if eta == 1.0 {
+        return 0.0;
+    }
+    let mu_c = if eta < 1.0 { ((1.0 - eta) * (1.0 + eta)).sqrt() } else { 0.0 };
+    let tir = mu_c * mu_c * mu_c / 3.0;
+    let f = |mu: f64| fresnel_reflectance(mu, eta) * mu * mu;
+    tir + graded_integral(f, mu_c, 1.0)
+}
+
 /// Hemispherical Fresnel transmittance `T(eta) = 1 - 2 FM1(eta)`: the fraction of Lambertian
 /// light that crosses the interface. Across one interface `T(1/eta) = T(eta) / eta^2` (radiance
 /// is compressed by `eta^2` on refraction), which the tests check.

@@ -8,6 +8,8 @@
 //! - [`dipole`]: the diffuse reflectance profile `R_d(r)` (seed Eq. 8), its total, its exact
 //!   disk and ring integrals, and the BSSRDF `S_d` (seed Eq. 9) with an energy-conserving
 //!   normalization.
+//! - [`directional_dipole`]: the directional dipole of Frisvad et al. 2014: the BSSRDF of a ray
+//!   source, with the incident direction and the normals at entry and exit.
 //! - [`fresnel`]: exact dielectric Fresnel reflectance and transmission, the first Fresnel moment,
 //!   and the fits for the diffuse Fresnel reflectance `F_dr`.
 //! - [`kernel`]: the near-field kernel: what one sample point of area `dA` contributes to a
@@ -19,6 +21,7 @@
 //! - [`gpu`]: the std430 records shared with the shaders, mirrored with `#[repr(C)]` + bytemuck.
 
 pub mod dipole;
+pub mod directional_dipole;
 pub mod fresnel;
 pub mod gpu;
 pub mod kernel;

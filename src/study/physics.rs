@@ -9,6 +9,11 @@
 //! - the model error, the dipole's exact integral against the RTE (the same for every row);
 //! - the total error, the renderer against the RTE.
 //!
+//! Beside the dipole it measures other models' exact exitance against the same reference
+//! ([`Physics::alternatives`]: single scattering added or alone, and the directional dipole of
+//! Frisvad et al. 2014 in three variants), and every model's error per band of incidence at the
+//! vertex ([`Physics::bands`], [`BANDS`]).
+//!
 //! The reference has its own noise: a relative standard error per vertex. Against a noisy
 //! reference an RMS error reads `sqrt(e^2 + s^2)` on average, with `s` the RMS relative
 //! standard error ([`Physics::noise`]); the report prints `s` beside every figure and the
@@ -54,9 +59,21 @@ pub struct Physics {
     pub options: MeshOptions,
     /// Other models against the same reference, per channel: the dipole with the
     /// single-scattering exitance added (`reference::single`, Jensen et al. 2001's sum of the
-    /// two terms), and single scattering alone (what leaves a dark medium: nearly all of it).
+    /// two terms), single scattering alone (what leaves a dark medium: nearly all of it), and
+    /// the directional dipole of Frisvad et al. 2014 (`reference::directional`) in three
+    /// variants: the diffusion coefficient `1/(3 sigma_t')`, Grosjean's, and the source scaled by
+    /// `alpha'` (`optics::directional_dipole::Strength`).
     pub alternatives: Vec<(String, VertexError)>,
+    /// Per model (the dipole first, then the alternatives, in order) and band of incidence
+    /// ([`BANDS`]): the error over the lit vertices whose normal has a cosine to the first light
+    /// in that band.
+    pub bands: Vec<(String, Vec<VertexError>)>,
 }
+
+/// The bands of `cos(normal, first light)` the models' errors are split by: the facing side,
+/// towards the terminator, at it, and the far side (lit through the object only).
+pub const BANDS: [(f64, f64, &str); 4] =
+    [(0.5, 1.01, "cos > 0.5"), (0.2, 0.5, "0.2 to 0.5"), (0.0, 0.2, "0 to 0.2"), (-1.01, 0.0, "cos < 0 (unlit side)")];
 
 impl Physics {
     /// The reference of `base` (from the cache folder `dir` if walked before, else walked and
@@ -93,17 +110,11 @@ impl Physics {
         }
         let model = vertex_error_f64(&exitance, &truth.exitance);
         let noise = noise(&exitance, &stderr);
-        let single = crate::reference::single::exitance(base);
-        let sum: Vec<Vec<[f64; 3]>> = truth
-            .exitance
-            .iter()
-            .zip(&single)
-            .map(|(t, s)| t.iter().zip(s).map(|(t, s)| [0, 1, 2].map(|c| t[c] + s[c])).collect())
-            .collect();
-        let alternatives = vec![
-            ("dipole + single scattering".to_string(), vertex_error_f64(&exitance, &sum)),
-            ("single scattering alone".to_string(), vertex_error_f64(&exitance, &single)),
-        ];
+        let models = alternative_models(base, &truth.exitance);
+        let alternatives =
+            models.iter().skip(1).map(|(name, m)| (name.clone(), vertex_error_f64(&exitance, m))).collect();
+        let cosines = light_cosines(base);
+        let bands = models.iter().map(|(name, m)| (name.clone(), band_errors(&exitance, m, &cosines))).collect();
         Ok(Physics {
             exitance,
             stderr,
@@ -116,8 +127,87 @@ impl Physics {
             cached,
             options: *options,
             alternatives,
+            bands,
         })
     }
+}
+
+/// Every model's exitance per object and vertex, named: the dipole's truth first, then the
+/// alternatives (see [`Physics::alternatives`]).
+fn alternative_models(base: &PreparedScene, truth: &[Vec<[f64; 3]>]) -> Vec<(String, Vec<Vec<[f64; 3]>>)> {
+    use crate::optics::directional_dipole::{Diffusion, Strength};
+    use crate::reference::directional;
+    let single = crate::reference::single::exitance(base);
+    let sum = truth
+        .iter()
+        .zip(&single)
+        .map(|(t, s)| t.iter().zip(s).map(|(t, s)| [0, 1, 2].map(|c| t[c] + s[c])).collect())
+        .collect();
+    let fineness = directional::FINENESS;
+    let variant = |d, s| directional::exitance_with(base, d, s, fineness, None);
+    vec![
+        ("dipole".to_string(), truth.to_vec()),
+        ("dipole + single scattering".to_string(), sum),
+        ("single scattering alone".to_string(), single),
+        ("directional dipole, D = 1/(3 sigma_t')".to_string(), variant(Diffusion::Classical, Strength::Paper)),
+        ("directional dipole, Grosjean's D".to_string(), variant(Diffusion::Grosjean, Strength::Paper)),
+        (
+            "directional dipole, Grosjean's D, source alpha'".to_string(),
+            variant(Diffusion::Grosjean, Strength::ReducedAlbedo),
+        ),
+    ]
+}
+
+/// Per object and vertex, the cosine between the vertex normal and the direction to the first
+/// light (NaN without lights).
+pub fn light_cosines(base: &PreparedScene) -> Vec<Vec<f64>> {
+    base.objects
+        .iter()
+        .map(|o| {
+            o.mesh
+                .positions()
+                .iter()
+                .zip(o.mesh.vertex_normals())
+                .map(|(p, n)| match base.lights.first() {
+                    Some(l) => {
+                        let (wi, ..) = crate::reference::light_incidence(l, p.as_dvec3());
+                        n.as_dvec3().normalize().dot(wi)
+                    }
+                    None => f64::NAN,
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// One object's exitance per vertex.
+type Exitance = Vec<[f64; 3]>;
+
+/// [`vertex_error_f64`] of `estimate` against `reference` per band of [`BANDS`]: the lit floor
+/// is the object's, as over all vertices; each band keeps the vertices whose cosine is in it.
+pub fn band_errors(reference: &[Vec<[f64; 3]>], estimate: &[Vec<[f64; 3]>], cosines: &[Vec<f64>]) -> Vec<VertexError> {
+    BANDS
+        .iter()
+        .map(|&(lo, hi, _)| {
+            // Outside the band the reference reads 0 (unlit, so left out); the floor is kept
+            // by a copy of the brightest vertex placed where no estimate is compared.
+            let (r, e): (Vec<Exitance>, Vec<Exitance>) = reference
+                .iter()
+                .zip(estimate)
+                .zip(cosines)
+                .map(|((r, e), cos)| {
+                    let brightest = [0, 1, 2].map(|c| r.iter().map(|v| v[c]).fold(0.0, f64::max));
+                    let mut rr: Vec<[f64; 3]> =
+                        r.iter().zip(cos).map(|(v, k)| if *k >= lo && *k < hi { *v } else { [0.0; 3] }).collect();
+                    let mut ee = e.clone();
+                    rr.push(brightest);
+                    ee.push([f64::NAN; 3]);
+                    (rr, ee)
+                })
+                .unzip();
+            vertex_error_f64(&r, &e)
+        })
+        .collect()
 }
 
 /// Per channel, the RMS over the lit vertices of every object (at least [`LIT_FLOOR`] of the
@@ -207,6 +297,7 @@ pub fn markdown(physics: &Physics, rows: &[Row]) -> String {
         );
     }
     alternatives_table(&mut out, physics);
+    bands_table(&mut out, physics);
     split_table(&mut out, rows);
     crossover_table(&mut out, rows, physics.model.rel_rms);
     out
@@ -226,6 +317,32 @@ fn alternatives_table(out: &mut String, p: &Physics) {
     for (name, e) in models {
         let cell = |c: usize| format!("{} % ({:+.1} %)", percent(e.rel_rms[c]), 100.0 * e.bias[c]);
         let _ = writeln!(out, "| {name} | {} | {} | {} |", cell(0), cell(1), cell(2));
+    }
+}
+
+/// Each model's error per band of incidence at the vertex.
+fn bands_table(out: &mut String, p: &Physics) {
+    let _ = writeln!(
+        out,
+        "\nBy the cosine between the vertex normal and the first light (relative RMS per vertex, mean bias in \
+         brackets, lit vertices counted in the band; `reference::directional` for the directional dipole):\n"
+    );
+    let _ = writeln!(out, "| model | band | vertices (r, g, b) | r | g | b |");
+    let _ = writeln!(out, "|---|---|---|---:|---:|---:|");
+    for (name, bands) in &p.bands {
+        for (e, (.., band)) in bands.iter().zip(BANDS) {
+            let cell = |c: usize| format!("{} % ({:+.1} %)", percent(e.rel_rms[c]), 100.0 * e.bias[c]);
+            let _ = writeln!(
+                out,
+                "| {name} | {band} | {}, {}, {} | {} | {} | {} |",
+                e.lit[0],
+                e.lit[1],
+                e.lit[2],
+                cell(0),
+                cell(1),
+                cell(2)
+            );
+        }
     }
 }
 
