@@ -71,6 +71,7 @@ pub(super) struct GroupGather {
     pub set: DescriptorSet,
     /// Stage 0's output, read by stage 1.
     pub handoff: Resource,
+    /// What stage 0 runs over: the sparse gather's samples, or the hierarchy by height.
     pub stage0: Stage0,
 }
 
