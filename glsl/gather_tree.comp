@@ -72,7 +72,7 @@ void combine(uint i, uint l, uint r) {
     float wa = a.mean_weight.w, wb = b.mean_weight.w, w = wa + wb;
     vec3 power = a.power.rgb + b.power.rgb;
     if (!(w > 0.0)) {
-        node_power[i] = NodePowerRecord(vec4(power, 0.0), vec4(center, 0.0), vec4(0.0), vec4(0.0));
+        node_power[i] = NodePowerRecord(vec4(power, tree_nodes[i].area_reach.z), vec4(center, 0.0), vec4(0.0), vec4(0.0));
         return;
     }
     vec3 ya = a.mean_weight.xyz - center, yb = b.mean_weight.xyz - center;
@@ -81,7 +81,7 @@ void combine(uint i, uint l, uint r) {
     vec3 diag = (wa * (a.cov_diag.xyz + da * da) + wb * (b.cov_diag.xyz + db * db)) / w;
     vec3 off = (wa * (a.cov_off.xyz + vec3(da.x * da.y, da.x * da.z, da.y * da.z))
                 + wb * (b.cov_off.xyz + vec3(db.x * db.y, db.x * db.z, db.y * db.z))) / w;
-    node_power[i] = NodePowerRecord(vec4(power, 0.0), vec4(center + m, w), vec4(max(diag, vec3(0.0)), 0.0), vec4(off, 0.0));
+    node_power[i] = NodePowerRecord(vec4(power, tree_nodes[i].area_reach.z), vec4(center + m, w), vec4(max(diag, vec3(0.0)), 0.0), vec4(off, 0.0));
 }
 
 void aggregate(uint i) {
@@ -110,7 +110,7 @@ void aggregate(uint i) {
     // Covariance about the centroid: E[y y^T] - m m^T, never negative on the diagonal.
     vec3 cov_diag = weight > 0.0 ? max(diag / weight - m * m, vec3(0.0)) : vec3(0.0);
     vec3 cov_off = weight > 0.0 ? off / weight - vec3(m.x * m.y, m.x * m.z, m.y * m.z) : vec3(0.0);
-    node_power[i] = NodePowerRecord(vec4(power, 0.0), vec4(center + m, weight), vec4(cov_diag, 0.0), vec4(cov_off, 0.0));
+    node_power[i] = NodePowerRecord(vec4(power, n.area_reach.z), vec4(center + m, weight), vec4(cov_diag, 0.0), vec4(cov_off, 0.0));
 }
 
 void main() {
@@ -139,7 +139,8 @@ void main() {
             vec3 cd = p.cov_diag.xyz, co = p.cov_off.xyz;
             float tr_cov = cd.x + cd.y + cd.z;
             float axial_cov = dot(w * w, cd) + 2.0 * (w.x * w.y * co.x + w.x * w.z * co.y + w.y * w.z * co.z);
-            float beta = DIPOLE_B_PER_SQRT_AREA * DIPOLE_B_PER_SQRT_AREA * tree_nodes[node].area_reach.z;
+            // The members' mean area rides in the power record: one load per item, not two.
+            float beta = DIPOLE_B_PER_SQRT_AREA * DIPOLE_B_PER_SQRT_AREA * p.power.w;
             vec3 power = p.power.rgb;
             for (int c = 0; c < 3; ++c) {
                 g.partial[c] += power[c] * dipole_r_d_far_cluster_sq(ch[c], r_sq, beta, tr_cov, axial_cov);

@@ -54,7 +54,7 @@ struct TreeNodeRecord {
 
 // Per node, after each splat (gather_tree.comp stage 0).
 struct NodePowerRecord {
-    vec4 power;             // rgb: sum E_i A_i per channel; w: 0
+    vec4 power;             // rgb: sum E_i A_i per channel; w: the members' mean area (TreeNodeRecord)
     vec4 mean_weight;       // xyz: power-weighted centroid; w: total weight
     vec4 cov_diag;          // xyz: power-weighted covariance of the members about it: xx, yy, zz
     vec4 cov_off;           // xyz: xy, xz, yz

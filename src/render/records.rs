@@ -166,7 +166,8 @@ impl TreeNodeRecord {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct NodePowerRecord {
-    /// rgb: transmitted power `sum E_i A_i` per channel; w: 0.
+    /// rgb: transmitted power `sum E_i A_i` per channel; w: the members' mean area (the node's
+    /// `TreeNodeRecord::area_reach` z), so that stage 1 reads one record per node item.
     pub power: [f32; 4],
     /// xyz: centroid of the samples weighted by their power summed over channels (the bounding
     /// centre when unlit); w: that total weight.
