@@ -166,6 +166,29 @@ impl Bvh {
         best2.sqrt()
     }
 
+    /// Appends to `out` every triangle within `radius` of `p` (by its nearest point).
+    pub fn within(&self, p: DVec3, radius: f64, out: &mut Vec<u32>) {
+        let r2 = radius * radius;
+        let mut stack = vec![0u32];
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            if self.triangles.is_empty() || node.bounds.distance2(p) > r2 {
+                continue;
+            }
+            if node.count > 0 {
+                let leaf = &self.order[node.first as usize..(node.first + node.count) as usize];
+                out.extend(leaf.iter().filter(|&&t| point_triangle_distance2(&self.triangles[t as usize], p) <= r2));
+            } else {
+                stack.extend([node.first, node.first + 1]);
+            }
+        }
+    }
+
+    /// Triangle `t` as given to [`Bvh::new`].
+    pub fn triangle(&self, t: usize) -> &[DVec3; 3] {
+        &self.triangles[t]
+    }
+
     /// The triangles of every leaf whose box the ray origin + t dir meets before `t_far`, each
     /// given to `leaf` with the current `t_far`, which it may shorten (a closest hit prunes the
     /// boxes behind it); `leaf` returning true ends the walk (any hit will do).
@@ -253,7 +276,7 @@ fn intersect(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> Option<f64> {
 }
 
 /// [`intersect`] with the barycentric coordinates `(u, v)` of corners 1 and 2 at the hit.
-fn intersect_uv(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> Option<(f64, f64, f64)> {
+pub(crate) fn intersect_uv(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> Option<(f64, f64, f64)> {
     let e1 = tri[1] - tri[0];
     let e2 = tri[2] - tri[0];
     let p = dir.cross(e2);
