@@ -19,7 +19,8 @@ fn quiet(_: RteProgress) {}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let scene = PreparedScene::new(&Scene::load(std::path::Path::new(&args[1])).unwrap(), &Overrides::default()).unwrap();
+    let scene =
+        PreparedScene::new(&Scene::load(std::path::Path::new(&args[1])).unwrap(), &Overrides::default()).unwrap();
     let seconds: f64 = args[2].parse().unwrap();
     let budget = Budget { max_photons: u64::MAX / 2, relative_stderr: None, max_seconds: Some(seconds) };
     let rte = rte_mesh::exitance(&scene, &MeshOptions { budget, seed: 1 }, &quiet).unwrap();
@@ -31,7 +32,8 @@ fn main() {
     println!("{} photons in {:.0} s, relative standard error {:.4}", rte.photons, rte.seconds, rte.relative_stderr);
     for c in 0..3 {
         let floor = LIT_FLOOR * rte.exitance.iter().map(|m| m[c]).fold(0.0, f64::max);
-        let lit: Vec<usize> = (0..rte.exitance.len()).filter(|&v| rte.exitance[v][c] > 0.0 && rte.exitance[v][c] >= floor).collect();
+        let lit: Vec<usize> =
+            (0..rte.exitance.len()).filter(|&v| rte.exitance[v][c] > 0.0 && rte.exitance[v][c] >= floor).collect();
         let rel = |v: usize| t.exitance[0][v][c] / rte.exitance[v][c] - 1.0;
         let total: f64 = lit.iter().map(|&v| rel(v).powi(2)).sum();
         println!("channel {c}: {} lit, RMS {:.1}%", lit.len(), 100.0 * (total / lit.len() as f64).sqrt());
