@@ -14,11 +14,14 @@
 //! At the boundary, found with the BVH's closest hit, the walk splits by expected value: the
 //! share `1 - R` (Fresnel reflectance of the face) of its weight leaves there and is tallied to
 //! the vertex whose surface cell holds the point, the share `R` reflects internally and walks
-//! on, under Russian roulette. The expectation is that of choosing one or the other with those
-//! probabilities (the walk before issue 26 did), without the noise of the choice: in ketchup's
-//! green and blue, most light that leaves does so after one or two scatterings, and `eta` 1.3
-//! reflects much of it back. A flight that the clearance grid (`reference::clearance`) says
-//! cannot reach the surface skips the closest-hit query, whose answer is then known.
+//! on (`rte::after_reflection`: its weight times `R` under Russian roulette in a dark medium,
+//! the whole weight with probability `R` in a bright one, whose walks are long). The
+//! expectation is that of choosing to leave or reflect with those probabilities (the walk
+//! before issue 26 did), without the noise of the choice: in ketchup's green and blue, most
+//! light that leaves does so after one or two scatterings, and `eta` 1.3 reflects much of it
+//! back. A flight that the clearance grid (`reference::clearance`) says cannot reach the
+//! surface skips the closest-hit query, whose answer is then known; one that it says can reach
+//! only a few faces tests those alone.
 //!
 //! # Geometry
 //!
