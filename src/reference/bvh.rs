@@ -143,11 +143,11 @@ impl Bvh {
         if self.triangles.is_empty() {
             return best2;
         }
-        let mut stack = [0u32; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let node = &self.nodes[stack[top] as usize];
+        // A growing stack: a subtree dropped for want of room would make the distance too large,
+        // and the clearance grid's bound unsafe.
+        let mut stack = vec![0u32];
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
             if node.bounds.distance2(p) >= best2 {
                 continue;
             }
@@ -155,12 +155,11 @@ impl Bvh {
                 for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
                     best2 = best2.min(point_triangle_distance2(&self.triangles[t as usize], p));
                 }
-            } else if top + 2 <= stack.len() {
+            } else {
                 let (a, b) = (node.first, node.first + 1);
                 // The nearer child is pushed last, so it is searched first.
                 let near_a = self.nodes[a as usize].bounds.distance2(p) <= self.nodes[b as usize].bounds.distance2(p);
-                (stack[top], stack[top + 1]) = if near_a { (b, a) } else { (a, b) };
-                top += 2;
+                stack.extend(if near_a { [b, a] } else { [a, b] });
             }
         }
         best2.sqrt()

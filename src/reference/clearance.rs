@@ -72,7 +72,8 @@ impl Clearance {
                 if bound <= reach {
                     bvh.within(centre, reach + half_diagonal + margin, &mut near);
                 }
-                (bound as f32, near)
+                // Shrunk by a millionth first, so that rounding to f32 cannot raise it.
+                ((bound * (1.0 - 1e-6)) as f32, near)
             })
             .collect();
         let mut start = Vec::with_capacity(cells.len() + 1);
