@@ -18,6 +18,11 @@ impl Aabb {
         self.min = self.min.min(p);
         self.max = self.max.max(p);
     }
+    /// The squared distance from `p` to the box (0 inside).
+    fn distance2(&self, p: DVec3) -> f64 {
+        let d = (self.min - p).max(p - self.max).max(DVec3::ZERO);
+        d.length_squared()
+    }
     /// Slab test: does the ray origin + t dir, t in (0, t_max), touch the box?
     fn hit(&self, origin: DVec3, inv_dir: DVec3, t_max: f64) -> bool {
         let t0 = (self.min - origin) * inv_dir;
@@ -130,6 +135,59 @@ impl Bvh {
         best
     }
 
+    /// The distance from `p` to the nearest triangle (infinite if there is none): a
+    /// branch-and-bound descent, nearer child first, pruning every box farther than the nearest
+    /// triangle found so far. What `reference::clearance` builds its grid from.
+    pub fn distance(&self, p: DVec3) -> f64 {
+        let mut best2 = f64::INFINITY;
+        if self.triangles.is_empty() {
+            return best2;
+        }
+        // A growing stack: a subtree dropped for want of room would make the distance too large,
+        // and the clearance grid's bound unsafe.
+        let mut stack = vec![0u32];
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            if node.bounds.distance2(p) >= best2 {
+                continue;
+            }
+            if node.count > 0 {
+                for &t in &self.order[node.first as usize..(node.first + node.count) as usize] {
+                    best2 = best2.min(point_triangle_distance2(&self.triangles[t as usize], p));
+                }
+            } else {
+                let (a, b) = (node.first, node.first + 1);
+                // The nearer child is pushed last, so it is searched first.
+                let near_a = self.nodes[a as usize].bounds.distance2(p) <= self.nodes[b as usize].bounds.distance2(p);
+                stack.extend(if near_a { [b, a] } else { [a, b] });
+            }
+        }
+        best2.sqrt()
+    }
+
+    /// Appends to `out` every triangle within `radius` of `p` (by its nearest point).
+    pub fn within(&self, p: DVec3, radius: f64, out: &mut Vec<u32>) {
+        let r2 = radius * radius;
+        let mut stack = vec![0u32];
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            if self.triangles.is_empty() || node.bounds.distance2(p) > r2 {
+                continue;
+            }
+            if node.count > 0 {
+                let leaf = &self.order[node.first as usize..(node.first + node.count) as usize];
+                out.extend(leaf.iter().filter(|&&t| point_triangle_distance2(&self.triangles[t as usize], p) <= r2));
+            } else {
+                stack.extend([node.first, node.first + 1]);
+            }
+        }
+    }
+
+    /// Triangle `t` as given to [`Bvh::new`].
+    pub fn triangle(&self, t: usize) -> &[DVec3; 3] {
+        &self.triangles[t]
+    }
+
     /// The triangles of every leaf whose box the ray origin + t dir meets before `t_far`, each
     /// given to `leaf` with the current `t_far`, which it may shorten (a closest hit prunes the
     /// boxes behind it); `leaf` returning true ends the walk (any hit will do).
@@ -174,13 +232,50 @@ pub struct Hit {
     pub v: f64,
 }
 
+/// The squared distance from `p` to the triangle: its closest point by the Voronoi regions of
+/// the corners, edges and face (Ericson 2005, Real-Time Collision Detection, 5.1.5).
+fn point_triangle_distance2(tri: &[DVec3; 3], p: DVec3) -> f64 {
+    let [a, b, c] = *tri;
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return ap.length_squared();
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return bp.length_squared();
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return (ap - ab * (d1 / (d1 - d3))).length_squared();
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return cp.length_squared();
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return (ap - ac * (d2 / (d2 - d6))).length_squared();
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (bp - (c - b) * w).length_squared();
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    (ap - ab * v - ac * w).length_squared()
+}
+
 /// Möller-Trumbore ray-triangle intersection (Möller and Trumbore 1997): the ray parameter t.
 fn intersect(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> Option<f64> {
     intersect_uv(tri, origin, dir).map(|(t, ..)| t)
 }
 
 /// [`intersect`] with the barycentric coordinates `(u, v)` of corners 1 and 2 at the hit.
-fn intersect_uv(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> Option<(f64, f64, f64)> {
+pub(crate) fn intersect_uv(tri: &[DVec3; 3], origin: DVec3, dir: DVec3) -> Option<(f64, f64, f64)> {
     let e1 = tri[1] - tri[0];
     let e2 = tri[2] - tri[0];
     let p = dir.cross(e2);
@@ -235,6 +330,32 @@ mod tests {
             hits += brute as u32;
         }
         assert!(hits > 50, "the test must exercise hits too ({hits})");
+    }
+
+    #[test]
+    fn distance_matches_brute_force_and_bounds_the_triangles() {
+        let mut tris = Vec::new();
+        for i in 0..10 {
+            for j in 0..10 {
+                let o = DVec3::new(i as f64, (i * j % 5) as f64 * 0.4, j as f64);
+                tris.push([o, o + DVec3::new(1.3, 0.2, 0.1), o + DVec3::new(0.1, 0.3, 1.4)]);
+            }
+        }
+        let bvh = Bvh::new(tris.clone());
+        let mut rnd = uniform(99);
+        for _ in 0..2000 {
+            let p = DVec3::new(rnd() * 14.0 - 2.0, rnd() * 6.0 - 2.0, rnd() * 14.0 - 2.0);
+            let brute = tris.iter().map(|t| point_triangle_distance2(t, p)).fold(f64::INFINITY, f64::min).sqrt();
+            let d = bvh.distance(p);
+            assert!((d - brute).abs() <= 1e-12 * (1.0 + brute), "{d} vs {brute}");
+            // No point of any triangle is nearer: sample the triangles' points.
+            for t in &tris {
+                let (u, v) = (rnd(), rnd());
+                let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+                let q = t[0] * (1.0 - u - v) + t[1] * u + t[2] * v;
+                assert!(q.distance(p) >= d - 1e-12, "a point at {} is nearer than {d}", q.distance(p));
+            }
+        }
     }
 
     #[test]

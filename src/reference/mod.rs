@@ -4,6 +4,7 @@
 //! transfer equation, what the dipole model itself approximates.
 
 pub mod bvh;
+pub mod clearance;
 pub mod directional;
 pub mod rte;
 pub mod rte_cache;

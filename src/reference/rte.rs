@@ -243,10 +243,30 @@ pub(crate) fn after_collision(w: f64, albedo: f64, rng: &mut Pcg64) -> Option<f6
     if albedo >= ANALOG_ALBEDO {
         return (rng.random::<f64>() < albedo).then_some(w);
     }
-    let w = w * albedo;
+    roulette(w * albedo, rng)
+}
+
+/// The photon's weight after an internal reflection of reflectance `r` in a medium of albedo
+/// `albedo`, its share `1 - r` having left (expected-value splitting, `rte_mesh`): as
+/// [`after_collision`] treats the albedo, so that a walk lives as long in either regime. From
+/// [`ANALOG_ALBEDO`] up it reflects with probability `r` and its weight unchanged (a walk in a
+/// nearly white medium is long, and carrying every reflected share to the end of it would
+/// cost more than the choice's noise); below, its weight is multiplied by `r`, then Russian
+/// roulette. `None`: the photon is gone.
+pub(crate) fn after_reflection(w: f64, r: f64, albedo: f64, rng: &mut Pcg64) -> Option<f64> {
+    if albedo >= ANALOG_ALBEDO {
+        return (rng.random::<f64>() < r).then_some(w);
+    }
+    roulette(w * r, rng)
+}
+
+/// Russian roulette below [`ROULETTE_WEIGHT`]: the weight `w` as it is from there up, else
+/// `w / ROULETTE_SURVIVAL` with that chance (unbiased: the expected weight is `w`), else `None`.
+/// Weights are relative to the photon's at its start (1). A weight of 0 is gone without a draw.
+pub(crate) fn roulette(w: f64, rng: &mut Pcg64) -> Option<f64> {
     if w >= ROULETTE_WEIGHT {
         Some(w)
-    } else if rng.random::<f64>() < ROULETTE_SURVIVAL {
+    } else if w > 0.0 && rng.random::<f64>() < ROULETTE_SURVIVAL {
         Some(w / ROULETTE_SURVIVAL)
     } else {
         None

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 
 /// The version of the walk: a change to what `rte_mesh` computes bumps it, so older files are
 /// walked anew.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 
 /// The reference of every object of a scene, as cached.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -7,10 +7,21 @@
 //! Fresnel transmittance and the light's visibility (ray cast through the scene's shadow
 //! casters, as `reference::transmitted_irradiance` does), over the density it was drawn with.
 //! It refracts in by Snell's law and walks each colour channel's medium in turn (one walk per
-//! channel from the same entry, with the channel's own random numbers). At the boundary, found
-//! with the BVH's closest hit, it reflects internally with the Fresnel reflectance of the face
-//! or leaves; where it leaves, its weight is tallied to the vertex whose surface cell holds the
-//! exit point.
+//! channel from the same entry, with the channel's own random numbers). Its weight in the walk
+//! is relative to the entry's (1 there), so that Russian roulette (`rte::roulette`) plays at
+//! the same point of a photon's life as in the half-space walk, whatever the scene's units.
+//!
+//! At the boundary, found with the BVH's closest hit, the walk splits by expected value: the
+//! share `1 - R` (Fresnel reflectance of the face) of its weight leaves there and is tallied to
+//! the vertex whose surface cell holds the point, the share `R` reflects internally and walks
+//! on (`rte::after_reflection`: its weight times `R` under Russian roulette in a dark medium,
+//! the whole weight with probability `R` in a bright one, whose walks are long). The
+//! expectation is that of choosing to leave or reflect with those probabilities (the walk
+//! before issue 26 did), without the noise of the choice: in ketchup's green and blue, most
+//! light that leaves does so after one or two scatterings, and `eta` 1.3 reflects much of it
+//! back. A flight that the clearance grid (`reference::clearance`) says cannot reach the
+//! surface skips the closest-hit query, whose answer is then known; one that it says can reach
+//! only a few faces tests those alone.
 //!
 //! # Geometry
 //!
@@ -24,14 +35,19 @@
 //! barycentric coordinate is largest at that vertex (a third of the triangle's area). The
 //! exitance at a vertex is the flux leaving through its cell over the cell's area: the cell's
 //! mean, which differs from the value at the vertex by the exitance's curvature times the cell's
-//! second moment. Each photon leaves at most once per channel, so the per-photon scores' sums
-//! and sums of squares give an exact standard error per vertex and channel.
+//! second moment. A photon's score at a vertex and channel is the sum of every share it left
+//! there (one walk may leave through a cell more than once), so the per-photon scores' sums and
+//! sums of squares give an exact standard error per vertex and channel.
 //!
 //! Photons whose walk meets the surface from outside (a ray through a crack the f64
 //! intersection test leaves between triangles) are dropped and counted in `lost`.
 
+use super::bvh::intersect_uv;
 use super::bvh::{Bvh, Hit};
-use super::rte::{Budget, Medium, Progress, RteError, after_collision, chunk_rng, run_rounds, sample_hg_cos};
+use super::clearance::{Clearance, Flight};
+use super::rte::{
+    Budget, Medium, Progress, RteError, after_collision, after_reflection, chunk_rng, run_rounds, sample_hg_cos,
+};
 use super::truth::LIT_FLOOR;
 use super::{light_incidence, occluders, ray_offset};
 use crate::mesh::Mesh;
@@ -77,22 +93,102 @@ pub struct ObjectExitance {
     pub seconds: f64,
 }
 
+/// How the walk is done: this module's walk ([`WALK`]), or, for the tests that compare them,
+/// the walk before issue 26 and the walk without the clearance grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Method {
+    /// Expected-value splitting at the boundary with relative weights; else the analog choice
+    /// between reflecting and leaving, with weights in the scene's units (before issue 26).
+    split: bool,
+    /// Skip the closest-hit query where the clearance grid rules a hit out.
+    clearance: bool,
+}
+
+/// This module's walk.
+const WALK: Method = Method { split: true, clearance: true };
+
 /// The object as the walk sees it.
 struct Geometry<'a> {
     mesh: &'a Mesh,
     bvh: Bvh,
     /// Outward unit face normals.
     normals: Vec<DVec3>,
+    /// Per face, its plane's offset along its normal.
+    offsets: Vec<f64>,
+    /// A small length, far above the rounding of the hit test: the plane test's slack.
+    slack: f64,
+    /// A lower bound of the distance to the surface, if the method uses one.
+    clearance: Option<Clearance>,
 }
 
 impl<'a> Geometry<'a> {
-    fn new(mesh: &'a Mesh) -> Geometry<'a> {
+    fn new(mesh: &'a Mesh, clearance: bool) -> Geometry<'a> {
         let triangles: Vec<[DVec3; 3]> = (0..mesh.triangles().len()).map(|t| mesh.corners(t)).collect();
         // Six times the enclosed volume: negative when the winding faces inwards.
         let volume: f64 = triangles.iter().map(|[a, b, c]| a.dot(b.cross(*c))).sum();
         let sign = if volume < 0.0 { -1.0 } else { 1.0 };
-        let normals = triangles.iter().map(|[a, b, c]| sign * (*b - *a).cross(*c - *a).normalize()).collect();
-        Geometry { mesh, bvh: Bvh::new(triangles), normals }
+        let normals: Vec<DVec3> =
+            triangles.iter().map(|[a, b, c]| sign * (*b - *a).cross(*c - *a).normalize()).collect();
+        let offsets = triangles.iter().zip(&normals).map(|(t, n)| n.dot(t[0])).collect();
+        let size = triangles.iter().flatten().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+        let bvh = Bvh::new(triangles);
+        let clearance = clearance.then(|| {
+            let (min, max) = mesh.positions().iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
+            });
+            Clearance::new(&bvh, min, max)
+        });
+        Geometry { mesh, bvh, normals, offsets, slack: 1e-9 * size, clearance }
+    }
+
+    /// The first face a flight from `p` along `d` meets within `s`, other than `skip`: what
+    /// the BVH's query answers, without it where the clearance grid rules a hit out or lists
+    /// the faces the flight can meet.
+    fn closest_hit(&self, p: DVec3, d: DVec3, s: f64, skip: Option<usize>) -> Option<Hit> {
+        match self.clearance.as_ref().map_or(Flight::Far, |c| c.flight(p, s)) {
+            Flight::Clear => None,
+            Flight::Near(faces) => self.closest_among(faces, p, d, s, skip),
+            Flight::Far => self.bvh.closest_hit(p, d, 0.0, s, skip),
+        }
+    }
+
+    /// [`Geometry::closest_hit`] among `faces`, by the BVH's own hit test. A face whose plane
+    /// the flight does not cross within `(0, s)` (give or take the slack) is passed over
+    /// first: two dot products instead of the full test, for most of the list.
+    fn closest_among(&self, faces: &[u32], p: DVec3, d: DVec3, s: f64, skip: Option<usize>) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        let mut t_far = s;
+        for &f in faces {
+            let f = f as usize;
+            let (n, offset) = (self.normals[f], self.offsets[f]);
+            // The plane is met at t = num / den; within (0, s) iff num lies between 0 and s den.
+            let (num, den) = (offset - n.dot(p), n.dot(d));
+            if (num - 0.5 * s * den).abs() > 0.5 * s * den.abs() + self.slack || skip == Some(f) {
+                continue;
+            }
+            if let Some((t, u, v)) = intersect_uv(self.bvh.triangle(f), p, d)
+                && t > 0.0
+                && t < t_far
+            {
+                t_far = t;
+                best = Some(Hit { t, triangle: f, u, v });
+            }
+        }
+        best
+    }
+
+    /// The vertex whose cell holds the point of barycentric coordinates `(1 - u - v, u, v)` on
+    /// `triangle`: the corner of the largest.
+    fn cell_vertex(&self, triangle: usize, u: f64, v: f64) -> usize {
+        let w = 1.0 - u - v;
+        let corner = if w >= u && w >= v {
+            0
+        } else if u >= v {
+            1
+        } else {
+            2
+        };
+        self.mesh.triangles()[triangle][corner] as usize
     }
 }
 
@@ -157,6 +253,16 @@ pub fn exitance(
     options: &MeshOptions,
     progress: Progress,
 ) -> Result<Vec<Option<ObjectExitance>>, RteError> {
+    exitance_by(scene, options, progress, WALK)
+}
+
+/// [`exitance`] walked by `method`.
+fn exitance_by(
+    scene: &PreparedScene,
+    options: &MeshOptions,
+    progress: Progress,
+    method: Method,
+) -> Result<Vec<Option<ObjectExitance>>, RteError> {
     let casters = occluders(scene);
     let lighting = Lighting { lights: &scene.lights, occluders: &casters, eps: ray_offset(scene) };
     scene
@@ -170,14 +276,15 @@ pub fn exitance(
                 }
                 let media = dipoles.each_ref().map(Medium::reduced);
                 let options = MeshOptions { seed: options.seed.wrapping_add(i as u64), ..*options };
-                Ok(Some(object_exitance(&o.mesh, &media, &lighting, &options, progress)?))
+                Ok(Some(object_exitance(&o.mesh, &media, &lighting, &options, progress, method)?))
             }
             ResolvedMaterial::Opaque { .. } => Ok(None),
         })
         .collect()
 }
 
-/// Per vertex and channel, the sums of the photons' scores and of their squares.
+/// Per vertex and channel, the sums of the photons' scores and of their squares; per channel,
+/// the walks lost.
 struct Tally {
     sum: Vec<[f64; 3]>,
     sum2: Vec<[f64; 3]>,
@@ -191,12 +298,13 @@ fn object_exitance(
     lighting: &Lighting,
     options: &MeshOptions,
     progress: Progress,
+    method: Method,
 ) -> Result<ObjectExitance, RteError> {
     if options.budget.max_photons == 0 {
         return Err(RteError::NoPhotons);
     }
     let start = std::time::Instant::now();
-    let geometry = Geometry::new(mesh);
+    let geometry = Geometry::new(mesh, method.clearance);
     let sources = Sources::new(&geometry, lighting.lights);
     let cells = cell_areas(mesh);
     let count = mesh.positions().len();
@@ -214,11 +322,11 @@ fn object_exitance(
     }
     let walk_chunk = |chunk: u64, _first: u64, n: u64| {
         let mut rng = chunk_rng(options.seed, chunk);
-        let mut exits = Vec::new();
+        let (mut exits, mut lost) = (Vec::new(), [0; 3]);
         for _ in 0..n {
-            photon(&geometry, &sources, lighting, media, &mut rng, &mut exits);
+            photon(&geometry, &sources, lighting, media, method.split, &mut rng, &mut exits, &mut lost);
         }
-        exits
+        (exits, lost)
     };
     // Adding chunks and measuring the precision both need the tally: a cell between them.
     let tally =
@@ -244,17 +352,14 @@ fn object_exitance(
     })
 }
 
-/// Adds one chunk's exits to the tally.
-fn add_exits(tally: &mut Tally, exits: Vec<Exit>) {
-    for e in exits {
-        match e {
-            Exit::Left { vertex, channel, weight } => {
-                tally.sum[vertex][channel] += weight;
-                tally.sum2[vertex][channel] += weight * weight;
-            }
-            Exit::Lost { channel } => tally.lost[channel] += 1,
-        }
+/// Adds one chunk's exits (each photon's score at a vertex and channel once) and lost walks to
+/// the tally.
+fn add_exits(tally: &mut Tally, (exits, lost): (Vec<Exit>, [u64; 3])) {
+    for Exit { vertex, channel, weight } in exits {
+        tally.sum[vertex][channel] += weight;
+        tally.sum2[vertex][channel] += weight * weight;
     }
+    (0..3).for_each(|c| tally.lost[c] += lost[c]);
 }
 
 /// Per-vertex exitance and standard error after `n` photons, and the precision reached
@@ -305,22 +410,27 @@ fn cell_areas(mesh: &Mesh) -> Vec<f64> {
     cells
 }
 
-/// How one channel's walk ended, when it ended anywhere but in absorption.
-enum Exit {
-    /// It left through the cell of `vertex` with `weight`.
-    Left { vertex: usize, channel: usize, weight: f64 },
-    /// It met the surface from outside and was dropped.
-    Lost { channel: usize },
+/// Weight that left through the cell of `vertex` in `channel` (scene units: flux).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Exit {
+    vertex: usize,
+    channel: usize,
+    weight: f64,
 }
 
-/// One photon: an entry point, then a walk per channel; its exits are pushed to `exits`.
+/// One photon: an entry point, then a walk per channel; its exits are pushed to `exits` (one
+/// per vertex and channel, [`merge_photon`]), the walks that met the surface from outside are
+/// counted in `lost`.
+#[allow(clippy::too_many_arguments)] // what one photon needs and where it goes
 fn photon(
     geometry: &Geometry,
     sources: &Sources,
     lighting: &Lighting,
     media: &[Medium; 3],
+    split: bool,
     rng: &mut Pcg64,
     exits: &mut Vec<Exit>,
+    lost: &mut [u64; 3],
 ) {
     let ((l, t), p_pair) = sources.pick(rng.random::<f64>());
     let (r1, r2) = (rng.random::<f64>().sqrt(), rng.random::<f64>());
@@ -342,38 +452,69 @@ fn photon(
     let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (eta * eta)).max(0.0).sqrt();
     let d = (-wi / eta + n * (cos_i / eta - cos_t)).normalize();
     let density = p_pair / geometry.mesh.triangle_areas()[t];
-    for (c, medium) in media.iter().enumerate() {
-        let weight = e[c] * cos_i * f_t / density;
-        if weight > 0.0
-            && let Some(exit) = walk(geometry, medium, p, d, t, weight, rng, c)
-        {
-            exits.push(exit);
+    let first = exits.len();
+    for (channel, medium) in media.iter().enumerate() {
+        let weight = e[channel] * cos_i * f_t / density;
+        let start = Start { p, d, triangle: t, channel, weight };
+        if weight > 0.0 && walk(geometry, medium, &start, split, rng, exits) {
+            lost[channel] += 1;
         }
     }
+    merge_photon(exits, first);
 }
 
-/// One channel's walk from `p` on triangle `from` in direction `d` (inwards) with `weight`:
-/// where it left, if it did.
-#[allow(clippy::too_many_arguments)] // the state of one walk
+/// Sums the exits from `first` on (one photon's) that share a vertex and channel into one: the
+/// photon's score there, whose square the variance needs.
+fn merge_photon(exits: &mut Vec<Exit>, first: usize) {
+    if exits.len() - first < 2 {
+        return;
+    }
+    exits[first..].sort_unstable_by_key(|e| (e.channel, e.vertex));
+    let mut last = first;
+    for k in first + 1..exits.len() {
+        if (exits[k].channel, exits[k].vertex) == (exits[last].channel, exits[last].vertex) {
+            exits[last].weight += exits[k].weight;
+        } else {
+            last += 1;
+            exits[last] = exits[k];
+        }
+    }
+    exits.truncate(last + 1);
+}
+
+/// Where one channel's walk starts: at `p` on `triangle`, inwards along `d`, with `weight`
+/// (scene units).
+struct Start {
+    p: DVec3,
+    d: DVec3,
+    triangle: usize,
+    channel: usize,
+    weight: f64,
+}
+
+/// One channel's walk from `start`: its exits are pushed to `exits`; true if it met the surface
+/// from outside (and was dropped there). With `split`, expected-value splitting at the boundary
+/// (see the module's documentation), else the analog choice between reflecting and leaving.
 fn walk(
     geometry: &Geometry,
     medium: &Medium,
-    mut p: DVec3,
-    mut d: DVec3,
-    from: usize,
-    mut weight: f64,
+    start: &Start,
+    split: bool,
     rng: &mut Pcg64,
-    channel: usize,
-) -> Option<Exit> {
+    exits: &mut Vec<Exit>,
+) -> bool {
     let (sigma_t, albedo) = (medium.sigma_t(), medium.albedo());
-    let mut skip = Some(from);
+    // The split walk's weights are relative to the entry's (see the module's documentation).
+    let (scale, mut weight) = if split { (start.weight, 1.0) } else { (1.0, start.weight) };
+    let (mut p, mut d, mut skip) = (start.p, start.d, Some(start.triangle));
     loop {
         let s = -(1.0 - rng.random::<f64>()).ln() / sigma_t;
-        let Some(Hit { t, triangle, u, v }) = geometry.bvh.closest_hit(p, d, 0.0, s, skip) else {
+        let Some(Hit { t, triangle, u, v }) = geometry.closest_hit(p, d, s, skip) else {
             p += d * s;
             skip = None;
-            weight = after_collision(weight, albedo, rng)?;
-            d = scatter(d, sample_hg_cos(medium.g, rng.random::<f64>()), rng.random::<f64>());
+            let Some(w) = after_collision(weight, albedo, rng) else { return false };
+            weight = w;
+            d = scatter(d, medium.g, rng);
             continue;
         };
         p += d * t;
@@ -381,29 +522,200 @@ fn walk(
         let n = geometry.normals[triangle];
         let cos = d.dot(n);
         if cos <= 0.0 {
-            return Some(Exit::Lost { channel });
+            return true;
         }
-        if rng.random::<f64>() < fresnel::fresnel_reflectance(cos, 1.0 / medium.eta) {
-            d -= n * (2.0 * cos);
-            continue;
+        let r = fresnel::fresnel_reflectance(cos, 1.0 / medium.eta);
+        let channel = start.channel;
+        if split {
+            if r < 1.0 {
+                exits.push(Exit {
+                    vertex: geometry.cell_vertex(triangle, u, v),
+                    channel,
+                    weight: scale * weight * (1.0 - r),
+                });
+            }
+            let Some(w) = after_reflection(weight, r, albedo, rng) else { return false };
+            weight = w;
+        } else if rng.random::<f64>() >= r {
+            exits.push(Exit { vertex: geometry.cell_vertex(triangle, u, v), channel, weight });
+            return false;
         }
-        let bary = [1.0 - u - v, u, v];
-        let corner = if bary[0] >= bary[1] && bary[0] >= bary[2] {
-            0
-        } else if bary[1] >= bary[2] {
-            1
-        } else {
-            2
-        };
-        let vertex = geometry.mesh.triangles()[triangle][corner] as usize;
-        return Some(Exit::Left { vertex, channel, weight });
+        d -= n * (2.0 * cos);
     }
 }
 
-/// `d` turned by the scattering angle of cosine `cos`, about it by the azimuth `u` turns.
-fn scatter(d: DVec3, cos: f64, u: f64) -> DVec3 {
+/// The direction after a scattering of `d` by the Henyey-Greenstein phase function of mean
+/// cosine `g`. Isotropic (`g` 0, every reduced medium's, `Medium::reduced`) it does not depend
+/// on `d`: a uniform direction by Marsaglia's method (1972), without the sine and cosine of an
+/// azimuth that were a tenth of the walk's time in marble.
+fn scatter(d: DVec3, g: f64, rng: &mut Pcg64) -> DVec3 {
+    if g == 0.0 {
+        loop {
+            let (x, y) = (2.0 * rng.random::<f64>() - 1.0, 2.0 * rng.random::<f64>() - 1.0);
+            let s = x * x + y * y;
+            if s < 1.0 {
+                let r = 2.0 * (1.0 - s).sqrt();
+                return DVec3::new(x * r, y * r, 1.0 - 2.0 * s);
+            }
+        }
+    }
+    let cos = sample_hg_cos(g, rng.random::<f64>());
     let (a, b) = d.any_orthonormal_pair();
     let sin = (1.0 - cos * cos).max(0.0).sqrt();
-    let phi = std::f64::consts::TAU * u;
+    let phi = std::f64::consts::TAU * rng.random::<f64>();
     (d * cos + (a * phi.cos() + b * phi.sin()) * sin).normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+    use crate::scene::build::Overrides;
+
+    fn quiet(_: super::super::rte::RteProgress) {}
+
+    /// A 2 cm ketchup sphere (dark green and blue: implicit capture) and a 6 mm marble one
+    /// (bright: analog absorption, eta 1.5; small, as its walks are long), coarse, under one
+    /// directional light.
+    fn spheres() -> PreparedScene {
+        let text = r#"
+[camera]
+eye = [0.0, 0.0, 0.05]
+target = [0.0, 0.0, 0.0]
+resolution = [16, 16]
+
+[[object]]
+shape = { type = "sphere", radius = 0.01, divisions = 8 }
+material = { type = "translucent", preset = "ketchup", mm_per_unit = 1000.0 }
+casts_shadow = false
+
+[[object]]
+shape = { type = "sphere", radius = 0.003, divisions = 8 }
+transform = { translate = [0.02, 0.0, 0.0] }
+material = { type = "translucent", preset = "marble", mm_per_unit = 1000.0 }
+casts_shadow = false
+
+[[light]]
+type = "directional"
+direction = [0.8, 0.5, 0.3]
+irradiance = [1.0, 1.0, 1.0]
+"#;
+        PreparedScene::new(&Scene::parse(text, "spheres.toml", None).unwrap(), &Overrides::default()).unwrap()
+    }
+
+    fn run(scene: &PreparedScene, photons: u64, seed: u64, method: Method) -> Vec<ObjectExitance> {
+        let options = MeshOptions { budget: Budget::photons(photons), seed };
+        exitance_by(scene, &options, &quiet, method).unwrap().into_iter().map(Option::unwrap).collect()
+    }
+
+    /// Per object and channel, the flux that left (exitance times cell area, summed).
+    fn flux(scene: &PreparedScene, result: &[ObjectExitance]) -> Vec<[f64; 3]> {
+        result
+            .iter()
+            .zip(&scene.objects)
+            .map(|(r, o)| {
+                let cells = cell_areas(&o.mesh);
+                [0, 1, 2].map(|c| r.exitance.iter().zip(&cells).map(|(m, a)| m[c] * a).sum())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_clearance_grid_changes_nothing_but_the_time() {
+        // The grid only answers closest-hit queries whose answer is "none": the same random
+        // numbers meet the same faces, so the walks are the same to the bit.
+        let scene = spheres();
+        let with = run(&scene, 4000, 3, WALK);
+        let without = run(&scene, 4000, 3, Method { clearance: false, ..WALK });
+        for (a, b) in with.iter().zip(&without) {
+            assert_eq!((&a.exitance, &a.stderr, a.photons), (&b.exitance, &b.stderr, b.photons));
+        }
+    }
+
+    #[test]
+    fn the_split_walk_agrees_with_the_analog_walk_and_is_less_noisy() {
+        // Eight seeds of each walk: the flux out per object and channel, its mean and the
+        // standard error of that mean from the seeds' spread (which counts every covariance
+        // between vertices, unlike the per-vertex errors); the two walks within 3 combined
+        // standard errors. And at equal photons the split walk's precision (the module's
+        // figure, over the pooled seeds) is better by more than 1 / 0.7 in ketchup's dark
+        // channels, where most light leaves after one or two scatterings (measured: 0.126
+        // against 0.393 in green, 0.129 against 0.398 in blue).
+        let scene = spheres();
+        let old = Method { split: false, clearance: false };
+        let (seeds, photons) = (8, 6000);
+        let runs = |method: Method| -> Vec<Vec<ObjectExitance>> {
+            (0..seeds).map(|s| run(&scene, photons, 100 + 2 * s, method)).collect()
+        };
+        let (new_runs, old_runs) = (runs(WALK), runs(old));
+        let stats = |runs: &[Vec<ObjectExitance>], o: usize, c: usize| {
+            let f: Vec<f64> = runs.iter().map(|r| flux(&scene, r)[o][c]).collect();
+            let n = f.len() as f64;
+            let mean = f.iter().sum::<f64>() / n;
+            let var = f.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+            (mean, (var / n).sqrt())
+        };
+        for o in 0..2 {
+            for c in 0..3 {
+                let ((a, sa), (b, sb)) = (stats(&new_runs, o, c), stats(&old_runs, o, c));
+                let combined = (sa * sa + sb * sb).sqrt();
+                assert!(
+                    (a - b).abs() <= 3.0 * combined,
+                    "object {o} channel {c}: split {a:.5e} ± {sa:.1e}, analog {b:.5e} ± {sb:.1e}"
+                );
+                assert!(combined < 0.1 * a, "object {o} channel {c}: the test must measure something");
+            }
+        }
+        // The seeds pooled: per vertex the mean of their means, its variance a 64th of the
+        // sum of theirs.
+        let pooled = |runs: &[Vec<ObjectExitance>]| -> [f64; 3] {
+            let n = runs.len() as f64;
+            let count = runs[0][0].exitance.len();
+            let mean: Vec<[f64; 3]> = (0..count)
+                .map(|v| [0, 1, 2].map(|c| runs.iter().map(|r| r[0].exitance[v][c]).sum::<f64>() / n))
+                .collect();
+            let se: Vec<[f64; 3]> = (0..count)
+                .map(|v| [0, 1, 2].map(|c| runs.iter().map(|r| r[0].stderr[v][c].powi(2)).sum::<f64>().sqrt() / n))
+                .collect();
+            [0, 1, 2].map(|c| {
+                let pick = |x: &[[f64; 3]]| x.iter().map(|m| [m[c]; 3]).collect::<Vec<_>>();
+                relative_stderr(&pick(&mean), &pick(&se))
+            })
+        };
+        let (new, old) = (pooled(&new_runs), pooled(&old_runs));
+        for c in [1, 2] {
+            assert!(
+                new[c] < 0.7 * old[c],
+                "ketchup channel {c}: relative standard error {} against {}",
+                new[c],
+                old[c]
+            );
+        }
+    }
+
+    #[test]
+    fn isotropic_directions_are_uniform() {
+        // Uniform on the sphere: each coordinate uniform on [-1, 1] (Archimedes), so mean 0
+        // and mean square 1 / 3; unit length.
+        let mut rng = chunk_rng(4, 0);
+        let n = 200_000;
+        let (mut sum, mut sum2) = (DVec3::ZERO, DVec3::ZERO);
+        for _ in 0..n {
+            let d = scatter(DVec3::X, 0.0, &mut rng);
+            assert!((d.length() - 1.0).abs() < 1e-12);
+            sum += d;
+            sum2 += d * d;
+        }
+        let tolerance = 5.0 / (n as f64).sqrt();
+        assert!(sum.abs().max_element() / (n as f64) < tolerance, "mean {}", sum / n as f64);
+        assert!((sum2 / n as f64 - 1.0 / 3.0).abs().max_element() < tolerance, "mean square {}", sum2 / n as f64);
+    }
+
+    #[test]
+    fn a_photons_exits_at_one_vertex_are_one_score() {
+        let e = |vertex, channel, weight| Exit { vertex, channel, weight };
+        let mut exits = vec![e(9, 0, 5.0), e(3, 1, 1.0), e(4, 1, 2.0), e(3, 1, 0.5), e(3, 0, 0.25)];
+        merge_photon(&mut exits, 1);
+        assert_eq!(exits, vec![e(9, 0, 5.0), e(3, 0, 0.25), e(3, 1, 1.5), e(4, 1, 2.0)]);
+    }
 }
