@@ -338,16 +338,10 @@ fn single_scattering_glsl_twin_matches_f64_reference() {
     );
 }
 
-/// `glsl/common/directional_dipole.glsl` against `optics::directional_dipole` (issue 26): the
-/// exitance per entering flux and its real and virtual source terms over marble, ketchup and
-/// skin, both diffusion coefficients and both source strengths, entry points on a plane and on
-/// spheres of radius 2 and 10 mm, incidence from normal to grazing, exit points from 0.01 to
-/// 8 mm away in every direction. Every value finite; the exitance and each source term within
-/// 1e-4 of the two terms' absolute sum of the f64 (evaluated on the same f32 inputs): the
-/// exitance is their difference and each term a difference of its fluence and flux parts, so a
-/// plain relative bound fails where they cancel (1.65e-4 on a virtual term 1e-3 of the real one).
-#[test]
-fn directional_dipole_glsl_twin_matches_f64_reference() {
+/// The directional dipole twin's cases (see its test): per case the GPU record (the model's
+/// coefficients rounded to f32, then x_i, n_i, w_12, x_o, n_o) and the f64 model on the same
+/// coefficients.
+fn directional_records() -> (Vec<[[f32; 4]; 7]>, Vec<translucent::optics::directional_dipole::DirectionalDipole>) {
     use glam::DVec3;
     use translucent::optics::directional_dipole::{Diffusion, DirectionalDipole, Strength, refract_in};
     let mut records: Vec<[[f32; 4]; 7]> = Vec::new();
@@ -404,6 +398,21 @@ fn directional_dipole_glsl_twin_matches_f64_reference() {
             }
         }
     }
+    (records, models)
+}
+
+/// `glsl/common/directional_dipole.glsl` against `optics::directional_dipole` (issue 26): the
+/// exitance per entering flux and its real and virtual source terms over marble, ketchup and
+/// skin, both diffusion coefficients and both source strengths, entry points on a plane and on
+/// spheres of radius 2 and 10 mm, incidence from normal to grazing, exit points from 0.01 to
+/// 8 mm away in every direction. Every value finite; the exitance and each source term within
+/// 1e-4 of the two terms' absolute sum of the f64 (evaluated on the same f32 inputs): the
+/// exitance is their difference and each term a difference of its fluence and flux parts, so a
+/// plain relative bound fails where they cancel (1.65e-4 on a virtual term 1e-3 of the real one).
+#[test]
+fn directional_dipole_glsl_twin_matches_f64_reference() {
+    use glam::DVec3;
+    let (records, models) = directional_records();
     let outputs: Vec<[f32; 4]> = eval_on_gpu("directional_dipole_eval.comp", &records);
     let v = |p: [f32; 4]| DVec3::new(p[0].into(), p[1].into(), p[2].into());
     let (mut worst, mut worst_exitance) = ([0.0f64; 2], 0.0f64);
