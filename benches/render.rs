@@ -557,7 +557,15 @@ fn wanted(section: &str) -> bool {
 }
 
 fn main() {
-    let options = GpuOptions { device: std::env::var("TRANSLUCENT_DEVICE").ok(), ..Default::default() };
+    // TRANSLUCENT_VALIDATION=1 checks the benchmark's own passes (the yardsticks record their own
+    // barriers); TRANSLUCENT_SYNC_VALIDATION=1 adds synchronisation validation. Off for figures.
+    let on = |name: &str| std::env::var(name).is_ok_and(|v| !v.is_empty() && v != "0");
+    let options = GpuOptions {
+        device: std::env::var("TRANSLUCENT_DEVICE").ok(),
+        validation: on("TRANSLUCENT_VALIDATION") || on("TRANSLUCENT_SYNC_VALIDATION"),
+        sync_validation: on("TRANSLUCENT_SYNC_VALIDATION"),
+        ..Default::default()
+    };
     let gpu = Gpu::new(&options).expect("a Vulkan device (run `bash scripts/setup`)");
     println!("device: {} ({}, {} {})", gpu.info().name, gpu.info().kind, gpu.info().driver, gpu.info().driver_info);
     println!("cores: {}", std::thread::available_parallelism().map(|n| n.get()).unwrap_or(0));
@@ -595,11 +603,18 @@ fn main() {
     if wanted("planner") {
         planner(&gpu);
     }
-    if !wanted("gathers") {
-        return;
+    if wanted("gathers") {
+        gathers(&gpu, &scene);
+        fps_against_samples(&gpu, &scene);
     }
-    gathers(&gpu, &scene);
-    fps_against_samples(&gpu, &scene);
+    if gpu.validation_enabled() {
+        let messages = gpu.validation().messages();
+        println!("validation: {} messages", messages.len());
+        for m in &messages {
+            println!("  {m}");
+        }
+        assert!(messages.is_empty(), "the benchmark's passes raised validation messages");
+    }
 }
 
 /// The "frames" section: per-pass times of the default scene with the key light moving and with
