@@ -29,11 +29,11 @@
 //! the change against half of it.
 
 use super::bvh::Bvh;
-use super::{light_incidence, occluders, ray_offset};
+use super::{occluders, per_translucent_object, ray_offset, reaching};
 use crate::mesh::Mesh;
 use crate::optics::directional_dipole::{Diffusion, DirectionalDipole, Strength, refract_in};
 use crate::optics::fresnel;
-use crate::scene::build::{PreparedScene, ResolvedMaterial};
+use crate::scene::build::PreparedScene;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -68,46 +68,39 @@ pub fn exitance_with(
 ) -> Vec<Vec<[f64; 3]>> {
     let casters = occluders(scene);
     let eps = ray_offset(scene);
-    scene
-        .objects
-        .iter()
-        .map(|o| {
-            let count = o.mesh.positions().len();
-            let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else {
-                return vec![[0.0; 3]; count];
-            };
-            let models = dipoles.map(|d| DirectionalDipole::with_options(&d, diffusion, strength));
-            let source = Sources { scene, casters: &casters, eps, eta: dipoles[0].eta };
-            (0..count)
-                .into_par_iter()
-                .map(|v| {
-                    let x_o = o.mesh.positions()[v].as_dvec3();
-                    let n_o = o.mesh.vertex_normals()[v].as_dvec3().normalize();
-                    [0, 1, 2].map(|c| {
-                        let model = &models[c];
-                        let eval = |x_i: DVec3, n_i: DVec3, w: DVec3| match kernel {
-                            Some(k) => k(c, x_i, n_i, w, x_o, n_o),
-                            None => model.exitance_per_flux(x_i, n_i, w, x_o, n_o),
-                        };
-                        let receiver = Receiver {
-                            x_o,
-                            channel: c,
-                            sigma_tr: model.sigma_tr,
-                            width: 1.0 / (3.0 * model.sigma_t_prime),
-                            fineness,
-                        };
-                        (0..o.mesh.triangles().len())
-                            .map(|t| {
-                                let corners = o.mesh.corners(t);
-                                let bary = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-                                receiver.piece(&o.mesh, t, corners, bary, 0, &source, &eval)
-                            })
-                            .sum::<f64>()
-                    })
+    per_translucent_object(scene, |o, dipoles, _| {
+        let count = o.mesh.positions().len();
+        let models = dipoles.map(|d| DirectionalDipole::with_options(&d, diffusion, strength));
+        let source = Sources { scene, casters: &casters, eps, eta: dipoles[0].eta };
+        (0..count)
+            .into_par_iter()
+            .map(|v| {
+                let x_o = o.mesh.positions()[v].as_dvec3();
+                let n_o = o.mesh.vertex_normals()[v].as_dvec3().normalize();
+                [0, 1, 2].map(|c| {
+                    let model = &models[c];
+                    let eval = |x_i: DVec3, n_i: DVec3, w: DVec3| match kernel {
+                        Some(k) => k(c, x_i, n_i, w, x_o, n_o),
+                        None => model.exitance_per_flux(x_i, n_i, w, x_o, n_o),
+                    };
+                    let receiver = Receiver {
+                        x_o,
+                        channel: c,
+                        sigma_tr: model.sigma_tr,
+                        width: 1.0 / (3.0 * model.sigma_t_prime),
+                        fineness,
+                    };
+                    (0..o.mesh.triangles().len())
+                        .map(|t| {
+                            let corners = o.mesh.corners(t);
+                            let bary = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+                            receiver.piece(&o.mesh, t, corners, bary, 0, &source, &eval)
+                        })
+                        .sum::<f64>()
                 })
-                .collect()
-        })
-        .collect()
+            })
+            .collect()
+    })
 }
 
 /// What lights a point of the surface.
@@ -122,13 +115,7 @@ impl Sources<'_> {
     /// Sum over lights of the entering flux per unit area times `kernel(x_i, n_i, w_12)`.
     fn at(&self, p: DVec3, n: DVec3, kernel: &dyn Fn(DVec3, DVec3, DVec3) -> f64) -> [f64; 3] {
         let mut out = [0.0; 3];
-        for l in &self.scene.lights {
-            let (wi, e, dist) = light_incidence(l, p);
-            let cos_i = n.dot(wi);
-            if cos_i <= 0.0 || (l.shadow_layer.is_some() && self.casters.occluded(p + n * self.eps, wi, self.eps, dist))
-            {
-                continue;
-            }
+        for (wi, e, cos_i) in self.scene.lights.iter().filter_map(|l| reaching(l, self.casters, p, n, self.eps)) {
             let Some(w_12) = refract_in(wi, n, self.eta) else { continue };
             let k = kernel(p, n, w_12) * cos_i * fresnel::fresnel_transmittance(cos_i, self.eta);
             (0..3).for_each(|c| out[c] += e[c] * k);

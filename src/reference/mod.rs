@@ -84,6 +84,22 @@ pub fn splat(scene: &PreparedScene, occluders: &Bvh) -> Vec<[f64; 3]> {
         .collect()
 }
 
+/// Light `l` at surface point `p` with shading normal `n`: its direction, its irradiance and the
+/// incidence cosine, where it faces the point and no caster blocks it (a ray cast from `eps`
+/// off the surface, for lights that cast shadows); `None` otherwise.
+pub(crate) fn reaching(
+    l: &PreparedLight,
+    occluders: &Bvh,
+    p: DVec3,
+    n: DVec3,
+    eps: f64,
+) -> Option<(DVec3, DVec3, f64)> {
+    let (wi, e, dist) = light_incidence(l, p);
+    let cos_i = n.dot(wi);
+    let blocked = || l.shadow_layer.is_some() && occluders.occluded(p + n * eps, wi, eps, dist);
+    (cos_i > 0.0 && !blocked()).then_some((wi, e, cos_i))
+}
+
 /// How far a visibility ray starts off the surface: the scale of f32 positions in the scene.
 pub fn ray_offset(scene: &PreparedScene) -> f64 {
     ray_offset_within(scene.bounds.1)

@@ -49,7 +49,7 @@ use super::rte::{
     Budget, Medium, Progress, RteError, after_collision, after_reflection, chunk_rng, run_rounds, sample_hg_cos,
 };
 use super::truth::LIT_FLOOR;
-use super::{light_incidence, occluders, ray_offset};
+use super::{light_incidence, occluders, ray_offset, reaching};
 use crate::mesh::Mesh;
 use crate::optics::fresnel;
 use crate::scene::build::{PreparedScene, ResolvedMaterial};
@@ -438,14 +438,12 @@ fn photon(
     let p = geometry.mesh.point(t, bary);
     let n = geometry.normals[t];
     let light = &lighting.lights[l];
-    let (wi, e, dist) = light_incidence(light, p);
-    let cos_i = n.dot(wi);
+    let Some((wi, e, cos_i)) = reaching(light, lighting.occluders, p, n, lighting.eps) else {
+        return;
+    };
     let eta = media[0].eta;
     let f_t = fresnel::fresnel_transmittance(cos_i, eta);
-    if cos_i <= 0.0 || f_t <= 0.0 {
-        return;
-    }
-    if light.shadow_layer.is_some() && lighting.occluders.occluded(p + n * lighting.eps, wi, lighting.eps, dist) {
+    if f_t <= 0.0 {
         return;
     }
     // Snell: the tangential part shrinks by 1 / eta, the normal part points inwards.

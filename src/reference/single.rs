@@ -11,9 +11,9 @@
 //! gathered exitance per vertex for `model = dipole + single`; `study --physics` measures it
 //! against the radiative-transfer reference (docs/STUDY.md).
 
-use super::{light_incidence, occluders, ray_offset};
+use super::{occluders, per_translucent_object, ray_offset, reaching};
 use crate::optics::{fresnel, single_scatter};
-use crate::scene::build::{PreparedScene, ResolvedMaterial};
+use crate::scene::build::PreparedScene;
 use rayon::prelude::*;
 
 /// Per object (scene order), per vertex, RGB: the single-scattering exitance `M1` (see the
@@ -21,35 +21,22 @@ use rayon::prelude::*;
 pub fn exitance(scene: &PreparedScene) -> Vec<Vec<[f64; 3]>> {
     let casters = occluders(scene);
     let eps = ray_offset(scene);
-    scene
-        .objects
-        .iter()
-        .map(|o| {
-            let count = o.mesh.positions().len();
-            let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else {
-                return vec![[0.0; 3]; count];
-            };
-            let eta = dipoles[0].eta;
-            (0..count)
-                .into_par_iter()
-                .map(|v| {
-                    let p = o.mesh.positions()[v].as_dvec3();
-                    let n = o.mesh.vertex_normals()[v].as_dvec3().normalize();
-                    let mut m = [0.0; 3];
-                    for l in &scene.lights {
-                        let (wi, e, dist) = light_incidence(l, p);
-                        let cos_i = n.dot(wi);
-                        if cos_i <= 0.0 || (l.shadow_layer.is_some() && casters.occluded(p + n * eps, wi, eps, dist)) {
-                            continue;
-                        }
-                        let e_t = e * (cos_i * fresnel::fresnel_transmittance(cos_i, eta));
-                        for (c, d) in dipoles.iter().enumerate() {
-                            m[c] += e_t[c] * single_scatter::reflectance(d.alpha_prime, 0.0, eta, cos_i.min(1.0));
-                        }
+    per_translucent_object(scene, |o, dipoles, _| {
+        let eta = dipoles[0].eta;
+        (0..o.mesh.positions().len())
+            .into_par_iter()
+            .map(|v| {
+                let p = o.mesh.positions()[v].as_dvec3();
+                let n = o.mesh.vertex_normals()[v].as_dvec3().normalize();
+                let mut m = [0.0; 3];
+                for (_, e, cos_i) in scene.lights.iter().filter_map(|l| reaching(l, &casters, p, n, eps)) {
+                    let e_t = e * (cos_i * fresnel::fresnel_transmittance(cos_i, eta));
+                    for (c, d) in dipoles.iter().enumerate() {
+                        m[c] += e_t[c] * single_scatter::reflectance(d.alpha_prime, 0.0, eta, cos_i.min(1.0));
                     }
-                    m
-                })
-                .collect()
-        })
-        .collect()
+                }
+                m
+            })
+            .collect()
+    })
 }
