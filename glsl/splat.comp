@@ -2,7 +2,7 @@
 // Irradiance splat: for every sample point, the irradiance transmitted into the medium from
 // every light: sum over lights of E_light cos(theta_i) F_t(cos theta_i, eta) V, with V from the
 // light's shadow map (one bilinear compare tap at the sample, no normal offset: the sharpest,
-// closest to ray casting). Also the sample's near-field energy per channel (dipole_near_energy),
+// closest to ray casting) or from a shadow ray against the casters' hierarchy (SPLAT_VISIBILITY). Also the sample's near-field energy per channel (dipole_near_energy),
 // which depends only on its area and material, so that the gather pays for it once per sample
 // instead of once per pair.
 //
@@ -15,7 +15,8 @@
 // Bindings: 0 = samples (SampleRecord[], read), 1 = objects (ObjectRecord[], read),
 // 2 = lights (Light[], read), 3 = shadow maps (sampler2DArrayShadow),
 // 4 = splat output (SplatRecord[]), write, 5 = the environment's part (vec4 per sample), read
-// when kept, else written.
+// when kept, else written, 6 = the casters' hierarchy (BvhNode[]), 7 = its triangles
+// (BvhTriangle[]), both read.
 // Push: SplatPush.
 #include "dipole.glsl"
 #include "lights.glsl"
@@ -28,31 +29,64 @@ layout(std430, set = 0, binding = 2) readonly buffer Lights { Light lights[]; };
 layout(set = 0, binding = 3) uniform sampler2DArrayShadow shadow_maps;
 layout(std430, set = 0, binding = 4) writeonly buffer Splat { SplatRecord splat[]; };
 layout(std430, set = 0, binding = 5) buffer SplatEnvironment { vec4 kept_environment[]; };
+#define RAYS_NODES_BINDING 6
+#define RAYS_TRIANGLES_BINDING 7
+#include "rays.glsl"
 struct SplatPush {
-    uint first_sample;      // one dispatch per object: its samples
+    uint object;            // one dispatch per object: its index and its samples
+    uint first_sample;
     uint sample_count;
     uint light_count;       // all lights: key lights first, then the environment's directions
     uint key_light_count;
     uint environment_kept;  // 1: read the environment's part; 0: compute and keep it
+    uint caster_triangles;  // triangles in bvh_triangles (0: nothing casts a shadow)
+    float ray_offset;       // a ray leaves p + n ray_offset and counts hits past ray_offset
 };
 layout(push_constant) uniform SplatPushBlock { SplatPush push; };
+// scene::SplatVisibility: 0 = the lights' shadow maps; 1 = shadow rays against the casters'
+// hierarchy (exact, as the truth's: reference::transmitted_irradiance); 2 = hybrid, the map where
+// it is sure and a ray where it is not.
+layout(constant_id = 0) const uint SPLAT_VISIBILITY = 0u;
 
-// Irradiance transmitted at `p` (normal `n`, index ratio `eta`) from lights [first, end).
-vec3 transmitted(uint first, uint end, vec3 p, vec3 n, float eta) {
+// A shadow ray from the sample towards the light (as reference::transmitted_irradiance casts
+// it): 1 when nothing blocks it.
+float ray_visibility(Light l, vec3 p, vec3 n, vec3 wi) {
+    if (push.caster_triangles == 0u) return 1.0;
+    float t_max = l.kind == LIGHT_DIRECTIONAL ? 3.0e38 : length(l.position - p);
+    return ray_occluded(p + n * push.ray_offset, wi, push.ray_offset, t_max) ? 0.0 : 1.0;
+}
+
+// Whether light `l` (direction `wi` from `p`, normal `n`, cosine `cos_i`) reaches the sample;
+// `terminator`: the sine of the normal's angle to the sample's face normal.
+float sample_visibility(Light l, vec3 p, vec3 n, vec3 wi, float cos_i, float terminator) {
+    if (l.power_layer.w < 0.0) return 1.0;
+    if (SPLAT_VISIBILITY == 1u) return ray_visibility(l, p, n, wi);
+    // Looked up at the sample itself, without the normal offset the shading pass takes
+    // against acne: the truth casts its rays from the point (reference::ray_offset), and
+    // the offset lit samples beside the terminator of coarse meshes that a ray finds
+    // blocked (docs/STUDY.md, "Visibility in the splat"). The maps' slope-scaled depth
+    // bias still keeps lit faces free of acne.
+    Light unbiased = l;
+    unbiased.spot_texel.z = 0.0;
+    if (SPLAT_VISIBILITY == 0u) return light_visibility(unbiased, shadow_maps, p, n, 0);
+    // Hybrid: the four texels the bilinear tap would read; where they agree and the triangle
+    // faces the light (cos_i >= terminator), the map's answer is the ray's but for occluders
+    // thinner than a texel.
+    vec4 taps = light_texels(unbiased, shadow_maps, p, n);
+    bool sure = cos_i >= terminator && all(equal(taps, taps.xxxx));
+    return sure ? taps.x : ray_visibility(l, p, n, wi);
+}
+
+// Irradiance transmitted at `p` (normal `n`, index ratio `eta`) from lights [first, end);
+// `terminator` as sample_visibility's.
+vec3 transmitted(uint first, uint end, vec3 p, vec3 n, float eta, float terminator) {
     vec3 e = vec3(0.0);
     for (uint l = first; l < end; ++l) {
         vec3 wi, irradiance;
         light_incidence(lights[l], p, wi, irradiance);
         float cos_i = dot(n, wi);
         if (cos_i <= 0.0) continue;
-        // Looked up at the sample itself, without the normal offset the shading pass takes
-        // against acne: the truth casts its rays from the point (reference::ray_offset), and
-        // the offset lit samples beside the terminator of coarse meshes that a ray finds
-        // blocked (docs/STUDY.md, "Visibility in the splat"). The maps' slope-scaled depth
-        // bias still keeps lit faces free of acne.
-        Light unbiased = lights[l];
-        unbiased.spot_texel.z = 0.0;
-        float v = light_visibility(unbiased, shadow_maps, p, n, 0);
+        float v = sample_visibility(lights[l], p, n, wi, cos_i, terminator);
         e += irradiance * (cos_i * dipole_fresnel_transmittance(cos_i, eta) * v);
     }
     return e;
@@ -62,17 +96,18 @@ void main() {
     if (gl_GlobalInvocationID.x >= push.sample_count) return;
     uint i = push.first_sample + gl_GlobalInvocationID.x;
     SampleRecord s = samples[i];
-    ObjectRecord o = objects[uint(s.normal_object.w)];
+    ObjectRecord o = objects[push.object];
     vec3 p = s.position_area.xyz;
-    vec3 n = s.normal_object.xyz;
+    vec3 n = s.normal_terminator.xyz;
+    float terminator = s.normal_terminator.w;
     vec3 environment;
     if (push.environment_kept != 0u) {
         environment = kept_environment[i].xyz;
     } else {
-        environment = transmitted(push.key_light_count, push.light_count, p, n, o.eta);
+        environment = transmitted(push.key_light_count, push.light_count, p, n, o.eta, terminator);
         kept_environment[i] = vec4(environment, 0.0);
     }
-    vec3 e = transmitted(0u, push.key_light_count, p, n, o.eta) + environment;
+    vec3 e = transmitted(0u, push.key_light_count, p, n, o.eta, terminator) + environment;
     float area = s.position_area.w;
     if (push.environment_kept != 0u) {
         // The near energy depends on the sample's area and material alone, and whatever

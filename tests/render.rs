@@ -8,7 +8,7 @@ use translucent::reference;
 use translucent::render::plan::{Change, Pass};
 use translucent::render::renderer::Renderer;
 use translucent::scene::build::{Overrides, PreparedScene};
-use translucent::scene::{GatherMode, Scene, TransportMode, lights};
+use translucent::scene::{GatherMode, Scene, SplatVisibility, TransportMode, lights};
 
 /// Whole meshes unless the test asks for levels of detail: these tests compare every vertex's
 /// exitance.
@@ -139,43 +139,53 @@ fn gather_matches_the_f64_reference_on_the_default_scene() {
 
 #[test]
 fn splat_visibility_matches_ray_casting() {
+    // The shadow rays are the f64 reference's own test in f32: every sample agrees but where a
+    // ray grazes a triangle's edge. The hybrid trusts the map only where its four texels agree
+    // and the triangle faces the light. The shadow maps' one tap is off by up to a texel at
+    // shadow edges: at most 2% of the samples.
+    let cases = [
+        (SplatVisibility::Rays, 1e-4, 0.001),
+        (SplatVisibility::Hybrid, 1e-4, 0.001),
+        (SplatVisibility::ShadowMaps, 0.02, 0.02),
+    ];
     with_gpu(|gpu| {
-        let overrides = Overrides { resolution: Some([64, 64]), ..Default::default() };
-        let prepared = builtin(&overrides);
-        let occluders = reference::occluders(&prepared);
-        let expected = reference::splat(&prepared, &occluders);
-        let renderer = run_all(gpu, prepared);
-        let got = renderer.splat_irradiance().unwrap();
-        let peak = expected.iter().flat_map(|e| e.iter()).fold(0.0f64, |a, b| a.max(*b));
-        let differing = got
-            .iter()
-            .zip(&expected)
-            .filter(|((g, _), e)| (0..3).any(|c| (g[c] as f64 - e[c]).abs() > 0.02 * e[c].max(0.05 * peak)))
-            .count();
-        for k in 0..5 {
-            eprintln!("sample {k}: gpu {:?} cpu {:?}", got[k].0, expected[k]);
+        for (visibility, tolerance, allowed) in cases {
+            let overrides =
+                Overrides { resolution: Some([64, 64]), splat_visibility: Some(visibility), ..Default::default() };
+            let prepared = builtin(&overrides);
+            let expected = reference::splat(&prepared, &reference::occluders(&prepared));
+            let renderer = run_all(gpu, prepared);
+            let got: Vec<[f32; 3]> = renderer.splat_irradiance().unwrap().iter().map(|(g, _)| *g).collect();
+            let fraction = splat_differing(visibility, &got, &expected, tolerance);
+            assert!(
+                fraction <= allowed,
+                "{visibility}: {:.3}% of the samples differ by over {tolerance}",
+                100.0 * fraction
+            );
         }
-        let mut rel: Vec<f64> = got
-            .iter()
-            .zip(&expected)
-            .map(|((g, _), e)| (0..3).map(|c| (g[c] as f64 - e[c]).abs() / e[c].max(0.05 * peak)).fold(0.0, f64::max))
-            .collect();
-        rel.sort_by(f64::total_cmp);
-        eprintln!(
-            "splat relative differences: median {:.2e}, 95% {:.2e}, 98% {:.2e}, max {:.2e}",
-            rel[rel.len() / 2],
-            rel[rel.len() * 95 / 100],
-            rel[rel.len() * 98 / 100],
-            rel[rel.len() - 1]
-        );
-        let fraction = differing as f64 / got.len() as f64;
-        eprintln!(
-            "splat: {differing} of {} samples differ from ray-cast visibility by over 2% ({:.2}%)",
-            got.len(),
-            100.0 * fraction
-        );
-        assert!(fraction <= 0.02, "{differing} of {} samples differ", got.len());
     });
+}
+
+/// The share of samples whose splat `got` differs from the f64 `expected` by over `tolerance`
+/// relative (floored at 5% of the peak), with the differences' quantiles printed.
+fn splat_differing(visibility: SplatVisibility, got: &[[f32; 3]], expected: &[[f64; 3]], tolerance: f64) -> f64 {
+    let peak = expected.iter().flat_map(|e| e.iter()).fold(0.0f64, |a, b| a.max(*b));
+    let mut rel: Vec<f64> = got
+        .iter()
+        .zip(expected)
+        .map(|(g, e)| (0..3).map(|c| (g[c] as f64 - e[c]).abs() / e[c].max(0.05 * peak)).fold(0.0, f64::max))
+        .collect();
+    rel.sort_by(f64::total_cmp);
+    let differing = rel.iter().filter(|&&r| r > tolerance).count();
+    eprintln!(
+        "splat ({visibility}) against ray casting in f64: relative differences median {:.2e}, 95% {:.2e}, max {:.2e}; \
+         {differing} of {} samples over {tolerance}",
+        rel[rel.len() / 2],
+        rel[rel.len() * 95 / 100],
+        rel[rel.len() - 1],
+        got.len(),
+    );
+    differing as f64 / got.len() as f64
 }
 
 #[test]

@@ -78,7 +78,7 @@ fn scene_records_match_glsl() {
     assert_eq!(size, size_of::<SampleRecord>());
     let rust = [
         ("position_area", offset_of!(SampleRecord, position_area)),
-        ("normal_object", offset_of!(SampleRecord, normal_object)),
+        ("normal_terminator", offset_of!(SampleRecord, normal_terminator)),
     ];
     assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
 }

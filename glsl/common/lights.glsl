@@ -71,4 +71,15 @@ float light_visibility(Light l, sampler2DArrayShadow maps, vec3 p, vec3 n, int r
     return 0.25 * lit;
 }
 
+// The shadow-map compares of the four texels a one-tap `light_visibility` (radius 0) filters
+// at `p` (1 = lit each); all 1 where the light casts no shadow or `p` lies outside its map.
+vec4 light_texels(Light l, sampler2DArrayShadow maps, vec3 p, vec3 n) {
+    float layer = l.power_layer.w;
+    if (layer < 0.0) return vec4(1.0);
+    vec4 clip = l.shadow_matrix * vec4(p + n * l.spot_texel.z, 1.0);
+    if (clip.w <= 0.0) return vec4(1.0);
+    vec3 ndc = clip.xyz / clip.w;
+    ndc.z = min(ndc.z, 1.0);
+    return textureGather(maps, vec3(ndc.xy * 0.5 + 0.5, layer), ndc.z);
+}
 #endif

@@ -35,7 +35,7 @@ vec3 object_gathered_channels(ObjectRecord o) {
 
 struct SampleRecord {
     vec4 position_area;     // xyz: world position; w: area weight (scene units^2)
-    vec4 normal_object;     // xyz: unit normal; w: object index (as float)
+    vec4 normal_terminator; // xyz: unit normal; w: sine of its angle to the face normal (records::SampleRecord)
 };
 
 // One sample's splat output (splat.comp writes it, the gathers read it).

@@ -10,7 +10,7 @@ use translucent::render::plan::{Change, Pass};
 use translucent::render::renderer::Renderer;
 use translucent::sampling::Method;
 use translucent::scene::build::{Overrides, PreparedScene};
-use translucent::scene::{GatherMode, Light, Scene, TransportMode, lights};
+use translucent::scene::{GatherMode, Light, Scene, SplatVisibility, TransportMode, lights};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -74,6 +74,11 @@ pub struct Args {
     /// (overrides render.transport)
     #[arg(long, value_parser = super::one_of::<TransportMode>(&TransportMode::ALL.map(TransportMode::name)))]
     pub transport: Option<TransportMode>,
+    /// How the splat finds whether a light reaches a sample: shadow rays into the casters'
+    /// triangles (exact) or one tap of the light's shadow map (overrides
+    /// render.splat_visibility)
+    #[arg(long, value_parser = super::one_of::<SplatVisibility>(&SplatVisibility::ALL.map(SplatVisibility::name)))]
+    pub splat_visibility: Option<SplatVisibility>,
     /// Write each translucent vertex's world position and the RGB radiant exitance drawn there
     /// to a PLY: gathered channels as gathered, local ones as R_d,total E_t at the vertex
     /// (implies --full-detail: every vertex gathered)
@@ -117,6 +122,7 @@ impl Default for Args {
             timings: false,
             explain: false,
             transport: None,
+            splat_visibility: None,
             export_exitance: None,
             full_detail: false,
         }
@@ -207,6 +213,7 @@ fn prepare(args: &Args) -> Result<PreparedScene> {
         texture_resolution: args.texture_resolution,
         resolution: args.resolution,
         transport: args.transport,
+        splat_visibility: args.splat_visibility,
         // Exported exitance is every vertex's.
         level_of_detail: (args.full_detail || args.export_exitance.is_some()).then_some(false),
     };

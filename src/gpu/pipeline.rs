@@ -133,13 +133,26 @@ pub struct ComputePipeline {
 impl ComputePipeline {
     /// `shader` is a path under `glsl/` ("smoke.comp"); its interface is reflected.
     pub fn new(gpu: &Arc<Gpu>, shader: &str) -> GpuResult<ComputePipeline> {
+        Self::specialized(gpu, shader, &[])
+    }
+
+    /// [`ComputePipeline::new`] with specialization constants: `constant_id` i takes
+    /// `constants[i]` (a bool is 0 or 1), so a choice fixed for the pipeline's life is no branch
+    /// at run time.
+    pub fn specialized(gpu: &Arc<Gpu>, shader: &str, constants: &[u32]) -> GpuResult<ComputePipeline> {
         let interface = ShaderInterface::of(shader)?;
         let layout = Layout::new(gpu, shader, &interface, vk::ShaderStageFlags::COMPUTE)?;
         let module = Module::new(gpu, shader)?;
+        let entries: Vec<_> = (0..constants.len() as u32)
+            .map(|i| vk::SpecializationMapEntry { constant_id: i, offset: 4 * i, size: 4 })
+            .collect();
+        let specialization =
+            vk::SpecializationInfo::default().map_entries(&entries).data(bytemuck::cast_slice(constants));
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(module.raw)
-            .name(c"main");
+            .name(c"main")
+            .specialization_info(&specialization);
         let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout.pipeline_layout)];
         let cache = gpu.pipeline_cache.lock().unwrap_or_else(|e| e.into_inner());
         // SAFETY: valid create info referencing live module and layout; the cache is locked.

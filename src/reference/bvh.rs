@@ -183,6 +183,22 @@ impl Bvh {
         }
     }
 
+    /// The hierarchy as the GPU's ray cast walks it (`glsl/common/rays.glsl`): the nodes in
+    /// order, with f32 boxes rounded outward (so a ray the f64 box admits stays admitted), and
+    /// the triangles in leaf order, so that a leaf's `first` indexes them directly.
+    pub fn flat(&self) -> (Vec<FlatNode>, Vec<[[f32; 3]; 3]>) {
+        let down = |v: DVec3| v.to_array().map(|x| (x as f32).next_down());
+        let up = |v: DVec3| v.to_array().map(|x| (x as f32).next_up());
+        let nodes = self
+            .nodes
+            .iter()
+            .map(|n| FlatNode { min: down(n.bounds.min), max: up(n.bounds.max), first: n.first, count: n.count })
+            .collect();
+        let triangles =
+            self.order.iter().map(|&t| self.triangles[t as usize].map(|p| p.as_vec3().to_array())).collect();
+        (nodes, triangles)
+    }
+
     /// Triangle `t` as given to [`Bvh::new`].
     pub fn triangle(&self, t: usize) -> &[DVec3; 3] {
         &self.triangles[t]
@@ -217,6 +233,20 @@ impl Bvh {
             }
         }
     }
+}
+
+/// One node of [`Bvh::flat`]: a leaf's triangles are `first .. first + count` of the flat
+/// triangle list; an inner node (count 0) has its children at `first` and `first + 1`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlatNode {
+    /// The box's lower corner, rounded down to f32.
+    pub min: [f32; 3],
+    /// The box's upper corner, rounded up to f32.
+    pub max: [f32; 3],
+    /// A leaf's first triangle, or an inner node's left child.
+    pub first: u32,
+    /// A leaf's triangle count; 0 for an inner node.
+    pub count: u32,
 }
 
 /// Where a ray first meets a triangle ([`Bvh::closest_hit`]).

@@ -5,7 +5,8 @@
 
 use super::graph::Resource;
 use super::records::{
-    LightGpu, NodePowerRecord, ObjectRecord, ReceiverGroupRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
+    BvhNodeRecord, BvhTriangleRecord, LightGpu, NodePowerRecord, ObjectRecord, ReceiverGroupRecord, SampleRecord,
+    SplatRecord, TreeNodeRecord, Vertex,
 };
 use crate::gpu::{Buffer, BufferDesc, Gpu, GpuResult};
 use crate::optics::kernel::NEAR_BLEND_RADIUS;
@@ -165,6 +166,16 @@ pub struct GpuScene {
     pub vertex_texel: Buffer,
     /// Per node of every atlas's sum tree (f32), written by the texture gather's stage 0.
     pub texture_pyramid: Buffer,
+    /// The shadow casters' hierarchy (`BvhNodeRecord` per node of `reference::bvh::Bvh::flat`),
+    /// for the splat's shadow rays; one empty node when nothing casts a shadow.
+    pub bvh_nodes: Buffer,
+    /// Its triangles in leaf order (`BvhTriangleRecord`).
+    pub bvh_triangles: Buffer,
+    /// Triangles in `bvh_triangles`: 0 when nothing casts a shadow.
+    pub caster_triangles: u32,
+    /// How far a shadow ray starts off the surface, along the normal, and the least distance
+    /// at which it counts a hit (`reference::ray_offset`, as the truth's rays).
+    pub ray_offset: f32,
     /// Per object, in scene order: its atlas and sum tree's place (`TextureRange`).
     pub textures: Vec<TextureRange>,
     /// Per level of detail of every object, one after another: the object-relative indices of
@@ -293,6 +304,8 @@ struct PackedObjects {
     vertex_texel: Vec<u32>,
     pyramid_nodes: usize,
     textures: Vec<TextureRange>,
+    bvh_nodes: Vec<BvhNodeRecord>,
+    bvh_triangles: Vec<BvhTriangleRecord>,
 }
 
 impl PackedObjects {
@@ -300,16 +313,29 @@ impl PackedObjects {
         let mut packed = PackedObjects::default();
         for (i, o) in scene.objects.iter().enumerate() {
             let first = [packed.vertices.len() as u32, packed.samples.len() as u32];
-            packed.object(i, o);
+            packed.object(o);
             if matches!(o.material, crate::scene::build::ResolvedMaterial::Translucent { .. }) {
                 packed.receiver(scene, i, o, first);
             }
         }
+        packed.casters(scene);
         packed
     }
 
+    /// The shadow casters' hierarchy, when the splat casts rays into it and there is anything to
+    /// splat and to cast a shadow.
+    fn casters(&mut self, scene: &PreparedScene) {
+        let rays = scene.scene.file.render.splat_visibility != crate::scene::SplatVisibility::ShadowMaps;
+        if !rays || !scene.any_caster || self.samples.is_empty() {
+            return;
+        }
+        let (nodes, triangles) = crate::reference::occluders(scene).flat();
+        self.bvh_nodes = nodes.iter().map(BvhNodeRecord::new).collect();
+        self.bvh_triangles = triangles.iter().map(BvhTriangleRecord::new).collect();
+    }
+
     /// Object `i`'s vertices, boundary distances, samples and record.
-    fn object(&mut self, i: usize, o: &crate::scene::build::PreparedObject) {
+    fn object(&mut self, o: &crate::scene::build::PreparedObject) {
         let (first_vertex, first_sample) = (self.vertices.len() as u32, self.samples.len() as u32);
         let normals = o.mesh.vertex_normals();
         let positions = o.mesh.positions();
@@ -321,7 +347,8 @@ impl PackedObjects {
         } else {
             self.vertex_boundary.extend(std::iter::repeat_n([crate::mesh::NO_BOUNDARY; 2], positions.len()));
         }
-        self.samples.extend(o.samples.iter().map(|s| SampleRecord::new(s, i)));
+        let faces = o.mesh.face_normals();
+        self.samples.extend(o.samples.iter().map(|s| SampleRecord::new(s, faces[s.triangle as usize])));
         let ranges = [first_vertex, positions.len() as u32, first_sample, o.samples.len() as u32];
         self.objects.push(ObjectRecord::new(o, ranges));
         self.atlas(o);
@@ -513,6 +540,10 @@ impl GpuScene {
             texel_index: upload(gpu, "texel index", &p.texel_index, none)?,
             vertex_texel: upload(gpu, "vertex texel", &p.vertex_texel, none)?,
             texture_pyramid: sized("texture pyramid", std::mem::size_of::<f32>(), p.pyramid_nodes)?,
+            bvh_nodes: upload(gpu, "caster hierarchy", &p.bvh_nodes, none)?,
+            bvh_triangles: upload(gpu, "caster triangles", &p.bvh_triangles, none)?,
+            caster_triangles: p.bvh_triangles.len() as u32,
+            ray_offset: crate::reference::ray_offset(scene) as f32,
             textures: p.textures,
             levels: l.levels,
             casters: l.casters,

@@ -65,6 +65,10 @@ pub enum Resource {
     VertexTexel,
     /// The texture gather's sum trees of texel power, its stage 0 (`GpuScene::texture_pyramid`).
     TexturePyramid,
+    /// The shadow casters' hierarchy, for the splat's shadow rays (`GpuScene::bvh_nodes`).
+    BvhNodes,
+    /// Its triangles in leaf order (`GpuScene::bvh_triangles`).
+    BvhTriangles,
     /// Exitance at the samples, the sparse gather's stage 0 (owned by `GatherSparsePass`).
     SampleExitance,
     /// The shadow-map array (`FrameTargets::shadow_maps`).
@@ -113,6 +117,8 @@ impl Resource {
             TexelIndex => "TexelIndex",
             VertexTexel => "VertexTexel",
             TexturePyramid => "TexturePyramid",
+            BvhNodes => "BvhNodes",
+            BvhTriangles => "BvhTriangles",
             ShadowMaps => "shadow_maps",
             Hdr => "hdr",
             Surface => "surface",
@@ -141,7 +147,7 @@ pub const HOST_READ: [Resource; 5] = [
 ];
 
 /// Every resource that is a `GpuScene` buffer (`Resources::buffer`).
-pub const SCENE_BUFFERS: [Resource; 22] = [
+pub const SCENE_BUFFERS: [Resource; 24] = [
     Resource::Vertices,
     Resource::Objects,
     Resource::Lights,
@@ -164,6 +170,8 @@ pub const SCENE_BUFFERS: [Resource; 22] = [
     Resource::TexelIndex,
     Resource::VertexTexel,
     Resource::TexturePyramid,
+    Resource::BvhNodes,
+    Resource::BvhTriangles,
 ];
 
 /// One declared access of a pass (`gpu::Use` over `Resource`).
@@ -236,6 +244,8 @@ impl<'a> Resources<'a> {
             TexelIndex => &s.texel_index,
             VertexTexel => &s.vertex_texel,
             TexturePyramid => &s.texture_pyramid,
+            BvhNodes => &s.bvh_nodes,
+            BvhTriangles => &s.bvh_triangles,
             _ => return None,
         })
     }

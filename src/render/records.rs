@@ -100,17 +100,21 @@ impl ObjectRecord {
 pub struct SampleRecord {
     /// xyz: world position; w: area weight (scene units^2).
     pub position_area: [f32; 4],
-    /// xyz: unit normal; w: index of the object the sample lies on, as a float.
-    pub normal_object: [f32; 4],
+    /// xyz: unit (interpolated) normal; w: the sine of its angle to its triangle's face normal,
+    /// `|n x n_f|`: where the light's cosine to `n` is at least this, the triangle faces the
+    /// light (the splat's hybrid visibility trusts the shadow map only there).
+    pub normal_terminator: [f32; 4],
 }
 
 impl SampleRecord {
-    /// Pack one sample point of object `object`.
-    pub fn new(sample: &SamplePoint, object: usize) -> SampleRecord {
+    /// Pack one sample point lying on a triangle of unit face normal `face_normal`.
+    pub fn new(sample: &SamplePoint, face_normal: glam::Vec3) -> SampleRecord {
         let (p, n) = (sample.position, sample.normal);
+        // Rounded up a little, so that f32 cosines at the bound still count as unsure.
+        let terminator = (n.cross(face_normal).length() + 1e-4).min(1.0);
         SampleRecord {
             position_area: [p.x, p.y, p.z, sample.area as f32],
-            normal_object: [n.x, n.y, n.z, object as f32],
+            normal_terminator: [n.x, n.y, n.z, terminator],
         }
     }
 }
@@ -271,5 +275,41 @@ impl Vertex {
             format: vk::Format::R32G32B32_SFLOAT,
             offset: 12,
         }
+    }
+}
+
+/// `BvhNode` in glsl/common/rays.glsl: one node of the shadow casters' hierarchy
+/// (`reference::bvh::FlatNode`), its first and count stored as the bits of the w components.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct BvhNodeRecord {
+    /// xyz: the box's lower corner; w: the bits of a leaf's first triangle or an inner node's left
+    /// child.
+    pub min_first: [f32; 4],
+    /// xyz: the box's upper corner; w: the bits of a leaf's triangle count (0: inner node).
+    pub max_count: [f32; 4],
+}
+
+impl BvhNodeRecord {
+    /// Pack one flat node.
+    pub fn new(n: &crate::reference::bvh::FlatNode) -> BvhNodeRecord {
+        let [a, b, c] = n.min;
+        let [d, e, f] = n.max;
+        BvhNodeRecord { min_first: [a, b, c, f32::from_bits(n.first)], max_count: [d, e, f, f32::from_bits(n.count)] }
+    }
+}
+
+/// `BvhTriangle` in glsl/common/rays.glsl: a caster triangle's corners (w unused).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct BvhTriangleRecord {
+    /// The corners, xyz each.
+    pub corners: [[f32; 4]; 3],
+}
+
+impl BvhTriangleRecord {
+    /// Pack one triangle.
+    pub fn new(t: &[[f32; 3]; 3]) -> BvhTriangleRecord {
+        BvhTriangleRecord { corners: t.map(|[x, y, z]| [x, y, z, 0.0]) }
     }
 }

@@ -528,7 +528,7 @@ impl Renderer {
         Ok(Renderer {
             gpu: gpu.clone(),
             vertex_light: VertexLightPass::new(gpu, &resources)?,
-            splat: SplatPass::new(gpu, &resources)?,
+            splat: SplatPass::new(gpu, &resources, scene.scene.file.render.splat_visibility)?,
             tonemap: targets.hdr().is_some().then(|| TonemapPass::new(gpu, &resources)).transpose()?,
             shadow: ShadowPass::new(gpu, scene.shadow_layers)?,
             gather,
@@ -1210,7 +1210,8 @@ impl Renderer {
         let settings = &self.scene.scene.file.render;
         // Built first, then swapped in: an error leaves the renderer as it was.
         let gather = Self::gather_pass(&gpu, &resources, settings, self.needs.pixel_gather)?;
-        let (vertex_light, splat) = (VertexLightPass::new(&gpu, &resources)?, SplatPass::new(&gpu, &resources)?);
+        let (vertex_light, splat) =
+            (VertexLightPass::new(&gpu, &resources)?, SplatPass::new(&gpu, &resources, settings.splat_visibility)?);
         let shade = ShadePass::new(&gpu, self.target, &resources, self.needs.pixel_gather, self.options.shade())?;
         (self.gather, self.vertex_light, self.splat, self.shade) = (gather, vertex_light, splat, shade);
         self.buffers = buffers;

@@ -240,7 +240,30 @@ pub fn place(mesh: &Mesh, options: &SampleOptions) -> Result<Vec<SurfacePoint>, 
         }
     };
     debug_assert_eq!(points.len(), n);
+    let mut points = points;
+    spatial_order(mesh, &mut points);
     Ok(points)
+}
+
+/// Sort `points` along a Morton (Z-order) curve through the mesh's bounding box, so that
+/// neighbours on the surface are mostly neighbours in the list: the GPU's lanes then take
+/// similar paths (the splat's shadow rays walk the same boxes) and read nearby memory.
+fn spatial_order(mesh: &Mesh, points: &mut [SurfacePoint]) {
+    let (lo, hi) = mesh.bounds();
+    let (lo, extent) = (lo.as_dvec3(), (hi - lo).as_dvec3().max(glam::DVec3::splat(1e-30)));
+    // 21 bits per axis: a 63-bit key.
+    let spread = |x: f64| -> u64 {
+        let mut v = (x.clamp(0.0, 1.0) * ((1u64 << 21) - 1) as f64) as u64;
+        v = (v | v << 32) & 0x1f00000000ffff;
+        v = (v | v << 16) & 0x1f0000ff0000ff;
+        v = (v | v << 8) & 0x100f00f00f00f00f;
+        v = (v | v << 4) & 0x10c30c30c30c30c3;
+        (v | v << 2) & 0x1249249249249249
+    };
+    points.sort_by_cached_key(|p| {
+        let u = (p.position(mesh) - lo) / extent;
+        spread(u.x) | spread(u.y) << 1 | spread(u.z) << 2
+    });
 }
 
 /// Turn placed points into samples with positions, normals and the given area weights.

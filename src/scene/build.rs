@@ -193,6 +193,8 @@ pub struct Overrides {
     pub resolution: Option<[u32; 2]>,
     /// `--transport`: replaces `render.transport`.
     pub transport: Option<crate::scene::TransportMode>,
+    /// `--splat-visibility`: replaces `render.splat_visibility`.
+    pub splat_visibility: Option<crate::scene::SplatVisibility>,
     /// `--full-detail` (false): replaces `render.level_of_detail`.
     pub level_of_detail: Option<bool>,
     /// `--max-error`: replaces `render.max_error` ([`crate::scene::MIN_MAX_ERROR`] to
@@ -351,6 +353,9 @@ fn apply_overrides(scene: &mut Scene, overrides: &Overrides) -> Result<(), Scene
     }
     if let Some(t) = overrides.transport {
         scene.file.render.transport = t;
+    }
+    if let Some(v) = overrides.splat_visibility {
+        scene.file.render.splat_visibility = v;
     }
     let render = &mut scene.file.render;
     render.texture_samples = overrides.texture_samples.unwrap_or(render.texture_samples);

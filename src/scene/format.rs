@@ -330,6 +330,59 @@ pub struct RenderSettings {
     /// `mesh::atlas::MAX_RESOLUTION`).
     #[serde(default = "texture_resolution")]
     pub texture_resolution: u32,
+    /// How the splat finds whether a light reaches a sample (default `"hybrid"`).
+    #[serde(default)]
+    pub splat_visibility: SplatVisibility,
+}
+
+/// How the splat finds whether a light reaches a sample: `render.splat_visibility`,
+/// `--splat-visibility`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SplatVisibility {
+    /// The light's shadow map where it is sure, a ray where it is not: where the map's four
+    /// texels around the sample disagree (a shadow edge), or where the sample's triangle may
+    /// face away from the light while its interpolated normal faces it (a coarse mesh's
+    /// terminator). As exact as rays but for occluders thinner than a texel, at a fraction of
+    /// their cost
+    #[default]
+    Hybrid,
+    /// A shadow ray against the casters' triangles for every light and sample: exact, as the
+    /// truth's (docs/STUDY.md, "Visibility in the splat")
+    Rays,
+    /// One tap of the light's shadow map: off by up to a texel at shadow edges and beside a
+    /// coarse mesh's terminator
+    ShadowMaps,
+}
+
+impl SplatVisibility {
+    /// Both choices, in the order `--splat-visibility` lists them.
+    pub const ALL: [SplatVisibility; 3] = [SplatVisibility::Hybrid, SplatVisibility::Rays, SplatVisibility::ShadowMaps];
+
+    /// The name used in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            SplatVisibility::Hybrid => "hybrid",
+            SplatVisibility::Rays => "rays",
+            SplatVisibility::ShadowMaps => "shadow_maps",
+        }
+    }
+}
+
+impl std::str::FromStr for SplatVisibility {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        SplatVisibility::ALL
+            .into_iter()
+            .find(|m| m.name().eq_ignore_ascii_case(s))
+            .ok_or_else(|| format!("unknown splat visibility `{s}` (expected hybrid, rays or shadow_maps)"))
+    }
+}
+
+impl std::fmt::Display for SplatVisibility {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.name())
+    }
 }
 
 /// `render.texture_samples` when a scene names none (docs/STUDY.md, "The texture-space gather").
@@ -458,6 +511,7 @@ impl Default for RenderSettings {
             max_error: DEFAULT_MAX_ERROR,
             texture_samples: DEFAULT_TEXTURE_SAMPLES,
             texture_resolution: DEFAULT_TEXTURE_RESOLUTION,
+            splat_visibility: SplatVisibility::default(),
         }
     }
 }
