@@ -56,9 +56,9 @@ float ray_visibility(Light l, vec3 p, vec3 n, vec3 wi) {
     return ray_occluded(p + n * push.ray_offset, wi, push.ray_offset, t_max) ? 0.0 : 1.0;
 }
 
-// Whether light `l` (direction `wi` from `p`, normal `n`, cosine `cos_i`) reaches the sample;
-// `terminator`: the sine of the normal's angle to the sample's face normal.
-float sample_visibility(Light l, vec3 p, vec3 n, vec3 wi, float cos_i, float terminator) {
+// Whether light `l` (direction `wi` from `p`, normal `n`) reaches the sample, which lies on a
+// triangle of normal `face`.
+float sample_visibility(Light l, vec3 p, vec3 n, vec3 wi, vec3 face) {
     if (l.power_layer.w < 0.0) return 1.0;
     if (SPLAT_VISIBILITY == 1u) return ray_visibility(l, p, n, wi);
     // Looked up at the sample itself, without the normal offset the shading pass takes
@@ -70,23 +70,24 @@ float sample_visibility(Light l, vec3 p, vec3 n, vec3 wi, float cos_i, float ter
     unbiased.spot_texel.z = 0.0;
     if (SPLAT_VISIBILITY == 0u) return light_visibility(unbiased, shadow_maps, p, n, 0);
     // Hybrid: the four texels the bilinear tap would read; where they agree and the triangle
-    // faces the light (cos_i >= terminator), the map's answer is the ray's but for occluders
-    // thinner than a texel.
+    // faces the light, the map's answer is the ray's but for occluders thinner than a texel.
+    // Beside a coarse mesh's terminator the triangle can face away while the normal faces the
+    // light: the ray finds the mesh itself in the way, the map (its depth bias) does not.
     vec4 taps = light_texels(unbiased, shadow_maps, p, n);
-    bool sure = cos_i >= terminator && all(equal(taps, taps.xxxx));
+    bool sure = dot(face, wi) > 1e-3 && all(equal(taps, taps.xxxx));
     return sure ? taps.x : ray_visibility(l, p, n, wi);
 }
 
-// Irradiance transmitted at `p` (normal `n`, index ratio `eta`) from lights [first, end);
-// `terminator` as sample_visibility's.
-vec3 transmitted(uint first, uint end, vec3 p, vec3 n, float eta, float terminator) {
+// Irradiance transmitted at `p` (normal `n`, face normal `face`, index ratio `eta`) from lights
+// [first, end).
+vec3 transmitted(uint first, uint end, vec3 p, vec3 n, vec3 face, float eta) {
     vec3 e = vec3(0.0);
     for (uint l = first; l < end; ++l) {
         vec3 wi, irradiance;
         light_incidence(lights[l], p, wi, irradiance);
         float cos_i = dot(n, wi);
         if (cos_i <= 0.0) continue;
-        float v = sample_visibility(lights[l], p, n, wi, cos_i, terminator);
+        float v = sample_visibility(lights[l], p, n, wi, face);
         e += irradiance * (cos_i * dipole_fresnel_transmittance(cos_i, eta) * v);
     }
     return e;
@@ -98,16 +99,16 @@ void main() {
     SampleRecord s = samples[i];
     ObjectRecord o = objects[push.object];
     vec3 p = s.position_area.xyz;
-    vec3 n = s.normal_terminator.xyz;
-    float terminator = s.normal_terminator.w;
+    vec3 n = s.normal;
+    vec3 face = unpack_octahedral(s.face_normal);
     vec3 environment;
     if (push.environment_kept != 0u) {
         environment = kept_environment[i].xyz;
     } else {
-        environment = transmitted(push.key_light_count, push.light_count, p, n, o.eta, terminator);
+        environment = transmitted(push.key_light_count, push.light_count, p, n, face, o.eta);
         kept_environment[i] = vec4(environment, 0.0);
     }
-    vec3 e = transmitted(0u, push.key_light_count, p, n, o.eta, terminator) + environment;
+    vec3 e = transmitted(0u, push.key_light_count, p, n, face, o.eta) + environment;
     float area = s.position_area.w;
     if (push.environment_kept != 0u) {
         // The near energy depends on the sample's area and material alone, and whatever

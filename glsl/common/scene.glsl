@@ -35,8 +35,17 @@ vec3 object_gathered_channels(ObjectRecord o) {
 
 struct SampleRecord {
     vec4 position_area;     // xyz: world position; w: area weight (scene units^2)
-    vec4 normal_terminator; // xyz: unit normal; w: sine of its angle to the face normal (records::SampleRecord)
+    vec3 normal;            // unit shading normal
+    uint face_normal;       // its triangle's unit normal, octahedral (records::pack_octahedral)
 };
+
+// records::pack_octahedral's inverse: the unit vector of two snorm16 octahedral coordinates.
+vec3 unpack_octahedral(uint bits) {
+    vec2 e = unpackSnorm2x16(bits);
+    vec3 v = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+    if (v.z < 0.0) v.xy = (1.0 - abs(e.yx)) * vec2(e.x >= 0.0 ? 1.0 : -1.0, e.y >= 0.0 ? 1.0 : -1.0);
+    return normalize(v);
+}
 
 // One sample's splat output (splat.comp writes it, the gathers read it).
 struct SplatRecord {

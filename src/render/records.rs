@@ -100,23 +100,35 @@ impl ObjectRecord {
 pub struct SampleRecord {
     /// xyz: world position; w: area weight (scene units^2).
     pub position_area: [f32; 4],
-    /// xyz: unit (interpolated) normal; w: the sine of its angle to its triangle's face normal,
-    /// `|n x n_f|`: where the light's cosine to `n` is at least this, the triangle faces the
-    /// light (the splat's hybrid visibility trusts the shadow map only there).
-    pub normal_terminator: [f32; 4],
+    /// Unit (interpolated) shading normal.
+    pub normal: [f32; 3],
+    /// The unit normal of the triangle the sample lies on, [`pack_octahedral`]: where it faces
+    /// away from a light that the shading normal faces, the sample sits beside its mesh's
+    /// terminator, and the splat's hybrid visibility asks a ray rather than the shadow map.
+    pub face_normal: u32,
 }
 
 impl SampleRecord {
     /// Pack one sample point lying on a triangle of unit face normal `face_normal`.
     pub fn new(sample: &SamplePoint, face_normal: glam::Vec3) -> SampleRecord {
         let (p, n) = (sample.position, sample.normal);
-        // Rounded up a little, so that f32 cosines at the bound still count as unsure.
-        let terminator = (n.cross(face_normal).length() + 1e-4).min(1.0);
         SampleRecord {
             position_area: [p.x, p.y, p.z, sample.area as f32],
-            normal_terminator: [n.x, n.y, n.z, terminator],
+            normal: n.to_array(),
+            face_normal: pack_octahedral(face_normal),
         }
     }
+}
+
+/// A unit vector in 32 bits: its octahedral map (Cigolle et al. 2014, "A Survey of Efficient
+/// Representations for Independent Unit Vectors") as two snorm16 values, x in the low half,
+/// as GLSL's `unpackSnorm2x16` reads them (`unpack_octahedral` in glsl/common/scene.glsl).
+pub fn pack_octahedral(n: glam::Vec3) -> u32 {
+    let n = n / (n.x.abs() + n.y.abs() + n.z.abs()).max(f32::MIN_POSITIVE);
+    let sign = |v: f32| if v >= 0.0 { 1.0 } else { -1.0 };
+    let (x, y) = if n.z >= 0.0 { (n.x, n.y) } else { ((1.0 - n.y.abs()) * sign(n.x), (1.0 - n.x.abs()) * sign(n.y)) };
+    let snorm = |v: f32| u32::from((v.clamp(-1.0, 1.0) * 32767.0).round() as i16 as u16);
+    snorm(x) | snorm(y) << 16
 }
 
 /// `SplatRecord` in glsl/common/scene.glsl: what the splat pass writes for one sample.
@@ -311,5 +323,38 @@ impl BvhTriangleRecord {
     /// Pack one triangle.
     pub fn new(t: &[[f32; 3]; 3]) -> BvhTriangleRecord {
         BvhTriangleRecord { corners: t.map(|[x, y, z]| [x, y, z, 0.0]) }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::pack_octahedral;
+    use glam::Vec3;
+
+    /// `unpack_octahedral` of glsl/common/scene.glsl, line for line.
+    fn unpack(bits: u32) -> Vec3 {
+        let snorm = |h: u32| (f32::from(h as u16 as i16) / 32767.0).clamp(-1.0, 1.0);
+        let (x, y) = (snorm(bits & 0xffff), snorm(bits >> 16));
+        let mut v = Vec3::new(x, y, 1.0 - x.abs() - y.abs());
+        if v.z < 0.0 {
+            let sign = |a: f32| if a >= 0.0 { 1.0 } else { -1.0 };
+            (v.x, v.y) = ((1.0 - y.abs()) * sign(x), (1.0 - x.abs()) * sign(y));
+        }
+        v.normalize()
+    }
+
+    #[test]
+    fn octahedral_packing_keeps_a_unit_vector_within_1e_4() {
+        let mut worst = 0.0f32;
+        for i in 0..2000 {
+            // A spiral over the sphere, poles and the equator's axes included.
+            let z = 1.0 - 2.0 * i as f32 / 1999.0;
+            let phi = i as f32 * 2.399_963;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            for n in [Vec3::new(r * phi.cos(), r * phi.sin(), z), Vec3::X, Vec3::NEG_Y, Vec3::NEG_Z] {
+                worst = worst.max((unpack(pack_octahedral(n)) - n).length());
+            }
+        }
+        assert!(worst < 1e-4, "worst error {worst}");
     }
 }
