@@ -359,6 +359,23 @@ impl SplatVisibility {
     /// Both choices, in the order `--splat-visibility` lists them.
     pub const ALL: [SplatVisibility; 3] = [SplatVisibility::Hybrid, SplatVisibility::Rays, SplatVisibility::ShadowMaps];
 
+    /// What it does, for `plan` and `--explain`.
+    pub fn why(self) -> &'static str {
+        match self {
+            SplatVisibility::Hybrid => {
+                "a sample takes its shadow map's answer where the map's four texels agree and its triangle faces the \
+                 light, a shadow ray into the casters' triangles elsewhere (render.splat_visibility)"
+            }
+            SplatVisibility::Rays => {
+                "a shadow ray into the casters' triangles per light and sample (render.splat_visibility)"
+            }
+            SplatVisibility::ShadowMaps => {
+                "one tap of each light's shadow map: off by up to a texel at shadow edges and beside a coarse mesh's \
+                 terminator (render.splat_visibility)"
+            }
+        }
+    }
+
     /// The name used in scene files and on the command line.
     pub fn name(self) -> &'static str {
         match self {

@@ -22,6 +22,8 @@ pub struct SceneNeeds {
     pub host_target: bool,
     /// `render.transport`: the planner chooses, or every channel is forced one way.
     pub transport: super::TransportMode,
+    /// `render.splat_visibility`: how the splat finds whether a light reaches a sample.
+    pub splat_visibility: super::SplatVisibility,
     /// Per object, in scene order: what the planner weighs for it.
     pub objects: Vec<ObjectFacts>,
     /// Scene units a shadow-map texel spans (`PreparedScene::shadow_texel`).
@@ -137,6 +139,7 @@ impl PreparedScene {
             pixel_gather: self.scene.file.render.gather == super::GatherMode::Pixel,
             host_target: false,
             transport: self.scene.file.render.transport,
+            splat_visibility: self.scene.file.render.splat_visibility,
             objects: self.objects.iter().map(ObjectFacts::of).collect(),
             shadow_texel: self.shadow_texel(),
             caster_center: self.caster_bounds.0.to_array(),

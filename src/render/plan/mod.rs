@@ -248,6 +248,9 @@ pub struct Plan {
     /// Terms of the shading pass left out (`shade::TERM_*` bits), to measure what each costs
     /// (the benchmark's `terms` section); 0, every term, in any plan the planner makes.
     pub skip_terms: u32,
+    /// How this frame's splat finds visibility (`render.splat_visibility`); `None` when no
+    /// splat runs.
+    pub splat_visibility: Option<crate::scene::SplatVisibility>,
 }
 
 impl Plan {
@@ -290,6 +293,7 @@ impl Plan {
             "shadow_light": self.shadow_light,
             "one_tap_shadows": self.one_tap_shadows,
             "shadow_filter_why": self.shadow_filter.map_or_else(String::new, |f| f.to_string()),
+            "splat_visibility": self.splat_visibility.map(|v| v.name()),
             "objects": self.objects,
         })
     }
@@ -305,6 +309,9 @@ impl fmt::Display for Plan {
         }
         if let Some(filter) = &self.shadow_filter {
             writeln!(f, "  shadow filter: {filter}")?;
+        }
+        if let Some(v) = self.splat_visibility {
+            writeln!(f, "  splat visibility: {v}: {}", v.why())?;
         }
         for o in self.objects.iter().filter(|o| !o.channels.is_empty() || o.level > 0) {
             writeln!(f, "  object {} ({}): {}", o.object, o.name, o.why)?;

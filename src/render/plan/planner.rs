@@ -144,6 +144,7 @@ impl Planner {
             .collect();
         let (passes, skipped) = frame.passes(&objects);
         let shadow_filter = shadow_filter(needs, view);
+        let splat_visibility = passes.iter().any(|(p, _)| *p == Pass::Splat).then_some(needs.splat_visibility);
         Plan {
             change: Some(change),
             passes,
@@ -156,6 +157,7 @@ impl Planner {
             one_tap_shadows: shadow_filter.is_some_and(|f| f.one_tap),
             shadow_filter,
             skip_terms: 0,
+            splat_visibility,
         }
     }
 

@@ -45,6 +45,7 @@ fn needs(shadow_layers: u32, translucent_objects: usize) -> SceneNeeds {
         pixel_gather: false,
         host_target: false,
         transport: TransportMode::Auto,
+        splat_visibility: crate::scene::SplatVisibility::Hybrid,
         objects: (0..translucent_objects).map(|_| object(1.0, 0.1, 0.3)).collect(),
         shadow_texel: 0.01,
         caster_center: [0.0; 3],
@@ -303,6 +304,8 @@ fn every_pass_runs_or_is_skipped_once_with_its_reason() {
             );
             assert!(json["objects"][0]["why"].is_string() && json["objects"][0]["level_why"].is_string());
             assert!(json["objects"][0]["channels"][0]["why"].is_string() && json["shadow_filter_why"].is_string());
+            // The splat's visibility is named exactly when a splat runs.
+            assert_eq!(json["splat_visibility"].is_string(), p.runs(Pass::Splat), "{p}");
         }
     }
 }
