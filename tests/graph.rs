@@ -53,7 +53,9 @@ fn a_swapped_binding_fails_at_pipeline_creation_naming_both() {
             .bind_all(&[Resource::Objects, Resource::Samples, Resource::Lights, Resource::ShadowMaps])
             .unwrap();
         bindings.push(Resource::Splat.bind(Binding::Buffer(&buffer)));
-        bindings.push(resources.bind(Resource::SplatEnvironment).unwrap());
+        bindings.extend(
+            resources.bind_all(&[Resource::SplatEnvironment, Resource::BvhNodes, Resource::BvhTriangles]).unwrap(),
+        );
         match pipeline.descriptor_set(&bindings) {
             Err(e @ GpuError::BindingMismatch { binding: 0, .. }) => {
                 let message = e.to_string();
@@ -108,7 +110,7 @@ fn two_frames_with_a_new_reader(gpu: &Arc<Gpu>, declare_probe: bool) {
     let scene = GpuScene::new(gpu, &prepared).unwrap();
     let targets = FrameTargets::new(gpu, 64, prepared.shadow_layers, None).unwrap();
     let resources = Resources { scene: &scene, targets: &targets };
-    let splat = SplatPass::new(gpu, &resources).unwrap();
+    let splat = SplatPass::new(gpu, &resources, prepared.scene.file.render.splat_visibility).unwrap();
     let gather = GatherPass::new(gpu, &resources).unwrap();
     let probe = Probe::new(gpu, &resources);
     let hazards = RefCell::new(Hazards::new());

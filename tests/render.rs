@@ -145,7 +145,8 @@ fn splat_visibility_matches_ray_casting() {
     // test beside its terminator. The shadow maps' one tap is off by up to a texel at shadow
     // edges: at most 2% of the built-in scene's samples (the ears' share is printed).
     let ears = Scene::load(std::path::Path::new("assets/scenes/bunny-ears.toml")).unwrap();
-    let scenes: [(&str, Box<dyn Fn(&Overrides) -> PreparedScene>); 2] = [
+    type Prepare = Box<dyn Fn(&Overrides) -> PreparedScene>;
+    let scenes: [(&str, Prepare); 2] = [
         ("built-in", Box::new(builtin)),
         (
             "ears",

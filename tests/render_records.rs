@@ -184,24 +184,21 @@ const TEXTURE_PUSH_FIELDS: [&str; 12] = [
     "receiver_count",
 ];
 
+/// `SplatPush`'s fields, in order.
+const SPLAT_PUSH_FIELDS: [&str; 8] = [
+    "object",
+    "first_sample",
+    "sample_count",
+    "light_count",
+    "key_light_count",
+    "environment_kept",
+    "caster_triangles",
+    "ray_offset",
+];
+
 fn push_cases() -> [PushCase; 11] {
     [
-        (
-            "splat.comp",
-            include_str!("../glsl/splat.comp"),
-            "SplatPush",
-            size_of::<SplatPush>(),
-            &[
-                "object",
-                "first_sample",
-                "sample_count",
-                "light_count",
-                "key_light_count",
-                "environment_kept",
-                "caster_triangles",
-                "ray_offset",
-            ],
-        ),
+        ("splat.comp", include_str!("../glsl/splat.comp"), "SplatPush", size_of::<SplatPush>(), &SPLAT_PUSH_FIELDS),
         (
             "local_exitance.comp",
             include_str!("../glsl/local_exitance.comp"),
