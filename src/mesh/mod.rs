@@ -10,6 +10,7 @@
 
 pub mod atlas;
 mod boundary;
+pub mod bvh;
 mod curvature;
 mod lod;
 mod obj;

@@ -3,7 +3,8 @@
 //! the accuracy study. [`rte`] and [`rte_mesh`]: a Monte Carlo reference of the radiative
 //! transfer equation, what the dipole model itself approximates.
 
-pub mod bvh;
+/// The triangle hierarchy the reference casts its rays into (`mesh::bvh`, shared with the splat).
+pub use crate::mesh::bvh;
 pub mod clearance;
 pub mod directional;
 pub mod rte;
@@ -22,20 +23,15 @@ use bvh::Bvh;
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// Occluders of a prepared scene: every triangle of every shadow-casting object.
+/// Occluders of a prepared scene: every triangle of every shadow-casting object
+/// (`PreparedScene::occluders`).
 pub fn occluders(scene: &PreparedScene) -> Bvh {
-    occluders_of(&scene.objects)
+    scene.occluders()
 }
 
 /// [`occluders`] of `objects` alone (before the scene around them is complete).
 pub fn occluders_of(objects: &[PreparedObject]) -> Bvh {
-    let mut triangles = Vec::new();
-    for o in objects.iter().filter(|o| o.casts_shadow) {
-        for t in 0..o.mesh.triangles().len() {
-            triangles.push(o.mesh.corners(t));
-        }
-    }
-    Bvh::new(triangles)
+    crate::scene::build::occluders_of(objects)
 }
 
 /// Direction towards the light and the irradiance it brings to a surface facing it, and the
@@ -100,14 +96,14 @@ pub(crate) fn reaching(
     (cos_i > 0.0 && !blocked()).then_some((wi, e, cos_i))
 }
 
-/// How far a visibility ray starts off the surface: the scale of f32 positions in the scene.
+/// How far a visibility ray starts off the surface (`PreparedScene::ray_offset`).
 pub fn ray_offset(scene: &PreparedScene) -> f64 {
-    ray_offset_within(scene.bounds.1)
+    scene.ray_offset()
 }
 
 /// [`ray_offset`] for a scene whose bounding sphere has radius `radius`.
 pub fn ray_offset_within(radius: f32) -> f64 {
-    1e-5 * f64::from(radius)
+    crate::scene::build::ray_offset_within(radius)
 }
 
 /// Fresnel-transmitted irradiance `E_t(p) = sum_l E_l cos_i F_t(cos_i, eta) V_l(p)` at a surface

@@ -166,7 +166,7 @@ pub struct GpuScene {
     pub vertex_texel: Buffer,
     /// Per node of every atlas's sum tree (f32), written by the texture gather's stage 0.
     pub texture_pyramid: Buffer,
-    /// The shadow casters' hierarchy (`BvhNodeRecord` per node of `reference::bvh::Bvh::flat`),
+    /// The shadow casters' hierarchy (`BvhNodeRecord` per node of `mesh::bvh::Bvh::flat`),
     /// for the splat's shadow rays; one empty node when nothing casts a shadow.
     pub bvh_nodes: Buffer,
     /// Its triangles in leaf order (`BvhTriangleRecord`).
@@ -174,7 +174,7 @@ pub struct GpuScene {
     /// Triangles in `bvh_triangles`: 0 when nothing casts a shadow.
     pub caster_triangles: u32,
     /// How far a shadow ray starts off the surface, along the normal, and the least distance
-    /// at which it counts a hit (`reference::ray_offset`, as the truth's rays).
+    /// at which it counts a hit (`PreparedScene::ray_offset`, as the truth's rays).
     pub ray_offset: f32,
     /// Per object, in scene order: its atlas and sum tree's place (`TextureRange`).
     pub textures: Vec<TextureRange>,
@@ -329,7 +329,7 @@ impl PackedObjects {
         if !rays || !scene.any_caster || self.samples.is_empty() {
             return;
         }
-        let (nodes, triangles) = crate::reference::occluders(scene).flat();
+        let (nodes, triangles) = scene.occluders().flat();
         self.bvh_nodes = nodes.iter().map(BvhNodeRecord::new).collect();
         self.bvh_triangles = triangles.iter().map(BvhTriangleRecord::new).collect();
     }
@@ -543,7 +543,7 @@ impl GpuScene {
             bvh_nodes: upload(gpu, "caster hierarchy", &p.bvh_nodes, none)?,
             bvh_triangles: upload(gpu, "caster triangles", &p.bvh_triangles, none)?,
             caster_triangles: p.bvh_triangles.len() as u32,
-            ray_offset: crate::reference::ray_offset(scene) as f32,
+            ray_offset: scene.ray_offset() as f32,
             textures: p.textures,
             levels: l.levels,
             casters: l.casters,

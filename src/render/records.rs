@@ -291,7 +291,7 @@ impl Vertex {
 }
 
 /// `BvhNode` in glsl/common/rays.glsl: one node of the shadow casters' hierarchy
-/// (`reference::bvh::FlatNode`), its first and count stored as the bits of the w components.
+/// (`mesh::bvh::FlatNode`), its first and count stored as the bits of the w components.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct BvhNodeRecord {
@@ -304,7 +304,7 @@ pub struct BvhNodeRecord {
 
 impl BvhNodeRecord {
     /// Pack one flat node.
-    pub fn new(n: &crate::reference::bvh::FlatNode) -> BvhNodeRecord {
+    pub fn new(n: &crate::mesh::bvh::FlatNode) -> BvhNodeRecord {
         let [a, b, c] = n.min;
         let [d, e, f] = n.max;
         BvhNodeRecord { min_first: [a, b, c, f32::from_bits(n.first)], max_count: [d, e, f, f32::from_bits(n.count)] }

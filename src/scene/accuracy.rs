@@ -2,7 +2,7 @@
 //! error model weighs (`sampling::density`), measured on the placed meshes.
 
 use super::build::{PreparedObject, ResolvedMaterial};
-use crate::reference::bvh::Bvh;
+use crate::mesh::bvh::Bvh;
 use crate::sampling::density::{self, ChannelError, SurfaceFacts};
 use glam::DVec3;
 use rayon::prelude::*;

@@ -4,6 +4,7 @@
 
 use super::lights::{self, Environment, PreparedLight};
 use super::{AssetSource, Camera, GatherMode, Light, MaterialSpec, Scene, SceneError, Shape};
+use crate::mesh::bvh::Bvh;
 use crate::mesh::{LoadOptions, Mesh, MeshError};
 use crate::optics::{Dipole, Material};
 use crate::sampling::{self, Method, SampleOptions, SamplePoint};
@@ -206,7 +207,35 @@ pub struct Overrides {
     pub texture_resolution: Option<u32>,
 }
 
+/// Every triangle of every shadow-casting object of `objects`, in a hierarchy for rays.
+pub fn occluders_of(objects: &[PreparedObject]) -> Bvh {
+    let mut triangles = Vec::new();
+    for o in objects.iter().filter(|o| o.casts_shadow) {
+        for t in 0..o.mesh.triangles().len() {
+            triangles.push(o.mesh.corners(t));
+        }
+    }
+    Bvh::new(triangles)
+}
+
+/// [`PreparedScene::ray_offset`] for a scene whose bounding sphere has radius `radius`.
+pub fn ray_offset_within(radius: f32) -> f64 {
+    1e-5 * f64::from(radius)
+}
+
 impl PreparedScene {
+    /// The shadow casters' triangles in a hierarchy: what the truth's and the splat's shadow
+    /// rays are cast into.
+    pub fn occluders(&self) -> Bvh {
+        occluders_of(&self.objects)
+    }
+
+    /// How far a visibility ray starts off the surface, and the least distance at which it
+    /// counts a hit: the scale of f32 positions in the scene.
+    pub fn ray_offset(&self) -> f64 {
+        ray_offset_within(self.bounds.1)
+    }
+
     /// Scene units a shadow-map texel spans: the casters' bounding sphere's diameter over
     /// `render.shadow_map_size` (exact for directional lights, whose maps span that sphere).
     pub fn shadow_texel(&self) -> f64 {

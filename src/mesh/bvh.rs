@@ -1,6 +1,8 @@
-//! A bounding-volume hierarchy over triangles for the CPU reference's shadow rays (any-hit).
-//! Built by median split on the longest axis of the centroid bounds; f64 throughout, so the
-//! reference's visibility is limited by geometry, not by rounding.
+//! A bounding-volume hierarchy over triangles for shadow rays (any-hit) and the radiative-transfer
+//! walk's closest hits. Built by median split on the longest axis of the centroid bounds; f64
+//! throughout, so the CPU reference's visibility is limited by geometry, not by rounding. The
+//! splat casts its rays into the same hierarchy on the GPU, flattened to f32 (`Bvh::flat`,
+//! glsl/common/rays.glsl).
 
 use glam::DVec3;
 
