@@ -2,9 +2,10 @@
 // Irradiance splat: for every sample point, the irradiance transmitted into the medium from
 // every light: sum over lights of E_light cos(theta_i) F_t(cos theta_i, eta) V, with V from the
 // light's shadow map (one bilinear compare tap at the sample, no normal offset: the sharpest,
-// closest to ray casting) or from a shadow ray against the casters' hierarchy (SPLAT_VISIBILITY). Also the sample's near-field energy per channel (dipole_near_energy),
-// which depends only on its area and material, so that the gather pays for it once per sample
-// instead of once per pair.
+// closest to ray casting), from a shadow ray into the casters' hierarchy, or from the map where
+// it is sure and a ray elsewhere (SPLAT_VISIBILITY). Also the sample's near-field energy per
+// channel (dipole_near_energy), which depends only on its area and material, so that the gather
+// pays for it once per sample instead of once per pair.
 //
 // The environment's directions (lights key_light_count..light_count) rarely change while a key
 // light moves every frame, so their part is kept per sample (SplatEnvironment): a frame after a

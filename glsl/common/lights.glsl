@@ -45,6 +45,21 @@ void light_incidence(Light l, vec3 p, out vec3 wi, out vec3 irradiance) {
     }
 }
 
+// Where world point `p` (unit normal `n`, moved off the surface by the light's normal offset
+// `spot_texel.z`) falls in light `l`'s shadow map: (u, v, layer, depth), false where the light
+// casts no shadow or `p` lies behind its projection (lit either way). Beyond the far plane
+// (receivers that cast no shadow can lie past the casters' sphere) the depth is the far plane's,
+// so a texel that holds a caster still shadows and a cleared texel (depth 1) stays lit.
+bool light_map_coord(Light l, vec3 p, vec3 n, out vec4 coord) {
+    float layer = l.power_layer.w;
+    coord = vec4(0.0);
+    if (layer < 0.0) return false;
+    vec4 clip = l.shadow_matrix * vec4(p + n * l.spot_texel.z, 1.0);
+    if (clip.w <= 0.0) return false;
+    vec3 ndc = clip.xyz / clip.w;
+    coord = vec4(ndc.xy * 0.5 + 0.5, layer, min(ndc.z, 1.0));
+    return true;
+}
 // Fraction of `l` that reaches world point `p` with unit normal `n` (1 = lit), from the light's
 // shadow map through the compare sampler (each tap is itself a bilinear 2x2 percentage-closer
 // filter when the format allows). `radius` 0 takes one tap (sharpest, for the splat's sparse
@@ -52,34 +67,22 @@ void light_incidence(Light l, vec3 p, out vec3 wi, out vec3 irradiance) {
 // for shading pixels and vertices). Points outside the map are lit (border colour white). The lookup moves
 // off the surface along the normal by half a texel (`spot_texel.z`), against self-shadowing.
 float light_visibility(Light l, sampler2DArrayShadow maps, vec3 p, vec3 n, int radius) {
-    float layer = l.power_layer.w;
-    if (layer < 0.0) return 1.0;
-    vec4 clip = l.shadow_matrix * vec4(p + n * l.spot_texel.z, 1.0);
-    if (clip.w <= 0.0) return 1.0;
-    vec3 ndc = clip.xyz / clip.w;
-    // Beyond the far plane (receivers that cast no shadow can lie past the casters' sphere):
-    // compare at the far plane, so a texel that holds a caster still shadows and a cleared
-    // texel (depth 1) stays lit.
-    ndc.z = min(ndc.z, 1.0);
-    vec2 uv = ndc.xy * 0.5 + 0.5;
-    if (radius == 0) return texture(maps, vec4(uv, layer, ndc.z));
+    vec4 coord;
+    if (!light_map_coord(l, p, n, coord)) return 1.0;
+    if (radius == 0) return texture(maps, coord);
     // Four bilinear compare taps half a texel off centre: a 3x3-texel tent filter from 16 texel
     // reads (a 3x3 grid of taps would read 36).
     float h = 0.5 * l.spot_texel.y;
-    float lit = texture(maps, vec4(uv + vec2(-h, -h), layer, ndc.z)) + texture(maps, vec4(uv + vec2(h, -h), layer, ndc.z))
-              + texture(maps, vec4(uv + vec2(-h, h), layer, ndc.z)) + texture(maps, vec4(uv + vec2(h, h), layer, ndc.z));
+    float lit = texture(maps, coord + vec4(-h, -h, 0.0, 0.0)) + texture(maps, coord + vec4(h, -h, 0.0, 0.0))
+              + texture(maps, coord + vec4(-h, h, 0.0, 0.0)) + texture(maps, coord + vec4(h, h, 0.0, 0.0));
     return 0.25 * lit;
 }
 
 // The shadow-map compares of the four texels a one-tap `light_visibility` (radius 0) filters
 // at `p` (1 = lit each); all 1 where the light casts no shadow or `p` lies outside its map.
 vec4 light_texels(Light l, sampler2DArrayShadow maps, vec3 p, vec3 n) {
-    float layer = l.power_layer.w;
-    if (layer < 0.0) return vec4(1.0);
-    vec4 clip = l.shadow_matrix * vec4(p + n * l.spot_texel.z, 1.0);
-    if (clip.w <= 0.0) return vec4(1.0);
-    vec3 ndc = clip.xyz / clip.w;
-    ndc.z = min(ndc.z, 1.0);
-    return textureGather(maps, vec3(ndc.xy * 0.5 + 0.5, layer), ndc.z);
+    vec4 coord;
+    if (!light_map_coord(l, p, n, coord)) return vec4(1.0);
+    return textureGather(maps, coord.xyz, coord.w);
 }
 #endif
