@@ -475,20 +475,28 @@ impl PackedObjects {
 
     /// The hierarchical gather's lists must fit one storage-buffer range.
     fn check_lists(&self, gpu: &Gpu, epsilon: f32) -> GpuResult<()> {
-        let range = gpu.properties().limits.max_storage_buffer_range as u64;
-        let list_bytes = 4 * self.group_items.len() as u64;
-        if list_bytes <= range {
-            return Ok(());
-        }
-        Err(crate::gpu::GpuError::Limit {
-            what: format!(
-                "bytes of the hierarchical gather's item lists at render.gather_epsilon {epsilon} (raise it)"
-            ),
-            value: list_bytes,
-            limit: range,
-            name: "maxStorageBufferRange",
+        let what =
+            || format!("bytes of the hierarchical gather's item lists at render.gather_epsilon {epsilon} (raise it)");
+        check_range(gpu, 4 * self.group_items.len() as u64, what)
+    }
+
+    /// The splat's caster hierarchy must fit one storage-buffer range.
+    fn check_casters(&self, gpu: &Gpu) -> GpuResult<()> {
+        let bytes = std::mem::size_of_val(self.bvh_triangles.as_slice()) as u64;
+        check_range(gpu, bytes, || {
+            "bytes of the splat's shadow casters' triangles (render.splat_visibility = \"shadow_maps\" needs none)"
+                .into()
         })
     }
+}
+
+/// `bytes` of one storage buffer against the device's range, the error naming `what`.
+fn check_range(gpu: &Gpu, bytes: u64, what: impl Fn() -> String) -> GpuResult<()> {
+    let range = gpu.properties().limits.max_storage_buffer_range as u64;
+    if bytes <= range {
+        return Ok(());
+    }
+    Err(crate::gpu::GpuError::Limit { what: what(), value: bytes, limit: range, name: "maxStorageBufferRange" })
 }
 
 impl GpuScene {
@@ -500,6 +508,7 @@ impl GpuScene {
         let levels = pack_levels(scene);
         let packed = PackedObjects::of(scene);
         packed.check_lists(gpu, scene.scene.file.render.gather_epsilon)?;
+        packed.check_casters(gpu)?;
         let mut gpu_scene = Self::upload(gpu, scene, packed, levels)?;
         gpu_scene.set_lights(scene);
         // Before any frame the buffer is idle: written from the host directly.
