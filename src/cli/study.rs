@@ -11,7 +11,7 @@ use translucent::reference::rte::Budget;
 use translucent::reference::rte_mesh::MeshOptions;
 use translucent::reference::truth;
 use translucent::sampling::Method;
-use translucent::scene::{GatherMode, MAX_GATHER_EPSILON, MAX_SAMPLE_COUNT, Scene};
+use translucent::scene::{GatherMode, MAX_GATHER_EPSILON, MAX_SAMPLE_COUNT, Scene, SplatVisibility};
 use translucent::study::{self, Event, StudyConfig, report};
 
 #[derive(clap::Args, Debug)]
@@ -68,6 +68,10 @@ pub struct Args {
     /// render.max_error)
     #[arg(long)]
     pub max_error: Option<f64>,
+    /// How every row's splat finds whether a light reaches a sample: hybrid, rays or
+    /// shadow_maps (overrides render.splat_visibility)
+    #[arg(long, value_parser = super::one_of::<SplatVisibility>(&SplatVisibility::ALL.map(SplatVisibility::name)))]
+    pub splat_visibility: Option<SplatVisibility>,
     /// Split each row's error against the physics: the model error (the dipole's exact
     /// integral against a Monte Carlo radiative-transfer reference walked in each mesh), the
     /// discretisation error (the renderer against the dipole integral) and the total error (the
@@ -301,6 +305,9 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
             .map_err(|(key, message)| anyhow::anyhow!("{key} {message}"))?;
         scene.file.render.max_error = e;
     }
+    if let Some(v) = args.splat_visibility {
+        scene.file.render.splat_visibility = v;
+    }
     let gpu: Arc<Gpu> = Gpu::new(&gpu_args.options())?;
     let device = gpu.info().name.clone();
     let cache = args.truth_cache.clone().unwrap_or_else(truth::default_cache_dir);
@@ -414,14 +421,17 @@ fn preamble(study: &study::Study, scene: &Scene, config: &StudyConfig, device: &
         "each pass in a submission of its own, submission to fence"
     };
     format!(
-        "Scene `{}`, device {device}, {} configurations x seeds. Times: median of {} frames after one warm-up, \
-         a moving light's frame (splat, gather, shade), {timing}.\n\n\
+        "Scene `{}`, device {device}, {} configurations x seeds, the splat's visibility `{}` and shadow maps of \
+         {}^2. Times: median of {} frames after one warm-up, a moving light's frame (splat, gather, shade), \
+         {timing}.\n\n\
          Truth: the exact dipole integral at {} (`reference::truth`), {} (last change between levels \
          {:.2e} RMS relative over lit vertices; tolerance {:.0e}){}. Per-vertex errors are relative, over \
          vertices at least {:.0}% of the object's brightest in each channel.\n\n\
          | level | eta | E_t points | change RMS | change max | seconds |\n|---|---|---|---|---|---|\n{levels}",
         scene.name,
         config.runs() / config.seeds.len(),
+        scene.file.render.splat_visibility,
+        scene.file.render.shadow_map_size,
         config.frames,
         t.subset.map_or("every vertex".to_string(), |n| format!(
             "{n} vertices per object spread over the mesh (so no truth image and no image errors)"
