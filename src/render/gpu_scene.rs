@@ -167,7 +167,8 @@ pub struct GpuScene {
     /// Per node of every atlas's sum tree (f32), written by the texture gather's stage 0.
     pub texture_pyramid: Buffer,
     /// The shadow casters' hierarchy (`BvhNodeRecord` per node of `mesh::bvh::Bvh::flat`),
-    /// for the splat's shadow rays; one empty node when nothing casts a shadow.
+    /// for the splat's shadow rays; empty (16 unread bytes) when nothing casts a shadow or the
+    /// splat takes the maps alone.
     pub bvh_nodes: Buffer,
     /// Its triangles in leaf order (`BvhTriangleRecord`).
     pub bvh_triangles: Buffer,
@@ -334,7 +335,7 @@ impl PackedObjects {
         self.bvh_triangles = triangles.iter().map(BvhTriangleRecord::new).collect();
     }
 
-    /// Object `i`'s vertices, boundary distances, samples and record.
+    /// An object's vertices, boundary distances, samples and record.
     fn object(&mut self, o: &crate::scene::build::PreparedObject) {
         let (first_vertex, first_sample) = (self.vertices.len() as u32, self.samples.len() as u32);
         let normals = o.mesh.vertex_normals();
