@@ -28,6 +28,9 @@
 
 #![warn(missing_docs)]
 
+#[macro_use]
+mod names;
+
 pub mod gpu;
 pub mod mesh;
 pub mod optics;

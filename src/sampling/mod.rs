@@ -22,9 +22,6 @@ pub mod turk;
 pub mod walk;
 pub mod weights;
 
-use std::fmt;
-use std::str::FromStr;
-
 use glam::Vec3;
 use rand::SeedableRng;
 use rand_pcg::Pcg64;
@@ -59,36 +56,12 @@ pub enum Method {
     Poisson,
 }
 
-impl Method {
-    /// Every method: what `--sampler` and `--method` accept and what parsing a name tries.
-    pub const ALL: [Method; 4] = [Method::Random, Method::Turk, Method::Feature, Method::Poisson];
-
-    /// The lowercase name used in scene files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Random => "random",
-            Method::Turk => "turk",
-            Method::Feature => "feature",
-            Method::Poisson => "poisson",
-        }
-    }
-}
-
-impl fmt::Display for Method {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.pad(self.name())
-    }
-}
-
-impl FromStr for Method {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        Method::ALL
-            .into_iter()
-            .find(|m| m.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| format!("unknown sampling method `{s}` (expected random, turk, feature or poisson)"))
-    }
-}
+named_choices!(Method, "sampling method", {
+    Random => "random",
+    Turk => "turk",
+    Feature => "feature",
+    Poisson => "poisson",
+});
 
 /// Errors of the samplers.
 #[derive(Debug, thiserror::Error, PartialEq)]

@@ -40,8 +40,8 @@ impl Density {
 }
 
 impl std::fmt::Display for Density {
-    /// `30505 samples for render.max_error 1%: predicted R 0.52%, G 0.74%, B 1% (spacing / radius
-    /// 0.087, 0.12, 0.155; thin part 1.15, 0.78, 0.626; shadow edges 2.47)`.
+    /// `30535 samples for render.max_error 1%: predicted R 0.52%, G 0.74%, B 1% (spacing / radius
+    /// 0.087, 0.12, 0.155; thin part 1.15, 0.78, 0.626; shadow edges 2.47; facets 1.2e-6, ...)`.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let pct = |x: f64| format!("{:.3}%", 100.0 * x);
         match self.target {
@@ -57,10 +57,11 @@ impl std::fmt::Display for Density {
         let three = |v: [f64; 3]| format!("{:.3}, {:.3}, {:.3}", v[0], v[1], v[2]);
         write!(
             f,
-            ": predicted R {r}, G {g}, B {b} (spacing / radius {}; thin part {}; shadow edges {:.3})",
+            ": predicted R {r}, G {g}, B {b} (spacing / radius {}; thin part {}; shadow edges {:.3}; facets {})",
             three(self.predicted.map(|c| c.spacing_over_radius)),
             three(self.predicted.map(|c| c.thin_term)),
-            self.predicted[0].shadow_term
+            self.predicted[0].shadow_term,
+            self.predicted.map(|c| format!("{:.2e}", c.facet_term)).join(", ")
         )
     }
 }
@@ -72,7 +73,13 @@ pub fn surface_facts(object: &PreparedObject, occluders: &Bvh, ray_offset: f64) 
     let area: f64 = a.iter().sum();
     let h2 = h.iter().zip(a).map(|(h, a)| h * h * a).sum::<f64>() / area.max(f64::MIN_POSITIVE);
     let curvature_radius = if h2 > 0.0 { 1.0 / h2.sqrt() } else { f64::INFINITY };
-    SurfaceFacts { area: mesh.total_area(), curvature_radius, occlusion: occlusion(object, occluders, ray_offset) }
+    SurfaceFacts {
+        area: mesh.total_area(),
+        curvature_radius,
+        occlusion: occlusion(object, occluders, ray_offset),
+        // Level 0 is the whole mesh.
+        edge_length: object.levels.first().map_or(0.0, |l| l.mean_edge),
+    }
 }
 
 /// The area-weighted share of the hemisphere above `object`'s surface that `occluders` block,
@@ -137,7 +144,7 @@ mod tests {
 
     /// The count a target chooses on a bunny-sized surface, with its prediction.
     fn density(target: f64) -> Density {
-        let facts = SurfaceFacts { area: 5e-3, curvature_radius: 5e-3, occlusion: 0.1 };
+        let facts = SurfaceFacts { area: 5e-3, curvature_radius: 5e-3, occlusion: 0.1, edge_length: 5e-4 };
         let radii = [5e-3, 3.7e-3, 2.8e-3];
         let count = density::count_for(&facts, radii, target);
         Density { count, target: Some(target), facts, predicted: density::predict(&facts, radii, count) }

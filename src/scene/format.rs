@@ -356,9 +356,6 @@ pub enum SplatVisibility {
 }
 
 impl SplatVisibility {
-    /// Both choices, in the order `--splat-visibility` lists them.
-    pub const ALL: [SplatVisibility; 3] = [SplatVisibility::Hybrid, SplatVisibility::Rays, SplatVisibility::ShadowMaps];
-
     /// What it does, for `plan` and `--explain`.
     pub fn why(self) -> &'static str {
         match self {
@@ -375,32 +372,13 @@ impl SplatVisibility {
             }
         }
     }
-
-    /// The name used in scene files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            SplatVisibility::Hybrid => "hybrid",
-            SplatVisibility::Rays => "rays",
-            SplatVisibility::ShadowMaps => "shadow_maps",
-        }
-    }
 }
 
-impl std::str::FromStr for SplatVisibility {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        SplatVisibility::ALL
-            .into_iter()
-            .find(|m| m.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| format!("unknown splat visibility `{s}` (expected hybrid, rays or shadow_maps)"))
-    }
-}
-
-impl std::fmt::Display for SplatVisibility {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.pad(self.name())
-    }
-}
+named_choices!(SplatVisibility, "splat visibility", {
+    Hybrid => "hybrid",
+    Rays => "rays",
+    ShadowMaps => "shadow_maps",
+});
 
 /// `render.texture_samples` when a scene names none (docs/STUDY.md, "The texture-space gather").
 pub const DEFAULT_TEXTURE_SAMPLES: u32 = 64;
@@ -437,37 +415,13 @@ pub enum GatherMode {
     Texture,
 }
 
-impl GatherMode {
-    /// Every gather mode: what `--gather` accepts and what parsing a name tries.
-    pub const ALL: [GatherMode; 5] =
-        [GatherMode::Vertex, GatherMode::Pixel, GatherMode::Sparse, GatherMode::Hierarchical, GatherMode::Texture];
-
-    /// The lowercase name used in scene files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            GatherMode::Vertex => "vertex",
-            GatherMode::Pixel => "pixel",
-            GatherMode::Sparse => "sparse",
-            GatherMode::Hierarchical => "hierarchical",
-            GatherMode::Texture => "texture",
-        }
-    }
-}
-
-impl std::str::FromStr for GatherMode {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        GatherMode::ALL.into_iter().find(|m| m.name().eq_ignore_ascii_case(s)).ok_or_else(|| {
-            format!("unknown gather mode `{s}` (expected vertex, pixel, sparse, hierarchical or texture)")
-        })
-    }
-}
-
-impl std::fmt::Display for GatherMode {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.pad(self.name())
-    }
-}
+named_choices!(GatherMode, "gather mode", {
+    Vertex => "vertex",
+    Pixel => "pixel",
+    Sparse => "sparse",
+    Hierarchical => "hierarchical",
+    Texture => "texture",
+});
 
 /// How translucent channels get their exitance: `render.transport`, `--transport`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize)]
@@ -483,35 +437,11 @@ pub enum TransportMode {
     Local,
 }
 
-impl TransportMode {
-    /// Every mode, in the order `--transport` lists them.
-    pub const ALL: [TransportMode; 3] = [TransportMode::Auto, TransportMode::Gather, TransportMode::Local];
-
-    /// The lowercase name used in scene files and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            TransportMode::Auto => "auto",
-            TransportMode::Gather => "gather",
-            TransportMode::Local => "local",
-        }
-    }
-}
-
-impl std::str::FromStr for TransportMode {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        TransportMode::ALL
-            .into_iter()
-            .find(|m| m.name().eq_ignore_ascii_case(s))
-            .ok_or_else(|| format!("unknown transport `{s}` (expected auto, gather or local)"))
-    }
-}
-
-impl std::fmt::Display for TransportMode {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.pad(self.name())
-    }
-}
+named_choices!(TransportMode, "transport", {
+    Auto => "auto",
+    Gather => "gather",
+    Local => "local",
+});
 
 impl Default for RenderSettings {
     fn default() -> Self {
