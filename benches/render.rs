@@ -692,7 +692,7 @@ fn gathers(gpu: &Arc<Gpu>, scene: &Scene) {
 /// system the seed compares itself with: Chang et al. 2008's texture-space gather against its
 /// draws per receiver (atlas 256). Each point's error is beside it: the per-vertex relative RMS
 /// over lit vertices (above 1% of the peak), mean of r, g, b, against the scene's own
-/// configuration (its 1% error target: 30,535 Turk samples, hierarchical gather at epsilon 0.3,
+/// configuration (its 1% error target: 30,686 Turk samples, hierarchical gather at epsilon 0.3,
 /// 0.91% from the exact integral, README), all with every vertex gathered.
 fn fps_against_samples(gpu: &Arc<Gpu>, scene: &Scene) {
     let reference = full_exitance(gpu, scene, &Overrides::default());

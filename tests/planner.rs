@@ -269,6 +269,14 @@ fn plan_prints_every_change_and_its_json_has_the_documented_fields() {
     }
     assert_eq!(bunny["channels"][0]["transport"], "gather");
     assert!(json["objects"][0]["channels"][0]["profile_radius"].as_f64().unwrap() > 0.0);
+    // docs/PLAN.md, "The sample count": the facts and each channel's terms.
+    let density = &bunny["density"];
+    for key in ["area", "curvature_radius", "occlusion", "edge_length"] {
+        assert!(density["facts"][key].as_f64().is_some_and(|v| v > 0.0), "{key} missing from {density}");
+    }
+    for key in ["spacing_over_radius", "thin_term", "shadow_term", "facet_term", "error"] {
+        assert!(density["predicted"][2][key].as_f64().is_some_and(|v| v > 0.0), "{key} missing from {density}");
+    }
 }
 
 #[test]

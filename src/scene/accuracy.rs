@@ -40,7 +40,7 @@ impl Density {
 }
 
 impl std::fmt::Display for Density {
-    /// `30535 samples for render.max_error 1%: predicted R 0.52%, G 0.74%, B 1% (spacing / radius
+    /// `30686 samples for render.max_error 1%: predicted R 0.52%, G 0.74%, B 1% (spacing / radius
     /// 0.087, 0.12, 0.155; thin part 1.15, 0.78, 0.626; shadow edges 2.47; facets 1.2e-6, ...)`.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let pct = |x: f64| format!("{:.3}%", 100.0 * x);
