@@ -41,6 +41,13 @@ fn default_render_runs_clean_under_validation() {
     for pass in ["shadow", "splat", "gather", "shade", "tonemap"] {
         assert!(stdout.contains(pass), "--timings lacks {pass}: {stdout}");
     }
+    // The frame's wall time beside the GPU's, and never less than the GPU's own total.
+    let ms = |name: &str| -> f64 {
+        let line =
+            stdout.lines().find(|l| l.trim_start().starts_with(name)).unwrap_or_else(|| panic!("{name}: {stdout}"));
+        line.split_whitespace().nth(1).and_then(|v| v.parse().ok()).unwrap_or_else(|| panic!("{line}"))
+    };
+    assert!(ms("wall") >= ms("total"), "{stdout}");
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -162,7 +162,7 @@ fn top_n(values: &[f64], n: usize, exclude: &[bool]) -> Vec<u32> {
 }
 
 /// Step 5: repulsion with the curvature density, in place.
-pub fn relax_by_curvature(mesh: &Mesh, points: &mut Vec<SurfacePoint>, params: &FeatureParams) {
+pub fn relax_by_curvature(mesh: &Mesh, points: &mut [SurfacePoint], params: &FeatureParams) {
     let density = curvature_density(mesh, params.contrast, params.cap);
     let integral: f64 = mesh
         .triangles()

@@ -37,6 +37,13 @@ impl SpatialHash {
 
     /// Rebuild over new positions, reusing the buffers.
     pub fn rebuild(&mut self, positions: &[DVec3], cell: f64) {
+        self.rebuild_in_order(positions, cell, None);
+    }
+
+    /// [`SpatialHash::rebuild`], each bucket listing its points in the order of `fill` (every
+    /// index once) rather than by index: a caller that keeps its points permuted visits
+    /// neighbours in the same order as without the permutation.
+    pub fn rebuild_in_order(&mut self, positions: &[DVec3], cell: f64, fill: Option<&[u32]>) {
         assert!(cell > 0.0 && cell.is_finite(), "spatial hash cell size must be positive, got {cell}");
         let n = positions.len();
         self.cell = cell;
@@ -68,11 +75,16 @@ impl SpatialHash {
         }
         self.entries.clear();
         self.entries.resize(n, 0);
-        // Fill in point order so each bucket lists its points by increasing index (determinism).
-        for (i, &b) in self.buckets.iter().enumerate() {
-            let slot = &mut self.bucket_start[b as usize];
-            self.entries[*slot as usize] = i as u32;
+        // Fill in point order (or `fill`'s) so each bucket lists its points in a fixed order
+        // (determinism).
+        let mut place = |i: u32| {
+            let slot = &mut self.bucket_start[self.buckets[i as usize] as usize];
+            self.entries[*slot as usize] = i;
             *slot += 1;
+        };
+        match fill {
+            Some(order) => order.iter().for_each(|&i| place(i)),
+            None => (0..n as u32).for_each(place),
         }
         // The fill advanced each start to the next bucket's start; shift back.
         for i in (1..=table).rev() {

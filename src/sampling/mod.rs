@@ -222,6 +222,12 @@ pub fn place(mesh: &Mesh, options: &SampleOptions) -> Result<Vec<SurfacePoint>, 
 /// neighbours on the surface are mostly neighbours in the list: the GPU's lanes then take
 /// similar paths (the splat's shadow rays walk the same boxes) and read nearby memory.
 fn spatial_order(mesh: &Mesh, points: &mut [SurfacePoint]) {
+    let key = morton_key(mesh);
+    points.sort_by_cached_key(|p| key(p));
+}
+
+/// A point's position along a Morton (Z-order) curve through `mesh`'s bounding box.
+fn morton_key(mesh: &Mesh) -> impl Fn(&SurfacePoint) -> u64 + '_ {
     let (lo, hi) = mesh.bounds();
     let (lo, extent) = (lo.as_dvec3(), (hi - lo).as_dvec3().max(glam::DVec3::splat(1e-30)));
     // 21 bits per axis: a 63-bit key.
@@ -233,10 +239,10 @@ fn spatial_order(mesh: &Mesh, points: &mut [SurfacePoint]) {
         v = (v | v << 4) & 0x10c30c30c30c30c3;
         (v | v << 2) & 0x1249249249249249
     };
-    points.sort_by_cached_key(|p| {
+    move |p| {
         let u = (p.position(mesh) - lo) / extent;
         spread(u.x) | spread(u.y) << 1 | spread(u.z) << 2
-    });
+    }
 }
 
 /// Turn placed points into samples with positions, normals and the given area weights.
