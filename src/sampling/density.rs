@@ -57,7 +57,7 @@ pub const FIT_MARGIN: f64 = 1.35;
 /// Fewest samples an error target may choose for an object.
 pub const MIN_CHOSEN: usize = 100;
 /// Most samples an error target may choose for an object: what placement and the gather can
-/// afford (Turk's repulsion of this many points takes about 10 s on two cores).
+/// afford (Turk's repulsion of this many points takes about 4 s on two cores).
 pub const MAX_CHOSEN: usize = 131_072;
 
 /// What the model weighs about an object's surface, independent of its material and lights.
