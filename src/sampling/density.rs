@@ -108,9 +108,10 @@ pub fn predict(facts: &SurfaceFacts, radii: [f64; 3], count: usize) -> [ChannelE
     })
 }
 
-/// The worst channel's predicted error for `count` samples.
+/// The worst channel's predicted error for `count` samples; NaN if any channel's is (where
+/// `f64::max` would drop it).
 fn worst(facts: &SurfaceFacts, radii: [f64; 3], count: usize) -> f64 {
-    predict(facts, radii, count).iter().map(|c| c.error).fold(0.0, f64::max)
+    predict(facts, radii, count).iter().map(|c| c.error).fold(0.0, |w, e| if e.is_nan() || e > w { e } else { w })
 }
 
 /// The fewest samples (within [`MIN_CHOSEN`] to [`MAX_CHOSEN`]) whose predicted error is at
@@ -176,5 +177,12 @@ mod tests {
         // Nothing shadowed, no facet term: a coarse convex sphere converges like a fine one.
         let unshadowed = SurfaceFacts { occlusion: 0.0, ..coarse };
         assert_eq!(predict(&unshadowed, radii, 1000)[0].facet_term, 0.0);
+    }
+
+    #[test]
+    fn a_prediction_that_is_not_a_number_chooses_the_most_samples_not_the_fewest() {
+        let broken = SurfaceFacts { curvature_radius: f64::NAN, ..FACTS };
+        assert_eq!(count_for(&broken, [0.004, f64::NAN, 0.004], 0.01), MAX_CHOSEN);
+        assert_eq!(count_for(&FACTS, [0.004, f64::NAN, 0.004], 0.01), MAX_CHOSEN);
     }
 }
