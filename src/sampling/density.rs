@@ -108,17 +108,17 @@ pub fn predict(facts: &SurfaceFacts, radii: [f64; 3], count: usize) -> [ChannelE
     })
 }
 
-/// The worst channel's predicted error for `count` samples; NaN if any channel's is (where
+/// The worst channel's predicted error of `predicted`; NaN if any channel's is (where
 /// `f64::max` would drop it).
-fn worst(facts: &SurfaceFacts, radii: [f64; 3], count: usize) -> f64 {
-    predict(facts, radii, count).iter().map(|c| c.error).fold(0.0, |w, e| if e.is_nan() || e > w { e } else { w })
+pub fn worst(predicted: &[ChannelError; 3]) -> f64 {
+    predicted.iter().map(|c| c.error).fold(0.0, |w, e| if e.is_nan() || e > w { e } else { w })
 }
 
 /// The fewest samples (within [`MIN_CHOSEN`] to [`MAX_CHOSEN`]) whose predicted error is at
 /// most `max_error` in every channel of `radii`. [`predict`] falls with the count in every term,
 /// so a bisection over the count inverts it.
 pub fn count_for(facts: &SurfaceFacts, radii: [f64; 3], max_error: f64) -> usize {
-    let meets = |n: usize| worst(facts, radii, n) <= max_error;
+    let meets = |n: usize| worst(&predict(facts, radii, n)) <= max_error;
     if meets(MIN_CHOSEN) {
         return MIN_CHOSEN;
     }
@@ -146,9 +146,9 @@ mod tests {
         let radii = [0.005, 0.003, 0.001];
         for target in [0.003, 0.01, 0.03, 0.1] {
             let n = count_for(&FACTS, radii, target);
-            let worst = predict(&FACTS, radii, n).iter().map(|c| c.error).fold(0.0, f64::max);
-            assert!(worst <= target * (1.0 + 1e-9) || n == MAX_CHOSEN || n == MIN_CHOSEN, "{target}: {n} -> {worst}");
-            let fewer = predict(&FACTS, radii, n - 1).iter().map(|c| c.error).fold(0.0, f64::max);
+            let at_n = worst(&predict(&FACTS, radii, n));
+            assert!(at_n <= target * (1.0 + 1e-9) || n == MAX_CHOSEN || n == MIN_CHOSEN, "{target}: {n} -> {at_n}");
+            let fewer = worst(&predict(&FACTS, radii, n - 1));
             assert!(fewer > target || n == MIN_CHOSEN, "{target}: {} samples would do", n - 1);
         }
     }

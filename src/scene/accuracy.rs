@@ -33,9 +33,9 @@ impl Density {
         Density { count, target: None, facts: self.facts, predicted: density::predict(&self.facts, radii, count) }
     }
 
-    /// The worst channel's predicted error.
+    /// The worst channel's predicted error (`sampling::density::worst`).
     pub fn worst(&self) -> f64 {
-        self.predicted.iter().map(|c| c.error).fold(0.0, f64::max)
+        density::worst(&self.predicted)
     }
 }
 
