@@ -459,6 +459,9 @@ fn study_with_physics_splits_each_rows_error_into_model_discretisation_and_total
         let md = std::fs::read_to_string(out.join("study.md")).unwrap();
         assert!(md.contains("Against the physics") && md.contains("stop paying"), "{md}");
         assert!(md.contains("40000 photons, "), "{md}");
+        // The models beside the dipole, single scattering between points and the choice per channel among them.
+        assert!(md.contains("| single scattering between points |"), "{md}");
+        assert!(md.contains("| per channel: between points under albedo 0.3, else dipole |"), "{md}");
         assert_eq!(md.contains("when walked, read from the cache"), pass == "cached", "{pass}: {md}");
         csvs.push(std::fs::read_to_string(out.join("study.csv")).unwrap());
     }

@@ -5,6 +5,8 @@
 //!
 //! - [`material`]: a [`Material`] (per-channel `sigma_a`, `sigma_s_prime` in 1/mm, `eta`) and the
 //!   derived per-channel [`Dipole`] in scene units (`sigma_tr`, `z_r`, `z_v`, `F_dr`, `A`, ...).
+//! - [`beam_single`]: single scattering between two surface points, the BSSRDF form of
+//!   Jensen et al. 2001 Eq. 3 (the light carried along the refracted beam before it scatters).
 //! - [`dipole`]: the diffuse reflectance profile `R_d(r)` (seed Eq. 8), its total, its exact
 //!   disk and ring integrals, and the BSSRDF `S_d` (seed Eq. 9) with an energy-conserving
 //!   normalization.
@@ -20,6 +22,7 @@
 //!   Eq. 3), the first-order term the dipole leaves out.
 //! - [`gpu`]: the std430 records shared with the shaders, mirrored with `#[repr(C)]` + bytemuck.
 
+pub mod beam_single;
 pub mod dipole;
 pub mod directional_dipole;
 pub mod fresnel;

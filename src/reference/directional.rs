@@ -32,14 +32,26 @@ use super::bvh::Bvh;
 use super::{occluders, per_translucent_object, ray_offset, reaching};
 use crate::mesh::Mesh;
 use crate::optics::directional_dipole::{Diffusion, DirectionalDipole, Strength, refract_in};
-use crate::optics::fresnel;
+use crate::optics::{Dipole, fresnel};
 use crate::scene::build::PreparedScene;
 use glam::DVec3;
 use rayon::prelude::*;
 
-/// A kernel in place of the directional dipole's: `(channel, x_i, n_i, w_12, x_o, n_o)` to the
-/// exitance per unit entering flux.
-pub type Kernel = dyn Fn(usize, DVec3, DVec3, DVec3, DVec3, DVec3) -> f64 + Sync;
+/// A kernel in place of the directional dipole's: `(the object's dipole in this channel, x_i,
+/// n_i, w_12, x_o, n_o)` to the exitance per unit entering flux.
+pub type Kernel = dyn Fn(&Dipole, DVec3, DVec3, DVec3, DVec3, DVec3) -> f64 + Sync;
+
+/// A [`Kernel`] in place of the directional dipole's, with the width of its peak at the receiver.
+#[derive(Clone, Copy)]
+pub struct Custom<'a> {
+    /// The kernel.
+    pub kernel: &'a Kernel,
+    /// The width `l` of the kernel's peak at the receiver, in mean free paths `1 / sigma_t'`:
+    /// 1/3 for the standard dipole (its real source's depth). 0 for a kernel that is singular
+    /// there (as `1/d`): the pieces are then refined towards the receiver geometrically, at a
+    /// fixed ratio of their radius to their distance.
+    pub width: f64,
+}
 
 /// The fineness [`exitance`] integrates at.
 pub const FINENESS: f64 = 0.4;
@@ -64,7 +76,7 @@ pub fn exitance_with(
     diffusion: Diffusion,
     strength: Strength,
     fineness: f64,
-    kernel: Option<&Kernel>,
+    kernel: Option<Custom>,
 ) -> Vec<Vec<[f64; 3]>> {
     let casters = occluders(scene);
     let eps = ray_offset(scene);
@@ -80,14 +92,14 @@ pub fn exitance_with(
                 [0, 1, 2].map(|c| {
                     let model = &models[c];
                     let eval = |x_i: DVec3, n_i: DVec3, w: DVec3| match kernel {
-                        Some(k) => k(c, x_i, n_i, w, x_o, n_o),
+                        Some(k) => (k.kernel)(&dipoles[c], x_i, n_i, w, x_o, n_o),
                         None => model.exitance_per_flux(x_i, n_i, w, x_o, n_o),
                     };
                     let receiver = Receiver {
                         x_o,
                         channel: c,
                         sigma_tr: model.sigma_tr,
-                        width: 1.0 / (3.0 * model.sigma_t_prime),
+                        width: kernel.map_or(1.0 / 3.0, |k| k.width) / model.sigma_t_prime,
                         fineness,
                     };
                     (0..o.mesh.triangles().len())

@@ -10,6 +10,12 @@
 //! is flat and evenly lit over a few mean free paths. It is what the renderer would add to the
 //! gathered exitance per vertex for `model = dipole + single`; `study --physics` measures it
 //! against the radiative-transfer reference (docs/STUDY.md).
+//!
+//! [`between_points`] keeps what the local term loses on a curved or unevenly lit surface: it
+//! integrates the kernel of single scattering between two surface points
+//! (`optics::beam_single`) over the object's lit surface, as `reference::directional`
+//! integrates the directional dipole, so light carried along a refracted beam leaves where the
+//! beam takes it (past a terminator, through a thin part).
 
 use super::{occluders, per_translucent_object, ray_offset, reaching};
 use crate::optics::{fresnel, single_scatter};
@@ -39,4 +45,20 @@ pub fn exitance(scene: &PreparedScene) -> Vec<Vec<[f64; 3]>> {
             })
             .collect()
     })
+}
+
+/// Per object (scene order), per vertex, RGB: the exitance of light scattered once, carried
+/// along each refracted beam between the surface points (`optics::beam_single`), integrated at
+/// `fineness` by `reference::directional`'s quadrature ([`super::directional::FINENESS`] is
+/// its usual one); zero for opaque objects.
+pub fn between_points(scene: &PreparedScene, fineness: f64) -> Vec<Vec<[f64; 3]>> {
+    use crate::optics::beam_single::BeamSingle;
+    use crate::optics::directional_dipole::{Diffusion, Strength};
+    let kernel = |d: &crate::optics::Dipole, x_i, _n_i, w_12, x_o, n_o| {
+        BeamSingle::from_dipole(d).exitance_per_flux(x_i, w_12, x_o, n_o)
+    };
+    // The kernel grows as 1/d at the receiver: no width. The diffusion and strength only set
+    // the directional dipole's, unused with a kernel.
+    let custom = super::directional::Custom { kernel: &kernel, width: 0.0 };
+    super::directional::exitance_with(scene, Diffusion::Grosjean, Strength::Paper, fineness, Some(custom))
 }

@@ -145,8 +145,13 @@ fn alternative_models(base: &PreparedScene, truth: &[Vec<[f64; 3]>]) -> Vec<(Str
         .collect();
     let fineness = directional::FINENESS;
     let variant = |d, s| directional::exitance_with(base, d, s, fineness, None);
+    use crate::optics::beam_single;
+    let beam = crate::reference::single::between_points(base, fineness);
+    let chosen = per_channel_choice(base, truth, &beam);
     vec![
         ("dipole".to_string(), truth.to_vec()),
+        ("single scattering between points".to_string(), beam),
+        (format!("per channel: between points under albedo {}, else dipole", beam_single::ALBEDO_BELOW), chosen),
         ("dipole + single scattering".to_string(), sum),
         ("single scattering alone".to_string(), single),
         ("directional dipole, D = 1/(3 sigma_t')".to_string(), variant(Diffusion::Classical, Strength::Paper)),
@@ -156,6 +161,24 @@ fn alternative_models(base: &PreparedScene, truth: &[Vec<[f64; 3]>]) -> Vec<(Str
             variant(Diffusion::Grosjean, Strength::ReducedAlbedo),
         ),
     ]
+}
+
+/// Per object, vertex and channel: `single` where the channel's reduced albedo is under
+/// `optics::beam_single::ALBEDO_BELOW`, else the dipole's `truth`.
+fn per_channel_choice(base: &PreparedScene, truth: &[Exitance], single: &[Exitance]) -> Vec<Exitance> {
+    use crate::optics::beam_single::ALBEDO_BELOW;
+    use crate::scene::build::ResolvedMaterial;
+    base.objects
+        .iter()
+        .zip(truth.iter().zip(single))
+        .map(|(o, (t, s))| {
+            let once = match &o.material {
+                ResolvedMaterial::Translucent { dipoles, .. } => dipoles.map(|d| d.alpha_prime < ALBEDO_BELOW),
+                ResolvedMaterial::Opaque { .. } => [false; 3],
+            };
+            t.iter().zip(s).map(|(t, s)| [0, 1, 2].map(|c| if once[c] { s[c] } else { t[c] })).collect()
+        })
+        .collect()
 }
 
 /// Per object and vertex, the cosine between the vertex normal and the direction to the first
