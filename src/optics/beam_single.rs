@@ -34,8 +34,11 @@
 //! `h = |(x_o - x_i) - t* w_12|`, and `1/r^2` is a Lorentzian of width `h` there. Substituting
 //! `t = t* + h tan phi` makes `dt / r^2 = dphi / h` exactly, and leaves the exponential, which
 //! falls over `1 / sigma_t`. The range of `phi` (from `t = 0` to `t` at infinity) is split at
-//! the closest approach and where `t - t*` is 1, 4 and 16 mean free paths, and each piece takes
-//! [`POINTS`]-point Gauss-Legendre. The tests measure the rule against one four times finer.
+//! the closest approach, where `t - t*` is 4^-4 to 16 mean free paths (by fours: when `h` is
+//! small the exponential falls within the last `h / mfp` of the range) and where the path to
+//! `x_o` crosses the critical angle. There the transmittance starts as a square root, so the
+//! piece after it is taken in `u` with `phi = a + (b - a) u^2`. Each piece takes
+//! [`POINTS`]-point Gauss-Legendre; the tests measure the rule against one four times finer.
 //! The kernel grows as `1/|x_o - x_i|` where the two meet, and is infinite at `x_o = x_i`
 //! (`h = 0`): `h` is held at least [`H_MIN`] mean free paths, so it stays finite (the
 //! quadrature of the surface integral never puts a receiver on a source point). The f32 twin is
@@ -82,7 +85,7 @@ impl BeamSingle {
     /// `K1(x_i, w_12; x_o, n_o)`, the radiant exitance at `x_o` per unit flux that entered at
     /// `x_i` along `w_12` (see the module's documentation). `w_12` and `n_o` are unit vectors.
     pub fn exitance_per_flux(&self, x_i: DVec3, w_12: DVec3, x_o: DVec3, n_o: DVec3) -> f64 {
-        self.exitance_with(x_i, w_12, x_o, n_o, rule(POINTS))
+        self.exitance_with(x_i, w_12, x_o, n_o, rule())
     }
 
     /// [`Self::exitance_per_flux`] with `n` points per piece (for measuring the rule).
@@ -168,10 +171,9 @@ impl BeamSingle {
 }
 
 /// The [`POINTS`]-point rule, computed once.
-fn rule(n: usize) -> &'static (Vec<f64>, Vec<f64>) {
+fn rule() -> &'static (Vec<f64>, Vec<f64>) {
     static RULE: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
-    debug_assert_eq!(n, POINTS);
-    RULE.get_or_init(|| gauss_legendre(n))
+    RULE.get_or_init(|| gauss_legendre(POINTS))
 }
 
 #[cfg(test)]

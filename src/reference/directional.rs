@@ -18,7 +18,8 @@
 //! Per receiver and channel, each triangle is split in four recursively until a piece of
 //! radius `R` at distance `d` from the receiver satisfies `2 R kappa <= fineness`, with
 //! `kappa = sigma_tr + 3 / sqrt(d^2 + l^2)` (the truth's measure of how fast the kernel changes;
-//! `l = 1 / (3 sigma_t')`, the width of the real source's peak), and is then one point at its
+//! `l = 1 / (3 sigma_t')`, the width of the real source's peak, or a [`Custom`] kernel's; at
+//! `l = 0` the pieces shrink with their distance to the receiver), and is then one point at its
 //! centroid: `E_t` and the kernel evaluated there, times its area. Past 5 diffusion lengths
 //! (`sigma_tr (d - R) > 5`, where the kernel is under `e^-5` of its value near the receiver, and
 //! a receiver lit only from there is under the study's 1% lit floor) the fineness relaxes by

@@ -332,7 +332,8 @@ fn alternatives_table(out: &mut String, p: &Physics) {
         out,
         "\nThe models' exact exitance against the reference (relative RMS per vertex, mean bias in brackets; \
          single scattering: `reference::single`, the half-space term of Jensen et al. 2001 Eq. 3 at each \
-         vertex):\n"
+         vertex; between points: `reference::single::between_points`, the same term resolved in space \
+         along each refracted beam):\n"
     );
     let _ = writeln!(out, "| model | r | g | b |");
     let _ = writeln!(out, "|---|---:|---:|---:|");
