@@ -13,13 +13,22 @@ use translucent::study::vertex_error_f64;
 
 /// A sphere of radius 10 (1 unit = 1 mm), `divisions`, of `preset`, under one directional light.
 fn sphere(preset: &str, divisions: u32) -> PreparedScene {
-    let material = format!(r#"{{ type = "translucent", preset = "{preset}", mm_per_unit = 1.0 }}"#);
-    let text = sphere_text(&material, divisions);
-    PreparedScene::new(&Scene::parse(&text, "test.toml", None).unwrap(), &Overrides::default()).unwrap()
+    prepared(&sphere_text(&preset_material(preset), divisions))
 }
 
 /// The scene of [`sphere`] with any `material` table.
 fn sphere_text(material: &str, divisions: u32) -> String {
+    scene_text(&format!(r#"{{ type = "sphere", radius = 10.0, divisions = {divisions} }}"#), material, [0.8, 0.5, 0.3])
+}
+
+/// A translucent `preset` at 1 unit = 1 mm, as a `material` table.
+fn preset_material(preset: &str) -> String {
+    format!(r#"{{ type = "translucent", preset = "{preset}", mm_per_unit = 1.0 }}"#)
+}
+
+/// One object of `shape` and `material`, casting no shadow, under one directional light from
+/// `direction`.
+fn scene_text(shape: &str, material: &str, direction: [f64; 3]) -> String {
     format!(
         r#"
 [camera]
@@ -28,16 +37,21 @@ target = [0.0, 0.0, 0.0]
 resolution = [32, 32]
 
 [[object]]
-shape = {{ type = "sphere", radius = 10.0, divisions = {divisions} }}
+shape = {shape}
 material = {material}
 casts_shadow = false
 
 [[light]]
 type = "directional"
-direction = [0.8, 0.5, 0.3]
+direction = {direction:?}
 irradiance = [1.0, 1.0, 1.0]
 "#
     )
+}
+
+/// `text` parsed and prepared.
+fn prepared(text: &str) -> PreparedScene {
+    PreparedScene::new(&Scene::parse(text, "test.toml", None).unwrap(), &Overrides::default()).unwrap()
 }
 
 #[test]
@@ -101,25 +115,7 @@ fn cost_and_convergence_on_the_study_spheres() {
 /// A flat square of `preset` of side 60 mm (1 unit = 1 mm) under one directional light from
 /// `direction`.
 fn plane(preset: &str, direction: [f64; 3]) -> PreparedScene {
-    let text = format!(
-        r#"
-[camera]
-eye = [0.0, 40.0, 80.0]
-target = [0.0, 0.0, 0.0]
-resolution = [32, 32]
-
-[[object]]
-shape = {{ type = "plane", size = 60.0, divisions = 2 }}
-material = {{ type = "translucent", preset = "{preset}", mm_per_unit = 1.0 }}
-casts_shadow = false
-
-[[light]]
-type = "directional"
-direction = {direction:?}
-irradiance = [1.0, 1.0, 1.0]
-"#
-    );
-    PreparedScene::new(&Scene::parse(&text, "test.toml", None).unwrap(), &Overrides::default()).unwrap()
+    prepared(&scene_text(r#"{ type = "plane", size = 60.0, divisions = 2 }"#, &preset_material(preset), direction))
 }
 
 #[test]
@@ -157,7 +153,7 @@ fn single_scattering_between_points_changes_under_a_tenth_of_a_percent_when_the_
         r#"{ type = "translucent", sigma_a = [0.97, 1.45, 0.97], sigma_s_prime = [0.07, 0.03, 0.07], eta = 1.3, mm_per_unit = 1.0 }"#,
         6,
     );
-    let scene = PreparedScene::new(&Scene::parse(&text, "test.toml", None).unwrap(), &Overrides::default()).unwrap();
+    let scene = prepared(&text);
     let coarse = translucent::reference::single::between_points(&scene, directional::FINENESS);
     let fine = translucent::reference::single::between_points(&scene, 0.5 * directional::FINENESS);
     let e = vertex_error_f64(&fine, &coarse);
