@@ -11,7 +11,9 @@
 // light moves every frame, so their part is kept per sample (SplatEnvironment): a frame after a
 // key light moved reads it back and loops over the key lights alone. The sum is taken in the same
 // order either way (key lights + environment), so the kept splat equals a full one bit for bit;
-// the near energy, written with the environment's part, is kept with it.
+// the near energy, written with the environment's part, is kept with it. The beam direction
+// (SplatRecord::beam) is the key lights' alone, written every time: the environment's light
+// arrives from everywhere.
 //
 // Bindings: 0 = samples (SampleRecord[], read), 1 = objects (ObjectRecord[], read),
 // 2 = lights (Light[], read), 3 = shadow maps (sampler2DArrayShadow),
@@ -80,8 +82,9 @@ float sample_visibility(Light l, vec3 p, vec3 n, vec3 wi, vec3 face) {
 }
 
 // Irradiance transmitted at `p` (normal `n`, face normal `face`, index ratio `eta`) from lights
-// [first, end).
-vec3 transmitted(uint first, uint end, vec3 p, vec3 n, vec3 face, float eta) {
+// [first, end). `beam` gathers each light's refracted direction inside (Snell's law) weighted by
+// the flux it transmits (the sum over channels).
+vec3 transmitted(uint first, uint end, vec3 p, vec3 n, vec3 face, float eta, inout vec3 beam) {
     vec3 e = vec3(0.0);
     for (uint l = first; l < end; ++l) {
         vec3 wi, irradiance;
@@ -89,7 +92,10 @@ vec3 transmitted(uint first, uint end, vec3 p, vec3 n, vec3 face, float eta) {
         float cos_i = dot(n, wi);
         if (cos_i <= 0.0) continue;
         float v = sample_visibility(lights[l], p, n, wi, face);
-        e += irradiance * (cos_i * dipole_fresnel_transmittance(cos_i, eta) * v);
+        vec3 t = irradiance * (cos_i * dipole_fresnel_transmittance(cos_i, eta) * v);
+        e += t;
+        float cos_t = sqrt(max(1.0 - (1.0 - cos_i * cos_i) / (eta * eta), 0.0));
+        beam += (t.r + t.g + t.b) * (-(wi - n * cos_i) / eta - n * cos_t);
     }
     return e;
 }
@@ -106,16 +112,21 @@ void main() {
     if (push.environment_kept != 0u) {
         environment = kept_environment[i].xyz;
     } else {
-        environment = transmitted(push.key_light_count, push.light_count, p, n, face, o.eta);
+        vec3 unused = vec3(0.0);
+        environment = transmitted(push.key_light_count, push.light_count, p, n, face, o.eta, unused);
         kept_environment[i] = vec4(environment, 0.0);
     }
-    vec3 e = transmitted(0u, push.key_light_count, p, n, face, o.eta) + environment;
+    vec3 weighted = vec3(0.0);
+    vec3 e = transmitted(0u, push.key_light_count, p, n, face, o.eta, weighted) + environment;
+    float length_sq = dot(weighted, weighted);
+    vec4 beam = vec4(length_sq > 0.0 ? weighted * inversesqrt(length_sq) : -n, 0.0);
     float area = s.position_area.w;
     if (push.environment_kept != 0u) {
         // The near energy depends on the sample's area and material alone, and whatever
         // changes those also splats the environment anew: it is the one written before, and
         // six Taylor remainders a sample (30 exponentials) are left out of a key light's frame.
         splat[i].irradiance_area = vec4(e, area);
+        splat[i].beam = beam;
         return;
     }
     float b = DIPOLE_B_PER_SQRT_AREA * sqrt(area);
@@ -123,5 +134,5 @@ void main() {
     for (int c = 0; c < 3; ++c) {
         near_energy[c] = dipole_near_energy(o.dipole[c], b);
     }
-    splat[i] = SplatRecord(vec4(e, area), vec4(near_energy, 0.0));
+    splat[i] = SplatRecord(vec4(e, area), vec4(near_energy, 0.0), beam);
 }

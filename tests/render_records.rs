@@ -124,6 +124,7 @@ fn splat_and_vertex_records_match_glsl() {
     let rust = [
         ("irradiance_area", offset_of!(SplatRecord, irradiance_area)),
         ("near_energy", offset_of!(SplatRecord, near_energy)),
+        ("beam", offset_of!(SplatRecord, beam)),
     ];
     assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
     let (fields, size) = glsl_layout(scene, "TreeNodeRecord");

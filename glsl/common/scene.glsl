@@ -51,6 +51,8 @@ vec3 unpack_octahedral(uint bits) {
 struct SplatRecord {
     vec4 irradiance_area;   // rgb: transmitted irradiance E_i; w: area weight
     vec4 near_energy;       // rgb: near-field energy per channel (dipole_near_energy); w: 0
+    vec4 beam;              // xyz: direction inside after refraction, the key lights' weighted
+                            // by transmitted flux (unit; -n where none reaches); w: 0
 };
 
 // One node of an object's sample hierarchy (sampling::SampleTree, packed by TreeNodeRecord):

@@ -23,6 +23,7 @@
 //! - [`gpu`]: the std430 records shared with the shaders, mirrored with `#[repr(C)]` + bytemuck.
 
 pub mod beam_single;
+pub mod beam_table;
 pub mod dipole;
 pub mod directional_dipole;
 pub mod fresnel;

@@ -172,6 +172,12 @@ pub struct GpuScene {
     pub bvh_nodes: Buffer,
     /// Its triangles in leaf order (`BvhTriangleRecord`).
     pub bvh_triangles: Buffer,
+    /// The between-points single scattering's kernel tables, one vec4 per node with an object's
+    /// channels, objects one after another (`beam_gather::pack_tables`); one unread entry when
+    /// there are none.
+    pub beam_tables: Buffer,
+    /// Per object, in scene order: its between-points channels and their tables' places.
+    pub beams: Vec<Option<super::beam_gather::ObjectBeams>>,
     /// Triangles in `bvh_triangles`: 0 when nothing casts a shadow.
     pub caster_triangles: u32,
     /// How far a shadow ray starts off the surface, along the normal, and the least distance
@@ -523,6 +529,7 @@ impl GpuScene {
     fn upload(gpu: &Arc<Gpu>, scene: &PreparedScene, p: PackedObjects, l: PackedLevels) -> GpuResult<GpuScene> {
         let none = vk::BufferUsageFlags::empty();
         let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER;
+        let (tables, beams) = super::beam_gather::pack_tables(scene);
         let zeros = vec![[0f32; 4]; p.vertices.len()];
         let sized = |name, item: usize, count: usize| storage(gpu, name, (item * count) as u64, none);
         Ok(GpuScene {
@@ -552,6 +559,8 @@ impl GpuScene {
             texture_pyramid: sized("texture pyramid", std::mem::size_of::<f32>(), p.pyramid_nodes)?,
             bvh_nodes: upload(gpu, "caster hierarchy", &p.bvh_nodes, none)?,
             bvh_triangles: upload(gpu, "caster triangles", &p.bvh_triangles, none)?,
+            beam_tables: upload(gpu, "beam tables", &tables, none)?,
+            beams,
             caster_triangles: p.bvh_triangles.len() as u32,
             ray_offset: scene.ray_offset() as f32,
             textures: p.textures,

@@ -69,6 +69,8 @@ pub enum Resource {
     BvhNodes,
     /// Its triangles in leaf order (`GpuScene::bvh_triangles`).
     BvhTriangles,
+    /// The between-points single scattering's kernel tables (`GpuScene::beam_tables`).
+    BeamTables,
     /// Exitance at the samples, the sparse gather's stage 0 (owned by `GatherSparsePass`).
     SampleExitance,
     /// The shadow-map array (`FrameTargets::shadow_maps`).
@@ -119,6 +121,7 @@ impl Resource {
             TexturePyramid => "TexturePyramid",
             BvhNodes => "BvhNodes",
             BvhTriangles => "BvhTriangles",
+            BeamTables => "BeamTables",
             ShadowMaps => "shadow_maps",
             Hdr => "hdr",
             Surface => "surface",
@@ -147,7 +150,7 @@ pub const HOST_READ: [Resource; 5] = [
 ];
 
 /// Every resource that is a `GpuScene` buffer (`Resources::buffer`).
-pub const SCENE_BUFFERS: [Resource; 24] = [
+pub const SCENE_BUFFERS: [Resource; 25] = [
     Resource::Vertices,
     Resource::Objects,
     Resource::Lights,
@@ -172,6 +175,7 @@ pub const SCENE_BUFFERS: [Resource; 24] = [
     Resource::TexturePyramid,
     Resource::BvhNodes,
     Resource::BvhTriangles,
+    Resource::BeamTables,
 ];
 
 /// One declared access of a pass (`gpu::Use` over `Resource`).
@@ -246,6 +250,7 @@ impl<'a> Resources<'a> {
             TexturePyramid => &s.texture_pyramid,
             BvhNodes => &s.bvh_nodes,
             BvhTriangles => &s.bvh_triangles,
+            BeamTables => &s.beam_tables,
             _ => return None,
         })
     }

@@ -3,6 +3,7 @@
 //! targets (`targets`), the two-stage gathers' shared shape (`group_gather`), the scene's GPU
 //! data (`gpu_scene`, `records`), the planner and the `Renderer`.
 
+pub mod beam_gather;
 pub mod edit;
 pub mod gather;
 pub mod gather_pixel;

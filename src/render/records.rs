@@ -139,14 +139,20 @@ pub struct SplatRecord {
     pub irradiance_area: [f32; 4],
     /// rgb: near-field energy per channel (`optics::kernel::near_energy`).
     pub near_energy: [f32; 4],
+    /// xyz: the direction light travels inside after refracting in, the key lights' directions
+    /// weighted by their transmitted flux (unit; `-n` where no key light reaches); w: 0. The
+    /// between-points single scattering reads it (glsl/beam_gather.comp).
+    pub beam: [f32; 4],
 }
 
 impl SplatRecord {
-    /// Pack one sample's splat output as splat.comp writes it (the w of `near_energy` is 0).
-    pub fn new(irradiance: [f32; 3], area: f32, near_energy: [f32; 3]) -> SplatRecord {
+    /// Pack one sample's splat output as splat.comp writes it (the w of `near_energy` and of
+    /// `beam` is 0).
+    pub fn new(irradiance: [f32; 3], area: f32, near_energy: [f32; 3], beam: [f32; 3]) -> SplatRecord {
         let [e0, e1, e2] = irradiance;
         let [n0, n1, n2] = near_energy;
-        SplatRecord { irradiance_area: [e0, e1, e2, area], near_energy: [n0, n1, n2, 0.0] }
+        let [b0, b1, b2] = beam;
+        SplatRecord { irradiance_area: [e0, e1, e2, area], near_energy: [n0, n1, n2, 0.0], beam: [b0, b1, b2, 0.0] }
     }
 }
 

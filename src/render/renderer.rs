@@ -2,6 +2,7 @@
 //! frame loop that records the passes a plan asks for, each timed with the `GpuTimer`. Outputs
 //! stay on the GPU between frames, so a frame that skips a pass reuses its last result.
 
+use super::beam_gather::{BeamGatherPass, GatherThenBeams};
 use super::edit::SceneEdit;
 use super::gather::GatherPass;
 use super::gather_pixel::GatherPixelPass;
@@ -57,6 +58,20 @@ pub enum RenderError {
     /// The pixel gather was asked of a renderer drawing into a host's target.
     #[error("the pixel gather needs the renderer's own HDR image: use vertex or sparse")]
     PixelGatherOnHostTarget,
+    /// A material whose `model` takes single scattering between points, in a scene gathered at
+    /// pixels: that model is gathered at the vertices.
+    #[error(
+        "object {0}: material.model takes single scattering between points, which is gathered at the vertices: \
+         use render.gather \"vertex\", \"hierarchical\", \"sparse\" or \"texture\", or material.model = \"dipole\""
+    )]
+    SingleScatteringOnPixelGather(usize),
+    /// `set_material` of an object whose `model` takes single scattering between points: its
+    /// kernel tables are built with the scene's GPU data.
+    #[error(
+        "set_material: object {0}'s material.model takes single scattering between points, whose tables are built \
+         once with the scene; load the scene with the new material instead"
+    )]
+    MaterialWithBeamTables(usize),
     /// `resize` of a renderer drawing into a host's target.
     #[error("resize: a host target's size comes with each frame's HostTarget")]
     ResizeHostTarget,
@@ -510,6 +525,11 @@ impl Renderer {
         if needs.host_target && needs.pixel_gather {
             return Err(RenderError::PixelGatherOnHostTarget);
         }
+        if let Some(i) = scene.objects.iter().position(|o| o.single_channels().contains(&true))
+            && needs.pixel_gather
+        {
+            return Err(RenderError::SingleScatteringOnPixelGather(i));
+        }
         let buffers = GpuScene::new(gpu, &scene)?;
         let settings = &scene.scene.file.render;
         let camera = (target == TargetDesc::Own).then_some((scene.scene.file.camera.resolution, needs.pixel_gather));
@@ -562,12 +582,17 @@ impl Renderer {
         settings: &crate::scene::RenderSettings,
         pixel: bool,
     ) -> Result<Box<dyn RenderPass>, RenderError> {
-        Ok(match settings.gather {
-            _ if pixel => Box::new(GatherPixelPass::new(gpu, resources)?),
+        let gather: Box<dyn RenderPass> = match settings.gather {
+            _ if pixel => return Ok(Box::new(GatherPixelPass::new(gpu, resources)?)),
             GatherMode::Sparse => Box::new(GatherSparsePass::new(gpu, resources)?),
             GatherMode::Hierarchical => Box::new(GatherTreePass::new(gpu, resources)?),
             GatherMode::Texture => Box::new(GatherTexturePass::new(gpu, resources, settings.texture_samples)?),
             _ => Box::new(GatherPass::new(gpu, resources)?),
+        };
+        // Channels of single scattering between points overwrite the dipole's after it.
+        Ok(match BeamGatherPass::new(gpu, resources)? {
+            Some(beams) => Box::new(GatherThenBeams { gather, beams }),
+            None => gather,
         })
     }
 
@@ -1153,6 +1178,9 @@ impl Renderer {
     /// (`Change::Material`). Errors when the object is opaque or the index is out of range.
     pub fn set_material(&mut self, object: usize, material: crate::optics::Material) -> Result<(), RenderError> {
         self.check_object(object)?;
+        if self.buffers.beams[object].is_some() {
+            return Err(RenderError::MaterialWithBeamTables(object));
+        }
         let o = &mut self.scene.objects[object];
         let crate::scene::build::ResolvedMaterial::Translucent { material: m, dipoles, mm_per_unit, .. } =
             &mut o.material

@@ -35,6 +35,8 @@ pub enum ResolvedMaterial {
         mm_per_unit: f64,
         /// GGX roughness of the dielectric specular lobe (0 to 1).
         roughness: f32,
+        /// Which model each channel takes (`material.model`).
+        model: super::ScatteringModel,
     },
     /// Lambertian with a GGX specular lobe.
     Opaque {
@@ -70,6 +72,17 @@ pub struct PreparedObject {
 }
 
 impl PreparedObject {
+    /// Per channel, whether it takes single scattering between points (`material.model`);
+    /// none for an opaque object.
+    pub fn single_channels(&self) -> [bool; 3] {
+        match &self.material {
+            ResolvedMaterial::Translucent { dipoles, model, .. } => {
+                model.single_channels(dipoles.map(|d| d.alpha_prime))
+            }
+            ResolvedMaterial::Opaque { .. } => [false; 3],
+        }
+    }
+
     /// The hierarchy over its samples for the hierarchical gather (built on each call; the
     /// renderer and the f64 reference each build it once, identically). Its reach is the widest
     /// channel's near-blend radius.
@@ -525,9 +538,9 @@ fn check_reach(scene: &Scene, i: usize, name: &str, mesh: &Mesh) -> Result<(), S
 /// given, a preset's own overridden where given) and its dipoles in scene units. Errors carry
 /// `key`, the material's place in the scene.
 fn resolve_material(spec: &MaterialSpec, key: &str) -> Result<ResolvedMaterial, SceneError> {
-    let (preset, sigma_a, sigma_s_prime, eta, mm_per_unit, roughness) = match spec {
-        MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, eta, mm_per_unit, roughness } => {
-            (preset, sigma_a, sigma_s_prime, eta, mm_per_unit, roughness)
+    let (preset, sigma_a, sigma_s_prime, eta, mm_per_unit, roughness, model) = match spec {
+        MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, eta, mm_per_unit, roughness, model } => {
+            (preset, sigma_a, sigma_s_prime, eta, mm_per_unit, roughness, model)
         }
         MaterialSpec::Opaque { albedo, roughness } => {
             return Ok(ResolvedMaterial::Opaque { albedo: *albedo, roughness: *roughness });
@@ -548,7 +561,13 @@ fn resolve_material(spec: &MaterialSpec, key: &str) -> Result<ResolvedMaterial, 
         material = material.with_eta(*e).with_context(key)?;
     }
     let dipoles = material.dipoles(*mm_per_unit).with_context(key)?;
-    Ok(ResolvedMaterial::Translucent { material, dipoles, mm_per_unit: *mm_per_unit, roughness: *roughness })
+    Ok(ResolvedMaterial::Translucent {
+        material,
+        dipoles,
+        mm_per_unit: *mm_per_unit,
+        roughness: *roughness,
+        model: *model,
+    })
 }
 
 /// The environment light's map loaded (or the procedural sky where it names none), if the scene

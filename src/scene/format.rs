@@ -152,6 +152,9 @@ pub enum MaterialSpec {
         /// GGX roughness of the dielectric specular lobe (default 0.35; 0 to 1).
         #[serde(default = "roughness")]
         roughness: f32,
+        /// Which model each channel takes (default `"dipole"`; `"auto"`, `"single"`).
+        #[serde(default)]
+        model: ScatteringModel,
     },
     /// Lambertian with a GGX specular lobe.
     Opaque {
@@ -422,6 +425,40 @@ named_choices!(GatherMode, "gather mode", {
     Hierarchical => "hierarchical",
     Texture => "texture",
 });
+
+/// Which light-transport model a translucent material's channels take: `material.model`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ScatteringModel {
+    /// The dipole in every channel (the paper's model, and the one the study's exact integral
+    /// measures the sum against)
+    #[default]
+    Dipole,
+    /// Per channel: single scattering between points where the reduced albedo is under 0.3
+    /// (`optics::beam_single::ALBEDO_BELOW`), where it is closer to the radiative transfer than
+    /// the dipole; the dipole elsewhere
+    Auto,
+    /// Single scattering between points in every channel
+    Single,
+}
+
+named_choices!(ScatteringModel, "scattering model", {
+    Dipole => "dipole",
+    Auto => "auto",
+    Single => "single",
+});
+
+impl ScatteringModel {
+    /// Per channel, whether it takes single scattering between points rather than the dipole:
+    /// `alpha'` is each channel's reduced albedo.
+    pub fn single_channels(self, alpha_prime: [f64; 3]) -> [bool; 3] {
+        match self {
+            ScatteringModel::Dipole => [false; 3],
+            ScatteringModel::Single => [true; 3],
+            ScatteringModel::Auto => alpha_prime.map(|a| a < crate::optics::beam_single::ALBEDO_BELOW),
+        }
+    }
+}
 
 /// How translucent channels get their exitance: `render.transport`, `--transport`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize)]

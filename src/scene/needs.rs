@@ -38,6 +38,9 @@ pub struct SceneNeeds {
 pub struct ObjectFacts {
     /// The mesh path or built-in shape.
     pub name: String,
+    /// Per channel, its reduced albedo `alpha'` where `material.model` gives it single
+    /// scattering between points (`ScatteringModel::single_channels`); `None` for the dipole.
+    pub single: [Option<f64>; 3],
     /// Centre of its bounding sphere.
     pub center: [f32; 3],
     /// Radius of its bounding sphere.
@@ -101,7 +104,13 @@ impl ObjectFacts {
             })),
             super::build::ResolvedMaterial::Opaque { .. } => None,
         };
+        let alpha = match &object.material {
+            super::build::ResolvedMaterial::Translucent { dipoles, .. } => dipoles.map(|d| d.alpha_prime),
+            super::build::ResolvedMaterial::Opaque { .. } => [0.0; 3],
+        };
+        let chosen = object.single_channels();
         ObjectFacts {
+            single: [0, 1, 2].map(|c| chosen[c].then_some(alpha[c])),
             name: object.name.clone(),
             center: center.to_array(),
             radius,

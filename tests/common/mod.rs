@@ -209,7 +209,9 @@ fn set_splat_irradiance(renderer: &mut Renderer, irradiance: &[[f32; 3]]) {
                 }
                 ResolvedMaterial::Opaque { .. } => [0.0; 3],
             };
-            records.push(SplatRecord::new(irradiance[records.len()], s.area as f32, near));
+            // Light along the inward normal: the dipole gathers these tests feed do not read it.
+            let beam = (-s.normal).to_array();
+            records.push(SplatRecord::new(irradiance[records.len()], s.area as f32, near, beam));
         }
     }
     renderer.buffers_mut().splat.write(0, &records).unwrap();

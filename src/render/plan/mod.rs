@@ -182,6 +182,9 @@ pub struct ChannelPlan {
 /// What one object gets this frame, and why.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct ObjectPlan {
+    /// Per channel, its reduced albedo where `material.model` gives it single scattering
+    /// between points (glsl/beam_gather.comp overwrites the dipole's exitance there).
+    pub single: [Option<f64>; 3],
     /// Index in the scene.
     pub object: usize,
     /// Mesh path or shape.
@@ -328,6 +331,18 @@ impl fmt::Display for Plan {
                     Transport::Gather => "gather",
                 };
                 writeln!(f, "    {c} {t} {}", ch.why)?;
+            }
+            for (c, alpha) in ["R", "G", "B"].iter().zip(o.single) {
+                let Some(alpha) = alpha else { continue };
+                let why = if alpha < crate::optics::beam_single::ALBEDO_BELOW {
+                    "under 0.3, where most light leaves after one scattering and the dipole reads low (docs/optics.md)"
+                } else {
+                    "material.model = \"single\" asks for it in every channel"
+                };
+                writeln!(
+                    f,
+                    "    {c} single scattering between points, after the gather: reduced albedo {alpha:.3}, {why}"
+                )?;
             }
         }
         Ok(())

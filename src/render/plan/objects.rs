@@ -109,6 +109,7 @@ impl Frame<'_> {
             if splat && kept && self.needs.environment.is_some() { SplatLights::KeyLights } else { SplatLights::All };
         ObjectPlan {
             object: i,
+            single: facts.single,
             name: facts.name.clone(),
             in_view,
             pixel_footprint: footprint,

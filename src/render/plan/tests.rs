@@ -6,6 +6,7 @@ fn object(radius: f32, spacing: f64, profile: f64) -> ObjectFacts {
     let channel = ChannelFacts { diffusion_length: profile, z_v: profile, profile_radius: profile, r_d_total: 0.5 };
     ObjectFacts {
         name: "sphere".into(),
+        single: [None; 3],
         center: [0.0, 0.0, 0.0],
         radius,
         sample_spacing: spacing,

@@ -1,0 +1,217 @@
+//! Between-points single-scattering pass (`glsl/beam_gather.comp`): for the channels a
+//! material's `model` gives to single scattering between points (`scene::ScatteringModel`), the
+//! exitance at the vertices of each such object's level of detail, from its samples' transmitted
+//! irradiance and beam directions (`SplatRecord::beam`) through the kernel's table
+//! (`optics::beam_table`). It runs in the gather's slot, after the dipole gather, and overwrites
+//! those channels alone.
+//!
+//! Bindings: `BINDINGS`, in binding order. Push: `BeamGatherPush`.
+
+use super::graph::{Resource, Resources, Use, compute_uses};
+use super::pass::{FrameInputs, RenderPass};
+use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuResult};
+use crate::optics::beam_table::{self, BeamTable};
+use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
+use ash::vk;
+use std::sync::Arc;
+
+/// `BeamGatherPush` in glsl/beam_gather.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct BeamGatherPush {
+    /// x: the object; y: its receivers' first entry in `level_vertices` or `receiver_order`;
+    /// z: their count; w: the channel mask.
+    pub object: [u32; 4],
+    /// x: its table's base in `GpuScene::beam_tables` (vec4 entries); y: its root in
+    /// `tree_nodes`; z: its node count; w: 1 when the receivers are `receiver_order`'s (the
+    /// whole mesh, absolute indices), 0 when `level_vertices`' (a coarser level).
+    pub tree: [u32; 4],
+    /// xyz: `sigma_t'` per channel in scene units; w: the critical cosine inside.
+    pub sigma_t: [f32; 4],
+    /// xyz: `R1(1)` per channel; w: the reach in scene units.
+    pub normal_total: [f32; 4],
+}
+
+/// One object's between-points channels and where their table lies.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ObjectBeams {
+    /// Bit `c`: channel `c` takes single scattering between points.
+    pub channels: u32,
+    /// Its table's base in `GpuScene::beam_tables` (vec4 entries, one channel in each lane).
+    pub table: u32,
+    /// `sigma_t'` per channel, scene units.
+    pub sigma_t: [f32; 3],
+    /// The critical cosine inside (`beam_table::critical_cosine`).
+    pub mu_c: f32,
+    /// `R1(1)` per channel (`BeamTable::normal_total`).
+    pub normal_total: [f32; 3],
+    /// How far a sample reaches, in scene units: `beam_table::REACH_MFP` mean free paths of the
+    /// longest of its channels.
+    pub reach: f32,
+}
+
+/// The tables of object `o`'s between-points channels for its samples' mean footprint, all
+/// with the same reach in scene units, and its `ObjectBeams` with its table at `base`; `None`
+/// when no channel of it takes the model.
+pub fn object_tables(o: &PreparedObject, base: usize) -> Option<(ObjectBeams, [Option<BeamTable>; 3])> {
+    let single = o.single_channels();
+    let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else { return None };
+    if !single.contains(&true) || o.samples.is_empty() {
+        return None;
+    }
+    let mean_area = o.samples.iter().map(|s| s.area).sum::<f64>() / o.samples.len() as f64;
+    let radius = (mean_area / std::f64::consts::PI).sqrt();
+    let longest = (0..3).filter(|&c| single[c]).map(|c| 1.0 / dipoles[c].sigma_t_prime).fold(0.0, f64::max);
+    let reach = beam_table::REACH_MFP * longest;
+    let curvature = mean_curvature(&o.mesh);
+    let tables = [0, 1, 2].map(|c| {
+        let d = &dipoles[c];
+        let (footprint, reach, bend) = (radius * d.sigma_t_prime, reach * d.sigma_t_prime, d.sigma_t_prime / curvature);
+        single[c].then(|| BeamTable::new(d.alpha_prime, d.eta, footprint, reach, bend))
+    });
+    let beams = ObjectBeams {
+        channels: (0..3).filter(|&c| single[c]).map(|c| 1 << c).sum(),
+        table: base as u32,
+        sigma_t: dipoles.map(|d| d.sigma_t_prime as f32),
+        mu_c: beam_table::critical_cosine(dipoles[0].eta) as f32,
+        normal_total: tables.each_ref().map(|t| t.as_ref().map_or(0.0, |t| t.normal_total as f32)),
+        reach: reach as f32,
+    };
+    Some((beams, tables))
+}
+
+/// The mesh's mean normal curvature (scene units), `(n_i - n_j) . (x_i - x_j) / |x_i - x_j|^2`
+/// over its edges weighted by their length: `1 / R` on a sphere of radius `R`, 0 on a plane; 0
+/// where it comes out negative (a concave mean: the tables are the plane's).
+pub fn mean_curvature(mesh: &crate::mesh::Mesh) -> f64 {
+    let (p, n) = (mesh.positions(), mesh.vertex_normals());
+    let (mut sum, mut weight) = (0.0, 0.0);
+    for t in mesh.triangles() {
+        for k in 0..3 {
+            let (i, j) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            let d = (p[i] - p[j]).as_dvec3();
+            let len = d.length();
+            if len > 0.0 {
+                sum += (n[i] - n[j]).as_dvec3().dot(d) / len;
+                weight += len;
+            }
+        }
+    }
+    if weight > 0.0 { (sum / weight).max(0.0) } else { 0.0 }
+}
+
+/// Every object's table packed one after another, one vec4 per node holding its channels
+/// (0 in channels without the model; at least one entry, so the buffer binds), and per object
+/// its `ObjectBeams`.
+pub fn pack_tables(scene: &PreparedScene) -> (Vec<[f32; 4]>, Vec<Option<ObjectBeams>>) {
+    let mut values = vec![[0.0f32; 4]];
+    let mut beams = Vec::with_capacity(scene.objects.len());
+    for o in &scene.objects {
+        let object = object_tables(o, values.len());
+        if let Some((_, tables)) = &object {
+            let at = |c: usize, k: usize| tables[c].as_ref().map_or(0.0, |t| t.values[k]);
+            values.extend((0..beam_table::LEN).map(|k| [at(0, k), at(1, k), at(2, k), 0.0]));
+        }
+        beams.push(object.map(|(b, _)| b));
+    }
+    (values, beams)
+}
+
+/// glsl/beam_gather.comp's bindings, in binding order.
+const BINDINGS: [Resource; 10] = [
+    Resource::Vertices,
+    Resource::Samples,
+    Resource::Splat,
+    Resource::Objects,
+    Resource::Exitance,
+    Resource::LevelVertices,
+    Resource::BeamTables,
+    Resource::TreeNodes,
+    Resource::TreeOrder,
+    Resource::ReceiverOrder,
+];
+
+/// One dispatch of glsl/beam_gather.comp per gathered object with a between-points channel.
+pub struct BeamGatherPass {
+    pipeline: ComputePipeline,
+    set: DescriptorSet,
+}
+
+impl BeamGatherPass {
+    /// The pipeline and one descriptor set over `BINDINGS`; `None` when no object of the scene
+    /// takes the model (the frame then records nothing for it).
+    pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<Option<BeamGatherPass>> {
+        if resources.scene.beams.iter().all(Option::is_none) {
+            return Ok(None);
+        }
+        let pipeline = ComputePipeline::new(gpu, "beam_gather.comp")?;
+        let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
+        Ok(Some(BeamGatherPass { pipeline, set }))
+    }
+
+    /// Whether this frame gathers an object with a between-points channel.
+    fn any(frame: &FrameInputs) -> bool {
+        frame.scene.beams.iter().enumerate().any(|(i, b)| b.is_some() && frame.plan.gathers(i))
+    }
+}
+
+impl RenderPass for BeamGatherPass {
+    fn uses(&self, _: &FrameInputs) -> Vec<Use> {
+        let mut uses = compute_uses(&BINDINGS, &[]);
+        // It keeps the dipole's channels: the exitance is read and written.
+        for u in &mut uses {
+            if u.resource == Resource::Exitance {
+                *u = Use::new(Resource::Exitance, Access::ComputeReadWrite);
+            }
+        }
+        uses
+    }
+
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        for r in frame.scene.receivers.iter() {
+            let object = r.object as usize;
+            let Some(b) = frame.scene.beams[object].filter(|_| frame.plan.gathers(object)) else { continue };
+            let level_index = frame.plan.level(object);
+            let level = frame.scene.level(object, level_index);
+            // The whole mesh's vertices in receiver-group order, where the walks of neighbouring
+            // invocations are alike; a coarser level's list otherwise.
+            let (first, count, grouped) = if level_index == 0 {
+                (r.first_receiver, r.vertex_count, 1)
+            } else {
+                (level.first_entry, level.vertex_count, 0)
+            };
+            let [s0, s1, s2] = b.sigma_t;
+            let [r0, r1, r2] = b.normal_total;
+            let push = BeamGatherPush {
+                object: [r.object, first, count, b.channels],
+                tree: [b.table, r.first_node, r.node_count, grouped],
+                sigma_t: [s0, s1, s2, b.mu_c],
+                normal_total: [r0, r1, r2, b.reach],
+            };
+            self.pipeline.dispatch(cmd, &self.set, &push, [count, 1, 1]);
+        }
+    }
+}
+
+/// The gather's slot with the between-points pass after it: the dipole gather writes every
+/// channel, then this pass overwrites its own (a barrier between them, from their declarations).
+pub struct GatherThenBeams {
+    /// The dipole gather `render.gather` names.
+    pub gather: Box<dyn RenderPass>,
+    /// The between-points pass.
+    pub beams: BeamGatherPass,
+}
+
+impl RenderPass for GatherThenBeams {
+    fn uses(&self, frame: &FrameInputs) -> Vec<Use> {
+        self.gather.uses(frame)
+    }
+
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        self.gather.record(cmd, frame);
+        if BeamGatherPass::any(frame) {
+            frame.before(cmd, &self.beams.uses(frame));
+            self.beams.record(cmd, frame);
+        }
+    }
+}
