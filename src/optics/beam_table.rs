@@ -53,8 +53,10 @@ use std::f64::consts::PI;
 
 /// The reach the renderer gives an object's tables, in mean free paths of its channel with the
 /// longest: past it the once-scattered light has crossed at least that much medium, and what
-/// still arrives from there is under `E1(8) = 4e-5` of `R1` on a plane.
-pub const REACH_MFP: f64 = 8.0;
+/// still arrives from there is of the order of `E1(5) = 1.1e-3` of `R1` on a plane. The pass's
+/// cost grows as its square: 8 mean free paths cost 2.3 times as much on the 2 cm ketchup
+/// sphere (docs/optics.md, "Single scattering between points in the renderer").
+pub const REACH_MFP: f64 = 5.0;
 /// Nodes along `x` (`rho = reach x^2`).
 pub const NX: usize = 48;
 /// Nodes along `cos phi`.
