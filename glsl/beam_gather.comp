@@ -37,7 +37,7 @@ struct BeamGatherPush {
     uvec4 tree;             // x: its table's base in beam_tables; y: its root in tree_nodes;
                             // z: its node count; w: 1: the receivers are receiver_order's
                             // (absolute, grouped in space), 0: level_vertices' (object-relative)
-    vec4 sigma_t;           // xyz: sigma_t' per channel (scene units); w: the critical cosine
+    vec4 critical;          // x: the critical cosine inside; yzw: 0
     vec4 normal_total;      // xyz: R1(1) per channel; w: the reach (scene units)
 };
 layout(push_constant) uniform BeamGatherPushBlock { BeamGatherPush push; };
@@ -59,7 +59,7 @@ void add_sample(uint s, vec3 x, inout vec3 sum, inout vec3 norm) {
     // The table's x axis: sqrt(rho / reach), the same distance for every channel.
     float x_axis = sqrt(sqrt(dist_sq) / reach);
     uint table = push.tree.x;
-    sum += pa.w * splat[s].irradiance_area.rgb * beam_table_lookup(table, push.sigma_t.w, x_axis, cos_phi, mu);
+    sum += pa.w * splat[s].irradiance_area.rgb * beam_table_lookup(table, push.critical.x, x_axis, cos_phi, mu);
     norm += pa.w * beam_table_normal(table, x_axis);
 }
 

@@ -102,11 +102,12 @@ impl BeamTable {
                 let v0 = DVec3::new(rho * cos_phi, rho * (1.0 - cos_phi * cos_phi).max(0.0).sqrt(), 0.0);
                 let big_r = WINDOW * footprint;
                 let value = if rho < WINDOW_REACH * big_r {
-                    window_average(&medium, w_12, v0, big_r)
+                    window_average(&medium, w_12, v0, big_r) + curvature_gain(&medium, w_12, rho, cos_phi, radius)
                 } else {
-                    medium.exitance_per_flux(DVec3::ZERO, w_12, v0, DVec3::Z)
+                    // Past the window, the point value on the curved surface itself.
+                    curved_point(&medium, w_12, rho, cos_phi, radius)
                 };
-                (value + curvature_gain(&medium, w_12, rho, cos_phi, radius)).max(0.0) as f32
+                value.max(0.0) as f32
             })
             .collect();
         let normal_total = reflectance(albedo, 0.0, eta, 1.0) + normal_gain(&medium, reach, radius);
@@ -172,11 +173,18 @@ fn curvature_gain(medium: &BeamSingle, w_12: DVec3, rho: f64, cos_phi: f64, radi
     if !radius.is_finite() {
         return 0.0;
     }
-    let flat = DVec3::new(rho * cos_phi, rho * (1.0 - cos_phi * cos_phi).max(0.0).sqrt(), 0.0);
-    let plane = medium.exitance_per_flux(DVec3::ZERO, w_12, flat, DVec3::Z);
-    let sphere =
-        on_sphere(rho, cos_phi, radius).map_or(0.0, |(x, n)| medium.exitance_per_flux(DVec3::ZERO, w_12, x, n));
-    sphere - plane
+    curved_point(medium, w_12, rho, cos_phi, radius) - curved_point(medium, w_12, rho, cos_phi, f64::INFINITY)
+}
+
+/// The kernel's point value with the receiver at chord `rho` and azimuth `phi` on the sphere of
+/// radius `radius` through the entry (0 past its diameter), or on the plane when the radius is
+/// infinite.
+fn curved_point(medium: &BeamSingle, w_12: DVec3, rho: f64, cos_phi: f64, radius: f64) -> f64 {
+    if !radius.is_finite() {
+        let flat = DVec3::new(rho * cos_phi, rho * (1.0 - cos_phi * cos_phi).max(0.0).sqrt(), 0.0);
+        return medium.exitance_per_flux(DVec3::ZERO, w_12, flat, DVec3::Z);
+    }
+    on_sphere(rho, cos_phi, radius).map_or(0.0, |(x, n)| medium.exitance_per_flux(DVec3::ZERO, w_12, x, n))
 }
 
 /// `integral curvature_gain(rho, mu = 1) 2 pi rho drho` out to `reach`: on a sphere the area

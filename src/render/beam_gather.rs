@@ -26,8 +26,9 @@ pub struct BeamGatherPush {
     /// `tree_nodes`; z: its node count; w: 1 when the receivers are `receiver_order`'s (the
     /// whole mesh, absolute indices), 0 when `level_vertices`' (a coarser level).
     pub tree: [u32; 4],
-    /// xyz: `sigma_t'` per channel in scene units; w: the critical cosine inside.
-    pub sigma_t: [f32; 4],
+    /// x: the critical cosine inside; yzw: 0. (The channels share the table's distance axis,
+    /// so their `sigma_t'` is not needed here.)
+    pub critical: [f32; 4],
     /// xyz: `R1(1)` per channel; w: the reach in scene units.
     pub normal_total: [f32; 4],
 }
@@ -39,7 +40,8 @@ pub struct ObjectBeams {
     pub channels: u32,
     /// Its table's base in `GpuScene::beam_tables` (vec4 entries, one channel in each lane).
     pub table: u32,
-    /// `sigma_t'` per channel, scene units.
+    /// `sigma_t'` per channel, scene units: a distance in mean free paths is the table's
+    /// `rho` (the f64 twin reads it; the shader needs only the shared distance axis).
     pub sigma_t: [f32; 3],
     /// The critical cosine inside (`beam_table::critical_cosine`).
     pub mu_c: f32,
@@ -180,12 +182,11 @@ impl RenderPass for BeamGatherPass {
             } else {
                 (level.first_entry, level.vertex_count, 0)
             };
-            let [s0, s1, s2] = b.sigma_t;
             let [r0, r1, r2] = b.normal_total;
             let push = BeamGatherPush {
                 object: [r.object, first, count, b.channels],
                 tree: [b.table, r.first_node, r.node_count, grouped],
-                sigma_t: [s0, s1, s2, b.mu_c],
+                critical: [b.mu_c, 0.0, 0.0, 0.0],
                 normal_total: [r0, r1, r2, b.reach],
             };
             self.pipeline.dispatch(cmd, &self.set, &push, [count, 1, 1]);
