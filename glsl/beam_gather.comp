@@ -11,12 +11,23 @@
 // correction (optics::beam_table's module doc): the same samples' sum at normal incidence
 // against the half-space's exact R1(1), which takes out the aliasing of the kernel's peak.
 // Samples are found by walking the object's hierarchy (glsl/common/tree.glsl), skipping nodes
-// beyond the reach. Runs after the dipole gather and overwrites its value in these channels only.
+// beyond the reach. A node whose radius is under render.beam_opening times its distance from x (or times the
+// table's window radius, on whose scale the tabulated kernel is smooth, when x is nearer) stands
+// in for its members: their summed A E and A at their area-weighted centroid, with their mean
+// normal and their power-weighted mean beam. Two stages, one dispatch each (push `stage.x`):
+//   0: per node, its BeamNodeRecord from this frame's splat: a leaf from its samples (writing
+//      each sample's BeamSourceRecord on the way, what stage 1 reads of it in one place), an
+//      inner node from its two children's, one height of the hierarchy per dispatch, leaves
+//      first;
+//   1: one invocation per receiver, the walk and the sum. Runs after the dipole gather and
+//      overwrites its value in these channels only.
 //
 // Bindings: 0 = vertices (VertexRecord[], read), 1 = samples (SampleRecord[], read), 2 = splat
 // (SplatRecord[], read), 3 = objects (ObjectRecord[], read), 4 = exitance (vec4 per vertex,
-// read and written), 5 = level vertices, 6 = the tables (vec4[]), 7 = tree nodes
-// (TreeNodeRecord[]), 8 = tree order (uint[]), 9 = receiver order (uint[]). Push: BeamGatherPush.
+// read and written), 5 = level vertices, 6 = the tables (uvec4[], packed f16), 7 = tree nodes
+// (TreeNodeRecord[]), 8 = tree order (uint[]), 9 = receiver order (uint[]), 10 = beam nodes
+// (BeamNodeRecord[], written by stage 0, read by stage 1), 11 = beam sources (BeamSourceRecord
+// per leaf-order entry, written by stage 0 at the leaves, read by stage 1). Push: BeamGatherPush.
 #include "dipole.glsl"
 #include "scene.glsl"
 
@@ -27,43 +38,113 @@ layout(std430, set = 0, binding = 2) readonly buffer Splat { SplatRecord splat[]
 layout(std430, set = 0, binding = 3) readonly buffer Objects { ObjectRecord objects[]; };
 layout(std430, set = 0, binding = 4) buffer Exitance { vec4 exitance[]; };
 layout(std430, set = 0, binding = 5) readonly buffer LevelVertices { uint level_vertices[]; };
-layout(std430, set = 0, binding = 6) readonly buffer BeamTables { vec4 beam_tables[]; };
+layout(std430, set = 0, binding = 6) readonly buffer BeamTables { uvec4 beam_tables[]; };
 layout(std430, set = 0, binding = 7) readonly buffer TreeNodes { TreeNodeRecord tree_nodes[]; };
 layout(std430, set = 0, binding = 8) readonly buffer TreeOrder { uint tree_order[]; };
 layout(std430, set = 0, binding = 9) readonly buffer ReceiverOrder { uint receiver_order[]; };
+layout(std430, set = 0, binding = 10) buffer BeamNodes { BeamNodeRecord beam_nodes[]; };
+layout(std430, set = 0, binding = 11) buffer BeamSources { BeamSourceRecord beam_sources[]; };
 struct BeamGatherPush {
     uvec4 object;           // x: the object; y: its receivers' first entry in level_vertices
                             // or receiver_order; z: their count; w: channel mask (bit c: channel c)
     uvec4 tree;             // x: its table's base in beam_tables; y: its root in tree_nodes;
                             // z: its node count; w: 1: the receivers are receiver_order's
                             // (absolute, grouped in space), 0: level_vertices' (object-relative)
-    vec4 critical;          // x: the critical cosine inside; yzw: 0
+    vec4 critical;          // x: the critical cosine inside; y: render.beam_opening; z: the table's window
+                            // radius (scene units); w: 0
     vec4 normal_total;      // xyz: R1(1) per channel; w: the reach (scene units)
+    uvec4 stage;            // x: 0 aggregate the nodes, 1 gather; y, z: stage 0's nodes,
+                            // tree_order[y + k] for k < z (one height); w: 0
 };
 layout(push_constant) uniform BeamGatherPushBlock { BeamGatherPush push; };
 
 #include "beam_table.glsl"
 
-// Sample s's terms at receiver x: A E T into `sum`, A T(rho, mu = 1) into `norm`.
-void add_sample(uint s, vec3 x, inout vec3 sum, inout vec3 norm) {
-    vec4 pa = samples[s].position_area;
-    vec3 d = x - pa.xyz;
+// The terms of light entering at p (normal nrm, beam at cosine mu inside whose direction along
+// the tangent plane is `along`, summed A E `power`, summed A `area`) at receiver x: A E T into
+// `sum`, A T(rho, mu = 1) into `norm`. cos phi is the angle between the chord's projection on
+// the tangent plane and `along`.
+void add_term(vec3 x, vec3 p, vec3 nrm, float mu, vec3 along, vec3 power, float area, inout vec3 sum, inout vec3 norm) {
+    vec3 d = x - p;
     float reach = push.normal_total.w;
     float dist_sq = dot(d, d);
     if (!(dist_sq < reach * reach)) return;
-    vec3 nrm = samples[s].normal, w = splat[s].beam.xyz;
-    float mu = clamp(-dot(w, nrm), 0.0, 1.0);
-    vec3 dt = d - dot(d, nrm) * nrm, wt = w + mu * nrm;
-    float len = length(dt) * length(wt);
-    float cos_phi = len > 0.0 ? dot(dt, wt) / len : 1.0;
+    float dn = dot(d, nrm);
+    float tangential = sqrt(max(dist_sq - dn * dn, 0.0));
+    float cos_phi = tangential > 0.0 ? dot(d, along) / tangential : 1.0;
     // The table's x axis: sqrt(rho / reach), the same distance for every channel.
     float x_axis = sqrt(sqrt(dist_sq) / reach);
     uint table = push.tree.x;
-    sum += pa.w * splat[s].irradiance_area.rgb * beam_table_lookup(table, push.critical.x, x_axis, cos_phi, mu);
-    norm += pa.w * beam_table_normal(table, x_axis);
+    sum += power * beam_table_lookup(table, push.object.w, push.critical.x, x_axis, cos_phi, mu);
+    norm += area * beam_table_normal(table, x_axis);
+}
+
+// The beam w's cosine with the inward normal and its unit direction along the tangent plane
+// (any tangent where it is normal: the table does not depend on phi at mu = 1).
+float beam_along(vec3 w, vec3 nrm, out vec3 along) {
+    float mu = clamp(-dot(w, nrm), 0.0, 1.0);
+    vec3 wt = w + mu * nrm;
+    float len = length(wt);
+    vec3 tangent = abs(nrm.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+    along = len > 1e-6 ? wt / len : normalize(cross(nrm, tangent));
+    return mu;
+}
+
+// The sample at leaf-order entry k (its BeamSourceRecord).
+void add_source(uint k, vec3 x, inout vec3 sum, inout vec3 norm) {
+    BeamSourceRecord r = beam_sources[k];
+    vec3 along = unpack_octahedral(floatBitsToUint(r.normal_along.w));
+    add_term(x, r.position_mu.xyz, r.normal_along.xyz, r.position_mu.w, along, r.power_area.rgb, r.power_area.w, sum, norm);
+}
+
+// Node i standing in for its members: the unit mean normal and beam (the inward normal where no
+// member is lit; its power is then 0).
+void add_node(uint i, vec3 x, inout vec3 sum, inout vec3 norm) {
+    BeamNodeRecord b = beam_nodes[i];
+    float nl = length(b.normal.xyz), bl = length(b.beam.xyz);
+    vec3 nrm = nl > 0.0 ? b.normal.xyz / nl : vec3(0.0, 0.0, 1.0);
+    vec3 along;
+    float mu = beam_along(bl > 0.0 ? b.beam.xyz / bl : -nrm, nrm, along);
+    add_term(x, b.position.xyz, nrm, mu, along, b.power.rgb, b.power.w, sum, norm);
+}
+
+// Stage 0: node i's record from its samples (a leaf) or its two children's.
+void aggregate(uint i) {
+    TreeNodeRecord n = tree_nodes[i];
+    if (n.range_skip.w == 0u) {
+        BeamNodeRecord l = beam_nodes[i + 1u], r = beam_nodes[tree_nodes[i + 1u].range_skip.z];
+        float a = l.power.w + r.power.w;
+        vec3 c = a > 0.0 ? (l.power.w * l.position.xyz + r.power.w * r.position.xyz) / a : n.center_radius.xyz;
+        beam_nodes[i] = BeamNodeRecord(l.power + r.power, vec4(c, l.position.w + r.position.w),
+                                       l.normal + r.normal, l.beam + r.beam);
+        return;
+    }
+    vec4 power = vec4(0.0);
+    vec3 offset = vec3(0.0), normal = vec3(0.0), beam = vec3(0.0);
+    float weight = 0.0;
+    for (uint e = n.range_skip.x; e < n.range_skip.x + n.range_skip.y; ++e) {
+        uint s = tree_order[e];
+        vec4 pa = samples[s].position_area;
+        vec3 p = pa.w * splat[s].irradiance_area.rgb, nrm = samples[s].normal, w = splat[s].beam.xyz;
+        power += vec4(p, pa.w);
+        // Relative to the node's centre, so that far-off objects keep their digits.
+        offset += pa.w * (pa.xyz - n.center_radius.xyz);
+        normal += pa.w * nrm;
+        beam += (p.r + p.g + p.b) * w;
+        weight += p.r + p.g + p.b;
+        vec3 along;
+        float mu = beam_along(w, nrm, along);
+        beam_sources[e] = BeamSourceRecord(vec4(pa.xyz, mu), vec4(p, pa.w), vec4(nrm, uintBitsToFloat(pack_octahedral(along))));
+    }
+    vec3 c = n.center_radius.xyz + (power.w > 0.0 ? offset / power.w : vec3(0.0));
+    beam_nodes[i] = BeamNodeRecord(power, vec4(c, weight), vec4(normal, 0.0), vec4(beam, 0.0));
 }
 
 void main() {
+    if (push.stage.x == 0u) {
+        if (gl_GlobalInvocationID.x < push.stage.z) aggregate(tree_order[push.stage.y + gl_GlobalInvocationID.x]);
+        return;
+    }
     uint receiver_count = push.object.z, mask = push.object.w;
     if (gl_GlobalInvocationID.x >= receiver_count) return;
     ObjectRecord o = objects[push.object.x];
@@ -71,16 +152,20 @@ void main() {
     // Neighbouring invocations walk nearly the same nodes when their receivers lie together.
     uint vi = push.tree.w != 0u ? receiver_order[entry] : o.ranges.x + level_vertices[entry];
     vec3 x = vertex_position(vertices[vi]);
-    float reach = push.normal_total.w;
+    float reach = push.normal_total.w, opening = push.critical.y, window = push.critical.z;
     vec3 sum = vec3(0.0), norm = vec3(0.0);
     uint i = push.tree.y, end = push.tree.y + push.tree.z;
     while (i < end) {
         TreeNodeRecord n = tree_nodes[i];
-        if (distance(x, n.center_radius.xyz) - n.center_radius.w >= reach) {
+        float dist = distance(x, n.center_radius.xyz);
+        if (dist - n.center_radius.w >= reach) {
+            i = n.range_skip.z;
+        } else if (n.center_radius.w < opening * max(dist, window)) {
+            add_node(i, x, sum, norm);
             i = n.range_skip.z;
         } else if (n.range_skip.w != 0u) {
             for (uint k = n.range_skip.x; k < n.range_skip.x + n.range_skip.y; ++k) {
-                add_sample(tree_order[k], x, sum, norm);
+                add_source(k, x, sum, norm);
             }
             i = n.range_skip.z;
         } else {

@@ -4,6 +4,7 @@
 
 use std::mem::{offset_of, size_of};
 use translucent::gpu::ShaderInterface;
+use translucent::render::beam_gather::BeamGatherPush;
 use translucent::render::gather::GatherPush;
 use translucent::render::gather_pixel::GatherPixelPush;
 use translucent::render::gather_sparse::GatherSparsePush;
@@ -11,7 +12,8 @@ use translucent::render::gather_texture::GatherTexturePush;
 use translucent::render::gather_tree::GatherTreePush;
 use translucent::render::local_exitance::LocalExitancePush;
 use translucent::render::records::{
-    LightGpu, NodePowerRecord, ObjectRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
+    BeamNodeRecord, BeamSourceRecord, LightGpu, NodePowerRecord, ObjectRecord, SampleRecord, SplatRecord,
+    TreeNodeRecord, Vertex,
 };
 use translucent::render::shade::ShadePush;
 use translucent::render::shadow::ShadowPush;
@@ -144,6 +146,23 @@ fn splat_and_vertex_records_match_glsl() {
         ("cov_off", offset_of!(NodePowerRecord, cov_off)),
     ];
     assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
+    let (fields, size) = glsl_layout(scene, "BeamNodeRecord");
+    assert_eq!(size, size_of::<BeamNodeRecord>());
+    let rust = [
+        ("power", offset_of!(BeamNodeRecord, power)),
+        ("position", offset_of!(BeamNodeRecord, position)),
+        ("normal", offset_of!(BeamNodeRecord, normal)),
+        ("beam", offset_of!(BeamNodeRecord, beam)),
+    ];
+    assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
+    let (fields, size) = glsl_layout(scene, "BeamSourceRecord");
+    assert_eq!(size, size_of::<BeamSourceRecord>());
+    let rust = [
+        ("position_mu", offset_of!(BeamSourceRecord, position_mu)),
+        ("power_area", offset_of!(BeamSourceRecord, power_area)),
+        ("normal_along", offset_of!(BeamSourceRecord, normal_along)),
+    ];
+    assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
     let (fields, size) = glsl_layout(scene, "VertexRecord");
     assert_eq!(size, size_of::<Vertex>());
     let rust = [("position", offset_of!(Vertex, position)), ("normal", offset_of!(Vertex, normal))];
@@ -197,8 +216,15 @@ const SPLAT_PUSH_FIELDS: [&str; 8] = [
     "ray_offset",
 ];
 
-fn push_cases() -> [PushCase; 11] {
+fn push_cases() -> [PushCase; 12] {
     [
+        (
+            "beam_gather.comp",
+            include_str!("../glsl/beam_gather.comp"),
+            "BeamGatherPush",
+            size_of::<BeamGatherPush>(),
+            &["object", "tree", "critical", "normal_total", "stage"],
+        ),
         ("splat.comp", include_str!("../glsl/splat.comp"), "SplatPush", size_of::<SplatPush>(), &SPLAT_PUSH_FIELDS),
         (
             "local_exitance.comp",

@@ -47,6 +47,13 @@ vec3 unpack_octahedral(uint bits) {
     return normalize(v);
 }
 
+// records::pack_octahedral in GLSL: a unit vector as two snorm16 octahedral coordinates.
+uint pack_octahedral(vec3 n) {
+    n /= max(abs(n.x) + abs(n.y) + abs(n.z), 1e-30);
+    vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    return packSnorm2x16(e);
+}
+
 // One sample's splat output (splat.comp writes it, the gathers read it).
 struct SplatRecord {
     vec4 irradiance_area;   // rgb: transmitted irradiance E_i; w: area weight
@@ -69,6 +76,25 @@ struct NodePowerRecord {
     vec4 mean_weight;       // xyz: power-weighted centroid; w: total weight
     vec4 cov_diag;          // xyz: power-weighted covariance of the members about it: xx, yy, zz
     vec4 cov_off;           // xyz: xy, xz, yz
+};
+
+// Per node, after each splat, for the between-points single scattering (beam_gather.comp
+// stage 0; BeamNodeRecord in src/render/records.rs).
+struct BeamNodeRecord {
+    vec4 power;             // rgb: sum A_i E_i per channel; w: sum A_i
+    vec4 position;          // xyz: the members' area-weighted centroid; w: sum P_i, P_i = A_i (E_r + E_g + E_b)
+    vec4 normal;            // xyz: sum A_i n_i; w: 0
+    vec4 beam;              // xyz: sum P_i w_i over the members' beams w_i; w: 0
+};
+
+// Per sample in its hierarchy's leaf order, after each splat, what the between-points single
+// scattering reads of it (beam_gather.comp stage 0 writes it; BeamSourceRecord in
+// src/render/records.rs).
+struct BeamSourceRecord {
+    vec4 position_mu;       // xyz: position; w: mu, the cosine of its beam with the inward normal
+    vec4 power_area;        // rgb: A E per channel; w: A
+    vec4 normal_along;      // xyz: unit normal; w: the beam's direction along the tangent plane,
+                            // unit, octahedral (pack_octahedral) as float bits; any tangent at mu = 1
 };
 
 // One group of the hierarchical gather's receivers (ReceiverGroupRecord; sampling::ReceiverGroups).

@@ -3,11 +3,14 @@
 //! exitance at the vertices of each such object's level of detail, from its samples' transmitted
 //! irradiance and beam directions (`SplatRecord::beam`) through the kernel's table
 //! (`optics::beam_table`). It runs in the gather's slot, after the dipole gather, and overwrites
-//! those channels alone.
+//! those channels alone. Two stages per object, as the hierarchical gather's: stage 0 aggregates
+//! each node of its sample hierarchy from this frame's splat (`BeamNodeRecord`), one height per
+//! dispatch; stage 1 walks the hierarchy per receiver, a node under `render.beam_opening` of its
+//! distance standing in for its members (`ObjectBeams::opening`).
 //!
 //! Bindings: `BINDINGS`, in binding order. Push: `BeamGatherPush`.
 
-use super::graph::{Resource, Resources, Use, compute_uses};
+use super::graph::{Resource, Resources, Use, compute_uses, read, write};
 use super::pass::{FrameInputs, RenderPass};
 use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use crate::optics::beam_table::{self, BeamTable};
@@ -22,15 +25,19 @@ pub struct BeamGatherPush {
     /// x: the object; y: its receivers' first entry in `level_vertices` or `receiver_order`;
     /// z: their count; w: the channel mask.
     pub object: [u32; 4],
-    /// x: its table's base in `GpuScene::beam_tables` (vec4 entries); y: its root in
+    /// x: its table's base in `GpuScene::beam_tables` (uvec4 entries); y: its root in
     /// `tree_nodes`; z: its node count; w: 1 when the receivers are `receiver_order`'s (the
     /// whole mesh, absolute indices), 0 when `level_vertices`' (a coarser level).
     pub tree: [u32; 4],
-    /// x: the critical cosine inside; yzw: 0. (The channels share the table's distance axis,
-    /// so their `sigma_t'` is not needed here.)
+    /// x: the critical cosine inside; y: `render.beam_opening`; z: the table's window radius in scene
+    /// units; w: 0. (The channels share the table's distance axis, so their `sigma_t'` is not
+    /// needed here.)
     pub critical: [f32; 4],
     /// xyz: `R1(1)` per channel; w: the reach in scene units.
     pub normal_total: [f32; 4],
+    /// x: 0 aggregate the nodes, 1 gather; y, z: stage 0's nodes, `tree_order[y + k]` for
+    /// `k < z` (one height of the hierarchy); w: 0.
+    pub stage: [u32; 4],
 }
 
 /// One object's between-points channels and where their table lies.
@@ -38,7 +45,7 @@ pub struct BeamGatherPush {
 pub struct ObjectBeams {
     /// Bit `c`: channel `c` takes single scattering between points.
     pub channels: u32,
-    /// Its table's base in `GpuScene::beam_tables` (vec4 entries, one channel in each lane).
+    /// Its tables' base in `GpuScene::beam_tables` (uvec4 entries, `pack_tables`).
     pub table: u32,
     /// `sigma_t'` per channel, scene units: a distance in mean free paths is the table's
     /// `rho` (the f64 twin reads it; the shader needs only the shared distance axis).
@@ -50,12 +57,21 @@ pub struct ObjectBeams {
     /// How far a sample reaches, in scene units: `beam_table::REACH_MFP` mean free paths of the
     /// longest of its channels.
     pub reach: f32,
+    /// The tables' smoothing window radius in scene units (`beam_table::WINDOW` footprint
+    /// radii): the tabulated kernel is smooth on this scale, so a node this much smaller may
+    /// stand in for its members however near the receiver.
+    pub window: f32,
+    /// `render.beam_opening`: a node whose radius is under this times its distance from the
+    /// receiver (or times `window`, when the receiver is nearer) stands in for its members:
+    /// their summed power and area at their area-weighted centroid, with their mean normal and
+    /// power-weighted mean beam. 0 is the sum over every sample within reach.
+    pub opening: f32,
 }
 
 /// The tables of object `o`'s between-points channels for its samples' mean footprint, all
-/// with the same reach in scene units, and its `ObjectBeams` with its table at `base`; `None`
-/// when no channel of it takes the model.
-pub fn object_tables(o: &PreparedObject, base: usize) -> Option<(ObjectBeams, [Option<BeamTable>; 3])> {
+/// with the same reach in scene units, and its `ObjectBeams` with its table at `base` and the
+/// walk's `opening` (`render.beam_opening`); `None` when no channel of it takes the model.
+pub fn object_tables(o: &PreparedObject, base: usize, opening: f32) -> Option<(ObjectBeams, [Option<BeamTable>; 3])> {
     let single = o.single_channels();
     let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else { return None };
     if !single.contains(&true) || o.samples.is_empty() {
@@ -78,6 +94,8 @@ pub fn object_tables(o: &PreparedObject, base: usize) -> Option<(ObjectBeams, [O
         mu_c: beam_table::critical_cosine(dipoles[0].eta) as f32,
         normal_total: tables.each_ref().map(|t| t.as_ref().map_or(0.0, |t| t.normal_total as f32)),
         reach: reach as f32,
+        window: (beam_table::WINDOW * radius) as f32,
+        opening,
     };
     Some((beams, tables))
 }
@@ -102,25 +120,57 @@ pub fn mean_curvature(mesh: &crate::mesh::Mesh) -> f64 {
     if weight > 0.0 { (sum / weight).max(0.0) } else { 0.0 }
 }
 
-/// Every object's table packed one after another, one vec4 per node holding its channels
-/// (0 in channels without the model; at least one entry, so the buffer binds), and per object
-/// its `ObjectBeams`.
-pub fn pack_tables(scene: &PreparedScene) -> (Vec<[f32; 4]>, Vec<Option<ObjectBeams>>) {
-    let mut values = vec![[0.0f32; 4]];
+/// Cells of one channel's block in a packed table (`glsl/common/beam_table.glsl`).
+const CELLS: usize = (beam_table::NX - 1) * (beam_table::NY - 1) * (beam_table::NZ - 1);
+
+/// Every object's tables packed one after another as `glsl/common/beam_table.glsl` reads them
+/// (at least one entry, so the buffer binds), and per object its `ObjectBeams`.
+pub fn pack_tables(scene: &PreparedScene) -> (Vec<[u32; 4]>, Vec<Option<ObjectBeams>>) {
+    let mut packed = vec![[0u32; 4]];
     let mut beams = Vec::with_capacity(scene.objects.len());
     for o in &scene.objects {
-        let object = object_tables(o, values.len());
+        let object = object_tables(o, packed.len(), scene.scene.file.render.beam_opening);
         if let Some((_, tables)) = &object {
-            let at = |c: usize, k: usize| tables[c].as_ref().map_or(0.0, |t| t.values[k]);
-            values.extend((0..beam_table::LEN).map(|k| [at(0, k), at(1, k), at(2, k), 0.0]));
+            packed.extend(pack_object(tables));
         }
         beams.push(object.map(|(b, _)| b));
     }
-    (values, beams)
+    (packed, beams)
+}
+
+/// One object's tables: per channel (zeros without the model) one entry per cell with its 8
+/// corners as f16 pairs along x, at (y0, z0), (y1, z0), (y0, z1), (y1, z1); then per x cell the
+/// normal-incidence row's two ends per channel.
+fn pack_object(tables: &[Option<BeamTable>; 3]) -> Vec<[u32; 4]> {
+    use beam_table::{NX, NY};
+    let value = |c: usize, ix: usize, iy: usize, iz: usize| {
+        tables[c].as_ref().map_or(0.0, |t| t.values[(iz * NY + iy) * NX + ix])
+    };
+    let pair = |c, ix, iy, iz| {
+        let half = |v: f32| u32::from(half::f16::from_f32(v).to_bits());
+        half(value(c, ix, iy, iz)) | half(value(c, ix + 1, iy, iz)) << 16
+    };
+    let mut out = Vec::with_capacity(3 * CELLS + NX - 1);
+    for c in 0..3 {
+        for k in 0..CELLS {
+            let (ix, iy, iz) = (k % (NX - 1), (k / (NX - 1)) % (NY - 1), k / ((NX - 1) * (NY - 1)));
+            out.push([
+                pair(c, ix, iy, iz),
+                pair(c, ix, iy + 1, iz),
+                pair(c, ix, iy, iz + 1),
+                pair(c, ix, iy + 1, iz + 1),
+            ]);
+        }
+    }
+    let (top_y, top_z) = (NY - 1, beam_table::NZ - 1);
+    out.extend(
+        (0..NX - 1).map(|ix| [pair(0, ix, top_y, top_z), pair(1, ix, top_y, top_z), pair(2, ix, top_y, top_z), 0]),
+    );
+    out
 }
 
 /// glsl/beam_gather.comp's bindings, in binding order.
-const BINDINGS: [Resource; 10] = [
+const BINDINGS: [Resource; 12] = [
     Resource::Vertices,
     Resource::Samples,
     Resource::Splat,
@@ -131,9 +181,12 @@ const BINDINGS: [Resource; 10] = [
     Resource::TreeNodes,
     Resource::TreeOrder,
     Resource::ReceiverOrder,
+    Resource::BeamNodes,
+    Resource::BeamSources,
 ];
 
-/// One dispatch of glsl/beam_gather.comp per gathered object with a between-points channel.
+/// Per gathered object with a between-points channel, glsl/beam_gather.comp's stage 0 (one
+/// dispatch per height of its hierarchy) and stage 1 (one).
 pub struct BeamGatherPass {
     pipeline: ComputePipeline,
     set: DescriptorSet,
@@ -160,19 +213,39 @@ impl BeamGatherPass {
 impl RenderPass for BeamGatherPass {
     fn uses(&self, _: &FrameInputs) -> Vec<Use> {
         let mut uses = compute_uses(&BINDINGS, &[]);
-        // It keeps the dipole's channels: the exitance is read and written.
+        // It keeps the dipole's channels: the exitance is read and written; stage 1 reads the
+        // nodes stage 0 wrote.
         for u in &mut uses {
-            if u.resource == Resource::Exitance {
-                *u = Use::new(Resource::Exitance, Access::ComputeReadWrite);
+            if matches!(u.resource, Resource::Exitance | Resource::BeamNodes | Resource::BeamSources) {
+                *u = Use::new(u.resource, Access::ComputeReadWrite);
             }
         }
         uses
     }
 
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        for r in frame.scene.receivers.iter() {
+        let planned = || {
+            frame.scene.receivers.iter().enumerate().filter_map(|(j, r)| {
+                let object = r.object as usize;
+                frame.scene.beams[object].filter(|_| frame.plan.gathers(object)).map(|b| (j, r, b))
+            })
+        };
+        for (j, r, b) in planned() {
+            for (h, &[first, count]) in frame.scene.node_heights[j].iter().enumerate() {
+                if h > 0 {
+                    // This height reads the nodes the heights before it wrote.
+                    frame.before(cmd, &[write(Resource::BeamNodes, Access::ComputeReadWrite)]);
+                }
+                let push = BeamGatherPush { stage: [0, first, count, 0], ..Self::push(r, &b, r.first_receiver, 0, 1) };
+                self.pipeline.dispatch(cmd, &self.set, &push, [count, 1, 1]);
+            }
+        }
+        frame.before(
+            cmd,
+            &[read(Resource::BeamNodes, Access::ComputeRead), read(Resource::BeamSources, Access::ComputeRead)],
+        );
+        for (_, r, b) in planned() {
             let object = r.object as usize;
-            let Some(b) = frame.scene.beams[object].filter(|_| frame.plan.gathers(object)) else { continue };
             let level_index = frame.plan.level(object);
             let level = frame.scene.level(object, level_index);
             // The whole mesh's vertices in receiver-group order, where the walks of neighbouring
@@ -182,14 +255,22 @@ impl RenderPass for BeamGatherPass {
             } else {
                 (level.first_entry, level.vertex_count, 0)
             };
-            let [r0, r1, r2] = b.normal_total;
-            let push = BeamGatherPush {
-                object: [r.object, first, count, b.channels],
-                tree: [b.table, r.first_node, r.node_count, grouped],
-                critical: [b.mu_c, 0.0, 0.0, 0.0],
-                normal_total: [r0, r1, r2, b.reach],
-            };
-            self.pipeline.dispatch(cmd, &self.set, &push, [count, 1, 1]);
+            self.pipeline.dispatch(cmd, &self.set, &Self::push(r, &b, first, count, grouped), [count, 1, 1]);
+        }
+    }
+}
+
+impl BeamGatherPass {
+    /// Stage 1's push block for `count` receivers of `r` from `first` (`grouped`: 1 when they
+    /// are `receiver_order`'s).
+    fn push(r: &super::gpu_scene::Receiver, b: &ObjectBeams, first: u32, count: u32, grouped: u32) -> BeamGatherPush {
+        let [r0, r1, r2] = b.normal_total;
+        BeamGatherPush {
+            object: [r.object, first, count, b.channels],
+            tree: [b.table, r.first_node, r.node_count, grouped],
+            critical: [b.mu_c, b.opening, b.window, 0.0],
+            normal_total: [r0, r1, r2, b.reach],
+            stage: [1, 0, 0, 0],
         }
     }
 }

@@ -5,8 +5,8 @@
 
 use super::graph::Resource;
 use super::records::{
-    BvhNodeRecord, BvhTriangleRecord, LightGpu, NodePowerRecord, ObjectRecord, ReceiverGroupRecord, SampleRecord,
-    SplatRecord, TreeNodeRecord, Vertex,
+    BeamNodeRecord, BeamSourceRecord, BvhNodeRecord, BvhTriangleRecord, LightGpu, NodePowerRecord, ObjectRecord,
+    ReceiverGroupRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
 };
 use crate::gpu::{Buffer, BufferDesc, Gpu, GpuResult};
 use crate::optics::kernel::NEAR_BLEND_RADIUS;
@@ -176,6 +176,12 @@ pub struct GpuScene {
     /// channels, objects one after another (`beam_gather::pack_tables`); one unread entry when
     /// there are none.
     pub beam_tables: Buffer,
+    /// `BeamNodeRecord` per node of the sample hierarchies where an object takes the model (one
+    /// unread entry otherwise), written by the between-points pass's stage 0.
+    pub beam_nodes: Buffer,
+    /// `BeamSourceRecord` per entry of `tree_order` where an object takes the model (one unread
+    /// entry otherwise): its samples' entries, written by the between-points pass's stage 0.
+    pub beam_sources: Buffer,
     /// Per object, in scene order: its between-points channels and their tables' places.
     pub beams: Vec<Option<super::beam_gather::ObjectBeams>>,
     /// Triangles in `bvh_triangles`: 0 when nothing casts a shadow.
@@ -530,6 +536,9 @@ impl GpuScene {
         let none = vk::BufferUsageFlags::empty();
         let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER;
         let (tables, beams) = super::beam_gather::pack_tables(scene);
+        let any_beams = beams.iter().any(Option::is_some);
+        let beam_node_count = if any_beams { p.tree_nodes.len() } else { 1 };
+        let beam_source_count = if any_beams { p.tree_order.len() } else { 1 };
         let zeros = vec![[0f32; 4]; p.vertices.len()];
         let sized = |name, item: usize, count: usize| storage(gpu, name, (item * count) as u64, none);
         Ok(GpuScene {
@@ -560,6 +569,8 @@ impl GpuScene {
             bvh_nodes: upload(gpu, "caster hierarchy", &p.bvh_nodes, none)?,
             bvh_triangles: upload(gpu, "caster triangles", &p.bvh_triangles, none)?,
             beam_tables: upload(gpu, "beam tables", &tables, none)?,
+            beam_nodes: sized("beam nodes", std::mem::size_of::<BeamNodeRecord>(), beam_node_count)?,
+            beam_sources: sized("beam sources", std::mem::size_of::<BeamSourceRecord>(), beam_source_count)?,
             beams,
             caster_triangles: p.bvh_triangles.len() as u32,
             ray_offset: scene.ray_offset() as f32,

@@ -71,6 +71,10 @@ pub enum Resource {
     BvhTriangles,
     /// The between-points single scattering's kernel tables (`GpuScene::beam_tables`).
     BeamTables,
+    /// Its per-node aggregates, its stage 0 (`GpuScene::beam_nodes`).
+    BeamNodes,
+    /// Its per-sample records, its stage 0 (`GpuScene::beam_sources`).
+    BeamSources,
     /// Exitance at the samples, the sparse gather's stage 0 (owned by `GatherSparsePass`).
     SampleExitance,
     /// The shadow-map array (`FrameTargets::shadow_maps`).
@@ -122,6 +126,8 @@ impl Resource {
             BvhNodes => "BvhNodes",
             BvhTriangles => "BvhTriangles",
             BeamTables => "BeamTables",
+            BeamNodes => "BeamNodes",
+            BeamSources => "BeamSources",
             ShadowMaps => "shadow_maps",
             Hdr => "hdr",
             Surface => "surface",
@@ -150,7 +156,7 @@ pub const HOST_READ: [Resource; 5] = [
 ];
 
 /// Every resource that is a `GpuScene` buffer (`Resources::buffer`).
-pub const SCENE_BUFFERS: [Resource; 25] = [
+pub const SCENE_BUFFERS: [Resource; 27] = [
     Resource::Vertices,
     Resource::Objects,
     Resource::Lights,
@@ -176,6 +182,8 @@ pub const SCENE_BUFFERS: [Resource; 25] = [
     Resource::BvhNodes,
     Resource::BvhTriangles,
     Resource::BeamTables,
+    Resource::BeamNodes,
+    Resource::BeamSources,
 ];
 
 /// One declared access of a pass (`gpu::Use` over `Resource`).
@@ -251,6 +259,8 @@ impl<'a> Resources<'a> {
             BvhNodes => &s.bvh_nodes,
             BvhTriangles => &s.bvh_triangles,
             BeamTables => &s.beam_tables,
+            BeamNodes => &s.beam_nodes,
+            BeamSources => &s.beam_sources,
             _ => return None,
         })
     }

@@ -183,6 +183,36 @@ impl TreeNodeRecord {
     }
 }
 
+/// `BeamNodeRecord` in glsl/common/scene.glsl: what stage 0 of the between-points single
+/// scattering (glsl/beam_gather.comp) aggregates per node after each splat, so that a far node
+/// stands in for its members.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct BeamNodeRecord {
+    /// rgb: `sum A_i E_i` per channel; w: `sum A_i`.
+    pub power: [f32; 4],
+    /// xyz: the members' area-weighted centroid; w: `sum P_i`, `P_i = A_i (E_r + E_g + E_b)`.
+    pub position: [f32; 4],
+    /// xyz: `sum A_i n_i`; w: 0.
+    pub normal: [f32; 4],
+    /// xyz: `sum P_i w_i` over the members' beams; w: 0.
+    pub beam: [f32; 4],
+}
+
+/// `BeamSourceRecord` in glsl/common/scene.glsl: one sample as the between-points single
+/// scattering reads it, written per leaf-order entry by its stage 0.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct BeamSourceRecord {
+    /// xyz: position; w: `mu`, the cosine of its beam with the inward normal.
+    pub position_mu: [f32; 4],
+    /// rgb: `A E` per channel; w: `A`.
+    pub power_area: [f32; 4],
+    /// xyz: unit normal; w: the beam's unit direction along the tangent plane,
+    /// [`pack_octahedral`], as float bits.
+    pub normal_along: [f32; 4],
+}
+
 /// `NodePowerRecord` in glsl/common/scene.glsl: what stage 0 of the hierarchical gather
 /// aggregates per node after each splat.
 #[repr(C)]

@@ -421,7 +421,8 @@ fn check_lights(lights: &[Light]) -> Check {
     Ok(())
 }
 
-/// `[render]`: exposure positive, gather epsilon 0 to [`format::MAX_GATHER_EPSILON`], a
+/// `[render]`: exposure positive, gather epsilon 0 to [`format::MAX_GATHER_EPSILON`], beam
+/// opening 0 to [`format::MAX_BEAM_OPENING`], a
 /// shadow-map size of 16 to 8192 texels, a background that emits nothing negative.
 fn check_render(r: &RenderSettings) -> Check {
     if !(r.exposure.is_finite() && r.exposure > 0.0) {
@@ -431,6 +432,12 @@ fn check_render(r: &RenderSettings) -> Check {
         return Err((
             "render.gather_epsilon".into(),
             format!("{} must be 0 to {}", r.gather_epsilon, format::MAX_GATHER_EPSILON),
+        ));
+    }
+    if !(r.beam_opening >= 0.0 && r.beam_opening <= format::MAX_BEAM_OPENING) {
+        return Err((
+            "render.beam_opening".into(),
+            format!("{} must be 0 to {}", r.beam_opening, format::MAX_BEAM_OPENING),
         ));
     }
     if !(16..=8192).contains(&r.shadow_map_size) {
