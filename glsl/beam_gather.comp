@@ -9,7 +9,10 @@
 // chord's and the beam's paths along the sample's tangent plane, mu_i the cosine of the
 // sample's beam (SplatRecord::beam) with its inward normal. The quotient is the density
 // correction (optics::beam_table's module doc): the same samples' sum at normal incidence
-// against the half-space's exact R1(1), which takes out the aliasing of the kernel's peak.
+// against the half-space's exact R1(1), which takes out the aliasing of the kernel's peak. Its
+// denominator depends on the geometry alone and is summed once on the CPU over the same walk
+// (render::beam_gather::receiver_norms), so the walk here skips every node that transmits
+// nothing in the model's channels.
 // Samples are found by walking the object's hierarchy (glsl/common/tree.glsl), skipping nodes
 // beyond the reach. A node whose radius is under render.beam_opening times its distance from x (or times the
 // table's window radius, on whose scale the tabulated kernel is smooth, when x is nearer) stands
@@ -27,7 +30,9 @@
 // read and written), 5 = level vertices, 6 = the tables (uvec4[], packed f16), 7 = tree nodes
 // (TreeNodeRecord[]), 8 = tree order (uint[]), 9 = receiver order (uint[]), 10 = beam nodes
 // (BeamNodeRecord[], written by stage 0, read by stage 1), 11 = beam sources (BeamSourceRecord
-// per leaf-order entry, written by stage 0 at the leaves, read by stage 1). Push: BeamGatherPush.
+// per leaf-order entry, written by stage 0 at the leaves, read by stage 1), 12 = per vertex, the
+// density correction's denominator (vec4, render::beam_gather::receiver_norms). Push:
+// BeamGatherPush.
 #include "dipole.glsl"
 #include "scene.glsl"
 
@@ -44,6 +49,7 @@ layout(std430, set = 0, binding = 8) readonly buffer TreeOrder { uint tree_order
 layout(std430, set = 0, binding = 9) readonly buffer ReceiverOrder { uint receiver_order[]; };
 layout(std430, set = 0, binding = 10) buffer BeamNodes { BeamNodeRecord beam_nodes[]; };
 layout(std430, set = 0, binding = 11) buffer BeamSources { BeamSourceRecord beam_sources[]; };
+layout(std430, set = 0, binding = 12) readonly buffer BeamNorms { vec4 beam_norms[]; };
 struct BeamGatherPush {
     uvec4 object;           // x: the object; y: its receivers' first entry in level_vertices
                             // or receiver_order; z: their count; w: channel mask (bit c: channel c)
@@ -62,9 +68,8 @@ layout(push_constant) uniform BeamGatherPushBlock { BeamGatherPush push; };
 
 // The terms of light entering at p (normal nrm, beam at cosine mu inside whose direction along
 // the tangent plane is `along`, summed A E `power`, summed A `area`) at receiver x: A E T into
-// `sum`, A T(rho, mu = 1) into `norm`. cos phi is the angle between the chord's projection on
-// the tangent plane and `along`.
-void add_term(vec3 x, vec3 p, vec3 nrm, float mu, vec3 along, vec3 power, float area, inout vec3 sum, inout vec3 norm) {
+// `sum`. cos phi is the angle between the chord's projection on the tangent plane and `along`.
+void add_term(vec3 x, vec3 p, vec3 nrm, float mu, vec3 along, vec3 power, inout vec3 sum) {
     vec3 d = x - p;
     float reach = push.normal_total.w;
     float dist_sq = dot(d, d);
@@ -76,7 +81,6 @@ void add_term(vec3 x, vec3 p, vec3 nrm, float mu, vec3 along, vec3 power, float 
     float x_axis = sqrt(sqrt(dist_sq) / reach);
     uint table = push.tree.x;
     sum += power * beam_table_lookup(table, push.object.w, push.critical.x, x_axis, cos_phi, mu);
-    norm += area * beam_table_normal(table, x_axis);
 }
 
 // The beam w's cosine with the inward normal and its unit direction along the tangent plane
@@ -91,21 +95,22 @@ float beam_along(vec3 w, vec3 nrm, out vec3 along) {
 }
 
 // The sample at leaf-order entry k (its BeamSourceRecord).
-void add_source(uint k, vec3 x, inout vec3 sum, inout vec3 norm) {
+void add_source(uint k, vec3 x, inout vec3 sum) {
     BeamSourceRecord r = beam_sources[k];
+    if (!any(greaterThan(r.power_area.rgb, vec3(0.0)))) return;
     vec3 along = unpack_octahedral(floatBitsToUint(r.normal_along.w));
-    add_term(x, r.position_mu.xyz, r.normal_along.xyz, r.position_mu.w, along, r.power_area.rgb, r.power_area.w, sum, norm);
+    add_term(x, r.position_mu.xyz, r.normal_along.xyz, r.position_mu.w, along, r.power_area.rgb, sum);
 }
 
 // Node i standing in for its members: the unit mean normal and beam (the inward normal where no
 // member is lit; its power is then 0).
-void add_node(uint i, vec3 x, inout vec3 sum, inout vec3 norm) {
+void add_node(uint i, vec3 x, inout vec3 sum) {
     BeamNodeRecord b = beam_nodes[i];
     float nl = length(b.normal.xyz), bl = length(b.beam.xyz);
     vec3 nrm = nl > 0.0 ? b.normal.xyz / nl : vec3(0.0, 0.0, 1.0);
     vec3 along;
     float mu = beam_along(bl > 0.0 ? b.beam.xyz / bl : -nrm, nrm, along);
-    add_term(x, b.position.xyz, nrm, mu, along, b.power.rgb, b.power.w, sum, norm);
+    add_term(x, b.position.xyz, nrm, mu, along, b.power.rgb, sum);
 }
 
 // Stage 0: node i's record from its samples (a leaf) or its two children's.
@@ -153,26 +158,29 @@ void main() {
     uint vi = push.tree.w != 0u ? receiver_order[entry] : o.ranges.x + level_vertices[entry];
     vec3 x = vertex_position(vertices[vi]);
     float reach = push.normal_total.w, opening = push.critical.y, window = push.critical.z;
-    vec3 sum = vec3(0.0), norm = vec3(0.0);
+    vec3 sum = vec3(0.0);
+    bvec3 on = bvec3((mask & 1u) != 0u, (mask & 2u) != 0u, (mask & 4u) != 0u);
     uint i = push.tree.y, end = push.tree.y + push.tree.z;
     while (i < end) {
         TreeNodeRecord n = tree_nodes[i];
         float dist = distance(x, n.center_radius.xyz);
-        if (dist - n.center_radius.w >= reach) {
+        // Out of reach, or transmitting nothing in the model's channels (the denominator,
+        // which every node within reach adds to, is summed once: beam_norms).
+        if (dist - n.center_radius.w >= reach || !(dot(vec3(on), beam_nodes[i].power.rgb) > 0.0)) {
             i = n.range_skip.z;
         } else if (n.center_radius.w < opening * max(dist, window)) {
-            add_node(i, x, sum, norm);
+            add_node(i, x, sum);
             i = n.range_skip.z;
         } else if (n.range_skip.w != 0u) {
             for (uint k = n.range_skip.x; k < n.range_skip.x + n.range_skip.y; ++k) {
-                add_source(k, x, sum, norm);
+                add_source(k, x, sum);
             }
             i = n.range_skip.z;
         } else {
             i += 1u;
         }
     }
-    bvec3 on = bvec3((mask & 1u) != 0u, (mask & 2u) != 0u, (mask & 4u) != 0u);
+    vec3 norm = beam_norms[vi].rgb;
     vec3 m = mix(vec3(0.0), push.normal_total.rgb * sum / max(norm, vec3(1e-30)), greaterThan(norm, vec3(0.0)));
     vec4 old = exitance[vi];
     exitance[vi] = vec4(mix(old.rgb, max(m, vec3(0.0)), on), old.w);

@@ -3,10 +3,9 @@
 // Values at grid nodes over x = sqrt(rho / reach), cos phi in [-1, 1] and mu in [mu_c, 1], read
 // trilinearly. Packed per cell for the reader (render::beam_gather::pack_tables): per channel,
 // one uvec4 per cell holding its 8 corners as f16 (BeamTable rounds its values to f16, so both
-// twins read the same numbers), so that a pair costs one load per channel rather than eight;
-// after the three channels' cells, the normal-incidence row (mu = 1, where phi does not matter)
-// as one uvec4 per x cell with each channel's two ends. An object's channels share the distance
-// axis (render::beam_gather). Include after declaring the uvec4 array `beam_tables`.
+// twins read the same numbers), so that a pair costs one load per channel rather than eight.
+// An object's channels share the distance axis (render::beam_gather). Include after declaring
+// the uvec4 array `beam_tables`.
 #ifndef BEAM_TABLE_GLSL
 #define BEAM_TABLE_GLSL
 
@@ -45,16 +44,6 @@ vec3 beam_table_lookup(uint base, uint mask, float mu_c, float x, float cos_phi,
         if ((mask & (1u << c)) != 0u) v[c] = bt_trilinear(beam_tables[cell + c * BT_CELLS], f);
     }
     return v;
-}
-
-// The table at normal incidence (mu = 1, where phi does not matter): its last row, read
-// linearly in x as the trilinear lookup reads it there.
-vec3 beam_table_normal(uint base, float x) {
-    float fx;
-    uint ix = bt_cell(x * float(BT_NX - 1u), BT_NX, fx);
-    uvec4 q = beam_tables[base + 3u * BT_CELLS + ix];
-    vec2 r = unpackHalf2x16(q.x), g = unpackHalf2x16(q.y), b = unpackHalf2x16(q.z);
-    return vec3(mix(r.x, r.y, fx), mix(g.x, g.y, fx), mix(b.x, b.y, fx));
 }
 
 #endif

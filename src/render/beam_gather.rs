@@ -14,8 +14,11 @@ use super::graph::{Resource, Resources, Use, compute_uses, read, write};
 use super::pass::{FrameInputs, RenderPass};
 use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use crate::optics::beam_table::{self, BeamTable};
+use crate::sampling::SampleTree;
 use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
 use ash::vk;
+use glam::DVec3;
+use rayon::prelude::*;
 use std::sync::Arc;
 
 /// `BeamGatherPush` in glsl/beam_gather.comp.
@@ -120,27 +123,103 @@ pub fn mean_curvature(mesh: &crate::mesh::Mesh) -> f64 {
     if weight > 0.0 { (sum / weight).max(0.0) } else { 0.0 }
 }
 
+/// Where the walk of `tree` about receiver `x` goes, as glsl/beam_gather.comp takes it: nodes
+/// within `beams.reach` whose radius is under `beams.opening` times their distance (or times
+/// `beams.window`, when `x` is nearer) are visited whole (`Ok(node)`), leaves nearer give their
+/// samples (`Err(sample)`).
+pub fn walk(tree: &SampleTree, x: DVec3, beams: &ObjectBeams, mut visit: impl FnMut(Result<usize, usize>)) {
+    let (reach, opening, window) = (f64::from(beams.reach), f64::from(beams.opening), f64::from(beams.window));
+    let mut i = 0;
+    while i < tree.nodes.len() {
+        let n = &tree.nodes[i];
+        let (dist, radius) = (x.distance(DVec3::from(n.center.map(f64::from))), f64::from(n.radius));
+        if dist - radius >= reach {
+            i = n.skip as usize;
+        } else if radius < opening * dist.max(window) {
+            visit(Ok(i));
+            i = n.skip as usize;
+        } else if n.leaf {
+            tree.order[n.first as usize..(n.first + n.count) as usize].iter().for_each(|&s| visit(Err(s as usize)));
+            i = n.skip as usize;
+        } else {
+            i += 1;
+        }
+    }
+}
+
+/// Per vertex of object `o`, the density correction's denominator `sum_i A_i T(rho_i, 1, 1)` per
+/// channel over the walk the pass takes ([`walk`]; a node at its members' area-weighted
+/// centroid). It depends on the geometry alone, so it is summed here once (f64), and the pass
+/// sums only the lit terms, skipping every node that transmits nothing in the model's channels.
+pub fn receiver_norms(o: &PreparedObject, beams: &ObjectBeams, tables: &[Option<BeamTable>; 3]) -> Vec<[f32; 4]> {
+    let tree = o.sample_tree();
+    let at = |s: u32| (o.samples[s as usize].area, o.samples[s as usize].position.as_dvec3());
+    let nodes: Vec<(f64, DVec3)> = tree
+        .nodes
+        .iter()
+        .map(|n| {
+            let members = tree.order[n.first as usize..(n.first + n.count) as usize].iter().map(|&s| at(s));
+            let (area, moment) = members.fold((0.0, DVec3::ZERO), |(a, m), (da, p)| (a + da, m + da * p));
+            (area, if area > 0.0 { moment / area } else { DVec3::from(n.center.map(f64::from)) })
+        })
+        .collect();
+    o.mesh
+        .positions()
+        .par_iter()
+        .map(|x| {
+            let x = x.as_dvec3();
+            let mut norm = [0.0f64; 3];
+            walk(&tree, x, beams, |item| {
+                let (area, p) = item.map_or_else(|s| at(s as u32), |n| nodes[n]);
+                let dist = x.distance(p);
+                for (c, table) in tables.iter().enumerate() {
+                    if let Some(t) = table.as_ref().filter(|_| dist < f64::from(beams.reach)) {
+                        norm[c] += area * t.lookup(dist * f64::from(beams.sigma_t[c]), 1.0, 1.0);
+                    }
+                }
+            });
+            [norm[0] as f32, norm[1] as f32, norm[2] as f32, 0.0]
+        })
+        .collect()
+}
+
 /// Cells of one channel's block in a packed table (`glsl/common/beam_table.glsl`).
 const CELLS: usize = (beam_table::NX - 1) * (beam_table::NY - 1) * (beam_table::NZ - 1);
 
-/// Every object's tables packed one after another as `glsl/common/beam_table.glsl` reads them
-/// (at least one entry, so the buffer binds), and per object its `ObjectBeams`.
-pub fn pack_tables(scene: &PreparedScene) -> (Vec<[u32; 4]>, Vec<Option<ObjectBeams>>) {
-    let mut packed = vec![[0u32; 4]];
-    let mut beams = Vec::with_capacity(scene.objects.len());
+/// What the scene's objects with a between-points channel give the pass.
+pub struct PackedBeams {
+    /// Every object's tables one after another as `glsl/common/beam_table.glsl` reads them (at
+    /// least one entry, so the buffer binds).
+    pub tables: Vec<[u32; 4]>,
+    /// Per vertex of every object, objects one after another as in `GpuScene::vertices`, its
+    /// [`receiver_norms`] (0 on objects without the model); one entry when no object has it.
+    pub norms: Vec<[f32; 4]>,
+    /// Per object, its `ObjectBeams`.
+    pub beams: Vec<Option<ObjectBeams>>,
+}
+
+/// [`PackedBeams`] of `scene`.
+pub fn pack_tables(scene: &PreparedScene) -> PackedBeams {
+    let mut out = PackedBeams { tables: vec![[0u32; 4]], norms: Vec::new(), beams: Vec::new() };
     for o in &scene.objects {
-        let object = object_tables(o, packed.len(), scene.scene.file.render.beam_opening);
-        if let Some((_, tables)) = &object {
-            packed.extend(pack_object(tables));
+        let object = object_tables(o, out.tables.len(), scene.scene.file.render.beam_opening);
+        match &object {
+            Some((b, tables)) => {
+                out.tables.extend(pack_object(tables));
+                out.norms.extend(receiver_norms(o, b, tables));
+            }
+            None => out.norms.extend(std::iter::repeat_n([0.0; 4], o.mesh.positions().len())),
         }
-        beams.push(object.map(|(b, _)| b));
+        out.beams.push(object.map(|(b, _)| b));
     }
-    (packed, beams)
+    if out.beams.iter().all(Option::is_none) {
+        out.norms = vec![[0.0; 4]];
+    }
+    out
 }
 
 /// One object's tables: per channel (zeros without the model) one entry per cell with its 8
-/// corners as f16 pairs along x, at (y0, z0), (y1, z0), (y0, z1), (y1, z1); then per x cell the
-/// normal-incidence row's two ends per channel.
+/// corners as f16 pairs along x, at (y0, z0), (y1, z0), (y0, z1), (y1, z1).
 fn pack_object(tables: &[Option<BeamTable>; 3]) -> Vec<[u32; 4]> {
     use beam_table::{NX, NY};
     let value = |c: usize, ix: usize, iy: usize, iz: usize| {
@@ -150,7 +229,7 @@ fn pack_object(tables: &[Option<BeamTable>; 3]) -> Vec<[u32; 4]> {
         let half = |v: f32| u32::from(half::f16::from_f32(v).to_bits());
         half(value(c, ix, iy, iz)) | half(value(c, ix + 1, iy, iz)) << 16
     };
-    let mut out = Vec::with_capacity(3 * CELLS + NX - 1);
+    let mut out = Vec::with_capacity(3 * CELLS);
     for c in 0..3 {
         for k in 0..CELLS {
             let (ix, iy, iz) = (k % (NX - 1), (k / (NX - 1)) % (NY - 1), k / ((NX - 1) * (NY - 1)));
@@ -162,15 +241,11 @@ fn pack_object(tables: &[Option<BeamTable>; 3]) -> Vec<[u32; 4]> {
             ]);
         }
     }
-    let (top_y, top_z) = (NY - 1, beam_table::NZ - 1);
-    out.extend(
-        (0..NX - 1).map(|ix| [pair(0, ix, top_y, top_z), pair(1, ix, top_y, top_z), pair(2, ix, top_y, top_z), 0]),
-    );
     out
 }
 
 /// glsl/beam_gather.comp's bindings, in binding order.
-const BINDINGS: [Resource; 12] = [
+const BINDINGS: [Resource; 13] = [
     Resource::Vertices,
     Resource::Samples,
     Resource::Splat,
@@ -183,6 +258,7 @@ const BINDINGS: [Resource; 12] = [
     Resource::ReceiverOrder,
     Resource::BeamNodes,
     Resource::BeamSources,
+    Resource::BeamNorms,
 ];
 
 /// Per gathered object with a between-points channel, glsl/beam_gather.comp's stage 0 (one

@@ -172,8 +172,8 @@ pub struct GpuScene {
     pub bvh_nodes: Buffer,
     /// Its triangles in leaf order (`BvhTriangleRecord`).
     pub bvh_triangles: Buffer,
-    /// The between-points single scattering's kernel tables, one vec4 per node with an object's
-    /// channels, objects one after another (`beam_gather::pack_tables`); one unread entry when
+    /// The between-points single scattering's kernel tables, f16 cells packed as uvec4, objects
+    /// one after another (`beam_gather::pack_tables`); one unread entry when
     /// there are none.
     pub beam_tables: Buffer,
     /// `BeamNodeRecord` per node of the sample hierarchies where an object takes the model (one
@@ -182,6 +182,9 @@ pub struct GpuScene {
     /// `BeamSourceRecord` per entry of `tree_order` where an object takes the model (one unread
     /// entry otherwise): its samples' entries, written by the between-points pass's stage 0.
     pub beam_sources: Buffer,
+    /// Per vertex (vec4), the between-points density correction's denominator per channel
+    /// (`beam_gather::receiver_norms`; one entry when no object takes the model).
+    pub beam_norms: Buffer,
     /// Per object, in scene order: its between-points channels and their tables' places.
     pub beams: Vec<Option<super::beam_gather::ObjectBeams>>,
     /// Triangles in `bvh_triangles`: 0 when nothing casts a shadow.
@@ -535,7 +538,7 @@ impl GpuScene {
     fn upload(gpu: &Arc<Gpu>, scene: &PreparedScene, p: PackedObjects, l: PackedLevels) -> GpuResult<GpuScene> {
         let none = vk::BufferUsageFlags::empty();
         let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER;
-        let (tables, beams) = super::beam_gather::pack_tables(scene);
+        let super::beam_gather::PackedBeams { tables, norms, beams } = super::beam_gather::pack_tables(scene);
         let any_beams = beams.iter().any(Option::is_some);
         let beam_node_count = if any_beams { p.tree_nodes.len() } else { 1 };
         let beam_source_count = if any_beams { p.tree_order.len() } else { 1 };
@@ -571,6 +574,7 @@ impl GpuScene {
             beam_tables: upload(gpu, "beam tables", &tables, none)?,
             beam_nodes: sized("beam nodes", std::mem::size_of::<BeamNodeRecord>(), beam_node_count)?,
             beam_sources: sized("beam sources", std::mem::size_of::<BeamSourceRecord>(), beam_source_count)?,
+            beam_norms: upload(gpu, "beam norms", &norms, none)?,
             beams,
             caster_triangles: p.bvh_triangles.len() as u32,
             ray_offset: scene.ray_offset() as f32,

@@ -75,6 +75,8 @@ pub enum Resource {
     BeamNodes,
     /// Its per-sample records, its stage 0 (`GpuScene::beam_sources`).
     BeamSources,
+    /// Its density correction's denominator per vertex (`GpuScene::beam_norms`).
+    BeamNorms,
     /// Exitance at the samples, the sparse gather's stage 0 (owned by `GatherSparsePass`).
     SampleExitance,
     /// The shadow-map array (`FrameTargets::shadow_maps`).
@@ -128,6 +130,7 @@ impl Resource {
             BeamTables => "BeamTables",
             BeamNodes => "BeamNodes",
             BeamSources => "BeamSources",
+            BeamNorms => "BeamNorms",
             ShadowMaps => "shadow_maps",
             Hdr => "hdr",
             Surface => "surface",
@@ -156,7 +159,7 @@ pub const HOST_READ: [Resource; 5] = [
 ];
 
 /// Every resource that is a `GpuScene` buffer (`Resources::buffer`).
-pub const SCENE_BUFFERS: [Resource; 27] = [
+pub const SCENE_BUFFERS: [Resource; 28] = [
     Resource::Vertices,
     Resource::Objects,
     Resource::Lights,
@@ -184,6 +187,7 @@ pub const SCENE_BUFFERS: [Resource; 27] = [
     Resource::BeamTables,
     Resource::BeamNodes,
     Resource::BeamSources,
+    Resource::BeamNorms,
 ];
 
 /// One declared access of a pass (`gpu::Use` over `Resource`).
@@ -261,6 +265,7 @@ impl<'a> Resources<'a> {
             BeamTables => &s.beam_tables,
             BeamNodes => &s.beam_nodes,
             BeamSources => &s.beam_sources,
+            BeamNorms => &s.beam_norms,
             _ => return None,
         })
     }
