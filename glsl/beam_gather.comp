@@ -14,16 +14,16 @@
 // (render::beam_gather::receiver_norms), so the walk here skips every node that transmits
 // nothing in the model's channels.
 // Samples are found by walking the object's hierarchy (glsl/common/tree.glsl), skipping nodes
-// beyond the reach. A node whose radius is under render.beam_opening times its distance from x (or times the
-// table's window radius, on whose scale the tabulated kernel is smooth, when x is nearer) stands
-// in for its members: their summed A E and A at their area-weighted centroid, with their mean
-// normal and their power-weighted mean beam. Two stages, one dispatch each (push `stage.x`):
+// beyond the reach. A node whose radius is under render.beam_opening times its distance from x
+// (or times the table's window radius, on whose scale the tabulated kernel is smooth, when x is
+// nearer) stands in for its members: their summed A E at their area-weighted centroid, with their
+// mean normal and their power-weighted mean beam. Two stages (push `stage.x`):
 //   0: per node, its BeamNodeRecord from this frame's splat: a leaf from its samples (writing
 //      each sample's BeamSourceRecord on the way, what stage 1 reads of it in one place), an
 //      inner node from its two children's, one height of the hierarchy per dispatch, leaves
 //      first;
-//   1: one invocation per receiver, the walk and the sum. Runs after the dipole gather and
-//      overwrites its value in these channels only.
+//   1: one dispatch, one invocation per receiver: the walk and the sum. Runs after the dipole
+//      gather and overwrites its value in these channels only.
 //
 // Bindings: 0 = vertices (VertexRecord[], read), 1 = samples (SampleRecord[], read), 2 = splat
 // (SplatRecord[], read), 3 = objects (ObjectRecord[], read), 4 = exitance (vec4 per vertex,
@@ -56,8 +56,8 @@ struct BeamGatherPush {
     uvec4 tree;             // x: its table's base in beam_tables; y: its root in tree_nodes;
                             // z: its node count; w: 1: the receivers are receiver_order's
                             // (absolute, grouped in space), 0: level_vertices' (object-relative)
-    vec4 critical;          // x: the critical cosine inside; y: render.beam_opening; z: the table's window
-                            // radius (scene units); w: 0
+    vec4 critical;          // x: the critical cosine inside; y: render.beam_opening; z: the
+                            // table's window radius (scene units); w: 0
     vec4 normal_total;      // xyz: R1(1) per channel; w: the reach (scene units)
     uvec4 stage;            // x: 0 aggregate the nodes, 1 gather; y, z: stage 0's nodes,
                             // tree_order[y + k] for k < z (one height); w: 0
@@ -67,8 +67,7 @@ layout(push_constant) uniform BeamGatherPushBlock { BeamGatherPush push; };
 #include "beam_table.glsl"
 
 // The terms of light entering at p (normal nrm, beam at cosine mu inside whose direction along
-// the tangent plane is `along`, summed A E `power`, summed A `area`) at receiver x: A E T into
-// `sum`. cos phi is the angle between the chord's projection on the tangent plane and `along`.
+// the tangent plane is `along`, summed A E `power`) at receiver x: A E T into `sum`. cos phi is the angle between the chord's projection on the tangent plane and `along`.
 void add_term(vec3 x, vec3 p, vec3 nrm, float mu, vec3 along, vec3 power, inout vec3 sum) {
     vec3 d = x - p;
     float reach = push.normal_total.w;

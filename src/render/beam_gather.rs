@@ -123,11 +123,19 @@ pub fn mean_curvature(mesh: &crate::mesh::Mesh) -> f64 {
     if weight > 0.0 { (sum / weight).max(0.0) } else { 0.0 }
 }
 
+/// What the walk of a sample hierarchy sums next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WalkItem {
+    /// A node standing in for its members.
+    Node(usize),
+    /// One sample (its index in the object's samples).
+    Sample(usize),
+}
+
 /// Where the walk of `tree` about receiver `x` goes, as glsl/beam_gather.comp takes it: nodes
 /// within `beams.reach` whose radius is under `beams.opening` times their distance (or times
-/// `beams.window`, when `x` is nearer) are visited whole (`Ok(node)`), leaves nearer give their
-/// samples (`Err(sample)`).
-pub fn walk(tree: &SampleTree, x: DVec3, beams: &ObjectBeams, mut visit: impl FnMut(Result<usize, usize>)) {
+/// `beams.window`, when `x` is nearer) are visited whole, leaves nearer give their samples.
+pub fn walk(tree: &SampleTree, x: DVec3, beams: &ObjectBeams, mut visit: impl FnMut(WalkItem)) {
     let (reach, opening, window) = (f64::from(beams.reach), f64::from(beams.opening), f64::from(beams.window));
     let mut i = 0;
     while i < tree.nodes.len() {
@@ -136,10 +144,11 @@ pub fn walk(tree: &SampleTree, x: DVec3, beams: &ObjectBeams, mut visit: impl Fn
         if dist - radius >= reach {
             i = n.skip as usize;
         } else if radius < opening * dist.max(window) {
-            visit(Ok(i));
+            visit(WalkItem::Node(i));
             i = n.skip as usize;
         } else if n.leaf {
-            tree.order[n.first as usize..(n.first + n.count) as usize].iter().for_each(|&s| visit(Err(s as usize)));
+            let members = &tree.order[n.first as usize..(n.first + n.count) as usize];
+            members.iter().for_each(|&s| visit(WalkItem::Sample(s as usize)));
             i = n.skip as usize;
         } else {
             i += 1;
@@ -170,7 +179,10 @@ pub fn receiver_norms(o: &PreparedObject, beams: &ObjectBeams, tables: &[Option<
             let x = x.as_dvec3();
             let mut norm = [0.0f64; 3];
             walk(&tree, x, beams, |item| {
-                let (area, p) = item.map_or_else(|s| at(s as u32), |n| nodes[n]);
+                let (area, p) = match item {
+                    WalkItem::Node(n) => nodes[n],
+                    WalkItem::Sample(s) => at(s as u32),
+                };
                 let dist = x.distance(p);
                 for (c, table) in tables.iter().enumerate() {
                     if let Some(t) = table.as_ref().filter(|_| dist < f64::from(beams.reach)) {
