@@ -77,12 +77,19 @@ pub const LEN: usize = NX * NY * NZ;
 /// Within this many window radii of the point of entry a value is the window's average.
 pub const WINDOW_REACH: f64 = 3.0;
 
-/// One channel's kernel on a grid (see the module doc), in units of `1 / mfp^2`.
+/// One channel's kernel on a grid (see the module doc), in units of `1 / mfp^2` times
+/// [`BeamTable::scale`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct BeamTable {
-    /// `values[(iz * NY + iy) * NX + ix]`, rounded to f16 as the GPU reads them (3 significant
-    /// digits; a pair's share of a receiver's sum is under 1%, and the rounding is not biased).
+    /// `values[(iz * NY + iy) * NX + ix]`, the kernel times `scale`, rounded to f16 as the GPU
+    /// reads them (3 significant digits; a pair's share of a receiver's sum is under 1%, and the
+    /// rounding is not biased).
     pub values: Vec<f32>,
+    /// The power of two the values are multiplied by, so that the largest lies between 2^14 and
+    /// 2^15: far values keep f16's full precision, and no footprint or medium can push the peak
+    /// past f16's range. The renderer reads the table only in the density correction's
+    /// quotient, where it cancels.
+    pub scale: f64,
     /// The critical cosine inside, `mu_c`: the `mu` axis starts there.
     pub mu_c: f64,
     /// The last node's `rho`, in mean free paths: 0 beyond.
@@ -118,17 +125,21 @@ impl BeamTable {
                 value.max(0.0)
             })
             .collect();
+        // 1 where nothing scatters (albedo 0): no tail to put back, and no 0 / 0.
         let gain: Vec<f64> = (0..NZ)
-            .map(|iz| {
-                1.0 + tail(&medium, node(0, 0, iz, mu_c, reach).2, reach, radius) / slice_integral(&raw, iz, reach)
+            .map(|iz| match slice_integral(&raw, iz, reach) {
+                inside if inside > 0.0 => 1.0 + tail(&medium, node(0, 0, iz, mu_c, reach).2, reach, radius) / inside,
+                _ => 1.0,
             })
             .collect();
+        let scaled: Vec<f64> = raw.iter().enumerate().map(|(k, v)| v * gain[k / (NX * NY)]).collect();
+        let largest = scaled.iter().copied().fold(0.0, f64::max);
+        let scale = if largest > 0.0 { (32768.0 / largest).log2().floor().exp2() } else { 1.0 };
         // f16, as the renderer packs it (render::beam_gather::pack_tables), so that the f64 twin
         // reads the numbers the GPU reads.
-        let values =
-            raw.iter().enumerate().map(|(k, v)| half::f16::from_f64(v * gain[k / (NX * NY)]).to_f32()).collect();
+        let values = scaled.iter().map(|v| half::f16::from_f64(v * scale).to_f32()).collect();
         let normal_total = reflectance(albedo, 0.0, eta, 1.0) + normal_gain(&medium, reach, radius);
-        BeamTable { values, mu_c, reach, normal_total }
+        BeamTable { values, scale, mu_c, reach, normal_total }
     }
 
     /// The tabulated kernel at `rho` mean free paths, `cos_phi` and `mu`, trilinear between the
@@ -227,8 +238,8 @@ fn slice_integral(values: &[f64], iz: usize, reach: f64) -> f64 {
     sum
 }
 
-/// How far past the reach [`tail`] integrates, in mean free paths: the kernel has fallen below
-/// `e^-8` of its value at the reach by then.
+/// How far past the reach [`tail`] integrates, in mean free paths: light arriving from there has
+/// crossed at least that much more medium, so at most `e^-8` of what arrives from the reach.
 const TAIL_SPAN: f64 = 8.0;
 
 /// `integral T dA` past the reach (to [`TAIL_SPAN`] beyond it) for light at cosine `mu` inside:
@@ -344,6 +355,24 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Where nothing scatters the table is 0 everywhere, not 0 / 0.
+    #[test]
+    fn a_table_of_a_medium_that_does_not_scatter_is_finite_and_zero() {
+        let table = BeamTable::new(0.0, 1.3, 0.1, REACH_MFP, 10.0);
+        assert!(table.values.iter().all(|&v| v == 0.0), "{:?}", table.values.iter().find(|v| **v != 0.0));
+        assert!(table.normal_total.is_finite());
+    }
+
+    /// However narrow the footprint (here a millionth of a mean free path), the largest value
+    /// lies between 2^14 and 2^15 and every value is finite.
+    #[test]
+    fn a_table_fills_f16s_range_without_leaving_it() {
+        let table = BeamTable::new(0.067, 1.3, 1e-6, REACH_MFP, f64::INFINITY);
+        let largest = table.values.iter().copied().fold(0.0f32, f32::max);
+        assert!(largest.is_finite() && largest > 16384.0 && largest <= 65504.0, "{largest}");
+        assert!(table.values.iter().all(|v| v.is_finite()));
     }
 
     #[test]
