@@ -9,7 +9,7 @@ mod common;
 use glam::DVec3;
 use translucent::optics::beam_table::BeamTable;
 use translucent::optics::directional_dipole::refract_in;
-use translucent::render::beam_gather::{ObjectBeams, object_tables};
+use translucent::render::beam_gather::{ObjectBeams, WalkItem, object_tables, walk};
 use translucent::render::plan::Change;
 use translucent::render::renderer::Renderer;
 use translucent::scene::Scene;
@@ -68,8 +68,9 @@ struct Entry {
 }
 
 /// The f64 twin of glsl/beam_gather.comp at vertex `x` in channel `c`: the walk of the object's
-/// hierarchy with nodes under `opening` of their distance (or of the window) standing in for
-/// their members, the entries' `A E T` against their `A T(rho, 1, 1)`, times `R1(1)`.
+/// hierarchy (`beam_gather::walk`) with nodes under `opening` of their distance (or of the
+/// window) standing in for their members, the entries' `A E T` against their `A T(rho, 1, 1)`
+/// (summed here, not read from `receiver_norms`), times `R1(1)`.
 fn twin(
     o: &PreparedObject,
     beams: &ObjectBeams,
@@ -96,24 +97,14 @@ fn twin(
         sum += e.power * table.lookup(rho, cos_phi, mu);
         norm += e.area * table.lookup(rho, 1.0, 1.0);
     };
-    let mut i = 0;
-    while i < tree.nodes.len() {
-        let n = &tree.nodes[i];
-        let dist = x.distance(DVec3::from(n.center.map(f64::from)));
-        let radius = f64::from(n.radius);
-        let members = &tree.order[n.first as usize..(n.first + n.count) as usize];
-        if dist - radius >= f64::from(beams.reach) {
-            i = n.skip as usize;
-        } else if radius < opening * dist.max(f64::from(beams.window)) {
-            add(node_entry(o, members, splat, c));
-            i = n.skip as usize;
-        } else if n.leaf {
-            members.iter().for_each(|&s| add(sample_entry(o, s as usize, splat, c)));
-            i = n.skip as usize;
-        } else {
-            i += 1;
+    let beams = ObjectBeams { opening: opening as f32, ..*beams };
+    walk(&tree, x, &beams, |item| match item {
+        WalkItem::Node(i) => {
+            let n = &tree.nodes[i];
+            add(node_entry(o, &tree.order[n.first as usize..(n.first + n.count) as usize], splat, c));
         }
-    }
+        WalkItem::Sample(s) => add(sample_entry(o, s, splat, c)),
+    });
     if norm > 0.0 { table.normal_total * sum / norm } else { 0.0 }
 }
 

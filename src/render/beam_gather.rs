@@ -160,8 +160,12 @@ pub fn walk(tree: &SampleTree, x: DVec3, beams: &ObjectBeams, mut visit: impl Fn
 /// channel over the walk the pass takes ([`walk`]; a node at its members' area-weighted
 /// centroid). It depends on the geometry alone, so it is summed here once (f64), and the pass
 /// sums only the lit terms, skipping every node that transmits nothing in the model's channels.
-pub fn receiver_norms(o: &PreparedObject, beams: &ObjectBeams, tables: &[Option<BeamTable>; 3]) -> Vec<[f32; 4]> {
-    let tree = o.sample_tree();
+pub fn receiver_norms(
+    o: &PreparedObject,
+    tree: &SampleTree,
+    beams: &ObjectBeams,
+    tables: &[Option<BeamTable>; 3],
+) -> Vec<[f32; 4]> {
     let at = |s: u32| (o.samples[s as usize].area, o.samples[s as usize].position.as_dvec3());
     let nodes: Vec<(f64, DVec3)> = tree
         .nodes
@@ -178,14 +182,17 @@ pub fn receiver_norms(o: &PreparedObject, beams: &ObjectBeams, tables: &[Option<
         .map(|x| {
             let x = x.as_dvec3();
             let mut norm = [0.0f64; 3];
-            walk(&tree, x, beams, |item| {
+            walk(tree, x, beams, |item| {
                 let (area, p) = match item {
                     WalkItem::Node(n) => nodes[n],
                     WalkItem::Sample(s) => at(s as u32),
                 };
                 let dist = x.distance(p);
+                if dist >= f64::from(beams.reach) {
+                    return;
+                }
                 for (c, table) in tables.iter().enumerate() {
-                    if let Some(t) = table.as_ref().filter(|_| dist < f64::from(beams.reach)) {
+                    if let Some(t) = table {
                         norm[c] += area * t.lookup(dist * f64::from(beams.sigma_t[c]), 1.0, 1.0);
                     }
                 }
@@ -210,15 +217,24 @@ pub struct PackedBeams {
     pub beams: Vec<Option<ObjectBeams>>,
 }
 
-/// [`PackedBeams`] of `scene`.
-pub fn pack_tables(scene: &PreparedScene) -> PackedBeams {
+/// [`PackedBeams`] of `scene`, with `trees[i]` object `i`'s sample hierarchy where the scene's
+/// packing already built it (built here otherwise).
+pub fn pack_tables(scene: &PreparedScene, trees: &[Option<SampleTree>]) -> PackedBeams {
     let mut out = PackedBeams { tables: vec![[0u32; 4]], norms: Vec::new(), beams: Vec::new() };
-    for o in &scene.objects {
+    for (i, o) in scene.objects.iter().enumerate() {
         let object = object_tables(o, out.tables.len(), scene.scene.file.render.beam_opening);
         match &object {
             Some((b, tables)) => {
                 out.tables.extend(pack_object(tables));
-                out.norms.extend(receiver_norms(o, b, tables));
+                let built;
+                let tree = match trees.get(i) {
+                    Some(Some(tree)) => tree,
+                    _ => {
+                        built = o.sample_tree();
+                        &built
+                    }
+                };
+                out.norms.extend(receiver_norms(o, tree, b, tables));
             }
             None => out.norms.extend(std::iter::repeat_n([0.0; 4], o.mesh.positions().len())),
         }

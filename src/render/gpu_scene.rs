@@ -322,11 +322,14 @@ struct PackedObjects {
     textures: Vec<TextureRange>,
     bvh_nodes: Vec<BvhNodeRecord>,
     bvh_triangles: Vec<BvhTriangleRecord>,
+    /// Per object, its sample hierarchy where a channel takes single scattering between
+    /// points (`beam_gather::pack_tables` reads it rather than building it again).
+    beam_trees: Vec<Option<crate::sampling::SampleTree>>,
 }
 
 impl PackedObjects {
     fn of(scene: &PreparedScene) -> PackedObjects {
-        let mut packed = PackedObjects::default();
+        let mut packed = PackedObjects { beam_trees: vec![None; scene.objects.len()], ..Default::default() };
         for (i, o) in scene.objects.iter().enumerate() {
             let first = [packed.vertices.len() as u32, packed.samples.len() as u32];
             packed.object(o);
@@ -433,6 +436,7 @@ impl PackedObjects {
             Vec::new()
         };
         self.coarser_receivers.push(coarser);
+        self.beam_trees[i] = o.single_channels().contains(&true).then_some(tree);
     }
 
     /// Object `i`'s receivers `at.vertices` (object-relative indices) grouped, with each group's
@@ -538,7 +542,8 @@ impl GpuScene {
     fn upload(gpu: &Arc<Gpu>, scene: &PreparedScene, p: PackedObjects, l: PackedLevels) -> GpuResult<GpuScene> {
         let none = vk::BufferUsageFlags::empty();
         let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER;
-        let super::beam_gather::PackedBeams { tables, norms, beams } = super::beam_gather::pack_tables(scene);
+        let super::beam_gather::PackedBeams { tables, norms, beams } =
+            super::beam_gather::pack_tables(scene, &p.beam_trees);
         let any_beams = beams.iter().any(Option::is_some);
         let beam_node_count = if any_beams { p.tree_nodes.len() } else { 1 };
         let beam_source_count = if any_beams { p.tree_order.len() } else { 1 };
