@@ -21,7 +21,7 @@
 //   0: per node, its BeamNodeRecord from this frame's splat: a leaf from its samples (writing
 //      each sample's BeamSourceRecord on the way, what stage 1 reads of it in one place), an
 //      inner node from its two children's, one height of the hierarchy per dispatch, leaves
-//      first;
+//      first; and the node's stand-in, as a BeamSourceRecord;
 //   1: one dispatch, one invocation per receiver: the walk and the sum. Runs after the dipole
 //      gather and overwrites its value in these channels only.
 //
@@ -30,7 +30,8 @@
 // read and written), 5 = level vertices, 6 = the tables (uvec4[], packed f16), 7 = tree nodes
 // (TreeNodeRecord[]), 8 = tree order (uint[]), 9 = receiver order (uint[]), 10 = beam nodes
 // (BeamNodeRecord[], written by stage 0, read by stage 1), 11 = beam sources (BeamSourceRecord
-// per leaf-order entry, written by stage 0 at the leaves, read by stage 1), 12 = per vertex, the
+// per leaf-order entry, then per node its stand-in from entry push `stage.w`; written by stage
+// 0, read by stage 1), 12 = per vertex, the
 // density correction's denominator (vec4, render::beam_gather::receiver_norms). Push:
 // BeamGatherPush.
 #include "dipole.glsl"
@@ -60,14 +61,18 @@ struct BeamGatherPush {
                             // table's window radius (scene units); w: 0
     vec4 normal_total;      // xyz: R1(1) per channel; w: the reach (scene units)
     uvec4 stage;            // x: 0 aggregate the nodes, 1 gather; y, z: stage 0's nodes,
-                            // tree_order[y + k] for k < z (one height); w: 0
+                            // tree_order[y + k] for k < z (one height); w: the nodes' stand-ins'
+                            // first entry in beam_sources (tree_order's length)
 };
 layout(push_constant) uniform BeamGatherPushBlock { BeamGatherPush push; };
 
 #include "beam_table.glsl"
 
+const uint NO_TERM = 0xffffffffu;
+
 // The terms of light entering at p (normal nrm, beam at cosine mu inside whose direction along
-// the tangent plane is `along`, summed A E `power`) at receiver x: A E T into `sum`. cos phi is the angle between the chord's projection on the tangent plane and `along`.
+// the tangent plane is `along`, summed A E `power`) at receiver x: A E T into `sum`. cos phi is
+// the angle between the chord's projection on the tangent plane and `along`.
 void add_term(vec3 x, vec3 p, vec3 nrm, float mu, vec3 along, vec3 power, inout vec3 sum) {
     vec3 d = x - p;
     float reach = push.normal_total.w;
@@ -93,7 +98,7 @@ float beam_along(vec3 w, vec3 nrm, out vec3 along) {
     return mu;
 }
 
-// The sample at leaf-order entry k (its BeamSourceRecord).
+// The source at entry k of beam_sources: a sample (leaf-order entry k) or a node's stand-in.
 void add_source(uint k, vec3 x, inout vec3 sum) {
     BeamSourceRecord r = beam_sources[k];
     if (!any(greaterThan(r.power_area.rgb, vec3(0.0)))) return;
@@ -101,15 +106,16 @@ void add_source(uint k, vec3 x, inout vec3 sum) {
     add_term(x, r.position_mu.xyz, r.normal_along.xyz, r.position_mu.w, along, r.power_area.rgb, sum);
 }
 
-// Node i standing in for its members: the unit mean normal and beam (the inward normal where no
-// member is lit; its power is then 0).
-void add_node(uint i, vec3 x, inout vec3 sum) {
-    BeamNodeRecord b = beam_nodes[i];
+// The record of node i standing in for its members, from its BeamNodeRecord b: at their
+// area-weighted centroid, with their unit mean normal and beam (the inward normal where no
+// member is lit; its power is then 0). Written once per frame by stage 0 to the node's entry past
+// the samples' (push `stage.w + i`), so that stage 1 reads a node as it reads a sample.
+BeamSourceRecord stand_in(BeamNodeRecord b) {
     float nl = length(b.normal.xyz), bl = length(b.beam.xyz);
     vec3 nrm = nl > 0.0 ? b.normal.xyz / nl : vec3(0.0, 0.0, 1.0);
     vec3 along;
     float mu = beam_along(bl > 0.0 ? b.beam.xyz / bl : -nrm, nrm, along);
-    add_term(x, b.position.xyz, nrm, mu, along, b.power.rgb, sum);
+    return BeamSourceRecord(vec4(b.position.xyz, mu), b.power, vec4(nrm, uintBitsToFloat(pack_octahedral(along))));
 }
 
 // Stage 0: node i's record from its samples (a leaf) or its two children's.
@@ -119,8 +125,10 @@ void aggregate(uint i) {
         BeamNodeRecord l = beam_nodes[i + 1u], r = beam_nodes[tree_nodes[i + 1u].range_skip.z];
         float a = l.power.w + r.power.w;
         vec3 c = a > 0.0 ? (l.power.w * l.position.xyz + r.power.w * r.position.xyz) / a : n.center_radius.xyz;
-        beam_nodes[i] = BeamNodeRecord(l.power + r.power, vec4(c, l.position.w + r.position.w),
-                                       l.normal + r.normal, l.beam + r.beam);
+        BeamNodeRecord b = BeamNodeRecord(l.power + r.power, vec4(c, l.position.w + r.position.w),
+                                          l.normal + r.normal, l.beam + r.beam);
+        beam_nodes[i] = b;
+        beam_sources[push.stage.w + i] = stand_in(b);
         return;
     }
     vec4 power = vec4(0.0);
@@ -141,7 +149,9 @@ void aggregate(uint i) {
         beam_sources[e] = BeamSourceRecord(vec4(pa.xyz, mu), vec4(p, pa.w), vec4(nrm, uintBitsToFloat(pack_octahedral(along))));
     }
     vec3 c = n.center_radius.xyz + (power.w > 0.0 ? offset / power.w : vec3(0.0));
-    beam_nodes[i] = BeamNodeRecord(power, vec4(c, weight), vec4(normal, 0.0), vec4(beam, 0.0));
+    BeamNodeRecord b = BeamNodeRecord(power, vec4(c, weight), vec4(normal, 0.0), vec4(beam, 0.0));
+    beam_nodes[i] = b;
+    beam_sources[push.stage.w + i] = stand_in(b);
 }
 
 void main() {
@@ -159,25 +169,35 @@ void main() {
     float reach = push.normal_total.w, opening = push.critical.y, window = push.critical.z;
     vec3 sum = vec3(0.0);
     bvec3 on = bvec3((mask & 1u) != 0u, (mask & 2u) != 0u, (mask & 4u) != 0u);
+    // One source summed per iteration at most, in one place: the invocations of a SIMD group
+    // walk apart, and a CPU driver runs every branch any of them takes, so a leaf's loop or a
+    // node's own term inside the walk's branches cost every invocation each time.
     uint i = push.tree.y, end = push.tree.y + push.tree.z;
-    while (i < end) {
-        TreeNodeRecord n = tree_nodes[i];
-        float dist = distance(x, n.center_radius.xyz);
-        // Out of reach, or transmitting nothing in the model's channels (the denominator,
-        // which every node within reach adds to, is summed once: beam_norms).
-        if (dist - n.center_radius.w >= reach || !(dot(vec3(on), beam_nodes[i].power.rgb) > 0.0)) {
-            i = n.range_skip.z;
-        } else if (n.center_radius.w < opening * max(dist, window)) {
-            add_node(i, x, sum);
-            i = n.range_skip.z;
-        } else if (n.range_skip.w != 0u) {
-            for (uint k = n.range_skip.x; k < n.range_skip.x + n.range_skip.y; ++k) {
-                add_source(k, x, sum);
-            }
-            i = n.range_skip.z;
+    uint k = 0u, k_end = 0u;  // a leaf's members still to sum (leaf-order entries)
+    while (k < k_end || i < end) {
+        uint term = NO_TERM;
+        if (k < k_end) {
+            term = k++;
         } else {
-            i += 1u;
+            TreeNodeRecord n = tree_nodes[i];
+            float dist = distance(x, n.center_radius.xyz);
+            uint standin = push.stage.w + i;
+            // Out of reach, or transmitting nothing in the model's channels (the denominator,
+            // which every node within reach adds to, is summed once: beam_norms).
+            if (dist - n.center_radius.w >= reach || !(dot(vec3(on), beam_sources[standin].power_area.rgb) > 0.0)) {
+                i = n.range_skip.z;
+            } else if (n.center_radius.w < opening * max(dist, window)) {
+                term = standin;
+                i = n.range_skip.z;
+            } else if (n.range_skip.w != 0u) {
+                k = n.range_skip.x;
+                k_end = k + n.range_skip.y;
+                i = n.range_skip.z;
+            } else {
+                i += 1u;
+            }
         }
+        if (term != NO_TERM) add_source(term, x, sum);
     }
     vec3 norm = beam_norms[vi].rgb;
     vec3 m = mix(vec3(0.0), push.normal_total.rgb * sum / max(norm, vec3(1e-30)), greaterThan(norm, vec3(0.0)));

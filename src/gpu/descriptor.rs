@@ -95,7 +95,7 @@ impl SetInterface<'_> {
         for (i, given) in bindings.iter().enumerate() {
             let declared = self.names.get(i).and_then(Option::as_deref);
             match declared {
-                Some(declared) if self.kinds[i].is_some() && declared != given.name => {
+                Some(declared) if self.kinds.get(i).is_some_and(Option::is_some) && declared != given.name => {
                     return Err(GpuError::BindingMismatch {
                         shader: self.shader.to_string(),
                         binding: i as u32,
@@ -218,5 +218,31 @@ impl Drop for DescriptorSet {
     fn drop(&mut self) {
         // SAFETY: destroying the pool frees its set; no submission using it is pending.
         unsafe { self.gpu.device().destroy_descriptor_pool(self.pool, None) };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(name: &str) -> Named<'_> {
+        let binding = Binding::Image {
+            view: vk::ImageView::null(),
+            layout: vk::ImageLayout::GENERAL,
+            sampler: vk::Sampler::null(),
+        };
+        Named { name, binding }
+    }
+
+    #[test]
+    fn a_resource_past_the_reflected_bindings_is_dropped_unchecked_not_a_panic() {
+        // The optimiser removed binding 1: its name may be reflected, its kind is not.
+        let kinds = [Some(BindingKind::StorageImage)];
+        let names = [Some("A".to_string()), Some("B".to_string())];
+        let set = SetInterface { shader: "t.comp", kinds: &kinds, names: &names };
+        assert!(set.check(&[image("A"), image("C")]).is_ok());
+        // A swapped name at a binding that is there is still an error naming both.
+        let err = set.check(&[image("B")]).unwrap_err().to_string();
+        assert!(err.contains('A') && err.contains('B'), "{err}");
     }
 }

@@ -4,9 +4,10 @@
 //! irradiance and beam directions (`SplatRecord::beam`) through the kernel's table
 //! (`optics::beam_table`). It runs in the gather's slot, after the dipole gather, and overwrites
 //! those channels alone. Two stages per object, as the hierarchical gather's: stage 0 aggregates
-//! each node of its sample hierarchy from this frame's splat (`BeamNodeRecord`), one height per
-//! dispatch; stage 1 walks the hierarchy per receiver, a node under `render.beam_opening` of its
-//! distance standing in for its members (`ObjectBeams::opening`).
+//! each node of its sample hierarchy from this frame's splat (`BeamNodeRecord`, and the node's
+//! stand-in as a `BeamSourceRecord`), one height per dispatch; stage 1 walks the hierarchy per
+//! receiver, a node under `render.beam_opening` of its distance standing in for its members
+//! (`ObjectBeams::opening`): one source (a sample or a stand-in) summed per step of the walk.
 //!
 //! Bindings: `BINDINGS`, in binding order. Push: `BeamGatherPush`.
 
@@ -39,7 +40,8 @@ pub struct BeamGatherPush {
     /// xyz: `R1(1)` per channel; w: the reach in scene units.
     pub normal_total: [f32; 4],
     /// x: 0 aggregate the nodes, 1 gather; y, z: stage 0's nodes, `tree_order[y + k]` for
-    /// `k < z` (one height of the hierarchy); w: 0.
+    /// `k < z` (one height of the hierarchy); w: the nodes' stand-ins' first entry in
+    /// `GpuScene::beam_sources` (`GpuScene::beam_standins`).
     pub stage: [u32; 4],
 }
 
@@ -340,7 +342,11 @@ impl RenderPass for BeamGatherPass {
                     // This height reads the nodes the heights before it wrote.
                     frame.before(cmd, &[write(Resource::BeamNodes, Access::ComputeReadWrite)]);
                 }
-                let push = BeamGatherPush { stage: [0, first, count, 0], ..Self::push(r, &b, r.first_receiver, 0, 1) };
+                let base = frame.scene.beam_standins;
+                let push = BeamGatherPush {
+                    stage: [0, first, count, base],
+                    ..Self::push(frame, r, &b, r.first_receiver, 0, 1)
+                };
                 self.pipeline.dispatch(cmd, &self.set, &push, [count, 1, 1]);
             }
         }
@@ -359,7 +365,8 @@ impl RenderPass for BeamGatherPass {
             } else {
                 (level.first_entry, level.vertex_count, 0)
             };
-            self.pipeline.dispatch(cmd, &self.set, &Self::push(r, &b, first, count, grouped), [count, 1, 1]);
+            let push = Self::push(frame, r, &b, first, count, grouped);
+            self.pipeline.dispatch(cmd, &self.set, &push, [count, 1, 1]);
         }
     }
 }
@@ -367,14 +374,21 @@ impl RenderPass for BeamGatherPass {
 impl BeamGatherPass {
     /// Stage 1's push block for `count` receivers of `r` from `first` (`grouped`: 1 when they
     /// are `receiver_order`'s).
-    fn push(r: &super::gpu_scene::Receiver, b: &ObjectBeams, first: u32, count: u32, grouped: u32) -> BeamGatherPush {
+    fn push(
+        frame: &FrameInputs,
+        r: &super::gpu_scene::Receiver,
+        b: &ObjectBeams,
+        first: u32,
+        count: u32,
+        grouped: u32,
+    ) -> BeamGatherPush {
         let [r0, r1, r2] = b.normal_total;
         BeamGatherPush {
             object: [r.object, first, count, b.channels],
             tree: [b.table, r.first_node, r.node_count, grouped],
             critical: [b.mu_c, b.opening, b.window, 0.0],
             normal_total: [r0, r1, r2, b.reach],
-            stage: [1, 0, 0, 0],
+            stage: [1, 0, 0, frame.scene.beam_standins],
         }
     }
 }

@@ -179,14 +179,17 @@ pub struct GpuScene {
     /// `BeamNodeRecord` per node of the sample hierarchies where an object takes the model (one
     /// unread entry otherwise), written by the between-points pass's stage 0.
     pub beam_nodes: Buffer,
-    /// `BeamSourceRecord` per entry of `tree_order` where an object takes the model (one unread
-    /// entry otherwise): its samples' entries, written by the between-points pass's stage 0.
+    /// `BeamSourceRecord` per entry of `tree_order`, then per node of `tree_nodes` (its stand-in
+    /// for its members), where an object takes the model (one unread entry otherwise), written
+    /// by the between-points pass's stage 0.
     pub beam_sources: Buffer,
     /// Per vertex (vec4), the between-points density correction's denominator per channel
     /// (`beam_gather::receiver_norms`; one entry when no object takes the model).
     pub beam_norms: Buffer,
     /// Per object, in scene order: its between-points channels and their tables' places.
     pub beams: Vec<Option<super::beam_gather::ObjectBeams>>,
+    /// The nodes' stand-ins' first entry in `beam_sources`: `tree_order`'s length.
+    pub beam_standins: u32,
     /// Triangles in `bvh_triangles`: 0 when nothing casts a shadow.
     pub caster_triangles: u32,
     /// How far a shadow ray starts off the surface, along the normal, and the least distance
@@ -546,7 +549,8 @@ impl GpuScene {
             super::beam_gather::pack_tables(scene, &p.beam_trees);
         let any_beams = beams.iter().any(Option::is_some);
         let beam_node_count = if any_beams { p.tree_nodes.len() } else { 1 };
-        let beam_source_count = if any_beams { p.tree_order.len() } else { 1 };
+        // The samples' entries, then the nodes' stand-ins.
+        let beam_source_count = if any_beams { p.tree_order.len() + p.tree_nodes.len() } else { 1 };
         let zeros = vec![[0f32; 4]; p.vertices.len()];
         let sized = |name, item: usize, count: usize| storage(gpu, name, (item * count) as u64, none);
         Ok(GpuScene {
@@ -581,6 +585,7 @@ impl GpuScene {
             beam_sources: sized("beam sources", std::mem::size_of::<BeamSourceRecord>(), beam_source_count)?,
             beam_norms: upload(gpu, "beam norms", &norms, none)?,
             beams,
+            beam_standins: p.tree_order.len() as u32,
             caster_triangles: p.bvh_triangles.len() as u32,
             ray_offset: scene.ray_offset() as f32,
             textures: p.textures,
