@@ -1,8 +1,9 @@
 //! The between-points single scattering in the renderer (`glsl/beam_gather.comp`) against its
 //! f64 twin: the same table (`optics::beam_table`) read in f64 over the same walk of the sample
 //! hierarchy, clusters standing in for their members as `render.beam_opening` says, with the
-//! density correction, per vertex; the cut against the sum over every sample; and the channels
-//! the material's `model` leaves to the dipole untouched.
+//! density correction, per vertex; the cut against the sum over every sample; the channels the
+//! material's `model` leaves to the dipole untouched; and an object whose records come after
+//! another's.
 
 mod common;
 
@@ -47,14 +48,42 @@ count = 3000
 /// One full frame gathered at every vertex; the exitance of object 0, the splat's transmitted
 /// irradiance per sample and the plan as `plan` prints it.
 fn frame(prepared: PreparedScene) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, String) {
+    frame_of(prepared, 0)
+}
+
+/// [`frame`] with the exitance of `object` and the splat of its own samples.
+fn frame_of(prepared: PreparedScene, object: usize) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, String) {
+    let first_sample: usize = prepared.objects[..object].iter().map(|o| o.samples.len()).sum();
     common::with_gpu(|gpu| {
         let mut renderer = Renderer::new(gpu, prepared).unwrap();
         let mut plan = renderer.plan(Change::Everything);
         plan.objects.iter_mut().for_each(|o| o.level = 0);
         renderer.frame(&plan).unwrap();
-        let splat = renderer.splat_irradiance().unwrap().into_iter().map(|(e, _)| e).collect();
-        (renderer.exitance(0).unwrap(), splat, plan.to_string())
+        let splat = renderer.splat_irradiance().unwrap().into_iter().skip(first_sample).map(|(e, _)| e).collect();
+        (renderer.exitance(object).unwrap(), splat, plan.to_string())
     })
+}
+
+/// The worst difference of `ours` (object `o`'s exitance) from the f64 twin at `opening` in
+/// green and blue, and the worst of the twin at `opening` from the flat sum, both as a share of
+/// the brightest vertex.
+fn against_twin(o: &PreparedObject, ours: &[[f32; 3]], splat: &[[f32; 3]], opening: f32) -> (f64, f64) {
+    let (beams, tables) = object_tables(o, 1, opening).unwrap();
+    let positions = o.mesh.positions();
+    let brightest = ours.iter().map(|m| m[1].max(m[2])).fold(0.0f32, f32::max);
+    assert!(brightest > 0.0);
+    let (mut worst, mut cut) = (0.0f64, 0.0f64);
+    for (v, m) in ours.iter().enumerate() {
+        assert!(m.iter().all(|x| x.is_finite() && *x >= 0.0), "vertex {v}: {m:?}");
+        for c in [1, 2] {
+            let at = |opening| twin(o, &beams, tables[c].as_ref().unwrap(), c, splat, positions[v].as_dvec3(), opening);
+            let expect = at(f64::from(beams.opening));
+            worst = worst.max((f64::from(m[c]) - expect).abs() / f64::from(brightest));
+            // What the clusters cost: the same twin over every sample within reach.
+            cut = cut.max((expect - at(0.0)).abs() / f64::from(brightest));
+        }
+    }
+    (worst, cut)
 }
 
 /// What enters at one point or node: position, unit normal, unit beam, summed `A E` in the
@@ -151,25 +180,11 @@ fn the_gpu_between_points_sum_matches_its_f64_twin_and_leaves_the_dipoles_channe
     // The plan says which channels take the model and why; the dipole's plan says nothing of it.
     assert!(plan.contains("G single scattering between points") && plan.contains("B single scattering"), "{plan}");
     assert!(!plan.contains("R single") && !plain.contains("single scattering"), "{plan}\n{plain}");
-    let (beams, tables) = object_tables(&object, 1, translucent::scene::DEFAULT_BEAM_OPENING).unwrap();
-    let positions = object.mesh.positions();
-    let brightest = ours.iter().map(|m| m[1].max(m[2])).fold(0.0f32, f32::max);
-    assert!(brightest > 0.0);
-    let (mut worst, mut cut) = (0.0f64, 0.0f64);
     for (v, (m, d)) in ours.iter().zip(&dipole).enumerate() {
-        assert!(m.iter().all(|x| x.is_finite() && *x >= 0.0), "vertex {v}: {m:?}");
         // The dipole's channel is what the dipole gather wrote, bit for bit.
         assert_eq!(m[0].to_bits(), d[0].to_bits(), "vertex {v}: red {} against the dipole's {}", m[0], d[0]);
-        for c in [1, 2] {
-            let at = |opening| {
-                twin(&object, &beams, tables[c].as_ref().unwrap(), c, &splat, positions[v].as_dvec3(), opening)
-            };
-            let expect = at(f64::from(beams.opening));
-            worst = worst.max((f64::from(m[c]) - expect).abs() / f64::from(brightest));
-            // What the clusters cost: the same twin over every sample within reach.
-            cut = cut.max((expect - at(0.0)).abs() / f64::from(brightest));
-        }
     }
+    let (worst, cut) = against_twin(&object, &ours, &splat, translucent::scene::DEFAULT_BEAM_OPENING);
     eprintln!(
         "worst difference from the f64 twin: {worst:.2e} of the brightest vertex; the cut from the flat sum: {cut:.2e}"
     );
@@ -179,6 +194,47 @@ fn the_gpu_between_points_sum_matches_its_f64_twin_and_leaves_the_dipoles_channe
     assert!(cut < 0.01, "the cut is {cut:.2e} of the brightest vertex from the sum over every sample");
     // Green and blue are the model's, not the dipole's: they differ at some vertex.
     assert!(ours.iter().zip(&dipole).any(|(m, d)| (m[1] - d[1]).abs() > 0.05 * d[1].abs().max(1e-6)));
+}
+
+#[test]
+fn an_object_after_another_walks_its_own_hierarchy_and_stand_ins() {
+    // A dipole sphere first, so the model's object has its nodes, samples and stand-ins after
+    // another's in the shared buffers.
+    let sphere = |x: f32, model: &str| {
+        format!(
+            r#"
+[[object]]
+shape = {{ type = "sphere", radius = 10.0, divisions = 12 }}
+transform = {{ translate = [{x:?}, 0.0, 0.0] }}
+material = {{ type = "translucent", preset = "ketchup", mm_per_unit = 1.0, model = "{model}" }}
+casts_shadow = false
+"#
+        )
+    };
+    let text = format!(
+        r#"
+[camera]
+eye = [0.0, 12.0, 120.0]
+target = [0.0, 0.0, 0.0]
+resolution = [32, 32]
+{}{}
+[[light]]
+type = "directional"
+direction = {LIGHT:?}
+irradiance = [1.0, 1.0, 1.0]
+
+[sampling]
+count = 3000
+"#,
+        sphere(-30.0, "dipole"),
+        sphere(30.0, "auto")
+    );
+    let prepared = PreparedScene::new(&Scene::parse(&text, "two.toml", None).unwrap(), &Overrides::default()).unwrap();
+    let object = prepared.objects[1].clone();
+    let (ours, splat, _) = frame_of(prepared, 1);
+    let (worst, _) = against_twin(&object, &ours, &splat, translucent::scene::DEFAULT_BEAM_OPENING);
+    eprintln!("second object: worst difference from the f64 twin {worst:.2e} of its brightest vertex");
+    assert!(worst < 1e-3, "the second object's sum is {worst:.2e} of its brightest vertex from its f64 twin");
 }
 
 #[test]
