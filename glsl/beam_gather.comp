@@ -11,13 +11,15 @@
 // correction (optics::beam_table's module doc): the same samples' sum at normal incidence
 // against the half-space's exact R1(1), which takes out the aliasing of the kernel's peak. Its
 // denominator depends on the geometry alone and is summed once on the CPU over the same walk
-// (render::beam_gather::receiver_norms), so the walk here skips every node that transmits
-// nothing in the model's channels.
+// (render::beam_gather::receiver_walks), so the pass sums only the lit terms.
 // Samples are found by walking the object's hierarchy (glsl/common/tree.glsl), skipping nodes
 // beyond the reach. A node whose radius is under render.beam_opening times its distance from x
 // (or times the table's window radius, on whose scale the tabulated kernel is smooth, when x is
 // nearer) stands in for its members: their summed A E at their area-weighted centroid, with their
-// mean normal and their power-weighted mean beam. Two stages (push `stage.x`):
+// mean normal and their power-weighted mean beam. The walk depends on the geometry alone too:
+// where render.beam_walk_mib allows, each vertex's was taken at upload and is read from
+// beam_items (a step per source, no node tests); otherwise it is taken here each frame, skipping
+// the nodes that transmit nothing in the model's channels. Two stages (push `stage.x`):
 //   0: per node, its BeamNodeRecord from this frame's splat: a leaf from its samples (writing
 //      each sample's BeamSourceRecord on the way, what stage 1 reads of it in one place), an
 //      inner node from its two children's, one height of the hierarchy per dispatch, leaves
@@ -31,8 +33,9 @@
 // (TreeNodeRecord[]), 8 = tree order (uint[]), 9 = receiver order (uint[]), 10 = beam nodes
 // (BeamNodeRecord[], written by stage 0, read by stage 1), 11 = beam sources (BeamSourceRecord
 // per leaf-order entry, then per node its stand-in from entry push `stage.w`; written by stage
-// 0, read by stage 1), 12 = per vertex, the
-// density correction's denominator (vec4, render::beam_gather::receiver_norms). Push:
+// 0, read by stage 1), 12 = per vertex and one more, BeamReceiverRecord (the density
+// correction's denominator and the vertex's first walk item), 13 = the walks' items (uint[]:
+// NODE_ITEM | a node, or a sample's leaf-order entry, both object-relative). Push:
 // BeamGatherPush.
 #include "dipole.glsl"
 #include "scene.glsl"
@@ -50,13 +53,15 @@ layout(std430, set = 0, binding = 8) readonly buffer TreeOrder { uint tree_order
 layout(std430, set = 0, binding = 9) readonly buffer ReceiverOrder { uint receiver_order[]; };
 layout(std430, set = 0, binding = 10) buffer BeamNodes { BeamNodeRecord beam_nodes[]; };
 layout(std430, set = 0, binding = 11) buffer BeamSources { BeamSourceRecord beam_sources[]; };
-layout(std430, set = 0, binding = 12) readonly buffer BeamNorms { vec4 beam_norms[]; };
+layout(std430, set = 0, binding = 12) readonly buffer BeamNorms { BeamReceiverRecord beam_norms[]; };
+layout(std430, set = 0, binding = 13) readonly buffer BeamItems { uint beam_items[]; };
 struct BeamGatherPush {
     uvec4 object;           // x: the object; y: its receivers' first entry in level_vertices
                             // or receiver_order; z: their count; w: channel mask (bit c: channel c)
     uvec4 tree;             // x: its table's base in beam_tables; y: its root in tree_nodes;
-                            // z: its node count; w: 1: the receivers are receiver_order's
-                            // (absolute, grouped in space), 0: level_vertices' (object-relative)
+                            // z: its node count; w: bit 0: the receivers are receiver_order's
+                            // (absolute, grouped in space), else level_vertices' (object-
+                            // relative); bit 1: their walks are read from beam_items, else taken
     vec4 critical;          // x: the critical cosine inside; y: render.beam_opening; z: the
                             // table's window radius (scene units); w: 0
     vec4 normal_total;      // xyz: R1(1) per channel; w: the reach (scene units)
@@ -154,21 +159,10 @@ void aggregate(uint i) {
     beam_sources[push.stage.w + i] = stand_in(b);
 }
 
-void main() {
-    if (push.stage.x == 0u) {
-        if (gl_GlobalInvocationID.x < push.stage.z) aggregate(tree_order[push.stage.y + gl_GlobalInvocationID.x]);
-        return;
-    }
-    uint receiver_count = push.object.z, mask = push.object.w;
-    if (gl_GlobalInvocationID.x >= receiver_count) return;
-    ObjectRecord o = objects[push.object.x];
-    uint entry = push.object.y + gl_GlobalInvocationID.x;
-    // Neighbouring invocations walk nearly the same nodes when their receivers lie together.
-    uint vi = push.tree.w != 0u ? receiver_order[entry] : o.ranges.x + level_vertices[entry];
-    vec3 x = vertex_position(vertices[vi]);
+// The walk of the object's hierarchy about x, each frame: nodes beyond the reach or transmitting
+// nothing in the model's channels (on) skipped, near enough ones standing in for their members.
+void walk(vec3 x, bvec3 on, inout vec3 sum) {
     float reach = push.normal_total.w, opening = push.critical.y, window = push.critical.z;
-    vec3 sum = vec3(0.0);
-    bvec3 on = bvec3((mask & 1u) != 0u, (mask & 2u) != 0u, (mask & 4u) != 0u);
     // One source summed per iteration at most, in one place: the invocations of a SIMD group
     // walk apart, and a CPU driver runs every branch any of them takes, so a leaf's loop or a
     // node's own term inside the walk's branches cost every invocation each time.
@@ -183,7 +177,7 @@ void main() {
             float dist = distance(x, n.center_radius.xyz);
             uint standin = push.stage.w + i;
             // Out of reach, or transmitting nothing in the model's channels (the denominator,
-            // which every node within reach adds to, is summed once: beam_norms).
+            // which every node within reach adds to, is summed once: BeamReceiverRecord).
             if (dist - n.center_radius.w >= reach || !(dot(vec3(on), beam_sources[standin].power_area.rgb) > 0.0)) {
                 i = n.range_skip.z;
             } else if (n.center_radius.w < opening * max(dist, window)) {
@@ -199,7 +193,35 @@ void main() {
         }
         if (term != NO_TERM) add_source(term, x, sum);
     }
-    vec3 norm = beam_norms[vi].rgb;
+}
+
+void main() {
+    if (push.stage.x == 0u) {
+        if (gl_GlobalInvocationID.x < push.stage.z) aggregate(tree_order[push.stage.y + gl_GlobalInvocationID.x]);
+        return;
+    }
+    uint receiver_count = push.object.z, mask = push.object.w;
+    if (gl_GlobalInvocationID.x >= receiver_count) return;
+    ObjectRecord o = objects[push.object.x];
+    uint entry = push.object.y + gl_GlobalInvocationID.x;
+    // Neighbouring invocations walk nearly the same nodes when their receivers lie together.
+    uint vi = (push.tree.w & 1u) != 0u ? receiver_order[entry] : o.ranges.x + level_vertices[entry];
+    vec3 x = vertex_position(vertices[vi]);
+    vec3 sum = vec3(0.0);
+    bvec3 on = bvec3((mask & 1u) != 0u, (mask & 2u) != 0u, (mask & 4u) != 0u);
+    if ((push.tree.w & 2u) != 0u) {
+        // The walk read as it was taken at upload (render::beam_gather::receiver_walks): a
+        // node as NODE_ITEM | its index, a sample as its leaf-order entry, both relative to the
+        // object's. The nodes that transmit nothing are on it too; add_source passes them by.
+        uint root = push.tree.y, first_entry = tree_nodes[root].range_skip.x;
+        for (uint j = beam_norms[vi].first_item; j < beam_norms[vi + 1u].first_item; ++j) {
+            uint item = beam_items[j];
+            add_source((item & NODE_ITEM) != 0u ? push.stage.w + root + (item & ~NODE_ITEM) : first_entry + item, x, sum);
+        }
+    } else {
+        walk(x, on, sum);
+    }
+    vec3 norm = beam_norms[vi].norm;
     vec3 m = mix(vec3(0.0), push.normal_total.rgb * sum / max(norm, vec3(1e-30)), greaterThan(norm, vec3(0.0)));
     vec4 old = exitance[vi];
     exitance[vi] = vec4(mix(old.rgb, max(m, vec3(0.0)), on), old.w);

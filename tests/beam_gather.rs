@@ -10,7 +10,7 @@ mod common;
 use glam::DVec3;
 use translucent::optics::beam_table::BeamTable;
 use translucent::optics::directional_dipole::refract_in;
-use translucent::render::beam_gather::{ObjectBeams, WalkItem, object_tables, walk};
+use translucent::render::beam_gather::{ObjectBeams, WalkItem, object_tables, pack_tables, walk};
 use translucent::render::plan::Change;
 use translucent::render::renderer::Renderer;
 use translucent::scene::Scene;
@@ -235,6 +235,55 @@ count = 3000
     let (worst, _) = against_twin(&object, &ours, &splat, translucent::scene::DEFAULT_BEAM_OPENING);
     eprintln!("second object: worst difference from the f64 twin {worst:.2e} of its brightest vertex");
     assert!(worst < 1e-3, "the second object's sum is {worst:.2e} of its brightest vertex from its f64 twin");
+}
+
+/// One frame of `prepared` with object 0 gathered at level of detail `level`: that level's
+/// exitance (vertices and values) and the splat.
+fn frame_at_level(prepared: PreparedScene, level: usize) -> (Vec<u32>, Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    common::with_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, prepared).unwrap();
+        let mut plan = renderer.plan(Change::Everything);
+        plan.objects[0].level = level;
+        renderer.frame(&plan).unwrap();
+        let splat = renderer.splat_irradiance().unwrap().into_iter().map(|(e, _)| e).collect();
+        let at = renderer.exitance_at_level(0).unwrap();
+        assert_eq!(at.level, level);
+        (at.vertices, at.values, splat)
+    })
+}
+
+#[test]
+fn walks_read_from_the_upload_give_the_same_sums_as_walks_taken_each_frame_at_every_level() {
+    let mut walked = ketchup("auto");
+    walked.scene.file.render.beam_walk_mib = 0;
+    let levels = walked.objects[0].levels.len();
+    assert!(levels > 1, "the test sphere has coarser levels of detail");
+    let object = walked.objects[0].clone();
+    // One path each: the default budget keeps the walks, 0 keeps none.
+    let lists = |p: &PreparedScene| pack_tables(p, &[]).beams[0].unwrap().lists;
+    assert!(lists(&ketchup("auto")) && !lists(&walked));
+    let (beams, tables) = object_tables(&object, 1, translucent::scene::DEFAULT_BEAM_OPENING).unwrap();
+    for level in [0, levels - 1] {
+        let (vertices, each_frame, splat) = frame_at_level(walked.clone(), level);
+        let (same, read, _) = frame_at_level(ketchup("auto"), level);
+        assert_eq!(vertices, same);
+        // The same sources in the same order: the same sums, bit for bit.
+        for (v, (a, b)) in each_frame.iter().zip(&read).enumerate() {
+            assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits), "level {level}, vertex {}", vertices[v]);
+        }
+        // And at a coarser level, its vertices' sums are the twin's at those vertices.
+        let brightest = read.iter().map(|m| m[1].max(m[2])).fold(0.0f32, f32::max);
+        assert!(brightest > 0.0);
+        let positions = object.mesh.positions();
+        for (&v, m) in vertices.iter().zip(&read) {
+            for c in [1, 2] {
+                let x = positions[v as usize].as_dvec3();
+                let expect = twin(&object, &beams, tables[c].as_ref().unwrap(), c, &splat, x, f64::from(beams.opening));
+                let off = (f64::from(m[c]) - expect).abs() / f64::from(brightest);
+                assert!(off < 1e-3, "level {level}, vertex {v}, channel {c}: {off:.2e} of the brightest from the twin");
+            }
+        }
+    }
 }
 
 #[test]

@@ -12,8 +12,8 @@ use translucent::render::gather_texture::GatherTexturePush;
 use translucent::render::gather_tree::GatherTreePush;
 use translucent::render::local_exitance::LocalExitancePush;
 use translucent::render::records::{
-    BeamNodeRecord, BeamSourceRecord, LightGpu, NodePowerRecord, ObjectRecord, SampleRecord, SplatRecord,
-    TreeNodeRecord, Vertex,
+    BeamNodeRecord, BeamReceiverRecord, BeamSourceRecord, LightGpu, NodePowerRecord, ObjectRecord, SampleRecord,
+    SplatRecord, TreeNodeRecord, Vertex,
 };
 use translucent::render::shade::ShadePush;
 use translucent::render::shadow::ShadowPush;
@@ -162,6 +162,11 @@ fn splat_and_vertex_records_match_glsl() {
         ("power_area", offset_of!(BeamSourceRecord, power_area)),
         ("normal_along", offset_of!(BeamSourceRecord, normal_along)),
     ];
+    assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
+    let (fields, size) = glsl_layout(scene, "BeamReceiverRecord");
+    assert_eq!(size, size_of::<BeamReceiverRecord>());
+    let rust =
+        [("norm", offset_of!(BeamReceiverRecord, norm)), ("first_item", offset_of!(BeamReceiverRecord, first_item))];
     assert_eq!(fields, rust.map(|(n, o)| (n.to_string(), o)));
     let (fields, size) = glsl_layout(scene, "VertexRecord");
     assert_eq!(size, size_of::<Vertex>());

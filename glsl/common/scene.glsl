@@ -87,6 +87,13 @@ struct BeamNodeRecord {
     vec4 beam;              // xyz: sum P_i w_i over the members' beams w_i; w: 0
 };
 
+// Per vertex, what the between-points single scattering's stage 1 knows of it before any frame
+// (BeamReceiverRecord in src/render/records.rs; render::beam_gather::receiver_walks).
+struct BeamReceiverRecord {
+    vec3 norm;              // the density correction's denominator per channel
+    uint first_item;        // its walk's first item in beam_items; the next vertex's ends it
+};
+
 // Per sample in its hierarchy's leaf order, after each splat, what the between-points single
 // scattering reads of it (beam_gather.comp stage 0 writes it; BeamSourceRecord in
 // src/render/records.rs).

@@ -5,14 +5,18 @@
 //! (`optics::beam_table`). It runs in the gather's slot, after the dipole gather, and overwrites
 //! those channels alone. Two stages per object, as the hierarchical gather's: stage 0 aggregates
 //! each node of its sample hierarchy from this frame's splat (`BeamNodeRecord`, and the node's
-//! stand-in as a `BeamSourceRecord`), one height per dispatch; stage 1 walks the hierarchy per
-//! receiver, a node under `render.beam_opening` of its distance standing in for its members
-//! (`ObjectBeams::opening`): one source (a sample or a stand-in) summed per step of the walk.
+//! stand-in as a `BeamSourceRecord`), one height per dispatch; stage 1 sums, per receiver, the
+//! sources of its walk of the hierarchy, a node under `render.beam_opening` of its distance
+//! standing in for its members (`ObjectBeams::opening`). The walk depends on the geometry alone,
+//! so [`receiver_walks`] takes it once at upload with the density correction's denominator, and
+//! stage 1 reads it (`ObjectBeams::lists`, within `render.beam_walk_mib`); past that budget
+//! stage 1 takes it each frame, one source (a sample or a stand-in) per step.
 //!
 //! Bindings: `BINDINGS`, in binding order. Push: `BeamGatherPush`.
 
 use super::graph::{Resource, Resources, Use, compute_uses, read, write};
 use super::pass::{FrameInputs, RenderPass};
+use super::records::BeamReceiverRecord;
 use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use crate::optics::beam_table::{self, BeamTable};
 use crate::sampling::SampleTree;
@@ -30,8 +34,10 @@ pub struct BeamGatherPush {
     /// z: their count; w: the channel mask.
     pub object: [u32; 4],
     /// x: its table's base in `GpuScene::beam_tables` (uvec4 entries); y: its root in
-    /// `tree_nodes`; z: its node count; w: 1 when the receivers are `receiver_order`'s (the
-    /// whole mesh, absolute indices), 0 when `level_vertices`' (a coarser level).
+    /// `tree_nodes`; z: its node count; w: bit 0: the receivers are `receiver_order`'s (the
+    /// whole mesh, absolute indices), else `level_vertices`' (a coarser level, object-relative);
+    /// bit 1: their walks are read from `GpuScene::beam_items` (`ObjectBeams::lists`), else
+    /// taken each frame.
     pub tree: [u32; 4],
     /// x: the critical cosine inside; y: `render.beam_opening`; z: the table's window radius in scene
     /// units; w: 0. (The channels share the table's distance axis, so their `sigma_t'` is not
@@ -71,6 +77,10 @@ pub struct ObjectBeams {
     /// their summed power and area at their area-weighted centroid, with their mean normal and
     /// power-weighted mean beam. 0 is the sum over every sample within reach.
     pub opening: f32,
+    /// Whether stage 1 reads each receiver's walk from `GpuScene::beam_items` (every vertex's,
+    /// so at any level of detail) rather than taking it each frame: set by [`pack_tables`],
+    /// within `render.beam_walk_mib`.
+    pub lists: bool,
 }
 
 /// The tables of object `o`'s between-points channels for its samples' mean footprint, all
@@ -101,6 +111,7 @@ pub fn object_tables(o: &PreparedObject, base: usize, opening: f32) -> Option<(O
         reach: reach as f32,
         window: (beam_table::WINDOW * radius) as f32,
         opening,
+        lists: false,
     };
     Some((beams, tables))
 }
@@ -158,16 +169,19 @@ pub fn walk(tree: &SampleTree, x: DVec3, beams: &ObjectBeams, mut visit: impl Fn
     }
 }
 
-/// Per vertex of object `o`, the density correction's denominator `sum_i A_i T(rho_i, 1, 1)` per
-/// channel over the walk the pass takes ([`walk`]; a node at its members' area-weighted
-/// centroid). It depends on the geometry alone, so it is summed here once (f64), and the pass
-/// sums only the lit terms, skipping every node that transmits nothing in the model's channels.
-pub fn receiver_norms(
+/// Per vertex of object `o`, what stage 1 knows of it before any frame: the density
+/// correction's denominator `sum_i A_i T(rho_i, 1, 1)` per channel over the walk the pass takes
+/// ([`walk`]; a node at its members' area-weighted centroid), and that walk's items, a node as
+/// `NODE_ITEM | n` and a sample as its leaf-order entry `e` (both relative to the object's). The
+/// denominator depends on the geometry alone, so it is summed here once (f64), and the pass sums
+/// only the lit terms; the walk too depends on the geometry alone, so the pass may read it
+/// rather than take it again each frame.
+pub fn receiver_walks(
     o: &PreparedObject,
     tree: &SampleTree,
     beams: &ObjectBeams,
     tables: &[Option<BeamTable>; 3],
-) -> Vec<[f32; 4]> {
+) -> Vec<([f32; 3], Vec<u32>)> {
     let at = |s: u32| (o.samples[s as usize].area, o.samples[s as usize].position.as_dvec3());
     let nodes: Vec<(f64, DVec3)> = tree
         .nodes
@@ -178,12 +192,14 @@ pub fn receiver_norms(
             (area, if area > 0.0 { moment / area } else { DVec3::from(n.center.map(f64::from)) })
         })
         .collect();
+    let mut entry = vec![0u32; o.samples.len()];
+    tree.order.iter().enumerate().for_each(|(e, &s)| entry[s as usize] = e as u32);
     o.mesh
         .positions()
         .par_iter()
         .map(|x| {
             let x = x.as_dvec3();
-            let mut norm = [0.0f64; 3];
+            let (mut norm, mut items) = ([0.0f64; 3], Vec::new());
             walk(tree, x, beams, |item| {
                 let (area, p) = match item {
                     WalkItem::Node(n) => nodes[n],
@@ -193,13 +209,17 @@ pub fn receiver_norms(
                 if dist >= f64::from(beams.reach) {
                     return;
                 }
+                items.push(match item {
+                    WalkItem::Node(n) => crate::sampling::NODE_ITEM | n as u32,
+                    WalkItem::Sample(s) => entry[s],
+                });
                 for (c, table) in tables.iter().enumerate() {
                     if let Some(t) = table {
                         norm[c] += area * t.lookup(dist * f64::from(beams.sigma_t[c]), 1.0, 1.0);
                     }
                 }
             });
-            [norm[0] as f32, norm[1] as f32, norm[2] as f32, 0.0]
+            (norm.map(|v| v as f32), items)
         })
         .collect()
 }
@@ -213,8 +233,11 @@ pub struct PackedBeams {
     /// least one entry, so the buffer binds).
     pub tables: Vec<[u32; 4]>,
     /// Per vertex of every object, objects one after another as in `GpuScene::vertices`, its
-    /// [`receiver_norms`] (0 on objects without the model); one entry when no object has it.
-    pub norms: Vec<[f32; 4]>,
+    /// [`receiver_walks`] denominator and first item (0 and an empty list on objects without
+    /// the model), then one record closing the last list.
+    pub receivers: Vec<BeamReceiverRecord>,
+    /// The walks' items, vertex after vertex (at least one entry, so the buffer binds).
+    pub items: Vec<u32>,
     /// Per object, its `ObjectBeams`.
     pub beams: Vec<Option<ObjectBeams>>,
 }
@@ -222,10 +245,12 @@ pub struct PackedBeams {
 /// [`PackedBeams`] of `scene`, with `trees[i]` object `i`'s sample hierarchy where the scene's
 /// packing already built it (built here otherwise).
 pub fn pack_tables(scene: &PreparedScene, trees: &[Option<SampleTree>]) -> PackedBeams {
-    let mut out = PackedBeams { tables: vec![[0u32; 4]], norms: Vec::new(), beams: Vec::new() };
+    let mut out = PackedBeams { tables: vec![[0u32; 4]], receivers: Vec::new(), items: Vec::new(), beams: Vec::new() };
+    let record = |norm: [f32; 3], first: usize| BeamReceiverRecord { norm, first_item: first as u32 };
+    let budget = scene.scene.file.render.beam_walk_mib as usize * (1 << 20);
     for (i, o) in scene.objects.iter().enumerate() {
-        let object = object_tables(o, out.tables.len(), scene.scene.file.render.beam_opening);
-        match &object {
+        let mut object = object_tables(o, out.tables.len(), scene.scene.file.render.beam_opening);
+        match &mut object {
             Some((b, tables)) => {
                 out.tables.extend(pack_object(tables));
                 let built;
@@ -236,14 +261,26 @@ pub fn pack_tables(scene: &PreparedScene, trees: &[Option<SampleTree>]) -> Packe
                         &built
                     }
                 };
-                out.norms.extend(receiver_norms(o, tree, b, tables));
+                let walks = receiver_walks(o, tree, b, tables);
+                let total: usize = walks.iter().map(|(_, items)| items.len()).sum();
+                b.lists = (out.items.len() + total) * std::mem::size_of::<u32>() <= budget;
+                for (norm, items) in walks {
+                    out.receivers.push(record(norm, out.items.len()));
+                    if b.lists {
+                        out.items.extend(items);
+                    }
+                }
             }
-            None => out.norms.extend(std::iter::repeat_n([0.0; 4], o.mesh.positions().len())),
+            None => {
+                let first = out.items.len();
+                out.receivers.extend(std::iter::repeat_n(record([0.0; 3], first), o.mesh.positions().len()));
+            }
         }
         out.beams.push(object.map(|(b, _)| b));
     }
-    if out.beams.iter().all(Option::is_none) {
-        out.norms = vec![[0.0; 4]];
+    out.receivers.push(record([0.0; 3], out.items.len()));
+    if out.items.is_empty() {
+        out.items.push(0);
     }
     out
 }
@@ -275,7 +312,7 @@ fn pack_object(tables: &[Option<BeamTable>; 3]) -> Vec<[u32; 4]> {
 }
 
 /// glsl/beam_gather.comp's bindings, in binding order.
-const BINDINGS: [Resource; 13] = [
+const BINDINGS: [Resource; 14] = [
     Resource::Vertices,
     Resource::Samples,
     Resource::Splat,
@@ -289,6 +326,7 @@ const BINDINGS: [Resource; 13] = [
     Resource::BeamNodes,
     Resource::BeamSources,
     Resource::BeamNorms,
+    Resource::BeamItems,
 ];
 
 /// Per gathered object with a between-points channel, glsl/beam_gather.comp's stage 0 (one
@@ -365,6 +403,8 @@ impl RenderPass for BeamGatherPass {
             } else {
                 (level.first_entry, level.vertex_count, 0)
             };
+            // A coarser level's vertices are the whole mesh's, with the same walks.
+            let grouped = grouped | u32::from(b.lists) << 1;
             let push = Self::push(frame, r, &b, first, count, grouped);
             self.pipeline.dispatch(cmd, &self.set, &push, [count, 1, 1]);
         }
@@ -372,8 +412,7 @@ impl RenderPass for BeamGatherPass {
 }
 
 impl BeamGatherPass {
-    /// Stage 1's push block for `count` receivers of `r` from `first` (`grouped`: 1 when they
-    /// are `receiver_order`'s).
+    /// Stage 1's push block for `count` receivers of `r` from `first` (`grouped`: `tree.w`).
     fn push(
         frame: &FrameInputs,
         r: &super::gpu_scene::Receiver,

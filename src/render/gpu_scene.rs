@@ -183,9 +183,14 @@ pub struct GpuScene {
     /// for its members), where an object takes the model (one unread entry otherwise), written
     /// by the between-points pass's stage 0.
     pub beam_sources: Buffer,
-    /// Per vertex (vec4), the between-points density correction's denominator per channel
-    /// (`beam_gather::receiver_norms`; one entry when no object takes the model).
+    /// `BeamReceiverRecord` per vertex, then one closing the last walk: the between-points
+    /// density correction's denominator per channel and the vertex's first walk item
+    /// (`beam_gather::receiver_walks`).
     pub beam_norms: Buffer,
+    /// The walks of the whole meshes' receivers where an object takes the model
+    /// (`beam_gather::receiver_walks`; `ObjectBeams::lists`), vertex after vertex; one unread
+    /// entry when there are none.
+    pub beam_items: Buffer,
     /// Per object, in scene order: its between-points channels and their tables' places.
     pub beams: Vec<Option<super::beam_gather::ObjectBeams>>,
     /// The nodes' stand-ins' first entry in `beam_sources`: `tree_order`'s length.
@@ -545,7 +550,7 @@ impl GpuScene {
     fn upload(gpu: &Arc<Gpu>, scene: &PreparedScene, p: PackedObjects, l: PackedLevels) -> GpuResult<GpuScene> {
         let none = vk::BufferUsageFlags::empty();
         let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER;
-        let super::beam_gather::PackedBeams { tables, norms, beams } =
+        let super::beam_gather::PackedBeams { tables, receivers, items, beams } =
             super::beam_gather::pack_tables(scene, &p.beam_trees);
         let any_beams = beams.iter().any(Option::is_some);
         let beam_node_count = if any_beams { p.tree_nodes.len() } else { 1 };
@@ -583,7 +588,8 @@ impl GpuScene {
             beam_tables: upload(gpu, "beam tables", &tables, none)?,
             beam_nodes: sized("beam nodes", std::mem::size_of::<BeamNodeRecord>(), beam_node_count)?,
             beam_sources: sized("beam sources", std::mem::size_of::<BeamSourceRecord>(), beam_source_count)?,
-            beam_norms: upload(gpu, "beam norms", &norms, none)?,
+            beam_norms: upload(gpu, "beam receivers", &receivers, none)?,
+            beam_items: upload(gpu, "beam walk items", &items, none)?,
             beams,
             beam_standins: p.tree_order.len() as u32,
             caster_triangles: p.bvh_triangles.len() as u32,

@@ -77,6 +77,8 @@ pub enum Resource {
     BeamSources,
     /// Its density correction's denominator per vertex (`GpuScene::beam_norms`).
     BeamNorms,
+    /// Per receiver of the whole mesh, the items of its walk (`GpuScene::beam_items`).
+    BeamItems,
     /// Exitance at the samples, the sparse gather's stage 0 (owned by `GatherSparsePass`).
     SampleExitance,
     /// The shadow-map array (`FrameTargets::shadow_maps`).
@@ -131,6 +133,7 @@ impl Resource {
             BeamNodes => "BeamNodes",
             BeamSources => "BeamSources",
             BeamNorms => "BeamNorms",
+            BeamItems => "BeamItems",
             ShadowMaps => "shadow_maps",
             Hdr => "hdr",
             Surface => "surface",
@@ -159,7 +162,7 @@ pub const HOST_READ: [Resource; 5] = [
 ];
 
 /// Every resource that is a `GpuScene` buffer (`Resources::buffer`).
-pub const SCENE_BUFFERS: [Resource; 28] = [
+pub const SCENE_BUFFERS: [Resource; 29] = [
     Resource::Vertices,
     Resource::Objects,
     Resource::Lights,
@@ -188,6 +191,7 @@ pub const SCENE_BUFFERS: [Resource; 28] = [
     Resource::BeamNodes,
     Resource::BeamSources,
     Resource::BeamNorms,
+    Resource::BeamItems,
 ];
 
 /// One declared access of a pass (`gpu::Use` over `Resource`).
@@ -266,6 +270,7 @@ impl<'a> Resources<'a> {
             BeamNodes => &s.beam_nodes,
             BeamSources => &s.beam_sources,
             BeamNorms => &s.beam_norms,
+            BeamItems => &s.beam_items,
             _ => return None,
         })
     }

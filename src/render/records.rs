@@ -213,6 +213,18 @@ pub struct BeamSourceRecord {
     pub normal_along: [f32; 4],
 }
 
+/// `BeamReceiverRecord` in glsl/common/scene.glsl: per vertex, what the between-points single
+/// scattering's stage 1 knows of it before any frame (`render::beam_gather::receiver_walks`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct BeamReceiverRecord {
+    /// The density correction's denominator per channel, `sum_i A_i T(rho_i, 1, 1)`.
+    pub norm: [f32; 3],
+    /// Its walk's first item in `GpuScene::beam_items`; the next vertex's is one past its last
+    /// (a last record closes the list).
+    pub first_item: u32,
+}
+
 /// `NodePowerRecord` in glsl/common/scene.glsl: what stage 0 of the hierarchical gather
 /// aggregates per node after each splat.
 #[repr(C)]
