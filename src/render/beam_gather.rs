@@ -169,6 +169,15 @@ pub fn walk(tree: &SampleTree, x: DVec3, beams: &ObjectBeams, mut visit: impl Fn
     }
 }
 
+/// One vertex's [`receiver_walks`].
+pub struct ReceiverWalk {
+    /// The density correction's denominator per channel, `sum_i A_i T(rho_i, 1, 1)`.
+    pub norm: [f32; 3],
+    /// The walk's items within reach: `NODE_ITEM | n` for node `n`'s stand-in, `e` for the
+    /// sample at leaf-order entry `e` (both relative to the object's).
+    pub items: Vec<u32>,
+}
+
 /// Per vertex of object `o`, what stage 1 knows of it before any frame: the density
 /// correction's denominator `sum_i A_i T(rho_i, 1, 1)` per channel over the walk the pass takes
 /// ([`walk`]; a node at its members' area-weighted centroid), and that walk's items, a node as
@@ -176,12 +185,19 @@ pub fn walk(tree: &SampleTree, x: DVec3, beams: &ObjectBeams, mut visit: impl Fn
 /// denominator depends on the geometry alone, so it is summed here once (f64), and the pass sums
 /// only the lit terms; the walk too depends on the geometry alone, so the pass may read it
 /// rather than take it again each frame.
+///
+/// The items are kept while the object's total stays within `max_items`; past it every list
+/// comes back empty (so a mesh too large for the budget costs no host memory for them) and the
+/// flag is false.
 pub fn receiver_walks(
     o: &PreparedObject,
     tree: &SampleTree,
     beams: &ObjectBeams,
     tables: &[Option<BeamTable>; 3],
-) -> Vec<([f32; 3], Vec<u32>)> {
+    max_items: usize,
+) -> (Vec<ReceiverWalk>, bool) {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let kept = AtomicUsize::new(0);
     let at = |s: u32| (o.samples[s as usize].area, o.samples[s as usize].position.as_dvec3());
     let nodes: Vec<(f64, DVec3)> = tree
         .nodes
@@ -194,12 +210,14 @@ pub fn receiver_walks(
         .collect();
     let mut entry = vec![0u32; o.samples.len()];
     tree.order.iter().enumerate().for_each(|(e, &s)| entry[s as usize] = e as u32);
-    o.mesh
+    let walks: Vec<ReceiverWalk> = o
+        .mesh
         .positions()
         .par_iter()
         .map(|x| {
             let x = x.as_dvec3();
             let (mut norm, mut items) = ([0.0f64; 3], Vec::new());
+            let keep = kept.load(Ordering::Relaxed) <= max_items;
             walk(tree, x, beams, |item| {
                 let (area, p) = match item {
                     WalkItem::Node(n) => nodes[n],
@@ -209,19 +227,27 @@ pub fn receiver_walks(
                 if dist >= f64::from(beams.reach) {
                     return;
                 }
-                items.push(match item {
-                    WalkItem::Node(n) => crate::sampling::NODE_ITEM | n as u32,
-                    WalkItem::Sample(s) => entry[s],
-                });
+                if keep {
+                    items.push(match item {
+                        WalkItem::Node(n) => crate::sampling::NODE_ITEM | n as u32,
+                        WalkItem::Sample(s) => entry[s],
+                    });
+                }
                 for (c, table) in tables.iter().enumerate() {
                     if let Some(t) = table {
                         norm[c] += area * t.lookup(dist * f64::from(beams.sigma_t[c]), 1.0, 1.0);
                     }
                 }
             });
-            (norm.map(|v| v as f32), items)
+            kept.fetch_add(items.len(), Ordering::Relaxed);
+            ReceiverWalk { norm: norm.map(|v| v as f32), items }
         })
-        .collect()
+        .collect();
+    if kept.load(Ordering::Relaxed) <= max_items {
+        (walks, true)
+    } else {
+        (walks.into_iter().map(|w| ReceiverWalk { items: Vec::new(), ..w }).collect(), false)
+    }
 }
 
 /// Cells of one channel's block in a packed table (`glsl/common/beam_table.glsl`).
@@ -261,14 +287,12 @@ pub fn pack_tables(scene: &PreparedScene, trees: &[Option<SampleTree>]) -> Packe
                         &built
                     }
                 };
-                let walks = receiver_walks(o, tree, b, tables);
-                let total: usize = walks.iter().map(|(_, items)| items.len()).sum();
-                b.lists = (out.items.len() + total) * std::mem::size_of::<u32>() <= budget;
-                for (norm, items) in walks {
-                    out.receivers.push(record(norm, out.items.len()));
-                    if b.lists {
-                        out.items.extend(items);
-                    }
+                let room = (budget / std::mem::size_of::<u32>()).saturating_sub(out.items.len());
+                let (walks, kept) = receiver_walks(o, tree, b, tables, room);
+                b.lists = kept;
+                for w in walks {
+                    out.receivers.push(record(w.norm, out.items.len()));
+                    out.items.extend(w.items);
                 }
             }
             None => {
