@@ -308,6 +308,24 @@ beam_opening = 0.9
 }
 
 #[test]
+fn a_walk_budget_past_its_limit_is_an_error_naming_the_key() {
+    let text = r#"
+[camera]
+eye = [0.0, 12.0, 45.0]
+target = [0.0, 0.0, 0.0]
+
+[[object]]
+shape = { type = "sphere", radius = 10.0, divisions = 12 }
+material = { type = "translucent", preset = "ketchup", mm_per_unit = 1.0, model = "auto" }
+
+[render]
+beam_walk_mib = 5000
+"#;
+    let err = Scene::parse(text, "walks.toml", None).expect_err("refused").to_string();
+    assert!(err.contains("render.beam_walk_mib") && err.contains("0 to 4095") && err.contains("walks.toml"), "{err}");
+}
+
+#[test]
 fn a_between_points_model_with_the_pixel_gather_is_refused_with_the_key_to_change() {
     let mut prepared = ketchup("auto");
     prepared.scene.file.render.gather = translucent::scene::GatherMode::Pixel;

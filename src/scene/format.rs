@@ -309,7 +309,7 @@ pub struct RenderSettings {
     /// walk of the sample hierarchy, taken once when the scene is uploaded (default
     /// [`DEFAULT_BEAM_WALK_MIB`]); an object whose walks do not fit is walked every frame
     /// instead, the pass then taking about 2.5 times as long on the 2 cm ketchup sphere
-    /// (`render::beam_gather`). 0 walks every frame.
+    /// (`render::beam_gather`). 0 walks every frame; at most [`MAX_BEAM_WALK_MIB`].
     #[serde(default = "beam_walk_mib")]
     pub beam_walk_mib: u32,
     /// How each translucent object's channels get their exitance (default `"auto"`: the
@@ -529,6 +529,8 @@ fn beam_opening() -> f32 {
 /// `render.beam_walk_mib` when a scene names none: the bunny in ketchup (54,347 vertices,
 /// 125,574 samples) keeps 34 MiB of walks.
 pub const DEFAULT_BEAM_WALK_MIB: u32 = 64;
+/// The largest `render.beam_walk_mib`: the walks' items are indexed by 32-bit offsets.
+pub const MAX_BEAM_WALK_MIB: u32 = 4095;
 fn beam_walk_mib() -> u32 {
     DEFAULT_BEAM_WALK_MIB
 }

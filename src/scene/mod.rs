@@ -422,8 +422,9 @@ fn check_lights(lights: &[Light]) -> Check {
 }
 
 /// `[render]`: exposure positive, gather epsilon 0 to [`format::MAX_GATHER_EPSILON`], beam
-/// opening 0 to [`format::MAX_BEAM_OPENING`], a
-/// shadow-map size of 16 to 8192 texels, a background that emits nothing negative.
+/// opening 0 to [`format::MAX_BEAM_OPENING`], beam walks' memory at most
+/// [`format::MAX_BEAM_WALK_MIB`], a shadow-map size of 16 to 8192 texels, a background that
+/// emits nothing negative.
 fn check_render(r: &RenderSettings) -> Check {
     if !(r.exposure.is_finite() && r.exposure > 0.0) {
         return Err(("render.exposure".into(), format!("{} must be positive", r.exposure)));
@@ -438,6 +439,12 @@ fn check_render(r: &RenderSettings) -> Check {
         return Err((
             "render.beam_opening".into(),
             format!("{} must be 0 to {}", r.beam_opening, format::MAX_BEAM_OPENING),
+        ));
+    }
+    if r.beam_walk_mib > format::MAX_BEAM_WALK_MIB {
+        return Err((
+            "render.beam_walk_mib".into(),
+            format!("{} must be 0 to {}", r.beam_walk_mib, format::MAX_BEAM_WALK_MIB),
         ));
     }
     if !(16..=8192).contains(&r.shadow_map_size) {
