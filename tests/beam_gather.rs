@@ -99,7 +99,7 @@ struct Entry {
 /// The f64 twin of glsl/beam_gather.comp at vertex `x` in channel `c`: the walk of the object's
 /// hierarchy (`beam_gather::walk`) with nodes under `opening` of their distance (or of the
 /// window) standing in for their members, the entries' `A E T` against their `A T(rho, 1, 1)`
-/// (summed here, not read from `receiver_norms`), times `R1(1)`.
+/// (summed here, not read from `receiver_walks`), times `R1(1)`.
 fn twin(
     o: &PreparedObject,
     beams: &ObjectBeams,
