@@ -2,7 +2,7 @@
 //! seed paper's FPS-against-sample-count comparison (its Figure 7), on whatever device the
 //! loader offers (TRANSLUCENT_DEVICE to choose). Prints figures; asserts nothing.
 //!
-//!     cargo bench --bench render [-- frames|savings|levels|terms|hierarchy|growth|planner|gathers]
+//!     cargo bench --bench render [-- frames|savings|levels|terms|hierarchy|growth|models|planner|gathers]
 //!
 //! Two timings per pass: GPU timestamp queries inside one submission, and the wall time of the
 //! pass submitted alone (submission to fence). On lavapipe a timestamp used to be taken only at
@@ -12,6 +12,8 @@
 
 #[path = "render/growth.rs"]
 mod growth;
+#[path = "render/models.rs"]
+mod models;
 #[path = "render/roofline.rs"]
 mod roofline;
 
@@ -599,6 +601,9 @@ fn main() {
     }
     if wanted("growth") {
         growth::growth(&gpu);
+    }
+    if wanted("models") {
+        models::models(&gpu);
     }
     if wanted("planner") {
         planner(&gpu);
