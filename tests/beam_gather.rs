@@ -45,42 +45,59 @@ count = 3000
     PreparedScene::new(&Scene::parse(&text, "test.toml", None).unwrap(), &Overrides::default()).unwrap()
 }
 
-/// One full frame gathered at every vertex; the exitance of object 0, the splat's transmitted
-/// irradiance per sample and the plan as `plan` prints it.
-fn frame(prepared: PreparedScene) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, String) {
-    frame_of(prepared, 0)
+/// What one frame of a scene gives the tests of one object.
+struct Frame {
+    /// The vertices it was gathered at (object-relative, ascending; every vertex at level 0).
+    vertices: Vec<u32>,
+    /// Their exitance, in the same order.
+    exitance: Vec<[f32; 3]>,
+    /// The splat's transmitted irradiance per sample of the object.
+    splat: Vec<[f32; 3]>,
+    /// The plan as `plan` prints it.
+    plan: String,
 }
 
-/// [`frame`] with the exitance of `object` and the splat of its own samples.
-fn frame_of(prepared: PreparedScene, object: usize) -> (Vec<[f32; 3]>, Vec<[f32; 3]>, String) {
+/// One full frame, every object at level 0 but `object` at `level`.
+fn frame_of(prepared: PreparedScene, object: usize, level: usize) -> Frame {
     let first_sample: usize = prepared.objects[..object].iter().map(|o| o.samples.len()).sum();
     common::with_gpu(|gpu| {
         let mut renderer = Renderer::new(gpu, prepared).unwrap();
         let mut plan = renderer.plan(Change::Everything);
         plan.objects.iter_mut().for_each(|o| o.level = 0);
+        plan.objects.iter_mut().filter(|o| o.object == object).for_each(|o| o.level = level);
         renderer.frame(&plan).unwrap();
         let splat = renderer.splat_irradiance().unwrap().into_iter().skip(first_sample).map(|(e, _)| e).collect();
-        (renderer.exitance(object).unwrap(), splat, plan.to_string())
+        let at = renderer.exitance_at_level(object).unwrap();
+        assert_eq!(at.level, level);
+        Frame { vertices: at.vertices, exitance: at.values, splat, plan: plan.to_string() }
     })
 }
 
-/// The worst difference of `ours` (object `o`'s exitance) from the f64 twin at `opening` in
-/// green and blue, and the worst of the twin at `opening` from the flat sum, both as a share of
-/// the brightest vertex.
-fn against_twin(o: &PreparedObject, ours: &[[f32; 3]], splat: &[[f32; 3]], opening: f32) -> (f64, f64) {
+/// [`frame_of`] object 0 at every vertex.
+fn frame(prepared: PreparedScene) -> Frame {
+    frame_of(prepared, 0, 0)
+}
+
+/// The worst difference of `f`'s exitance (object `o`'s) from the f64 twin at `opening` in
+/// green and blue and, `with_cut`, the worst of the twin at `opening` from the flat sum (0
+/// otherwise), both as a share of the brightest vertex.
+fn against_twin(o: &PreparedObject, f: &Frame, opening: f32, with_cut: bool) -> (f64, f64) {
     let (beams, tables) = object_tables(o, 1, opening).unwrap();
     let positions = o.mesh.positions();
-    let brightest = ours.iter().map(|m| m[1].max(m[2])).fold(0.0f32, f32::max);
+    let brightest = f.exitance.iter().map(|m| m[1].max(m[2])).fold(0.0f32, f32::max);
     assert!(brightest > 0.0);
     let (mut worst, mut cut) = (0.0f64, 0.0f64);
-    for (v, m) in ours.iter().enumerate() {
+    for (&v, m) in f.vertices.iter().zip(&f.exitance) {
         assert!(m.iter().all(|x| x.is_finite() && *x >= 0.0), "vertex {v}: {m:?}");
+        let x = positions[v as usize].as_dvec3();
         for c in [1, 2] {
-            let at = |opening| twin(o, &beams, tables[c].as_ref().unwrap(), c, splat, positions[v].as_dvec3(), opening);
+            let at = |opening| twin(o, &beams, tables[c].as_ref().unwrap(), c, &f.splat, x, opening);
             let expect = at(f64::from(beams.opening));
             worst = worst.max((f64::from(m[c]) - expect).abs() / f64::from(brightest));
-            // What the clusters cost: the same twin over every sample within reach.
-            cut = cut.max((expect - at(0.0)).abs() / f64::from(brightest));
+            if with_cut {
+                // What the clusters cost: the same twin over every sample within reach.
+                cut = cut.max((expect - at(0.0)).abs() / f64::from(brightest));
+            }
         }
     }
     (worst, cut)
@@ -175,16 +192,18 @@ fn the_gpu_between_points_sum_matches_its_f64_twin_and_leaves_the_dipoles_channe
     // Ketchup's red has alpha' 0.75, green and blue 0.067 and 0.020: `auto` gives them to
     // single scattering between points.
     assert_eq!(object.single_channels(), [false, true, true]);
-    let (ours, splat, plan) = frame(auto);
-    let (dipole, _, plain) = frame(ketchup("dipole"));
+    let ours_frame = frame(auto);
+    let (ours, plan) = (&ours_frame.exitance, &ours_frame.plan);
+    let dipole_frame = frame(ketchup("dipole"));
+    let (dipole, plain) = (&dipole_frame.exitance, &dipole_frame.plan);
     // The plan says which channels take the model and why; the dipole's plan says nothing of it.
     assert!(plan.contains("G single scattering between points") && plan.contains("B single scattering"), "{plan}");
     assert!(!plan.contains("R single") && !plain.contains("single scattering"), "{plan}\n{plain}");
-    for (v, (m, d)) in ours.iter().zip(&dipole).enumerate() {
+    for (v, (m, d)) in ours.iter().zip(dipole).enumerate() {
         // The dipole's channel is what the dipole gather wrote, bit for bit.
         assert_eq!(m[0].to_bits(), d[0].to_bits(), "vertex {v}: red {} against the dipole's {}", m[0], d[0]);
     }
-    let (worst, cut) = against_twin(&object, &ours, &splat, translucent::scene::DEFAULT_BEAM_OPENING);
+    let (worst, cut) = against_twin(&object, &ours_frame, translucent::scene::DEFAULT_BEAM_OPENING, true);
     eprintln!(
         "worst difference from the f64 twin: {worst:.2e} of the brightest vertex; the cut from the flat sum: {cut:.2e}"
     );
@@ -193,7 +212,7 @@ fn the_gpu_between_points_sum_matches_its_f64_twin_and_leaves_the_dipoles_channe
     // brightest vertex (0.26% measured).
     assert!(cut < 0.01, "the cut is {cut:.2e} of the brightest vertex from the sum over every sample");
     // Green and blue are the model's, not the dipole's: they differ at some vertex.
-    assert!(ours.iter().zip(&dipole).any(|(m, d)| (m[1] - d[1]).abs() > 0.05 * d[1].abs().max(1e-6)));
+    assert!(ours.iter().zip(dipole).any(|(m, d)| (m[1] - d[1]).abs() > 0.05 * d[1].abs().max(1e-6)));
 }
 
 #[test]
@@ -231,25 +250,9 @@ count = 3000
     );
     let prepared = PreparedScene::new(&Scene::parse(&text, "two.toml", None).unwrap(), &Overrides::default()).unwrap();
     let object = prepared.objects[1].clone();
-    let (ours, splat, _) = frame_of(prepared, 1);
-    let (worst, _) = against_twin(&object, &ours, &splat, translucent::scene::DEFAULT_BEAM_OPENING);
+    let (worst, _) = against_twin(&object, &frame_of(prepared, 1, 0), translucent::scene::DEFAULT_BEAM_OPENING, false);
     eprintln!("second object: worst difference from the f64 twin {worst:.2e} of its brightest vertex");
     assert!(worst < 1e-3, "the second object's sum is {worst:.2e} of its brightest vertex from its f64 twin");
-}
-
-/// One frame of `prepared` with object 0 gathered at level of detail `level`: that level's
-/// exitance (vertices and values) and the splat.
-fn frame_at_level(prepared: PreparedScene, level: usize) -> (Vec<u32>, Vec<[f32; 3]>, Vec<[f32; 3]>) {
-    common::with_gpu(|gpu| {
-        let mut renderer = Renderer::new(gpu, prepared).unwrap();
-        let mut plan = renderer.plan(Change::Everything);
-        plan.objects[0].level = level;
-        renderer.frame(&plan).unwrap();
-        let splat = renderer.splat_irradiance().unwrap().into_iter().map(|(e, _)| e).collect();
-        let at = renderer.exitance_at_level(0).unwrap();
-        assert_eq!(at.level, level);
-        (at.vertices, at.values, splat)
-    })
 }
 
 #[test]
@@ -262,45 +265,43 @@ fn walks_read_from_the_upload_give_the_same_sums_as_walks_taken_each_frame_at_ev
     // One path each: the default budget keeps the walks, 0 keeps none.
     let lists = |p: &PreparedScene| pack_tables(p, &[]).beams[0].unwrap().lists;
     assert!(lists(&ketchup("auto")) && !lists(&walked));
-    let (beams, tables) = object_tables(&object, 1, translucent::scene::DEFAULT_BEAM_OPENING).unwrap();
     for level in [0, levels - 1] {
-        let (vertices, each_frame, splat) = frame_at_level(walked.clone(), level);
-        let (same, read, _) = frame_at_level(ketchup("auto"), level);
-        assert_eq!(vertices, same);
+        let each_frame = frame_of(walked.clone(), 0, level);
+        let read = frame_of(ketchup("auto"), 0, level);
+        assert_eq!(each_frame.vertices, read.vertices);
         // The same sources in the same order: the same sums, bit for bit.
-        for (v, (a, b)) in each_frame.iter().zip(&read).enumerate() {
-            assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits), "level {level}, vertex {}", vertices[v]);
+        for (v, (a, b)) in each_frame.exitance.iter().zip(&read.exitance).enumerate() {
+            assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits), "level {level}, vertex {}", read.vertices[v]);
         }
         // And at a coarser level, its vertices' sums are the twin's at those vertices.
-        let brightest = read.iter().map(|m| m[1].max(m[2])).fold(0.0f32, f32::max);
-        assert!(brightest > 0.0);
-        let positions = object.mesh.positions();
-        for (&v, m) in vertices.iter().zip(&read) {
-            for c in [1, 2] {
-                let x = positions[v as usize].as_dvec3();
-                let expect = twin(&object, &beams, tables[c].as_ref().unwrap(), c, &splat, x, f64::from(beams.opening));
-                let off = (f64::from(m[c]) - expect).abs() / f64::from(brightest);
-                assert!(off < 1e-3, "level {level}, vertex {v}, channel {c}: {off:.2e} of the brightest from the twin");
-            }
-        }
+        let (worst, _) = against_twin(&object, &read, translucent::scene::DEFAULT_BEAM_OPENING, false);
+        assert!(worst < 1e-3, "level {level}: {worst:.2e} of the brightest vertex from the twin");
     }
 }
 
-#[test]
-fn a_beam_opening_out_of_range_is_an_error_naming_the_key_and_its_limit() {
-    let text = r#"
+/// The error of a ketchup sphere with `model = "auto"` whose `[render]` holds `line`, parsed as
+/// file `name`.
+fn render_error(line: &str, name: &str) -> String {
+    let text = format!(
+        r#"
 [camera]
 eye = [0.0, 12.0, 45.0]
 target = [0.0, 0.0, 0.0]
 
 [[object]]
-shape = { type = "sphere", radius = 10.0, divisions = 12 }
-material = { type = "translucent", preset = "ketchup", mm_per_unit = 1.0, model = "auto" }
+shape = {{ type = "sphere", radius = 10.0, divisions = 12 }}
+material = {{ type = "translucent", preset = "ketchup", mm_per_unit = 1.0, model = "auto" }}
 
 [render]
-beam_opening = 0.9
-"#;
-    let err = Scene::parse(text, "opening.toml", None).expect_err("refused").to_string();
+{line}
+"#
+    );
+    Scene::parse(&text, name, None).expect_err("refused").to_string()
+}
+
+#[test]
+fn a_beam_opening_out_of_range_is_an_error_naming_the_key_and_its_limit() {
+    let err = render_error("beam_opening = 0.9", "opening.toml");
     assert!(
         err.contains("render.beam_opening") && err.contains("must be 0 to 0.5") && err.contains("opening.toml"),
         "{err}"
@@ -309,19 +310,7 @@ beam_opening = 0.9
 
 #[test]
 fn a_walk_budget_past_its_limit_is_an_error_naming_the_key() {
-    let text = r#"
-[camera]
-eye = [0.0, 12.0, 45.0]
-target = [0.0, 0.0, 0.0]
-
-[[object]]
-shape = { type = "sphere", radius = 10.0, divisions = 12 }
-material = { type = "translucent", preset = "ketchup", mm_per_unit = 1.0, model = "auto" }
-
-[render]
-beam_walk_mib = 5000
-"#;
-    let err = Scene::parse(text, "walks.toml", None).expect_err("refused").to_string();
+    let err = render_error("beam_walk_mib = 5000", "walks.toml");
     assert!(err.contains("render.beam_walk_mib") && err.contains("0 to 4095") && err.contains("walks.toml"), "{err}");
 }
 
