@@ -249,6 +249,8 @@ struct Force {
     whole_opaque: bool,
     /// Shading terms left out (`Plan::skip_terms`).
     skip_terms: u32,
+    /// Every face drawn, the hidden ones too (`Plan::cull_hidden_faces` off).
+    every_face: bool,
 }
 
 /// Renderers on the default scene at 512x512, one per configuration, stepped side by side
@@ -270,6 +272,7 @@ fn side_by_side(renderers: &mut [(Renderer, Force)], change: Change, frames: usi
                 plan.one_tap_shadows = one_tap;
             }
             plan.skip_terms = force.skip_terms;
+            plan.cull_hidden_faces &= !force.every_face;
             if force.whole_opaque {
                 plan.objects.iter_mut().filter(|o| o.channels.is_empty()).for_each(|o| o.level = 0);
             }
@@ -309,7 +312,12 @@ fn savings(gpu: &Arc<Gpu>) {
         ("level of detail off", full_detail.clone(), Force::default()),
         ("floor whole (sky light unbaked)", Overrides::default(), Force { whole_opaque: true, ..Force::default() }),
         ("four-tap shadow filter", Overrides::default(), Force { one_tap: Some(false), ..Force::default() }),
-        ("full detail, four taps", full_detail, Force { one_tap: Some(false), ..Force::default() }),
+        ("hidden faces drawn", Overrides::default(), Force { every_face: true, ..Force::default() }),
+        (
+            "full detail, four taps, all faces",
+            full_detail,
+            Force { one_tap: Some(false), every_face: true, ..Force::default() },
+        ),
     ];
     println!(
         "\nWhat each saving buys, default scene 512x512, 400 samples, whole-frame wall time (median of {FRAMES} after \

@@ -2,10 +2,11 @@
 //! the same run as the renderer's frames, so each pass can be read as a ratio to its yardstick.
 //!
 //! - raster: the shading pass's geometry (the renderer's own vertex and index buffers, each
-//!   object at the level the plan draws it) into targets of the same formats and size, with a
+//!   object at the level the plan draws it, the faces it culls culled) into targets of the same formats and size, with a
 //!   one-interpolant vertex stage and a fragment stage that writes the normal
 //!   (glsl/bench/raster_trivial.*);
-//! - shadow: the shadow casters at their caster levels, depth-only into one map of the scene's
+//! - shadow: the shadow casters at their caster levels (the faces the shadow pass culls culled),
+//!   depth-only into one map of the scene's
 //!   size and format, no bias (glsl/bench/depth_only.vert): what a light frame redraws;
 //! - tone map: the HDR image texel by texel into packed RGBA8 with a clamp
 //!   (glsl/bench/tonemap_minimal.comp);
@@ -22,6 +23,7 @@
 use ash::vk;
 use std::sync::Arc;
 use std::time::Instant;
+use translucent::DepthConvention;
 use translucent::gpu::{
     Access, Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuTimer, GraphicsDesc, GraphicsPipeline,
     Image, ImageBarrier, ImageDesc, Named, Sampler, median,
@@ -29,7 +31,7 @@ use translucent::gpu::{
 use translucent::render::plan::Plan;
 use translucent::render::records::Vertex;
 use translucent::render::renderer::Renderer;
-use translucent::render::shade::{HDR_FORMAT, ShadePush};
+use translucent::render::shade::{HDR_FORMAT, ShadePush, hidden_faces};
 
 /// The camera's depth format (`render::targets::CAMERA_DEPTH_FORMAT`).
 const CAMERA_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
@@ -147,12 +149,14 @@ impl Roofline {
         desc.vertex_attributes = vec![Vertex::position_attribute(), Vertex::normal_attribute()];
         desc.color_formats = vec![HDR_FORMAT];
         desc.depth_format = Some(CAMERA_DEPTH);
+        desc.dynamic_cull = true;
         let raster = GraphicsPipeline::new(gpu, &desc).expect("trivial raster pipeline");
         let inputs = inputs_pipeline(gpu);
         let mut desc = GraphicsDesc::new("bench/depth_only.vert", None);
         desc.vertex_bindings = vec![Vertex::binding()];
         desc.vertex_attributes = vec![Vertex::position_attribute()];
         desc.depth_format = Some(SHADOW_DEPTH);
+        desc.dynamic_cull = true;
         let depth = GraphicsPipeline::new(gpu, &desc).expect("depth-only pipeline");
         let tonemap = ComputePipeline::new(gpu, "bench/tonemap_minimal.comp").expect("minimal tone map");
         let pixels = width as u64 * height as u64;
@@ -200,9 +204,39 @@ impl Roofline {
         let camera = renderer.camera();
         let view_proj = (camera.projection * camera.view).to_cols_array_2d();
         let scene = renderer.buffers();
-        let draws: Vec<_> = (0..scene.levels.len()).map(|i| scene.level(i, plan.level(i)).draw).collect();
-        let casters: Vec<_> = scene.casters.iter().map(|&(o, l)| scene.level(o, l).draw).collect();
+        // The faces the shading pass draws: those it culls are culled here too.
+        let draws: Vec<_> = (0..scene.levels.len())
+            .map(|i| {
+                let level = scene.level(i, plan.level(i));
+                let hidden = if plan.cull_hidden_faces {
+                    hidden_faces(
+                        level.enclosure,
+                        level.bounds,
+                        camera.projection * camera.view,
+                        DepthConvention::Standard,
+                    )
+                } else {
+                    vk::CullModeFlags::NONE
+                };
+                (level.draw, hidden)
+            })
+            .collect();
         let light = scene.light_matrices.first().copied().unwrap_or(view_proj);
+        // The casters as the shadow pass draws them, hidden faces culled as it culls them.
+        let casters: Vec<_> = scene
+            .casters
+            .iter()
+            .map(|&(o, l)| {
+                let level = scene.level(o, l);
+                let matrix = glam::Mat4::from_cols_array_2d(&light);
+                let hidden = if plan.cull_hidden_faces {
+                    hidden_faces(level.enclosure, level.bounds, matrix, DepthConvention::Standard)
+                } else {
+                    vk::CullModeFlags::NONE
+                };
+                (level.draw, hidden)
+            })
+            .collect();
         let (vertices, indices) = (scene.vertices.raw(), scene.indices.raw());
         let receivers = frame_receivers(renderer, plan);
         let mut timer = self.timer.take().expect("the timer is put back after each run");
@@ -260,7 +294,7 @@ impl Roofline {
         &self,
         cmd: vk::CommandBuffer,
         (vertices, indices): (vk::Buffer, vk::Buffer),
-        draws: &[translucent::render::gpu_scene::DrawRange],
+        draws: &[(translucent::render::gpu_scene::DrawRange, vk::CullModeFlags)],
         view_proj: &[[f32; 4]; 4],
     ) {
         let draw = |cmd| {
@@ -271,7 +305,8 @@ impl Roofline {
                 device.cmd_bind_index_buffer(cmd, indices, 0, vk::IndexType::UINT32);
             }
             self.raster.bind(cmd, None, view_proj, self.colour.extent());
-            for d in draws {
+            for (d, hidden) in draws {
+                self.raster.set_cull(cmd, *hidden);
                 self.raster.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
             }
         };
@@ -283,7 +318,7 @@ impl Roofline {
         &self,
         cmd: vk::CommandBuffer,
         renderer: &Renderer,
-        draws: &[translucent::render::gpu_scene::DrawRange],
+        draws: &[(translucent::render::gpu_scene::DrawRange, vk::CullModeFlags)],
         view_proj: &[[f32; 4]; 4],
     ) {
         let scene = renderer.buffers();
@@ -297,7 +332,8 @@ impl Roofline {
                 device.cmd_bind_index_buffer(cmd, scene.indices.raw(), 0, vk::IndexType::UINT32);
             }
             self.inputs.bind(cmd, None, &push, self.colour.extent());
-            for d in draws {
+            for (d, hidden) in draws {
+                self.inputs.set_cull(cmd, *hidden);
                 self.inputs.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
             }
         };
@@ -350,7 +386,7 @@ impl Roofline {
         &self,
         cmd: vk::CommandBuffer,
         (vertices, indices): (vk::Buffer, vk::Buffer),
-        casters: &[translucent::render::gpu_scene::DrawRange],
+        casters: &[(translucent::render::gpu_scene::DrawRange, vk::CullModeFlags)],
         light: &[[f32; 4]; 4],
     ) {
         let device = self.gpu.device();
@@ -375,7 +411,8 @@ impl Roofline {
             device.cmd_bind_index_buffer(cmd, indices, 0, vk::IndexType::UINT32);
         }
         self.depth.bind(cmd, None, light, extent);
-        for d in casters {
+        for (d, hidden) in casters {
+            self.depth.set_cull(cmd, *hidden);
             self.depth.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
         }
         unsafe { device.cmd_end_rendering(cmd) };
@@ -463,6 +500,7 @@ fn inputs_desc(fragment: &str) -> GraphicsDesc {
     desc.vertex_bindings = vec![Vertex::binding(), exitance.0, environment.0];
     desc.vertex_attributes = vec![Vertex::position_attribute(), Vertex::normal_attribute(), exitance.1, environment.1];
     desc.depth_format = Some(CAMERA_DEPTH);
+    desc.dynamic_cull = true;
     desc
 }
 
@@ -513,7 +551,7 @@ impl Deferred {
         &self,
         (gpu, cmd, depth): (&Gpu, vk::CommandBuffer, &Image),
         renderer: &Renderer,
-        draws: &[translucent::render::gpu_scene::DrawRange],
+        draws: &[(translucent::render::gpu_scene::DrawRange, vk::CullModeFlags)],
         view_proj: &[[f32; 4]; 4],
     ) {
         let device = gpu.device();
@@ -561,7 +599,8 @@ impl Deferred {
             device.cmd_bind_index_buffer(cmd, scene.indices.raw(), 0, vk::IndexType::UINT32);
         }
         self.raster.bind(cmd, None, &push, extent);
-        for d in draws {
+        for (d, hidden) in draws {
+            self.raster.set_cull(cmd, *hidden);
             self.raster.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
         }
         unsafe { device.cmd_end_rendering(cmd) };

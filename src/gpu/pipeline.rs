@@ -236,8 +236,12 @@ pub struct GraphicsDesc {
     pub depth_compare: vk::CompareOp,
     /// Samples per pixel of the attachments (rasterizationSamples); TYPE_1 unless set.
     pub samples: vk::SampleCountFlags,
-    /// Faces to cull (counter-clockwise is front); NONE unless set.
+    /// Faces to cull (counter-clockwise is front); NONE unless set. With `dynamic_cull`, the
+    /// faces culled until `GraphicsPipeline::set_cull` says otherwise.
     pub cull: vk::CullModeFlags,
+    /// The faces culled are dynamic state (Vulkan 1.3 core): `GraphicsPipeline::set_cull` picks
+    /// them per draw, so that one pipeline draws front faces and then back faces.
+    pub dynamic_cull: bool,
     /// Constant and slope depth bias, for shadow maps.
     pub depth_bias: Option<(f32, f32)>,
     /// Specialization constants of both stages: `constant_id` i takes value i (a bool is 0 or
@@ -260,6 +264,7 @@ impl GraphicsDesc {
             depth_compare: vk::CompareOp::LESS_OR_EQUAL,
             samples: vk::SampleCountFlags::TYPE_1,
             cull: vk::CullModeFlags::NONE,
+            dynamic_cull: false,
             depth_bias: None,
             specialization: Vec::new(),
         }
@@ -275,6 +280,8 @@ pub struct GraphicsPipeline {
     layout: Layout,
     /// The vertex shader's path, which names its draws in `Gpu::recorded`.
     name: String,
+    /// With a dynamic cull mode (`GraphicsDesc::dynamic_cull`), the faces `bind_area` culls.
+    cull: Option<vk::CullModeFlags>,
 }
 
 impl GraphicsPipeline {
@@ -334,7 +341,10 @@ impl GraphicsPipeline {
             .map(|_| vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA))
             .collect();
         let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&attachments);
-        let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        let mut dynamic_states = vec![vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+        if desc.dynamic_cull {
+            dynamic_states.push(vk::DynamicState::CULL_MODE);
+        }
         let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
         let mut rendering = vk::PipelineRenderingCreateInfo::default()
             .color_attachment_formats(&desc.color_formats)
@@ -355,7 +365,8 @@ impl GraphicsPipeline {
         // SAFETY: every pointer refers to locals alive for the call; dynamic rendering is enabled.
         let pipeline = unsafe { gpu.device().create_graphics_pipelines(*cache, &info, None) }
             .map_err(|(_, result)| GpuError::Vk { what: "vkCreateGraphicsPipelines", result })?[0];
-        Ok(GraphicsPipeline { pipeline, layout, name: desc.vertex.clone() })
+        let cull = desc.dynamic_cull.then_some(desc.cull);
+        Ok(GraphicsPipeline { pipeline, layout, name: desc.vertex.clone(), cull })
     }
 
     /// A descriptor set for this pipeline's set 0, binding i being `bindings[i]`, whose name must
@@ -400,8 +411,23 @@ impl GraphicsPipeline {
             device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
             device.cmd_set_viewport(cmd, 0, &[viewport]);
             device.cmd_set_scissor(cmd, 0, &[area]);
+            if let Some(cull) = self.cull {
+                device.cmd_set_cull_mode(cmd, cull);
+            }
         }
         self.layout.bind(cmd, vk::PipelineBindPoint::GRAPHICS, set, push);
+    }
+
+    /// Cull `faces` in the draws that follow, with this pipeline bound (`bind_area`). Returns
+    /// false, and records nothing, for a pipeline made without `GraphicsDesc::dynamic_cull`,
+    /// whose faces are fixed.
+    pub fn set_cull(&self, cmd: vk::CommandBuffer, faces: vk::CullModeFlags) -> bool {
+        if self.cull.is_none() {
+            return false;
+        }
+        // SAFETY: `cmd` is recording with this pipeline bound; its cull mode is dynamic state.
+        unsafe { self.layout.gpu.device().cmd_set_cull_mode(cmd, faces) };
+        true
     }
 
     /// Record an indexed draw with this pipeline bound (`bind`), counted in `Gpu::recorded`.

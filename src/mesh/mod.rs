@@ -12,6 +12,7 @@ pub mod atlas;
 mod boundary;
 pub mod bvh;
 mod curvature;
+mod enclosure;
 mod lod;
 mod obj;
 mod topology;
@@ -21,6 +22,7 @@ use std::path::PathBuf;
 use glam::{DVec3, Vec3};
 
 pub use boundary::NO_BOUNDARY;
+pub use enclosure::{Enclosure, enclosure};
 pub use lod::{LodLevel, MIN_LEVEL_TRIANGLES};
 pub use obj::LoadOptions;
 

@@ -9,10 +9,12 @@ use super::records::{
     ReceiverGroupRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
 };
 use crate::gpu::{Buffer, BufferDesc, Gpu, GpuResult};
+use crate::mesh::{Enclosure, enclosure};
 use crate::optics::kernel::NEAR_BLEND_RADIUS;
 use crate::sampling::{NODE_ITEM, SampleTree};
 use crate::scene::build::PreparedScene;
 use ash::vk;
+use glam::Vec3;
 use std::sync::Arc;
 
 /// One level of detail of an object (`mesh::LodLevel`): its draw, and its vertices (the
@@ -25,6 +27,11 @@ pub struct LevelRange {
     pub first_entry: u32,
     /// Vertices it uses (0 for an opaque object, which is never gathered).
     pub vertex_count: u32,
+    /// Whether its triangles enclose a volume, and which way they face (the shading pass culls
+    /// the faces hidden inside, `shade::hidden_faces`).
+    pub enclosure: Enclosure,
+    /// Its vertices' bounding box, scene units: (min, max).
+    pub bounds: (Vec3, Vec3),
 }
 
 /// A draw of one object: index range and vertex offset in the shared buffers.
@@ -266,7 +273,17 @@ fn pack_levels(scene: &PreparedScene) -> PackedLevels {
             if translucent {
                 level_vertices.extend(&level.vertices);
             }
-            ranges.push(LevelRange { draw, first_entry, vertex_count: level_vertices.len() as u32 - first_entry });
+            let positions = o.mesh.positions();
+            let bounds = level.vertices.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(positions[v as usize]), hi.max(positions[v as usize]))
+            });
+            ranges.push(LevelRange {
+                draw,
+                first_entry,
+                vertex_count: level_vertices.len() as u32 - first_entry,
+                enclosure: enclosure(positions, &level.triangles),
+                bounds,
+            });
         }
         levels.push(ranges);
         if o.casts_shadow {

@@ -1151,6 +1151,10 @@ impl Renderer {
 
     /// Splat output of every sample, in scene order: (irradiance RGB, area).
     pub fn splat_irradiance(&self) -> Result<Vec<([f32; 3], f32)>, RenderError> {
+        // A scene without samples still has a buffer, of 16 bytes: less than one record.
+        if self.scene.sample_count() == 0 {
+            return Ok(Vec::new());
+        }
         let all: Vec<super::records::SplatRecord> = self.buffers.splat.read()?;
         Ok(all
             .iter()

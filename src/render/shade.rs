@@ -13,7 +13,9 @@ use super::host::HostSync;
 use super::pass::{FrameInputs, RenderPass};
 use super::records::Vertex;
 use crate::gpu::{Access, DescriptorSet, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline};
+use crate::mesh::Enclosure;
 use ash::vk;
+use glam::{Mat4, Vec3};
 use std::sync::Arc;
 
 use super::targets::CAMERA_DEPTH_FORMAT;
@@ -172,6 +174,48 @@ pub struct HostAttachment {
     pub samples: vk::SampleCountFlags,
 }
 
+/// The faces of a level of detail (its `enclosure`, its vertices' `bounds`) that no ray from
+/// the eye reaches through `view_proj` (world -> clip,
+/// depth running as `convention` says), to cull: the inner side of a surface that encloses a
+/// volume, when the whole of it lies beyond the near plane (one the near plane cuts shows its
+/// inside); NONE for an open surface. On screen a face is front (counter-clockwise, with the
+/// viewport's positive height) when its winding's normal points towards the eye in clip space,
+/// which the sign of det(view_proj) (the sign of the map's Jacobian wherever w > 0) and the
+/// depth's direction decide.
+pub fn hidden_faces(
+    enclosure: Enclosure,
+    bounds: (Vec3, Vec3),
+    view_proj: Mat4,
+    convention: DepthConvention,
+) -> vk::CullModeFlags {
+    let outward = match enclosure {
+        Enclosure::Open => return vk::CullModeFlags::NONE,
+        Enclosure::Outward => true,
+        Enclosure::Inward => false,
+    };
+    let (lo, hi) = bounds;
+    let beyond_near = (0..8).all(|k| {
+        let corner = Vec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        );
+        let clip = view_proj * corner.extend(1.0);
+        // Vulkan's clip volume runs 0 <= z <= w; the near plane is z = 0, or z = w reversed.
+        clip.w > 0.0
+            && match convention {
+                DepthConvention::Standard => clip.z > 0.0,
+                DepthConvention::Reversed => clip.z < clip.w,
+            }
+    });
+    let det = view_proj.determinant();
+    if !beyond_near || !det.is_finite() || det == 0.0 {
+        return vk::CullModeFlags::NONE;
+    }
+    let front_visible = (det > 0.0) == (convention == DepthConvention::Standard);
+    if front_visible == outward { vk::CullModeFlags::BACK } else { vk::CullModeFlags::FRONT }
+}
+
 /// glsl/common/shade.glsl's bindings, in binding order.
 const BINDINGS: [Resource; 2] = [Resource::Lights, Resource::ShadowMaps];
 
@@ -184,8 +228,9 @@ pub struct ShadePass {
     variants: [[[(GraphicsPipeline, DescriptorSet); 2]; 2]; 2],
     /// Whether it draws the surface image too (shade_pixel.frag's second attachment).
     pixel_gather: bool,
-    /// What the depth attachment is cleared to when not loaded: the far plane.
-    depth_clear: f32,
+    /// The depth test: what the attachment is cleared to when not loaded (the far plane), and
+    /// which way depth runs (`hidden_faces`).
+    depth: DepthTest,
 }
 
 /// How the shading pass draws: its depth test and its samples per pixel
@@ -233,6 +278,7 @@ impl ShadePass {
         desc.depth_format = Some(depth_format);
         desc.depth_compare = options.depth.compare;
         desc.samples = options.samples;
+        desc.dynamic_cull = true;
         let bindings = resources.bind_all(&BINDINGS)?;
         let variant =
             |translucent: u32, radius: u32, directional: u32| -> GpuResult<(GraphicsPipeline, DescriptorSet)> {
@@ -244,7 +290,26 @@ impl ShadePass {
         let by_lights =
             |t, r| -> GpuResult<[(GraphicsPipeline, DescriptorSet); 2]> { Ok([variant(t, r, 0)?, variant(t, r, 1)?]) };
         let variants = [[by_lights(0, 0)?, by_lights(0, 1)?], [by_lights(1, 0)?, by_lights(1, 1)?]];
-        Ok(ShadePass { variants, pixel_gather, depth_clear: options.depth.far() })
+        Ok(ShadePass { variants, pixel_gather, depth: options.depth })
+    }
+
+    /// Object `i`'s pipeline variant, its set and its push block.
+    fn object_draw(&self, frame: &FrameInputs, i: usize) -> (&GraphicsPipeline, &DescriptorSet, ShadePush) {
+        let scene = frame.scene;
+        let eye = frame.eye;
+        let record = scene.object_record(i);
+        let push = ShadePush {
+            view_proj: frame.view_proj.to_cols_array_2d(),
+            eye_object: [eye.x, eye.y, eye.z, i as f32],
+            counts: [scene.light_count, scene.key_light_count, record.local_channels, frame.plan.skip_terms],
+            albedo_roughness: record.albedo_roughness,
+            material: [record.eta, record.norm, 0.0, 0.0],
+        };
+        let translucent = record.kind == super::records::MATERIAL_TRANSLUCENT;
+        let filter = usize::from(!frame.plan.one_tap_shadows);
+        let (pipeline, set) =
+            &self.variants[usize::from(translucent)][filter][usize::from(scene.key_lights_directional)];
+        (pipeline, set, push)
     }
 
     /// Views, depth view, render area and whether to load: the frame targets' camera images, or
@@ -327,7 +392,7 @@ impl RenderPass for ShadePass {
                 vk::AttachmentStoreOp::DONT_CARE
             })
             .clear_value(vk::ClearValue {
-                depth_stencil: vk::ClearDepthStencilValue { depth: self.depth_clear, stencil: 0 },
+                depth_stencil: vk::ClearDepthStencilValue { depth: self.depth.far(), stencil: 0 },
             });
         let info = vk::RenderingInfo::default()
             .render_area(area)
@@ -344,23 +409,19 @@ impl RenderPass for ShadePass {
             device.cmd_bind_vertex_buffers(cmd, 0, &streams, &[0, 0, 0]);
             device.cmd_bind_index_buffer(cmd, scene.indices.raw(), 0, vk::IndexType::UINT32);
         }
-        let eye = frame.eye;
         for i in 0..scene.levels.len() {
-            let d = scene.level(i, frame.plan.level(i)).draw;
-            let record = scene.object_record(i);
-            let push = ShadePush {
-                view_proj: frame.view_proj.to_cols_array_2d(),
-                eye_object: [eye.x, eye.y, eye.z, i as f32],
-                counts: [scene.light_count, scene.key_light_count, record.local_channels, frame.plan.skip_terms],
-                albedo_roughness: record.albedo_roughness,
-                material: [record.eta, record.norm, 0.0, 0.0],
+            let (pipeline, set, push) = self.object_draw(frame, i);
+            let level = scene.level(i, frame.plan.level(i));
+            // ALWAYS draws the last face over the others: culling would change which that is.
+            let culls = frame.plan.cull_hidden_faces && self.depth.compare != vk::CompareOp::ALWAYS;
+            let hidden = if culls {
+                hidden_faces(level.enclosure, level.bounds, frame.view_proj, self.depth.convention)
+            } else {
+                vk::CullModeFlags::NONE
             };
-            let translucent = record.kind == super::records::MATERIAL_TRANSLUCENT;
-            let filter = usize::from(!frame.plan.one_tap_shadows);
-            let (pipeline, set) =
-                &self.variants[usize::from(translucent)][filter][usize::from(scene.key_lights_directional)];
             pipeline.bind_area(cmd, Some(set), &push, area);
-            pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
+            pipeline.set_cull(cmd, hidden);
+            pipeline.draw_indexed(cmd, level.draw.index_count, level.draw.first_index, level.draw.vertex_offset);
         }
         unsafe { device.cmd_end_rendering(cmd) };
         if let Some(t) = frame.target {

@@ -7,6 +7,7 @@
 use super::graph::{Resource, Use, overwrite, read, write};
 use super::pass::{FrameInputs, RenderPass};
 use super::records::Vertex;
+use super::shade::{DepthConvention, hidden_faces};
 use super::targets::SHADOW_FORMAT;
 use crate::gpu::{Access, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline};
 use ash::vk;
@@ -41,6 +42,7 @@ impl ShadowPass {
         desc.depth_format = Some(DEPTH_FORMAT);
         // Slope-scaled bias against acne on surfaces grazing the light.
         desc.depth_bias = Some((1.0, 1.75));
+        desc.dynamic_cull = true;
         Ok(ShadowPass { pipeline: GraphicsPipeline::new(gpu, &desc)?, layers })
     }
 }
@@ -106,7 +108,17 @@ impl RenderPass for ShadowPass {
                 device.cmd_bind_index_buffer(cmd, scene.indices.raw(), 0, vk::IndexType::UINT32);
             }
             for &(object, level) in &scene.casters {
-                let d = scene.level(object, level).draw;
+                let level = scene.level(object, level);
+                // The nearest surface to the light is a face towards it: the map is the same
+                // without the hidden ones but for depth ties at the casters' silhouettes.
+                let hidden = if frame.plan.cull_hidden_faces {
+                    let matrix = glam::Mat4::from_cols_array_2d(matrix);
+                    hidden_faces(level.enclosure, level.bounds, matrix, DepthConvention::Standard)
+                } else {
+                    vk::CullModeFlags::NONE
+                };
+                self.pipeline.set_cull(cmd, hidden);
+                let d = level.draw;
                 self.pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
             }
         }

@@ -251,6 +251,12 @@ pub struct Plan {
     /// Terms of the shading pass left out (`shade::TERM_*` bits), to measure what each costs
     /// (the benchmark's `terms` section); 0, every term, in any plan the planner makes.
     pub skip_terms: u32,
+    /// Shading culls the faces no ray from the eye reaches: the inner side of each surface that
+    /// encloses a volume, where the near plane cuts none of it (`shade::hidden_faces`). The
+    /// image is the same but for depth ties at silhouettes; the hidden faces are neither
+    /// rasterised nor shaded. True in any plan the planner makes; the benchmark turns it off
+    /// to measure what it saves.
+    pub cull_hidden_faces: bool,
     /// How this frame's splat finds visibility (`render.splat_visibility`); `None` when no
     /// splat runs.
     pub splat_visibility: Option<crate::scene::SplatVisibility>,
@@ -295,6 +301,7 @@ impl Plan {
             "skipped": list(&self.skipped),
             "shadow_light": self.shadow_light,
             "one_tap_shadows": self.one_tap_shadows,
+            "cull_hidden_faces": self.cull_hidden_faces,
             "shadow_filter_why": self.shadow_filter.map_or_else(String::new, |f| f.to_string()),
             "splat_visibility": self.splat_visibility.map(|v| v.name()),
             "objects": self.objects,

@@ -157,6 +157,7 @@ impl Planner {
             one_tap_shadows: shadow_filter.is_some_and(|f| f.one_tap),
             shadow_filter,
             skip_terms: 0,
+            cull_hidden_faces: true,
             splat_visibility,
         }
     }
