@@ -10,6 +10,7 @@
 const bool SHADE_TRANSLUCENT = true;
 const int SHADE_SHADOW_RADIUS = 0;
 const bool SHADE_DIRECTIONAL_KEYS = true;
+const uint SHADE_KEY_LIGHTS = 0u;
 #include "shade.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

@@ -38,6 +38,10 @@ layout(constant_id = 1) const int SHADE_SHADOW_RADIUS = 0;  // light_visibility'
 // Every key light is directional: the point and spot lights' falloff, which would run (and read
 // its light fields) for every pixel whatever the light, is left out.
 layout(constant_id = 2) const bool SHADE_DIRECTIONAL_KEYS = false;
+// The scene's key-light count, where it is small (ShadePass::new; 0: read counts.y): a loop of a
+// constant count is unrolled, and each light's record is then read at a constant index, once for
+// all the lanes, where a CPU driver loads a storage buffer at a varying index lane by lane.
+layout(constant_id = 3) const uint SHADE_KEY_LIGHTS = 0u;
 #endif
 layout(std430, set = 0, binding = 0) readonly buffer Lights { Light lights[]; };
 layout(set = 0, binding = 1) uniform sampler2DArrayShadow shadow_maps;
@@ -79,7 +83,8 @@ vec3 shade_radiance(vec3 v_position, vec3 v_normal, vec3 v_exitance, vec3 v_envi
     vec3 transmitted = translucent ? v_environment : vec3(0.0);
     if (!translucent) radiance += v_environment * (push.albedo_roughness.rgb / DIPOLE_PI);
     // The key lights come first in the buffer (scene::lights::prepare); counts.y of them.
-    for (uint l = 0u; l < push.counts.y; ++l) {
+    uint key_lights = SHADE_KEY_LIGHTS > 0u ? SHADE_KEY_LIGHTS : push.counts.y;
+    for (uint l = 0u; l < key_lights; ++l) {
         vec3 wi, irradiance;
         if (SHADE_DIRECTIONAL_KEYS) {
             wi = lights[l].direction_cos.xyz;

@@ -216,6 +216,18 @@ pub fn hidden_faces(
     if front_visible == outward { vk::CullModeFlags::BACK } else { vk::CullModeFlags::FRONT }
 }
 
+/// Key lights up to this many are a specialization constant of the shading pipelines.
+pub const MAX_UNROLLED_KEY_LIGHTS: u32 = 4;
+
+/// The shading pipelines' key-light count (glsl/common/shade.glsl's SHADE_KEY_LIGHTS) for a
+/// scene of `key_lights`: the count itself up to `MAX_UNROLLED_KEY_LIGHTS`, so that the loop over
+/// them is unrolled and each light's record read at a constant index, once for every lane (a CPU
+/// driver loads a storage buffer at a varying index lane by lane: 4 of the default scene's 17 ms
+/// of shading on lavapipe); 0 above it, and the loop runs to the push block's count.
+pub fn unrolled_key_lights(key_lights: u32) -> u32 {
+    if key_lights <= MAX_UNROLLED_KEY_LIGHTS { key_lights } else { 0 }
+}
+
 /// glsl/common/shade.glsl's bindings, in binding order.
 const BINDINGS: [Resource; 2] = [Resource::Lights, Resource::ShadowMaps];
 
@@ -224,7 +236,8 @@ const BINDINGS: [Resource; 2] = [Resource::Lights, Resource::ShadowMaps];
 /// (`FrameTargets::camera`) or a host's. One indexed draw per object.
 pub struct ShadePass {
     /// Per `[translucent][shadow radius][key lights all directional]` (glsl/common/shade.glsl's
-    /// specialization constants): a pipeline and its set.
+    /// specialization constants; the fourth, the scene's key-light count, `unrolled_key_lights`,
+    /// is the same for all): a pipeline and its set.
     variants: [[[(GraphicsPipeline, DescriptorSet); 2]; 2]; 2],
     /// Whether it draws the surface image too (shade_pixel.frag's second attachment).
     pixel_gather: bool,
@@ -280,9 +293,11 @@ impl ShadePass {
         desc.samples = options.samples;
         desc.dynamic_cull = true;
         let bindings = resources.bind_all(&BINDINGS)?;
+        let keys = unrolled_key_lights(resources.scene.key_light_count);
         let variant =
             |translucent: u32, radius: u32, directional: u32| -> GpuResult<(GraphicsPipeline, DescriptorSet)> {
-                let desc = GraphicsDesc { specialization: vec![translucent, radius, directional], ..desc.clone() };
+                let desc =
+                    GraphicsDesc { specialization: vec![translucent, radius, directional, keys], ..desc.clone() };
                 let pipeline = GraphicsPipeline::new(gpu, &desc)?;
                 let set = pipeline.descriptor_set(&bindings)?;
                 Ok((pipeline, set))
