@@ -50,6 +50,10 @@ layout(push_constant) uniform SplatPushBlock { SplatPush push; };
 // hierarchy (exact, as the truth's: reference::transmitted_irradiance); 2 = hybrid, the map where
 // it is sure and a ray where it is not.
 layout(constant_id = 0) const uint SPLAT_VISIBILITY = 0u;
+// The scene's key-light count where it is small (shade::unrolled_key_lights; 0: read
+// push.key_light_count): the loop over them unrolls and each light's record is read at a
+// constant index, once for all lanes, where a CPU driver loads at a varying index lane by lane.
+layout(constant_id = 1) const uint SPLAT_KEY_LIGHTS = 0u;
 
 // A shadow ray from the sample towards the light (as reference::transmitted_irradiance casts
 // it): 1 when nothing blocks it.
@@ -117,7 +121,8 @@ void main() {
         kept_environment[i] = vec4(environment, 0.0);
     }
     vec3 weighted = vec3(0.0);
-    vec3 e = transmitted(0u, push.key_light_count, p, n, face, o.eta, weighted) + environment;
+    uint key_lights = SPLAT_KEY_LIGHTS > 0u ? SPLAT_KEY_LIGHTS : push.key_light_count;
+    vec3 e = transmitted(0u, key_lights, p, n, face, o.eta, weighted) + environment;
     float length_sq = dot(weighted, weighted);
     vec4 beam = vec4(length_sq > 0.0 ? weighted * inversesqrt(length_sq) : -n, 0.0);
     float area = s.position_area.w;

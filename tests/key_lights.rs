@@ -1,5 +1,6 @@
-//! The shading pass unrolls its loop over a few key lights (`shade::unrolled_key_lights`, a
-//! specialization constant) and loops at run time over more. The claim: both draw the same image.
+//! The shading and splat passes unroll their loops over a few key lights
+//! (`shade::unrolled_key_lights`, a specialization constant) and loop at run time over more. The
+//! claim: both give the same image (the sphere's exitance comes through the splat).
 
 mod common;
 

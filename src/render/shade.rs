@@ -216,11 +216,11 @@ pub fn hidden_faces(
     if front_visible == outward { vk::CullModeFlags::BACK } else { vk::CullModeFlags::FRONT }
 }
 
-/// Key lights up to this many are a specialization constant of the shading pipelines.
+/// Key lights up to this many are a specialization constant of the shading and splat pipelines.
 pub const MAX_UNROLLED_KEY_LIGHTS: u32 = 4;
 
-/// The shading pipelines' key-light count (glsl/common/shade.glsl's SHADE_KEY_LIGHTS) for a
-/// scene of `key_lights`: the count itself up to `MAX_UNROLLED_KEY_LIGHTS`, so that the loop over
+/// The shading and splat pipelines' key-light count (SHADE_KEY_LIGHTS in glsl/common/shade.glsl,
+/// SPLAT_KEY_LIGHTS in glsl/splat.comp) for a scene of `key_lights`: the count itself up to `MAX_UNROLLED_KEY_LIGHTS`, so that the loop over
 /// them is unrolled and each light's record read at a constant index, once for every lane (a CPU
 /// driver loads a storage buffer at a varying index lane by lane: 4 of the default scene's 17 ms
 /// of shading on lavapipe); 0 above it, and the loop runs to the push block's count.

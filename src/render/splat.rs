@@ -66,15 +66,17 @@ pub struct SplatPass {
 }
 
 impl SplatPass {
-    /// The pipeline for `visibility` (a specialization constant, so the other way costs
-    /// nothing) and one descriptor set over `BINDINGS`.
+    /// The pipeline for `visibility` and the scene's key-light count
+    /// (`shade::unrolled_key_lights`), both specialization constants, so the other ways cost
+    /// nothing, and one descriptor set over `BINDINGS`.
     pub fn new(gpu: &Arc<Gpu>, resources: &Resources, visibility: SplatVisibility) -> GpuResult<SplatPass> {
         let constant = match visibility {
             SplatVisibility::ShadowMaps => 0,
             SplatVisibility::Rays => 1,
             SplatVisibility::Hybrid => 2,
         };
-        let pipeline = ComputePipeline::specialized(gpu, "splat.comp", &[constant])?;
+        let keys = super::shade::unrolled_key_lights(resources.scene.key_light_count);
+        let pipeline = ComputePipeline::specialized(gpu, "splat.comp", &[constant, keys])?;
         let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
         let s = resources.scene;
         Ok(SplatPass {
