@@ -319,16 +319,17 @@ fn savings(gpu: &Arc<Gpu>) {
             Force { one_tap: Some(false), every_face: true, ..Force::default() },
         ),
     ];
+    let mut renderers: Vec<(Renderer, Force)> =
+        configs.iter().map(|(_, o, f)| (default_renderer(gpu, o.clone()), *f)).collect();
     println!(
-        "\nWhat each saving buys, default scene 512x512, 400 samples, whole-frame wall time (median of {FRAMES} after \
-         {WARM_UP} warm-up), renderers side by side; FLIP mean against the full-detail frame:"
+        "\nWhat each saving buys, default scene 512x512, {} samples, whole-frame wall time (median of {FRAMES} after \
+         {WARM_UP} warm-up), renderers side by side; FLIP mean against the full-detail frame:",
+        renderers[0].0.scene().sample_count()
     );
     println!(
         "  {:<32} {:>14} {:>10} {:>15} {:>10} {:>10}",
         "", "light ms", "frames/s", "camera ms", "frames/s", "FLIP"
     );
-    let mut renderers: Vec<(Renderer, Force)> =
-        configs.iter().map(|(_, o, f)| (default_renderer(gpu, o.clone()), *f)).collect();
     let light = side_by_side(&mut renderers, Change::Light(0), FRAMES);
     let camera = side_by_side(&mut renderers, Change::Camera, FRAMES);
     // Every saving off: the reference image.

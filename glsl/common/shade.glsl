@@ -118,7 +118,9 @@ vec3 shade_radiance(vec3 v_position, vec3 v_normal, vec3 v_exitance, vec3 v_envi
 #ifndef SHADE_COMPUTE
 void main() {
     if (shade_skips(SHADE_SKIP_ALL)) {
-        out_radiance = vec4(v_exitance + v_environment, 1.0);
+        // The inputs the pipeline's shading reads, no more: an opaque surface's pipeline has no
+        // use for the exitance, and an input read nowhere is not interpolated.
+        out_radiance = vec4((SHADE_TRANSLUCENT ? v_exitance : vec3(0.0)) + v_environment, 1.0);
 #ifdef PIXEL_GATHER
         out_surface = vec4(0.0);
 #endif
