@@ -239,8 +239,9 @@ pub struct GraphicsDesc {
     /// Faces to cull (counter-clockwise is front); NONE unless set. With `dynamic_cull`, the
     /// faces culled until `GraphicsPipeline::set_cull` says otherwise.
     pub cull: vk::CullModeFlags,
-    /// The faces culled are dynamic state (Vulkan 1.3 core): `GraphicsPipeline::set_cull` picks
-    /// them per draw, so that one pipeline draws front faces and then back faces.
+    /// The faces culled are dynamic state (Vulkan 1.3 core, no feature to enable):
+    /// `GraphicsPipeline::set_cull` picks them per draw, so that one pipeline serves draws that
+    /// cull differently.
     pub dynamic_cull: bool,
     /// Constant and slope depth bias, for shadow maps.
     pub depth_bias: Option<(f32, f32)>,

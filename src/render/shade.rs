@@ -175,13 +175,12 @@ pub struct HostAttachment {
 }
 
 /// The faces of a level of detail (its `enclosure`, its vertices' `bounds`) that no ray from
-/// the eye reaches through `view_proj` (world -> clip,
-/// depth running as `convention` says), to cull: the inner side of a surface that encloses a
-/// volume, when the whole of it lies beyond the near plane (one the near plane cuts shows its
-/// inside); NONE for an open surface. On screen a face is front (counter-clockwise, with the
-/// viewport's positive height) when its winding's normal points towards the eye in clip space,
-/// which the sign of det(view_proj) (the sign of the map's Jacobian wherever w > 0) and the
-/// depth's direction decide.
+/// the eye reaches through `view_proj` (world -> clip, depth running as `convention` says), to
+/// cull: the inner side of a surface that encloses a volume, when the whole of it lies beyond
+/// the near plane (one the near plane cuts shows its inside); NONE for an open surface. On
+/// screen a face is front (counter-clockwise, with the viewport's positive height) when its
+/// winding's normal points towards the eye in clip space, which the sign of det(view_proj) (the
+/// sign of the map's Jacobian wherever w > 0) and the depth's direction decide.
 pub fn hidden_faces(
     enclosure: Enclosure,
     bounds: (Vec3, Vec3),
@@ -220,10 +219,11 @@ pub fn hidden_faces(
 pub const MAX_UNROLLED_KEY_LIGHTS: u32 = 4;
 
 /// The shading and splat pipelines' key-light count (SHADE_KEY_LIGHTS in glsl/common/shade.glsl,
-/// SPLAT_KEY_LIGHTS in glsl/splat.comp) for a scene of `key_lights`: the count itself up to `MAX_UNROLLED_KEY_LIGHTS`, so that the loop over
-/// them is unrolled and each light's record read at a constant index, once for every lane (a CPU
-/// driver loads a storage buffer at a varying index lane by lane: 4 of the default scene's 17 ms
-/// of shading on lavapipe); 0 above it, and the loop runs to the push block's count.
+/// SPLAT_KEY_LIGHTS in glsl/splat.comp) for a scene of `key_lights`: the count itself up to
+/// `MAX_UNROLLED_KEY_LIGHTS`, so that the loop over them is unrolled and each light's record read
+/// at a constant index, once for every lane (a CPU driver loads a storage buffer at a varying
+/// index lane by lane: about 4 of the default scene's 17 ms of shading on lavapipe, measured
+/// under load); 0 above it, and the loop runs to the push block's count.
 pub fn unrolled_key_lights(key_lights: u32) -> u32 {
     if key_lights <= MAX_UNROLLED_KEY_LIGHTS { key_lights } else { 0 }
 }
