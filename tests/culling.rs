@@ -71,12 +71,10 @@ fn images(gpu: &Arc<Gpu>, prepared: PreparedScene, depth: DepthTest) -> (Vec<u8>
     let object = &renderer.scene().objects[0];
     let level = &object.levels[plan.level(0).min(object.levels.len() - 1)];
     let positions = object.mesh.positions();
-    let bounds = level.vertices.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| {
-        (lo.min(positions[v as usize]), hi.max(positions[v as usize]))
-    });
     let camera = renderer.camera();
+    let view_proj = camera.projection * camera.view;
     let faces =
-        hidden_faces(enclosure(positions, &level.triangles), bounds, camera.projection * camera.view, depth.convention);
+        hidden_faces(enclosure(positions, &level.triangles), level.bounds(positions), view_proj, depth.convention);
     // Everything again: the shadow maps, splat and gather too, every face drawn.
     let mut plan = renderer.plan(Change::Everything);
     plan.cull_hidden_faces = false;

@@ -31,7 +31,7 @@ use translucent::gpu::{
 use translucent::render::plan::Plan;
 use translucent::render::records::Vertex;
 use translucent::render::renderer::Renderer;
-use translucent::render::shade::{HDR_FORMAT, ShadePush, hidden_faces};
+use translucent::render::shade::{HDR_FORMAT, ShadePush, culled_faces};
 
 /// The camera's depth format (`render::targets::CAMERA_DEPTH_FORMAT`).
 const CAMERA_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
@@ -202,40 +202,21 @@ impl Roofline {
     /// medians `yardsticks` returns.
     pub fn run(&mut self, renderer: &Renderer, plan: &Plan) {
         let camera = renderer.camera();
-        let view_proj = (camera.projection * camera.view).to_cols_array_2d();
+        let camera_matrix = camera.projection * camera.view;
+        let view_proj = camera_matrix.to_cols_array_2d();
         let scene = renderer.buffers();
-        // The faces the shading pass draws: those it culls are culled here too.
+        // The faces the shading and shadow passes draw: those they cull are culled here too.
         let draws: Vec<_> = (0..scene.levels.len())
-            .map(|i| {
-                let level = scene.level(i, plan.level(i));
-                let hidden = if plan.cull_hidden_faces {
-                    hidden_faces(
-                        level.enclosure,
-                        level.bounds,
-                        camera.projection * camera.view,
-                        DepthConvention::Standard,
-                    )
-                } else {
-                    vk::CullModeFlags::NONE
-                };
-                (level.draw, hidden)
-            })
+            .map(|i| scene.level(i, plan.level(i)))
+            .map(|level| (level.draw, culled_faces(plan, &level, camera_matrix, DepthConvention::Standard)))
             .collect();
         let light = scene.light_matrices.first().copied().unwrap_or(view_proj);
-        // The casters as the shadow pass draws them, hidden faces culled as it culls them.
+        let light_matrix = glam::Mat4::from_cols_array_2d(&light);
         let casters: Vec<_> = scene
             .casters
             .iter()
-            .map(|&(o, l)| {
-                let level = scene.level(o, l);
-                let matrix = glam::Mat4::from_cols_array_2d(&light);
-                let hidden = if plan.cull_hidden_faces {
-                    hidden_faces(level.enclosure, level.bounds, matrix, DepthConvention::Standard)
-                } else {
-                    vk::CullModeFlags::NONE
-                };
-                (level.draw, hidden)
-            })
+            .map(|&(o, l)| scene.level(o, l))
+            .map(|level| (level.draw, culled_faces(plan, &level, light_matrix, DepthConvention::Standard)))
             .collect();
         let (vertices, indices) = (scene.vertices.raw(), scene.indices.raw());
         let receivers = frame_receivers(renderer, plan);

@@ -38,6 +38,16 @@ pub struct LodLevel {
     pub locked: bool,
 }
 
+impl LodLevel {
+    /// The bounding box (min, max) of its vertices, among the mesh's `positions`.
+    pub fn bounds(&self, positions: &[glam::Vec3]) -> (glam::Vec3, glam::Vec3) {
+        let (lo, hi) = (glam::Vec3::INFINITY, glam::Vec3::NEG_INFINITY);
+        self.vertices
+            .iter()
+            .fold((lo, hi), |(lo, hi), &v| (lo.min(positions[v as usize]), hi.max(positions[v as usize])))
+    }
+}
+
 impl Mesh {
     /// The mesh's levels of detail, finest first: level 0 is the mesh itself, each next level
     /// has about half the triangles of the one before, down to [`MIN_LEVEL_TRIANGLES`] or until

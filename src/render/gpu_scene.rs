@@ -273,16 +273,12 @@ fn pack_levels(scene: &PreparedScene) -> PackedLevels {
             if translucent {
                 level_vertices.extend(&level.vertices);
             }
-            let positions = o.mesh.positions();
-            let bounds = level.vertices.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| {
-                (lo.min(positions[v as usize]), hi.max(positions[v as usize]))
-            });
             ranges.push(LevelRange {
                 draw,
                 first_entry,
                 vertex_count: level_vertices.len() as u32 - first_entry,
-                enclosure: enclosure(positions, &level.triangles),
-                bounds,
+                enclosure: enclosure(o.mesh.positions(), &level.triangles),
+                bounds: level.bounds(o.mesh.positions()),
             });
         }
         levels.push(ranges);

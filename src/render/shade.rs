@@ -8,9 +8,11 @@
 //! environment irradiance (vec4 per vertex each).
 //! Bindings: 0 = lights, 1 = shadow maps. Push: `ShadePush` (with the object's material).
 
+use super::gpu_scene::LevelRange;
 use super::graph::{Resource, Resources, Use, overwrite, read, write};
 use super::host::HostSync;
 use super::pass::{FrameInputs, RenderPass};
+use super::plan::Plan;
 use super::records::Vertex;
 use crate::gpu::{Access, DescriptorSet, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline};
 use crate::mesh::Enclosure;
@@ -213,6 +215,21 @@ pub fn hidden_faces(
     }
     let front_visible = (det > 0.0) == (convention == DepthConvention::Standard);
     if front_visible == outward { vk::CullModeFlags::BACK } else { vk::CullModeFlags::FRONT }
+}
+
+/// The faces to cull when drawing `level` through `view_proj`: its `hidden_faces` where `plan`
+/// culls them (`Plan::cull_hidden_faces`), else none.
+pub fn culled_faces(
+    plan: &Plan,
+    level: &LevelRange,
+    view_proj: Mat4,
+    convention: DepthConvention,
+) -> vk::CullModeFlags {
+    if plan.cull_hidden_faces {
+        hidden_faces(level.enclosure, level.bounds, view_proj, convention)
+    } else {
+        vk::CullModeFlags::NONE
+    }
 }
 
 /// Key lights up to this many are a specialization constant of the shading and splat pipelines.
@@ -428,11 +445,9 @@ impl RenderPass for ShadePass {
             let (pipeline, set, push) = self.object_draw(frame, i);
             let level = scene.level(i, frame.plan.level(i));
             // ALWAYS draws the last face over the others: culling would change which that is.
-            let culls = frame.plan.cull_hidden_faces && self.depth.compare != vk::CompareOp::ALWAYS;
-            let hidden = if culls {
-                hidden_faces(level.enclosure, level.bounds, frame.view_proj, self.depth.convention)
-            } else {
-                vk::CullModeFlags::NONE
+            let hidden = match self.depth.compare {
+                vk::CompareOp::ALWAYS => vk::CullModeFlags::NONE,
+                _ => culled_faces(frame.plan, &level, frame.view_proj, self.depth.convention),
             };
             pipeline.bind_area(cmd, Some(set), &push, area);
             pipeline.set_cull(cmd, hidden);

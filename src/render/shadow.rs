@@ -7,7 +7,7 @@
 use super::graph::{Resource, Use, overwrite, read, write};
 use super::pass::{FrameInputs, RenderPass};
 use super::records::Vertex;
-use super::shade::{DepthConvention, hidden_faces};
+use super::shade::{DepthConvention, culled_faces};
 use super::targets::SHADOW_FORMAT;
 use crate::gpu::{Access, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline};
 use ash::vk;
@@ -102,6 +102,7 @@ impl RenderPass for ShadowPass {
                 continue;
             }
             let push = ShadowPush { light_matrix: *matrix, layer: [layer as u32, 0, 0, 0] };
+            let light_matrix = glam::Mat4::from_cols_array_2d(matrix);
             self.pipeline.bind(cmd, None, &push, extent);
             unsafe {
                 device.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.raw()], &[0]);
@@ -111,12 +112,7 @@ impl RenderPass for ShadowPass {
                 let level = scene.level(object, level);
                 // The nearest surface to the light is a face towards it: the map is the same
                 // without the hidden ones but for depth ties at the casters' silhouettes.
-                let hidden = if frame.plan.cull_hidden_faces {
-                    let matrix = glam::Mat4::from_cols_array_2d(matrix);
-                    hidden_faces(level.enclosure, level.bounds, matrix, DepthConvention::Standard)
-                } else {
-                    vk::CullModeFlags::NONE
-                };
+                let hidden = culled_faces(frame.plan, &level, light_matrix, DepthConvention::Standard);
                 self.pipeline.set_cull(cmd, hidden);
                 let d = level.draw;
                 self.pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
