@@ -20,6 +20,7 @@ mod roofline;
 use roofline::{Roofline, Yardsticks};
 use std::sync::Arc;
 use std::time::Instant;
+use translucent::SceneEdit;
 use translucent::gpu::{Gpu, GpuOptions, median};
 use translucent::render::plan::{Change, Pass};
 use translucent::render::renderer::Renderer;
@@ -48,7 +49,7 @@ fn measure(renderer: &mut Renderer, change: Change) -> Measured {
         if let Change::Light(i) = change {
             let scene = renderer.scene();
             let moved = lights::orbit(&scene.scene.file.lights[i], scene.bounds.0, 3.0).expect("a key light");
-            renderer.set_light(i, moved).expect("orbit");
+            renderer.edit(SceneEdit::Light { index: i, light: moved }).expect("orbit");
         }
         renderer.plan(change)
     };
@@ -98,7 +99,7 @@ fn print(title: &str, m: &Measured) {
 /// `FRAMES` times after a warm-up: (gather ms, naive ms, pairs).
 fn gather_against_naive(gpu: &Arc<Gpu>, renderer: &mut Renderer) -> (f64, f64, f64) {
     let (naive, set, _out) = roofline::naive_gather(gpu, renderer);
-    let b = renderer.buffers();
+    let b = renderer.scene_data();
     let receivers = b.receivers.clone();
     let pairs: f64 = receivers.iter().map(|r| r.vertex_count as f64 * r.sample_count as f64).sum();
     let mut plan = renderer.plan(Change::Everything);
@@ -144,7 +145,7 @@ fn prepared_renderer(gpu: &Arc<Gpu>, overrides: Overrides) -> Renderer {
 }
 
 fn first_exitance(renderer: &Renderer) -> Vec<[f32; 3]> {
-    let object = renderer.buffers().receivers[0].object as usize;
+    let object = renderer.scene_data().receivers[0].object as usize;
     renderer.exitance(object).expect("exitance")
 }
 
@@ -232,9 +233,9 @@ fn step(renderer: &mut Renderer, change: Change) {
         Change::Light(i) => {
             let scene = renderer.scene();
             let moved = lights::orbit(&scene.scene.file.lights[i], scene.bounds.0, 3.0).expect("a key light");
-            renderer.set_light(i, moved).expect("orbit");
+            renderer.edit(SceneEdit::Light { index: i, light: moved }).expect("orbit");
         }
-        _ => renderer.set_camera(renderer.camera().orbited(renderer.scene().bounds.0, 3.0)),
+        _ => renderer.edit(SceneEdit::Camera(renderer.camera().orbited(renderer.scene().bounds.0, 3.0))).expect("camera"),
     }
 }
 

@@ -15,11 +15,14 @@ use std::ffi::{CStr, c_void};
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use translucent::SceneEdit;
 use translucent::gpu::{EnabledFeatures, Gpu, GpuOptions, HostVulkan, required_features};
-use translucent::render::host::HostSync;
+use translucent::render::target::HostSync;
 use translucent::render::plan::Pass;
-use translucent::render::renderer::{CameraView, Renderer, RendererOptions};
-use translucent::render::shade::{DepthConvention, DepthTest, HostAttachment, HostTarget, TargetDesc};
+use translucent::render::camera::CameraView;
+use translucent::render::options::RendererOptions;
+use translucent::render::renderer::Renderer;
+use translucent::render::target::{DepthConvention, DepthTest, HostAttachment, HostTarget, TargetDesc};
 use translucent::scene::Scene;
 use translucent::scene::build::{Overrides, PreparedScene};
 
@@ -595,12 +598,15 @@ impl<'a> Engine<'a> {
             )
         }
         .unwrap();
+        // SAFETY: `pool` was just created on this device and only this `Engine` uses it; the
+        // buffer is freed with the pool in `destroy`.
         let cmd = unsafe {
             device.allocate_command_buffers(
                 &vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1),
             )
         }
         .unwrap()[0];
+        // SAFETY: default create info on the live device; destroyed in `destroy`.
         let fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }.unwrap();
         let far = options.depth.far();
         Engine { host, color, depth, ldr, linear_readback, ldr_readback, quad, ground, far, pool, cmd, fence }
@@ -869,9 +875,9 @@ fn render_frames(engine: &Engine, gpu: Arc<Gpu>, options: &Options) -> Result<Ru
     for i in 0..options.frames {
         let camera = camera_of(&prepared, i, options.depth);
         if i > 0 {
-            renderer.set_camera(camera);
+            renderer.edit(SceneEdit::Camera(camera)).map_err(|e| e.to_string())?;
             if let Some(s) = second.as_mut() {
-                s.set_camera(camera);
+                s.edit(SceneEdit::Camera(camera)).map_err(|e| e.to_string())?;
             }
         }
         frames.push(embedded_frame(engine, &mut renderer, second.as_mut(), &host_target, camera)?);

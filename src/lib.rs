@@ -52,11 +52,15 @@ pub use glam;
 pub use gpu::{EnabledFeatures, Gpu, GpuError, GpuOptions, HostVulkan, RequiredFeatures, required_features};
 pub use optics::Material;
 pub use output::{OutputError, OutputSet};
-pub use render::host::{DeclaredImage, HostSync, ImageState};
+pub use render::camera::CameraView;
+pub use render::edit::SceneEdit;
+pub use render::error::RenderError;
+pub use render::frame::{FrameTimings, LevelExitance, NonFinite, RecordedFrame};
+pub use render::options::RendererOptions;
 pub use render::plan::{Change, Pass, Plan};
-pub use render::renderer::{
-    CameraView, FrameTimings, NonFinite, RecordedFrame, RenderError, Renderer, RendererOptions,
+pub use render::renderer::Renderer;
+pub use render::target::{
+    DeclaredImage, DepthConvention, DepthTest, HostAttachment, HostSync, HostTarget, ImageState, TargetDesc,
 };
-pub use render::shade::{DepthConvention, DepthTest, HostAttachment, HostTarget, TargetDesc};
 pub use scene::build::{Overrides, PreparedScene};
 pub use scene::{GatherMode, Scene, SceneError};

@@ -129,6 +129,9 @@ fn record_triangle(
         .layer_count(1)
         .color_attachments(&colors)
         .depth_attachment(&depth_attachment);
+    // SAFETY: `cmd` is recording (inside `one_shot`); the barriers above put both attachments in
+    // the layouts named here, and the images, pipeline, set and vertex buffer outlive the
+    // submission (the caller holds them until `one_shot` returns); the render is ended here.
     unsafe {
         device.cmd_begin_rendering(cmd, &rendering);
         pipeline.bind(cmd, Some(set), &0.5f32, color.extent());

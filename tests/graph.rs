@@ -176,11 +176,11 @@ fn every_gather_and_frame_change_is_clean_under_synchronisation_validation() {
             renderer.frame(&everything).unwrap();
             // One light moved: its shadow maps redrawn alone, then splat, gather and shading.
             let moved = lights::orbit(&renderer.scene().scene.file.lights[1], glam::Vec3::ZERO, 10.0).unwrap();
-            renderer.set_light(1, moved).unwrap();
+            renderer.edit(SceneEdit::Light { index: 1, light: moved }).unwrap();
             let light = renderer.plan(Change::Light(1));
             renderer.frame(&light).unwrap();
             let camera = renderer.camera().orbited(glam::Vec3::ZERO, 5.0);
-            renderer.set_camera(camera);
+            renderer.edit(SceneEdit::Camera(camera)).unwrap();
             let camera_plan = renderer.plan(Change::Camera);
             renderer.frame(&camera_plan).unwrap();
             renderer.frame_isolated(&light).unwrap();

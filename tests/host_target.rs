@@ -10,6 +10,7 @@ mod embed;
 use ash::vk;
 use common::host::{self, HostCommands, HostImages};
 use std::sync::Arc;
+use translucent::SceneEdit;
 use translucent::gpu::ImageBarrier;
 use translucent::gpu::{
     Access, Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, EnabledFeatures, Gpu, GpuOptions, HostVulkan,
@@ -146,7 +147,7 @@ fn two_frames_recorded_into_one_command_buffer_draw_what_two_submissions_draw() 
             a.to_attachments(gpu, cmd);
             b.to_attachments(gpu, cmd);
             one.record_frame(cmd, Some(&a.whole())).unwrap();
-            one.set_camera(turned);
+            one.edit(SceneEdit::Camera(turned)).unwrap();
             one.record_frame(cmd, Some(&b.whole())).unwrap()
         })
         .unwrap();
@@ -155,7 +156,7 @@ fn two_frames_recorded_into_one_command_buffer_draw_what_two_submissions_draw() 
         let c = HostImages::new(gpu, 64, 64, host::COLOR);
         record(gpu, &mut apart, &c, &c.whole()).unwrap();
         assert_eq!(first, c.read_color(), "the first frame differs from the same frame submitted alone");
-        apart.set_camera(turned);
+        apart.edit(SceneEdit::Camera(turned)).unwrap();
         record(gpu, &mut apart, &c, &c.whole()).unwrap();
         assert_eq!(second, c.read_color(), "the second frame differs from the same frame submitted alone");
         assert_ne!(first, second, "the camera turned between them");
@@ -238,8 +239,8 @@ fn recorded_exitance_without_shading_equals_what_record_frame_gathers() {
             if step == 1 {
                 // A partial frame: one light moved, its shadows, splat and gather rerun.
                 let light = turned_light(&framed, 40.0);
-                framed.set_light(0, light.clone()).unwrap();
-                alone.set_light(0, light).unwrap();
+                framed.edit(SceneEdit::Light { index: 0, light: light.clone() }).unwrap();
+                alone.edit(SceneEdit::Light { index: 0, light }).unwrap();
             }
             record(gpu, &mut framed, &images, &images.whole()).unwrap();
             let frame = gpu
@@ -248,8 +249,8 @@ fn recorded_exitance_without_shading_equals_what_record_frame_gathers() {
                 .unwrap();
             assert!(frame.passes.contains(&Pass::Gather), "step {step}: {:?}", frame.passes);
             assert!(!frame.passes.contains(&Pass::Shade), "step {step}: shading recorded: {:?}", frame.passes);
-            let framed_exitance: Vec<[f32; 4]> = framed.buffers().exitance.read().unwrap();
-            let exitance: Vec<[f32; 4]> = alone.buffers().exitance.read().unwrap();
+            let framed_exitance: Vec<[f32; 4]> = framed.scene_data().buffers().exitance().read().unwrap();
+            let exitance: Vec<[f32; 4]> = alone.scene_data().buffers().exitance().read().unwrap();
             assert!(exitance.iter().filter(|e| e[0] > 0.0).count() > exitance.len() / 4, "step {step}: little lit");
             assert_eq!(exitance, framed_exitance, "step {step}: record_exitance and record_frame differ");
         }
@@ -291,7 +292,7 @@ struct HostReader {
 impl HostReader {
     fn new(gpu: &Arc<Gpu>, renderer: &Renderer) -> HostReader {
         let pipeline = ComputePipeline::new(gpu, "test/exitance_probe.comp").unwrap();
-        let exitance = &renderer.buffers().exitance;
+        let exitance = &renderer.scene_data().buffers().exitance();
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let out = Buffer::new(gpu, &BufferDesc::readback("host's copy", exitance.size(), usage)).unwrap();
         let set = pipeline
@@ -320,12 +321,12 @@ fn two_exitances_read_by_the_host(gpu: &Arc<Gpu>, readers: &[Access]) -> [Vec<[f
         renderer.record_exitance(cmd, extent(64, 64), readers).unwrap();
         probes[0].record(gpu, cmd);
         // The next gather overwrites what the host's pass reads: it must wait for that pass.
-        renderer.set_light(0, light).unwrap();
+        renderer.edit(SceneEdit::Light { index: 0, light }).unwrap();
         renderer.record_exitance(cmd, extent(64, 64), readers).unwrap();
         probes[1].record(gpu, cmd);
     })
     .unwrap();
-    let last: Vec<[f32; 4]> = renderer.buffers().exitance.read().unwrap();
+    let last: Vec<[f32; 4]> = renderer.scene_data().buffers().exitance().read().unwrap();
     let read = probes.map(|p| p.out.read::<[f32; 4]>().unwrap());
     assert_eq!(read[1], last, "the host's second read holds the second gather");
     read
@@ -444,7 +445,7 @@ fn a_reversed_z_host_draws_what_a_standard_depth_host_draws() {
         // The host's own reversed-Z depth, cleared to its far plane (0), kept (`load`).
         let mut loaded = images.whole();
         loaded.load = true;
-        reversed.set_camera(CameraView::of_scene(reversed.scene()).reversed_depth());
+        reversed.edit(SceneEdit::Camera(CameraView::of_scene(reversed.scene()).reversed_depth())).unwrap();
         let kept = draw(gpu, &mut reversed, &images, &loaded, Some(([0.0, 0.0, 0.0, 1.0], 0.0)));
         let (cleared_max, lit) = display_difference(&standard, &cleared);
         let (kept_max, _) = display_difference(&standard, &kept);
@@ -551,7 +552,7 @@ fn declared_frames(gpu: &Arc<Gpu>, second_entry: ImageState) -> [Vec<u8>; 2] {
         let mut target = HostTarget { sync: declared(ImageState::UNUSED, ImageState::UNUSED), ..images.whole() };
         renderer.record_frame(cmd, Some(&target)).unwrap();
         copy_color(gpu, cmd, &images, &copies[0]);
-        renderer.set_camera(turned);
+        renderer.edit(SceneEdit::Camera(turned)).unwrap();
         (target.load, target.sync) = (true, declared(second_entry, depth_testing()));
         renderer.record_frame(cmd, Some(&target)).unwrap();
         copy_color(gpu, cmd, &images, &copies[1]);
@@ -567,7 +568,7 @@ fn attachment_frames(gpu: &Arc<Gpu>) -> [Vec<u8>; 2] {
     let mut renderer = host_renderer(gpu);
     record(gpu, &mut renderer, &images, &images.whole()).unwrap();
     let first = images.read_color();
-    renderer.set_camera(CameraView::of_scene(renderer.scene()).orbited(glam::Vec3::ZERO, 25.0));
+    renderer.edit(SceneEdit::Camera(CameraView::of_scene(renderer.scene()).orbited(glam::Vec3::ZERO, 25.0))).unwrap();
     gpu.one_shot("loaded frame", |cmd| {
         let color = vk::ImageAspectFlags::COLOR;
         ImageBarrier::new(images.color.raw(), color, &[Access::TransferRead], &[Access::ColorAttachmentWrite])

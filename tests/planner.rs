@@ -7,6 +7,7 @@ mod common;
 use common::*;
 use glam::Vec3;
 use std::sync::Arc;
+use translucent::SceneEdit;
 use translucent::gpu::{Gpu, RecordCounts};
 use translucent::optics::Material;
 use translucent::render::plan::{BakedLevels, Change, LevelReason, SplatLights, Transport};
@@ -99,7 +100,7 @@ fn a_camera_orbit_splats_and_gathers_once_while_the_view_changes() {
         let mut images = Vec::new();
         for i in 0..10 {
             if i > 0 {
-                renderer.set_camera(renderer.camera().orbited(Vec3::ZERO, 12.0));
+                renderer.edit(SceneEdit::Camera(renderer.camera().orbited(Vec3::ZERO, 12.0))).unwrap();
             }
             let counts = frame(gpu, &mut renderer);
             for (k, v) in counts.0 {
@@ -125,7 +126,7 @@ fn a_moving_key_light_splats_and_gathers_every_frame_and_redraws_one_shadow_map(
         for _ in 0..3 {
             let light = &renderer.scene().scene.file.lights[0];
             let moved = lights::orbit(light, Vec3::ZERO, 5.0).unwrap();
-            renderer.set_light(0, moved).unwrap();
+            renderer.edit(SceneEdit::Light { index: 0, light: moved }).unwrap();
             let counts = frame(gpu, &mut renderer);
             assert_eq!(counts.get("shadow.vert"), 1, "one map of one caster: {counts:?}");
             assert_eq!((counts.get("splat.comp"), counts.get("gather.comp")), (1, 1), "{counts:?}");
@@ -179,7 +180,7 @@ fn ketchup_at_metre_scale_goes_local_in_green_and_blue_and_matches_a_dense_gathe
 fn marble_at_five_centimetres_is_gathered_in_every_channel() {
     let text = format!("{}{}", stage([0.0, 0.05, 0.15], 256), sphere(0.025, [0.0; 3], "marble", 1000.0, true));
     let prepared = prepare(&text, &Overrides { samples: Some(400), ..Overrides::default() });
-    let camera = translucent::render::renderer::CameraView::of_scene(&prepared);
+    let camera = translucent::render::camera::CameraView::of_scene(&prepared);
     let view = translucent::render::plan::View::of_camera(&camera, 256);
     let needs = translucent::render::plan::needs(&prepared, false, Default::default());
     let plan = translucent::render::plan::Planner::new(1, Change::Everything).plan(&needs, &view);
@@ -205,12 +206,12 @@ fn an_object_behind_the_camera_is_not_gathered_until_the_camera_turns_to_it() {
         assert!(behind.iter().all(|e| *e == [0.0; 3]), "the ball behind was gathered");
         // Turn round on the spot: the ball behind comes into view, stale, and is gathered.
         let eye = renderer.camera().eye;
-        renderer.set_camera(renderer.camera().orbited(eye, 180.0));
+        renderer.edit(SceneEdit::Camera(renderer.camera().orbited(eye, 180.0))).unwrap();
         let counts = frame(gpu, &mut renderer);
         assert_eq!((counts.get("splat.comp"), counts.get("gather.comp")), (1, 1), "back ball only: {counts:?}");
         assert!(renderer.exitance(1).unwrap().iter().any(|e| e[0] > 0.0), "the ball now in view has no exitance");
         // And once more: nothing stale, nothing gathered.
-        renderer.set_camera(renderer.camera().orbited(eye, 1.0));
+        renderer.edit(SceneEdit::Camera(renderer.camera().orbited(eye, 1.0))).unwrap();
         let counts = frame(gpu, &mut renderer);
         assert_eq!(counts.get("splat.comp") + counts.get("gather.comp"), 0, "{counts:?}");
     });
@@ -225,7 +226,7 @@ fn a_material_change_regathers_the_same_samples_and_a_transform_change_resamples
         let samples = renderer.scene().objects[0].samples.clone();
         let marble = renderer.exitance(0).unwrap();
 
-        renderer.set_material(0, Material::preset("skimmilk").unwrap()).unwrap();
+        renderer.edit(SceneEdit::Material { object: 0, material: Material::preset("skimmilk").unwrap() }).unwrap();
         let counts = frame(gpu, &mut renderer);
         assert_eq!((counts.get("splat.comp"), counts.get("gather.comp")), (1, 1), "{counts:?}");
         assert_eq!(counts.get("shadow.vert"), 0, "a material does not move shadows: {counts:?}");
@@ -233,7 +234,7 @@ fn a_material_change_regathers_the_same_samples_and_a_transform_change_resamples
         assert_ne!(renderer.exitance(0).unwrap(), marble, "the new material changed nothing");
 
         let moved = Transform { translate: Some([0.002, 0.0, 0.0]), ..Transform::default() };
-        renderer.set_transform(0, moved).unwrap();
+        renderer.edit(SceneEdit::Transform { object: 0, transform: moved }).unwrap();
         let counts = frame(gpu, &mut renderer);
         assert_eq!((counts.get("splat.comp"), counts.get("gather.comp")), (1, 1), "{counts:?}");
         assert_eq!(counts.get("shadow.vert"), 1, "geometry moved: shadows redrawn: {counts:?}");
@@ -318,7 +319,7 @@ fn levels_baked_from_sky_light_are_withdrawn_when_it_is_recomputed_and_offered_o
         // host would, without baking) its baked levels are offered no more.
         let sky = renderer.needs().environment.expect("an environment light");
         let light = renderer.scene().scene.file.lights[sky].clone();
-        renderer.set_light(sky, light).unwrap();
+        renderer.edit(SceneEdit::Light { index: sky, light }).unwrap();
         let plan = renderer.plan(renderer.pending_change().unwrap());
         assert_eq!(plan.objects[floor].level_why, LevelReason::SkyLightRecomputed, "{plan}");
         gpu.one_shot("frame", |cmd| renderer.record_frame(cmd, None)).unwrap().unwrap();
@@ -346,7 +347,7 @@ fn a_moved_key_light_resplats_only_its_own_part_and_matches_a_full_splat() {
         let mut renderer = Renderer::new(gpu, prepare(&text, &Overrides::default())).unwrap();
         frame(gpu, &mut renderer);
         let light = lights::orbit(&renderer.scene().scene.file.lights[0], Vec3::ZERO, 40.0).unwrap();
-        renderer.set_light(0, light).unwrap();
+        renderer.edit(SceneEdit::Light { index: 0, light }).unwrap();
         let plan = renderer.plan(renderer.pending_change().unwrap());
         for o in &plan.objects {
             assert!(o.splat, "{plan}");
@@ -386,7 +387,7 @@ fn a_moved_key_light_resplats_only_its_own_part_and_matches_a_full_splat() {
         eprintln!("exitance from the kept splat against the full one: worst relative difference {worst:.2e}");
         assert!(worst <= 1e-6, "worst relative difference {worst:e}");
         // A material change re-splats that object whole.
-        renderer.set_material(1, Material::preset("marble").unwrap()).unwrap();
+        renderer.edit(SceneEdit::Material { object: 1, material: Material::preset("marble").unwrap() }).unwrap();
         let plan = renderer.plan(renderer.pending_change().unwrap());
         assert_eq!(plan.objects[1].splat_lights, SplatLights::All, "{plan}");
     });

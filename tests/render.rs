@@ -3,6 +3,7 @@
 mod common;
 
 use common::{builtin, gather_from, plane_scene, run_all, with_gpu};
+use translucent::SceneEdit;
 use translucent::optics::{Dipole, Material, fresnel};
 use translucent::reference;
 use translucent::render::plan::{Change, Pass};
@@ -414,7 +415,7 @@ fn sparse_gather_matches_its_reference_and_stays_close_to_the_vertex_gather() {
 fn orbit_light(renderer: &mut Renderer, index: usize, degrees: f32) {
     let scene = renderer.scene();
     let moved = lights::orbit(&scene.scene.file.lights[index], scene.bounds.0, degrees).unwrap();
-    renderer.set_light(index, moved).unwrap();
+    renderer.edit(SceneEdit::Light { index, light: moved }).unwrap();
 }
 
 #[test]
@@ -424,11 +425,11 @@ fn resize_and_set_camera_mark_only_shading_and_change_the_image() {
         assert_eq!(renderer.pending_change(), None, "a recorded frame leaves nothing pending");
         let (before, _) = renderer.image().unwrap();
         // Resize: the own images are made anew at the new size; only shading reruns.
-        renderer.resize(80, 48).unwrap();
+        renderer.edit(SceneEdit::Resize { width: 80, height: 48 }).unwrap();
         assert_eq!(renderer.pending_change(), Some(Change::Camera));
         let mut camera = renderer.camera();
         camera.projection = glam::camera::rh::proj::vulkan::perspective(30f32.to_radians(), 80.0 / 48.0, 0.01, 1.0);
-        renderer.set_camera(camera);
+        renderer.edit(SceneEdit::Camera(camera)).unwrap();
         let plan = renderer.plan(renderer.pending_change().unwrap());
         assert_eq!(plan.passes.iter().map(|(p, _)| *p).collect::<Vec<_>>(), [Pass::Shade, Pass::Tonemap]);
         renderer.frame(&plan).unwrap();
@@ -438,7 +439,7 @@ fn resize_and_set_camera_mark_only_shading_and_change_the_image() {
         // Moving the eye changes the picture.
         let mut moved = renderer.camera();
         moved.view *= glam::Mat4::from_rotation_y(0.5);
-        renderer.set_camera(moved);
+        renderer.edit(SceneEdit::Camera(moved)).unwrap();
         renderer.frame(&renderer.plan(Change::Camera)).unwrap();
         let (turned, _) = renderer.image().unwrap();
         let differ = after.iter().zip(&turned).filter(|(a, b)| a != b).count();
@@ -463,20 +464,20 @@ fn a_level_of_detail_holds_the_whole_mesh_exitance_at_its_vertices_bit_for_bit()
         // Its other vertices were not gathered: reading every vertex is refused, not stale.
         assert!(simplified.exitance(bunny.object).is_err());
         let image = simplified.image().unwrap().0;
-        let at_level: Vec<[f32; 4]> = simplified.buffers().exitance.read().unwrap();
+        let at_level: Vec<[f32; 4]> = simplified.scene_data().buffers().exitance().read().unwrap();
         // The same frame gathered at every vertex (level 0 forced): the same values, bit for bit.
         let mut every = simplified.plan(Change::Everything);
         every.objects.iter_mut().for_each(|o| o.level = 0);
         simplified.frame(&every).unwrap();
-        let at_all: Vec<[f32; 4]> = simplified.buffers().exitance.read().unwrap();
-        let first = simplified.buffers().object_range(bunny.object).first_vertex as usize;
+        let at_all: Vec<[f32; 4]> = simplified.scene_data().buffers().exitance().read().unwrap();
+        let first = simplified.scene_data().object_range(bunny.object).first_vertex as usize;
         for &v in &level.vertices {
             assert_eq!(at_level[first + v as usize], at_all[first + v as usize], "vertex {v}");
         }
         assert!(simplified.exitance(bunny.object).is_ok(), "gathered at every vertex now");
         // Against the renderer with whole meshes throughout: its shadow maps draw the bunny whole
         // where this one draws it within half a texel, so the splat differs slightly.
-        let whole_exitance: Vec<[f32; 4]> = full.buffers().exitance.read().unwrap();
+        let whole_exitance: Vec<[f32; 4]> = full.scene_data().buffers().exitance().read().unwrap();
         let pairs: Vec<(f64, f64)> = level
             .vertices
             .iter()
@@ -533,7 +534,7 @@ count = 64
     with_gpu(|gpu| {
         let mut renderer = Renderer::new(gpu, prepared).unwrap();
         renderer.frame(&renderer.plan(Change::Everything)).unwrap();
-        assert_eq!(renderer.buffers().local_channels(0), 0b111, "every channel local");
+        assert_eq!(renderer.scene_data().local_channels(0), 0b111, "every channel local");
         let drawn = renderer.exitance_drawn(0).unwrap();
         let mut worst = 0.0f64;
         for (n, got) in mesh.vertex_normals().iter().zip(&drawn) {

@@ -211,9 +211,9 @@ fn a_non_finite_value_is_traced_to_its_pass_and_object() {
         renderer.frame(&renderer.plan(Change::Everything)).unwrap();
         assert!(renderer.find_non_finite().unwrap().is_empty(), "a clean frame reports nothing");
         // Poison one sample of the second object, as a broken splat would, and gather again.
-        let mut splat: Vec<SplatRecord> = renderer.buffers().splat.read().unwrap();
+        let mut splat: Vec<SplatRecord> = renderer.scene_data().buffers().splat().read().unwrap();
         splat[16].irradiance_area[0] = f32::NAN;
-        renderer.buffers_mut().splat.write(0, &splat).unwrap();
+        renderer.scene_data_mut().buffers_mut().get_mut(translucent::render::graph::Resource::Splat).unwrap().write(0, &splat).unwrap();
         let mut plan = renderer.plan(Change::Everything);
         plan.passes.retain(|(p, _)| !matches!(p, Pass::Shadow | Pass::Splat));
         renderer.frame(&plan).unwrap();

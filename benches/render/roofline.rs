@@ -31,7 +31,8 @@ use translucent::gpu::{
 use translucent::render::plan::Plan;
 use translucent::render::records::Vertex;
 use translucent::render::renderer::Renderer;
-use translucent::render::shade::{HDR_FORMAT, ShadePush, culled_faces};
+use translucent::render::cull::culled_faces;
+use translucent::render::shade::{HDR_FORMAT, ShadePush};
 
 /// The camera's depth format (`render::targets::CAMERA_DEPTH_FORMAT`).
 const CAMERA_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
@@ -204,7 +205,7 @@ impl Roofline {
         let camera = renderer.camera();
         let camera_matrix = camera.projection * camera.view;
         let view_proj = camera_matrix.to_cols_array_2d();
-        let scene = renderer.buffers();
+        let scene = renderer.scene_data();
         // The faces the shading and shadow passes draw: those they cull are culled here too.
         let draws: Vec<_> = (0..scene.levels.len())
             .map(|i| scene.level(i, plan.level(i)))
@@ -218,7 +219,7 @@ impl Roofline {
             .map(|&(o, l)| scene.level(o, l))
             .map(|level| (level.draw, culled_faces(plan, &level, light_matrix, DepthConvention::Standard)))
             .collect();
-        let (vertices, indices) = (scene.vertices.raw(), scene.indices.raw());
+        let (vertices, indices) = (scene.buffers().vertices().raw(), scene.indices.raw());
         let receivers = frame_receivers(renderer, plan);
         let mut timer = self.timer.take().expect("the timer is put back after each run");
         self.gpu
@@ -302,8 +303,8 @@ impl Roofline {
         draws: &[(translucent::render::gpu_scene::DrawRange, vk::CullModeFlags)],
         view_proj: &[[f32; 4]; 4],
     ) {
-        let scene = renderer.buffers();
-        let streams = [scene.vertices.raw(), scene.exitance.raw(), scene.environment_irradiance.raw()];
+        let scene = renderer.scene_data();
+        let streams = [scene.buffers().vertices().raw(), scene.buffers().exitance().raw(), scene.buffers().environment_irradiance().raw()];
         let push = ShadePush { view_proj: *view_proj, ..bytemuck::Zeroable::zeroed() };
         let draw = |cmd| {
             // SAFETY: as in `record_raster`.
@@ -353,6 +354,8 @@ impl Roofline {
         // SAFETY: `cmd` is recording; the attachments are in the layouts the barriers set.
         unsafe { device.cmd_begin_rendering(cmd, &info) };
         draw(cmd);
+        // SAFETY: ends the render begun just above in the same `cmd`; `draw` only records
+        // binds and draws inside it.
         unsafe { device.cmd_end_rendering(cmd) };
         ImageBarrier::new(
             self.colour.raw(),
@@ -396,6 +399,7 @@ impl Roofline {
             self.depth.set_cull(cmd, *hidden);
             self.depth.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
         }
+        // SAFETY: ends the shadow render begun above in the same `cmd`.
         unsafe { device.cmd_end_rendering(cmd) };
     }
 
@@ -416,7 +420,7 @@ impl Roofline {
 
 /// Each translucent object the frame of `plan` gathers, and its receiver count there.
 pub fn frame_receivers(renderer: &Renderer, plan: &Plan) -> Vec<(u32, u32)> {
-    let scene = renderer.buffers();
+    let scene = renderer.scene_data();
     (0..scene.receivers.len())
         .map(|j| {
             let object = scene.receivers[j].object;
@@ -427,7 +431,7 @@ pub fn frame_receivers(renderer: &Renderer, plan: &Plan) -> Vec<(u32, u32)> {
 
 /// Vertex-sample pairs of the frame of `plan`'s gather, if it were flat.
 pub fn frame_pairs(renderer: &Renderer, plan: &Plan) -> f64 {
-    let scene = renderer.buffers();
+    let scene = renderer.scene_data();
     frame_receivers(renderer, plan)
         .iter()
         .zip(&scene.receivers)
@@ -439,16 +443,16 @@ pub fn frame_pairs(renderer: &Renderer, plan: &Plan) -> f64 {
 pub fn naive_gather(gpu: &Arc<Gpu>, renderer: &Renderer) -> (ComputePipeline, DescriptorSet, Buffer) {
     use translucent::render::graph::Resource;
     let naive = ComputePipeline::new(gpu, "bench/gather_naive.comp").expect("naive gather pipeline");
-    let b = renderer.buffers();
+    let b = renderer.scene_data();
     let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
     let size = 16 * b.vertex_count.max(1) as u64;
     let out = Buffer::new(gpu, &BufferDesc::gpu_only("naive exitance", size, usage)).expect("buffer");
     let set = naive
         .descriptor_set(&[
-            Resource::Vertices.bind(Binding::Buffer(&b.vertices)),
-            Resource::Samples.bind(Binding::Buffer(&b.samples)),
-            Resource::Splat.bind(Binding::Buffer(&b.splat)),
-            Resource::Objects.bind(Binding::Buffer(&b.objects)),
+            Resource::Vertices.bind(Binding::Buffer(&b.buffers().vertices())),
+            Resource::Samples.bind(Binding::Buffer(&b.buffers().samples())),
+            Resource::Splat.bind(Binding::Buffer(&b.buffers().splat())),
+            Resource::Objects.bind(Binding::Buffer(&b.buffers().objects())),
             Resource::Exitance.bind(Binding::Buffer(&out)),
         ])
         .expect("descriptor set");
@@ -516,7 +520,7 @@ impl Deferred {
         };
         let names = ["g_position", "g_normal", "g_exitance", "g_environment"];
         let mut bindings = vec![
-            Named { name: "Lights", binding: Binding::Buffer(&renderer.buffers().lights) },
+            Named { name: "Lights", binding: Binding::Buffer(&renderer.scene_data().buffers().lights()) },
             Named { name: "shadow_maps", binding: sampled(shadow, &samplers[0]) },
         ];
         bindings.extend(names.iter().zip(&targets).map(|(&name, t)| Named { name, binding: sampled(t, &samplers[1]) }));
@@ -564,8 +568,8 @@ impl Deferred {
         // The depth image is the roofline's; its parts run one after another in one submission.
         let depth = attachment(depth.view(), vk::ImageLayout::DEPTH_ATTACHMENT_OPTIMAL, true);
         let extent = self.targets[0].extent();
-        let scene = renderer.buffers();
-        let streams = [scene.vertices.raw(), scene.exitance.raw(), scene.environment_irradiance.raw()];
+        let scene = renderer.scene_data();
+        let streams = [scene.buffers().vertices().raw(), scene.buffers().exitance().raw(), scene.buffers().environment_irradiance().raw()];
         let push = ShadePush { view_proj: *view_proj, ..bytemuck::Zeroable::zeroed() };
         let info = vk::RenderingInfo::default()
             .render_area(vk::Rect2D { offset: vk::Offset2D::default(), extent })
@@ -584,6 +588,7 @@ impl Deferred {
             self.raster.set_cull(cmd, *hidden);
             self.raster.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
         }
+        // SAFETY: ends the render begun above in the same `cmd`.
         unsafe { device.cmd_end_rendering(cmd) };
         for t in &self.targets {
             let (from, to) = ([Access::ColorAttachmentWrite], [Access::ComputeSampledRead]);
@@ -602,7 +607,7 @@ impl Deferred {
         let device = gpu.device();
         let (drawn, read) = ([Access::DepthAttachmentReadWrite], [Access::ComputeSampledRead]);
         ImageBarrier::new(shadow.raw(), vk::ImageAspectFlags::DEPTH, &drawn, &read).record(device, cmd);
-        let scene = renderer.buffers();
+        let scene = renderer.scene_data();
         let eye = renderer.camera().eye;
         let object = (0..scene.levels.len())
             .find(|&i| scene.object_record(i).kind == translucent::render::records::MATERIAL_TRANSLUCENT)

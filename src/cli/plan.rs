@@ -5,7 +5,7 @@
 use anyhow::Result;
 use std::path::PathBuf;
 use translucent::render::plan::{self, Change, Planner};
-use translucent::render::renderer::CameraView;
+use translucent::render::camera::CameraView;
 use translucent::scene::build::{Overrides, PreparedScene};
 use translucent::scene::{GatherMode, Scene, TransportMode};
 

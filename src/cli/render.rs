@@ -4,6 +4,7 @@ use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
 use std::sync::Arc;
+use translucent::SceneEdit;
 use translucent::gpu::{Gpu, median};
 use translucent::output::OutputSet;
 use translucent::render::plan::{Change, Pass};
@@ -134,13 +135,13 @@ fn orbit_light(renderer: &mut Renderer, index: usize, degrees: f32) -> Result<()
     let scene = renderer.scene();
     let light = &scene.scene.file.lights[index];
     let moved = lights::orbit(light, scene.bounds.0, degrees).context("an environment light cannot orbit")?;
-    Ok(renderer.set_light(index, moved)?)
+    Ok(renderer.edit(SceneEdit::Light { index, light: moved })?)
 }
 
 /// Turn the camera by `degrees` about the vertical axis through the scene's centre.
-fn orbit_camera(renderer: &mut Renderer, degrees: f32) {
+fn orbit_camera(renderer: &mut Renderer, degrees: f32) -> Result<()> {
     let camera = renderer.camera().orbited(renderer.scene().bounds.0, degrees);
-    renderer.set_camera(camera);
+    Ok(renderer.edit(SceneEdit::Camera(camera))?)
 }
 
 fn parse_resolution(s: &str) -> Result<[u32; 2], String> {
@@ -270,7 +271,7 @@ fn run_frames(renderer: &mut Renderer, args: &Args, moving: Change) -> Result<Ti
         let change = if frame == 0 { Change::Everything } else { moving };
         match change {
             Change::Light(i) => orbit_light(renderer, i, 3.0)?,
-            Change::Camera => orbit_camera(renderer, 3.0),
+            Change::Camera => orbit_camera(renderer, 3.0)?,
             _ => {}
         }
         let plan = renderer.plan(change);

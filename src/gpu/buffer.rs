@@ -62,6 +62,7 @@ impl Buffer {
             .sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: valid create info; the buffer is destroyed in Drop or below on failure.
         let raw = unsafe { device.create_buffer(&info, None) }.vk("vkCreateBuffer")?;
+        // SAFETY: `raw` was just created on this device and is not yet bound or destroyed.
         let requirements = unsafe { device.get_buffer_memory_requirements(raw) };
         let allocation = gpu.allocator().allocate(&AllocationCreateDesc {
             name: &desc.name,
@@ -73,12 +74,16 @@ impl Buffer {
         let allocation = match allocation {
             Ok(a) => a,
             Err(source) => {
+                // SAFETY: `raw` was created above on this device and never used by a command, and
+                // nothing else holds the handle.
                 unsafe { device.destroy_buffer(raw, None) };
                 return Err(GpuError::Alloc { what: desc.name.clone(), source });
             }
         };
         // SAFETY: the allocation satisfies `requirements` and is not bound elsewhere.
         if let Err(result) = unsafe { device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) } {
+            // SAFETY: `raw` was created above on this device and never used by a command; it is
+            // destroyed before its (unbound) allocation is freed.
             unsafe { device.destroy_buffer(raw, None) };
             let _ = gpu.allocator().free(allocation);
             return Err(GpuError::Vk { what: "vkBindBufferMemory", result });

@@ -43,10 +43,15 @@ impl Gpu {
         // SAFETY: allocation from a pool owned by this thread.
         let cmd = unsafe { device.allocate_command_buffers(&alloc) }.vk("vkAllocateCommandBuffers")?[0];
         let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        // SAFETY: `cmd` was just allocated from `pool`, which only this call uses, so it is in
+        // the initial state and not accessed from another thread.
         unsafe { device.begin_command_buffer(cmd, &begin) }.vk("vkBeginCommandBuffer")?;
         let result = record(cmd);
+        // SAFETY: `cmd` is in the recording state (begun above); `record` only appends commands
+        // and ends any rendering it begins.
         unsafe { device.end_command_buffer(cmd) }.vk("vkEndCommandBuffer")?;
 
+        // SAFETY: default create info on a live device; `Transient` destroys the fence.
         transient.fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }.vk("vkCreateFence")?;
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
         let submit = [vk::SubmitInfo2::default().command_buffer_infos(&cmds)];
@@ -61,10 +66,15 @@ impl Gpu {
             Ok(()) => Ok(result),
             Err(vk::Result::TIMEOUT) => {
                 // The pool must not be destroyed while the work is pending.
+                // SAFETY: the device is live while `self` is. vkDeviceWaitIdle also wants every
+                // queue externally synchronised, and the queue guard was dropped after the submit:
+                // this relies on no other thread submitting meanwhile.
                 let _ = unsafe { device.device_wait_idle() };
                 Err(GpuError::Timeout { what: what.to_string(), seconds: self.timeout().as_secs_f64() })
             }
             Err(result) => {
+                // SAFETY: as for the timeout above: a live device, and no concurrent submit
+                // assumed (the queue guard is not held); `Transient` then frees the idle pool.
                 let _ = unsafe { device.device_wait_idle() };
                 Err(GpuError::Vk { what: "vkWaitForFences", result })
             }

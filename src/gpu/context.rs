@@ -241,6 +241,7 @@ impl Gpu {
         let info = device::enumerate(&instance)?.into_iter().find(|d| d.handle == physical).unwrap();
         // SAFETY: plain queries.
         let properties = unsafe { instance.get_physical_device_properties(physical) };
+        // SAFETY: plain query on `physical`, a physical device of the live `instance`.
         let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
         let timestamp_valid_bits = families.get(queue_family as usize).map(|f| f.timestamp_valid_bits).unwrap_or(0);
         let allocator = Allocator::new(&AllocatorCreateDesc {

@@ -84,6 +84,8 @@ impl DebugMessenger {
     /// # Safety
     /// Call once, before the instance is destroyed.
     pub(crate) unsafe fn destroy(&self) {
+        // SAFETY: the caller's contract: called once, while the instance that made the messenger
+        // is still alive.
         unsafe { self.loader.destroy_debug_utils_messenger(self.messenger, None) };
     }
 }

@@ -160,6 +160,8 @@ impl DescriptorSet {
         let mut out = DescriptorSet { gpu: gpu.clone(), pool, set: vk::DescriptorSet::null() };
         let layouts = [layout];
         let alloc = vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts);
+        // SAFETY: `pool` was just made for one set, with one descriptor per kind in `kinds`, from
+        // which `layout` (live, the pipeline's) was made; the set is freed with the pool in Drop.
         out.set = unsafe { device.allocate_descriptor_sets(&alloc) }.vk("vkAllocateDescriptorSets")?[0];
         out.update(kinds, bindings)?;
         Ok(out)

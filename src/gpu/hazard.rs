@@ -19,19 +19,27 @@ pub struct Use<K> {
     pub resource: K,
     /// How the command touches it (its stages, access mask and image layout follow).
     pub access: Access,
+    /// Whether the command writes it: the barriers order later accesses after a write, and a
+    /// write after every earlier read (`Hazards::before`).
+    pub writes: bool,
     /// A write that overwrites all of an image: its old contents are dropped (old layout
     /// UNDEFINED), while earlier accesses are still waited for.
     pub discard: bool,
 }
 
 impl<K> Use<K> {
-    /// `access` to `resource`, keeping its contents.
-    pub const fn new(resource: K, access: Access) -> Use<K> {
-        Use { resource, access, discard: false }
+    /// `access` reads `resource`. A read through an access that writes is a contract violation,
+    /// caught in debug builds (`Hazards::before`).
+    pub const fn read(resource: K, access: Access) -> Use<K> {
+        Use { resource, access, writes: false, discard: false }
+    }
+    /// `access` writes `resource`, keeping its contents where it does not write.
+    pub const fn write(resource: K, access: Access) -> Use<K> {
+        Use { resource, access, writes: true, discard: false }
     }
     /// A write that overwrites all of `resource` (`discard`).
     pub const fn overwrite(resource: K, access: Access) -> Use<K> {
-        Use { resource, access, discard: true }
+        Use { resource, access, writes: true, discard: true }
     }
 }
 
@@ -134,6 +142,7 @@ impl<K: Copy + Eq + Hash + std::fmt::Debug> Hazards<K> {
         let mut global = Sides::default();
         let mut images = Vec::new();
         for u in uses {
+            debug_assert_eq!(u.writes, u.access.writes(), "{:?} declared as a {}", u.access, ["read", "write"][usize::from(u.writes)]);
             let state = self.states.entry(u.resource).or_default();
             let next_layout = state.layout.map(|_| u.access.layout());
             let relayout = u.discard || next_layout.is_some() && next_layout != state.layout;
@@ -143,7 +152,7 @@ impl<K: Copy + Eq + Hash + std::fmt::Debug> Hazards<K> {
             // behind an earlier layout change.
             let unseen = state.write.is_some() && !state.reads.contains(&u.access);
             let mut sides = Sides::default();
-            if u.access.writes() || relayout || unseen {
+            if u.writes || relayout || unseen {
                 sides.add(&state.reads, state.write, u.access);
             }
             match (state.image, relayout) {
@@ -165,7 +174,7 @@ impl<K: Copy + Eq + Hash + std::fmt::Debug> Hazards<K> {
                 }
                 _ => {}
             }
-            if u.access.writes() {
+            if u.writes {
                 state.write = Some(u.access);
                 state.reads.clear();
             } else if relayout {

@@ -121,6 +121,7 @@ impl Image {
             .initial_layout(vk::ImageLayout::UNDEFINED);
         // SAFETY: valid create info; destroyed in Drop or below on failure.
         let raw = unsafe { device.create_image(&info, None) }.vk("vkCreateImage")?;
+        // SAFETY: `raw` was just created on this device and is not yet bound or destroyed.
         let requirements = unsafe { device.get_image_memory_requirements(raw) };
         let allocation = match gpu.allocator().allocate(&AllocationCreateDesc {
             name: &desc.name,
@@ -131,6 +132,8 @@ impl Image {
         }) {
             Ok(a) => a,
             Err(source) => {
+                // SAFETY: `raw` was created above on this device, has no memory bound and was never
+                // used by a command, and nothing else holds the handle.
                 unsafe { device.destroy_image(raw, None) };
                 return Err(GpuError::Alloc { what: desc.name.clone(), source });
             }
@@ -157,6 +160,8 @@ impl Image {
                     .level_count(1)
                     .layer_count(desc.layers),
             );
+        // SAFETY: `raw` is bound to memory and the view's format, aspect and layers match its
+        // create info; Drop destroys the view (on error here `view` stays null and Drop skips it).
         image.view = unsafe { device.create_image_view(&view_info, None) }.vk("vkCreateImageView")?;
         Ok(image)
     }

@@ -91,8 +91,12 @@ impl OwnedInstance {
     /// Every object created from the instance must already be destroyed.
     pub(crate) unsafe fn destroy(&mut self) {
         if let Some(debug) = self.debug.take() {
+            // SAFETY: `take` makes this the only call for the messenger, and the instance is still
+            // alive (destroyed just below).
             unsafe { debug.destroy() };
         }
+        // SAFETY: the caller's contract: every object made from the instance is gone, and the
+        // messenger went just above.
         unsafe { self.instance.destroy_instance(None) };
     }
 }

@@ -198,6 +198,8 @@ impl ComputePipeline {
         // SAFETY: `cmd` is recording, outside a render pass.
         unsafe { device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline) };
         self.layout.bind(cmd, vk::PipelineBindPoint::COMPUTE, Some(set), push);
+        // SAFETY: `cmd` is recording outside a render pass, with this compute pipeline, its set
+        // and its push block bound just above; every group count is at least 1.
         unsafe { device.cmd_dispatch(cmd, groups[0], groups[1], groups[2]) };
         self.layout.gpu.count_recorded(&self.name);
     }

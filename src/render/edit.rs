@@ -5,7 +5,7 @@
 //! remakes the camera images. The renderer itself, its timers, frame targets and planner
 //! history, stays; the planner learns what changed (`plan::Change`).
 
-use super::renderer::CameraView;
+use super::camera::CameraView;
 use crate::optics::Material;
 use crate::scene::{Light, Transform};
 

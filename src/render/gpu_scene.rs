@@ -3,7 +3,7 @@
 //! write and read between frames (splat output, exitance, cached environment irradiance). The
 //! passes get their inputs from here; only lights and object records change after creation.
 
-use super::graph::Resource;
+use super::resource::{Resource, SceneBuffers};
 use super::records::{
     BeamNodeRecord, BeamSourceRecord, BvhNodeRecord, BvhTriangleRecord, LightGpu, NodePowerRecord, ObjectRecord,
     ReceiverGroupRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
@@ -101,61 +101,11 @@ pub struct ObjectRange {
 /// passes must be dropped first (`Renderer` declares its passes before its `GpuScene`). Only the
 /// light records and shadow matrices change after creation (`set_lights`).
 pub struct GpuScene {
-    /// `records::Vertex` per vertex of every object, objects one after another.
-    pub vertices: Buffer,
+    /// The buffers of every scene resource (`resource::SceneBuffers`).
+    pub(in crate::render) buffers: SceneBuffers,
     /// u32 triangle indices of every object, relative to its first vertex
     /// (`DrawRange::vertex_offset`).
     pub indices: Buffer,
-    /// Radiant exitance per vertex (vec4), written by the vertex and sparse gathers; zero on
-    /// opaque objects.
-    pub exitance: Buffer,
-    /// Per vertex (vec2), the distances to the two nearest open-boundary directions of a
-    /// translucent object (`mesh::Mesh::boundary_distances`; `mesh::NO_BOUNDARY` on closed
-    /// meshes and opaque objects), for the gathers' near-field edge factor.
-    pub vertex_boundary: Buffer,
-    /// Irradiance from the environment's directions per vertex (vec4), from the vertex-light pass.
-    pub environment_irradiance: Buffer,
-    /// The locally computed channels' exitance per vertex (vec4), written on demand by the
-    /// local-exitance pass (`Renderer::exitance_drawn`).
-    pub local_exitance: Buffer,
-    /// `ObjectRecord` per object, in scene order.
-    pub objects: Buffer,
-    /// `SampleRecord` per sample point, objects one after another (`ObjectRecord::ranges` says
-    /// where each object's are).
-    pub samples: Buffer,
-    /// `SplatRecord` per sample, from the splat pass.
-    pub splat: Buffer,
-    /// Per sample (vec4), the irradiance transmitted from the environment's directions alone,
-    /// kept by the splat pass so that a frame after a key light moved adds only the key lights
-    /// (`plan::SplatLights::KeyLights`).
-    pub splat_environment: Buffer,
-    /// `TreeNodeRecord` per node of every translucent object's sample hierarchy
-    /// (`sampling::SampleTree`), objects one after another (`Receiver::first_node`).
-    pub tree_nodes: Buffer,
-    /// Sample indices (u32, absolute) in the hierarchies' leaf order: node `n`'s samples are
-    /// `tree_order[n.first .. n.first + n.count]`. After each object's samples, its nodes
-    /// (absolute) grouped by height (`node_heights`).
-    pub tree_order: Buffer,
-    /// `NodePowerRecord` per node, written by the hierarchical gather's stage 0.
-    pub node_power: Buffer,
-    /// Vertex indices (u32, absolute) of every translucent object in group order
-    /// (`sampling::ReceiverGroups`): the hierarchical gather's invocation `k` of an object
-    /// gathers at `receiver_order[first_receiver + k]`.
-    pub receiver_order: Buffer,
-    /// `ReceiverGroupRecord` per group of `RECEIVER_GROUP_SIZE` receivers: its bounding sphere
-    /// and its range in `group_items`.
-    pub receiver_groups: Buffer,
-    /// The hierarchical gather's items (`sampling::SampleTree::cut`) of every group, groups one
-    /// after another, made absolute: a sample index, or `NODE_ITEM |` a node index. Built only
-    /// when the scene gathers hierarchically (otherwise empty).
-    pub group_items: Buffer,
-    /// The samples (absolute indices) whose near-blend radius reaches each group
-    /// (`sampling::SampleTree::within_reach`), groups one after another: what the sparse
-    /// gather's blend visits. Built only when the scene gathers sparsely (otherwise empty).
-    pub blend_items: Buffer,
-    /// `LightGpu` per prepared light, key lights first; rewritten inside a frame's command buffer
-    /// when lights change (`record_uploads`).
-    pub lights: Buffer,
     /// Per object, in scene order: its levels of detail, the whole mesh first.
     pub levels: Vec<Vec<LevelRange>>,
     /// The objects that cast shadows: (scene index, the level of detail drawn into shadow maps).
@@ -163,43 +113,8 @@ pub struct GpuScene {
     /// map spanning the casters' bounding sphere), so the full-detail surface the splat and
     /// shading look up from never falls behind a simplified caster (self-shadowing).
     pub casters: Vec<(usize, usize)>,
-    /// Per sample (u32), its atlas texel `x | y << 16` (0 for samples of objects without an
-    /// atlas).
-    pub texel_coords: Buffer,
-    /// Every atlas's index map, objects one after another (`TextureRange::first_index`):
-    /// per texel, row by row, its object-relative sample or `mesh::atlas::NO_TEXEL`.
-    pub texel_index: Buffer,
-    /// Per vertex (u32), its atlas texel `x | y << 16` (0 on objects without an atlas).
-    pub vertex_texel: Buffer,
-    /// Per node of every atlas's sum tree (f32), written by the texture gather's stage 0.
-    pub texture_pyramid: Buffer,
-    /// The shadow casters' hierarchy (`BvhNodeRecord` per node of `mesh::bvh::Bvh::flat`),
-    /// for the splat's shadow rays; empty (16 unread bytes) when nothing casts a shadow or the
-    /// splat takes the maps alone.
-    pub bvh_nodes: Buffer,
-    /// Its triangles in leaf order (`BvhTriangleRecord`).
-    pub bvh_triangles: Buffer,
-    /// The between-points single scattering's kernel tables, f16 cells packed as uvec4, objects
-    /// one after another (`beam_gather::pack_tables`); one unread entry when
-    /// there are none.
-    pub beam_tables: Buffer,
-    /// `BeamNodeRecord` per node of the sample hierarchies where an object takes the model (one
-    /// unread entry otherwise), written by the between-points pass's stage 0.
-    pub beam_nodes: Buffer,
-    /// `BeamSourceRecord` per entry of `tree_order`, then per node of `tree_nodes` (its stand-in
-    /// for its members), where an object takes the model (one unread entry otherwise), written
-    /// by the between-points pass's stage 0.
-    pub beam_sources: Buffer,
-    /// `BeamReceiverRecord` per vertex, then one closing the last walk: the between-points
-    /// density correction's denominator per channel and the vertex's first walk item
-    /// (`beam_gather::receiver_walks`).
-    pub beam_norms: Buffer,
-    /// The walks of the whole meshes' receivers where an object takes the model
-    /// (`beam_gather::receiver_walks`; `ObjectBeams::lists`), vertex after vertex; one unread
-    /// entry when there are none.
-    pub beam_items: Buffer,
     /// Per object, in scene order: its between-points channels and their tables' places.
-    pub beams: Vec<Option<super::beam_gather::ObjectBeams>>,
+    pub beams: Vec<Option<super::beam_tables::ObjectBeams>>,
     /// The nodes' stand-ins' first entry in `beam_sources`: `tree_order`'s length.
     pub beam_standins: u32,
     /// Triangles in `bvh_triangles`: 0 when nothing casts a shadow.
@@ -209,9 +124,6 @@ pub struct GpuScene {
     pub ray_offset: f32,
     /// Per object, in scene order: its atlas and sum tree's place (`TextureRange`).
     pub textures: Vec<TextureRange>,
-    /// Per level of detail of every object, one after another: the object-relative indices of
-    /// the vertices it uses, ascending (`LevelRange::first_entry`).
-    pub level_vertices: Buffer,
     /// World -> clip matrix of each shadow-map layer.
     pub light_matrices: Vec<[[f32; 4]; 4]>,
     /// The translucent objects, in scene order: what the gathers dispatch over.
@@ -554,7 +466,7 @@ impl GpuScene {
         gpu_scene.set_lights(scene);
         // Before any frame the buffer is idle: written from the host directly.
         if let Some(records) = gpu_scene.pending_lights.take().filter(|r| !r.is_empty()) {
-            gpu_scene.lights.write(0, &records)?;
+            gpu_scene.buffers.lights.write(0, &records)?;
         }
         Ok(gpu_scene)
     }
@@ -563,46 +475,51 @@ impl GpuScene {
     fn upload(gpu: &Arc<Gpu>, scene: &PreparedScene, p: PackedObjects, l: PackedLevels) -> GpuResult<GpuScene> {
         let none = vk::BufferUsageFlags::empty();
         let vertex_usage = vk::BufferUsageFlags::VERTEX_BUFFER;
-        let super::beam_gather::PackedBeams { tables, receivers, items, beams } =
-            super::beam_gather::pack_tables(scene, &p.beam_trees);
+        let super::beam_tables::PackedBeams { tables, receivers, items, beams } =
+            super::beam_tables::pack_tables(scene, &p.beam_trees);
         let any_beams = beams.iter().any(Option::is_some);
         let beam_node_count = if any_beams { p.tree_nodes.len() } else { 1 };
         // The samples' entries, then the nodes' stand-ins.
         let beam_source_count = if any_beams { p.tree_order.len() + p.tree_nodes.len() } else { 1 };
         let zeros = vec![[0f32; 4]; p.vertices.len()];
         let sized = |name, item: usize, count: usize| storage(gpu, name, (item * count) as u64, none);
+        // Made in the order they always were, vertices then indices first.
+        let vertices = upload(gpu, "vertices", &p.vertices, vertex_usage)?;
+        let indices = upload(gpu, "indices", &l.indices, vk::BufferUsageFlags::INDEX_BUFFER)?;
         Ok(GpuScene {
-            vertices: upload(gpu, "vertices", &p.vertices, vertex_usage)?,
-            indices: upload(gpu, "indices", &l.indices, vk::BufferUsageFlags::INDEX_BUFFER)?,
-            // Opaque vertices keep zero exitance; translucent ones are written by the gather.
-            exitance: upload(gpu, "exitance", &zeros, vertex_usage)?,
-            environment_irradiance: upload(gpu, "environment irradiance", &zeros, vertex_usage)?,
-            local_exitance: sized("local exitance", std::mem::size_of::<[f32; 4]>(), p.vertices.len())?,
-            vertex_boundary: upload(gpu, "vertex boundary", &p.vertex_boundary, none)?,
-            objects: upload(gpu, "objects", &p.objects, none)?,
-            samples: upload(gpu, "samples", &p.samples, none)?,
-            splat: sized("splat", std::mem::size_of::<SplatRecord>(), p.samples.len())?,
-            splat_environment: sized("splat environment", std::mem::size_of::<[f32; 4]>(), p.samples.len())?,
-            tree_nodes: upload(gpu, "tree nodes", &p.tree_nodes, none)?,
-            tree_order: upload(gpu, "tree order", &p.tree_order, none)?,
-            receiver_order: upload(gpu, "receiver order", &p.receiver_order, none)?,
-            receiver_groups: upload(gpu, "receiver groups", &p.receiver_groups, none)?,
-            group_items: upload(gpu, "group items", &p.group_items, none)?,
-            blend_items: upload(gpu, "blend items", &p.blend_items, none)?,
-            node_power: sized("node power", std::mem::size_of::<NodePowerRecord>(), p.tree_nodes.len())?,
-            lights: sized("lights", std::mem::size_of::<LightGpu>(), scene.lights.len())?,
-            level_vertices: upload(gpu, "level vertices", &l.level_vertices, none)?,
-            texel_coords: upload(gpu, "texel coordinates", &p.texel_coords, none)?,
-            texel_index: upload(gpu, "texel index", &p.texel_index, none)?,
-            vertex_texel: upload(gpu, "vertex texel", &p.vertex_texel, none)?,
-            texture_pyramid: sized("texture pyramid", std::mem::size_of::<f32>(), p.pyramid_nodes)?,
-            bvh_nodes: upload(gpu, "caster hierarchy", &p.bvh_nodes, none)?,
-            bvh_triangles: upload(gpu, "caster triangles", &p.bvh_triangles, none)?,
-            beam_tables: upload(gpu, "beam tables", &tables, none)?,
-            beam_nodes: sized("beam nodes", std::mem::size_of::<BeamNodeRecord>(), beam_node_count)?,
-            beam_sources: sized("beam sources", std::mem::size_of::<BeamSourceRecord>(), beam_source_count)?,
-            beam_norms: upload(gpu, "beam receivers", &receivers, none)?,
-            beam_items: upload(gpu, "beam walk items", &items, none)?,
+            buffers: SceneBuffers {
+                vertices,
+                // Opaque vertices keep zero exitance; translucent ones are written by the gather.
+                exitance: upload(gpu, "exitance", &zeros, vertex_usage)?,
+                environment_irradiance: upload(gpu, "environment irradiance", &zeros, vertex_usage)?,
+                local_exitance: sized("local exitance", std::mem::size_of::<[f32; 4]>(), p.vertices.len())?,
+                vertex_boundary: upload(gpu, "vertex boundary", &p.vertex_boundary, none)?,
+                objects: upload(gpu, "objects", &p.objects, none)?,
+                samples: upload(gpu, "samples", &p.samples, none)?,
+                splat: sized("splat", std::mem::size_of::<SplatRecord>(), p.samples.len())?,
+                splat_environment: sized("splat environment", std::mem::size_of::<[f32; 4]>(), p.samples.len())?,
+                tree_nodes: upload(gpu, "tree nodes", &p.tree_nodes, none)?,
+                tree_order: upload(gpu, "tree order", &p.tree_order, none)?,
+                receiver_order: upload(gpu, "receiver order", &p.receiver_order, none)?,
+                receiver_groups: upload(gpu, "receiver groups", &p.receiver_groups, none)?,
+                group_items: upload(gpu, "group items", &p.group_items, none)?,
+                blend_items: upload(gpu, "blend items", &p.blend_items, none)?,
+                node_power: sized("node power", std::mem::size_of::<NodePowerRecord>(), p.tree_nodes.len())?,
+                lights: sized("lights", std::mem::size_of::<LightGpu>(), scene.lights.len())?,
+                level_vertices: upload(gpu, "level vertices", &l.level_vertices, none)?,
+                texel_coords: upload(gpu, "texel coordinates", &p.texel_coords, none)?,
+                texel_index: upload(gpu, "texel index", &p.texel_index, none)?,
+                vertex_texel: upload(gpu, "vertex texel", &p.vertex_texel, none)?,
+                texture_pyramid: sized("texture pyramid", std::mem::size_of::<f32>(), p.pyramid_nodes)?,
+                bvh_nodes: upload(gpu, "caster hierarchy", &p.bvh_nodes, none)?,
+                bvh_triangles: upload(gpu, "caster triangles", &p.bvh_triangles, none)?,
+                beam_tables: upload(gpu, "beam tables", &tables, none)?,
+                beam_nodes: sized("beam nodes", std::mem::size_of::<BeamNodeRecord>(), beam_node_count)?,
+                beam_sources: sized("beam sources", std::mem::size_of::<BeamSourceRecord>(), beam_source_count)?,
+                beam_norms: upload(gpu, "beam receivers", &receivers, none)?,
+                beam_items: upload(gpu, "beam walk items", &items, none)?,
+            },
+            indices,
             beams,
             beam_standins: p.tree_order.len() as u32,
             caster_triangles: p.bvh_triangles.len() as u32,
@@ -677,6 +594,16 @@ impl GpuScene {
         }
     }
 
+    /// The scene's buffers, each also reachable by its `Resource` (`SceneBuffers::get`).
+    pub fn buffers(&self) -> &SceneBuffers {
+        &self.buffers
+    }
+
+    /// The scene's buffers, to write from the host (`Renderer::scene_data_mut` says when).
+    pub fn buffers_mut(&mut self) -> &mut SceneBuffers {
+        &mut self.buffers
+    }
+
     /// Object `object`'s range (`object_ranges`).
     pub fn object_range(&self, object: usize) -> ObjectRange {
         self.object_ranges().nth(object).expect("an object of the scene")
@@ -732,10 +659,10 @@ impl GpuScene {
     /// flight keep what they had). The barriers around it follow from `pending_uploads`.
     pub fn record_uploads(&mut self, device: &ash::Device, cmd: vk::CommandBuffer) {
         if let Some(records) = self.pending_lights.take().filter(|r| !r.is_empty()) {
-            update(device, cmd, &self.lights, bytemuck::cast_slice(&records));
+            update(device, cmd, &self.buffers.lights, bytemuck::cast_slice(&records));
         }
         if std::mem::take(&mut self.pending_objects) {
-            update(device, cmd, &self.objects, bytemuck::cast_slice(&self.object_records));
+            update(device, cmd, &self.buffers.objects, bytemuck::cast_slice(&self.object_records));
         }
     }
 }

@@ -3,65 +3,10 @@
 //! them, and what would otherwise be a validation error and, on some drivers, a crash is a
 //! `RenderError`), and the hand-over of its images when it declares their states (`HostSync`).
 
-use super::renderer::RenderError;
-use super::shade::{HostTarget, TargetDesc};
+use super::error::RenderError;
+use super::target::{DeclaredImage, HostSync, HostTarget, ImageState, TargetDesc};
 use crate::gpu::{Gpu, aspect_of, image_transition};
 use ash::vk;
-
-/// How the host hands its attachments to the shading pass and takes them back.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum HostSync {
-    /// In the attachment layouts on entry and on exit (COLOR_ATTACHMENT_OPTIMAL,
-    /// DEPTH_ATTACHMENT_OPTIMAL): the host's earlier attachment writes are waited for, and its
-    /// next use needs a barrier of its own from translucent's attachment writes.
-    #[default]
-    Attachments,
-    /// Each image's state on entry and the state the host wants it in on exit
-    /// (FidelityFX-style): translucent records the image barriers, layout changes included, from
-    /// the entry state to its attachment use and from that to the exit state, and the host
-    /// records none around it.
-    Declared {
-        /// The colour image.
-        color: DeclaredImage,
-        /// The depth image.
-        depth: DeclaredImage,
-    },
-}
-
-/// One of the host's images with its states on entry and exit (`HostSync::Declared`). The
-/// barriers cover mip level 0 and array layer 0, what the attachment's view shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct DeclaredImage {
-    /// The image the attachment's view is of.
-    pub image: vk::Image,
-    /// Its layout, and the stages and accesses of the host's last use before the frame
-    /// (`ImageState::UNUSED` for a new image). Its layout may be UNDEFINED only when the frame
-    /// does not `load` it.
-    pub entry: ImageState,
-    /// The layout the host wants it in after the frame, and the stages and accesses of its
-    /// next use: neither UNDEFINED nor PREINITIALIZED.
-    pub exit: ImageState,
-}
-
-/// A layout and the pipeline stages and accesses of a use of an image.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ImageState {
-    /// The image's layout during that use.
-    pub layout: vk::ImageLayout,
-    /// The stages of the use.
-    pub stages: vk::PipelineStageFlags2,
-    /// Its memory accesses (empty for a read-only use that needs no visibility, as on entry).
-    pub access: vk::AccessFlags2,
-}
-
-impl ImageState {
-    /// A new image: UNDEFINED, no earlier use to wait for.
-    pub const UNUSED: ImageState = ImageState {
-        layout: vk::ImageLayout::UNDEFINED,
-        stages: vk::PipelineStageFlags2::NONE,
-        access: vk::AccessFlags2::NONE,
-    };
-}
 
 /// How the shading pass uses the host's colour image: loads or clears it and writes it.
 const COLOR_USE: ImageState = ImageState {

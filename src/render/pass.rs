@@ -3,17 +3,21 @@
 //! frame which named resources it reads and writes (`uses`), and records from `FrameInputs`.
 //! The pass loop records the barriers its declaration needs before it (`FrameInputs::before`),
 //! so a pass knows nothing of who reads its output. Adding a pass: one GLSL file, one module
-//! implementing `RenderPass`, one entry in `plan::Pass` and in `Renderer::pass`.
+//! implementing `RenderPass` and `RegisteredPass`, and one line in `registry::for_each_pass!`.
 
+use super::error::RenderError;
 use super::gpu_scene::GpuScene;
-use super::graph::{Resource, Use};
-use super::plan::Plan;
-use super::shade::HostTarget;
+use super::graph::{Resource, Resources, Use};
+use super::options::RendererOptions;
+use super::plan::{Plan, SceneNeeds};
+use super::target::{HostTarget, TargetDesc};
 use super::targets::FrameTargets;
 use crate::gpu::{Gpu, Hazards};
+use crate::scene::build::PreparedScene;
 use ash::vk;
 use glam::{Mat4, Vec3};
 use std::cell::RefCell;
+use std::sync::Arc;
 
 /// What one frame gives the passes besides the scene data they were built with.
 pub struct FrameInputs<'a> {
@@ -52,11 +56,47 @@ impl FrameInputs<'_> {
 }
 
 /// A GPU pass: built once over the frame's resources, then recorded into the command buffer of
-/// every frame whose plan runs it. `Renderer::pass` maps each `plan::Pass` to one.
+/// every frame whose plan runs it. The registry (`registry::for_each_pass!`) maps each
+/// `plan::Pass` to one.
 pub trait RenderPass {
     /// Every access this frame's recording makes: what it reads and writes, and how. The pass
     /// loop records the barriers these need before `record`.
     fn uses(&self, frame: &FrameInputs) -> Vec<Use>;
     /// Record the pass into `cmd` (recording, outside any rendering).
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs);
+}
+
+/// What a registered pass is built from: the device, the frame's shared resources, the scene
+/// and what the planner knows of it, and the host's choices.
+pub struct PassContext<'a> {
+    /// The device the pass's pipelines are made on.
+    pub gpu: &'a Arc<Gpu>,
+    /// The scene's buffers and the frame targets, to bind by name.
+    pub resources: Resources<'a>,
+    /// The prepared scene (its settings choose among a pass's variants).
+    pub scene: &'a PreparedScene,
+    /// What the planner weighs for this scene and target (e.g. whether the gather is per pixel).
+    pub needs: &'a SceneNeeds,
+    /// Where shading draws.
+    pub target: TargetDesc,
+    /// The host's choices (depth test, samples).
+    pub options: &'a RendererOptions,
+}
+
+/// When the renderer builds a pass anew, besides when it is made.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rebuild {
+    /// The own target was resized (`SceneEdit::Resize`): its camera images are new.
+    Resize,
+    /// The scene's GPU data was made anew (`SceneEdit::Transform`): every scene buffer is new.
+    SceneData,
+}
+
+/// A pass the registry (`registry::for_each_pass!`) can build: how, and when again.
+pub trait RegisteredPass: RenderPass + Sized {
+    /// The events after which the pass is built anew, because it binds what they replace.
+    const REBUILT_ON: &'static [Rebuild];
+    /// The pass for `context`, or `None` where this renderer has none (the tone map of a host
+    /// target).
+    fn build(context: &PassContext) -> Result<Option<Self>, RenderError>;
 }

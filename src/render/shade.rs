@@ -8,16 +8,15 @@
 //! environment irradiance (vec4 per vertex each).
 //! Bindings: 0 = lights, 1 = shadow maps. Push: `ShadePush` (with the object's material).
 
-use super::gpu_scene::LevelRange;
 use super::graph::{Resource, Resources, Use, overwrite, read, write};
-use super::host::HostSync;
-use super::pass::{FrameInputs, RenderPass};
-use super::plan::Plan;
+use super::cull::culled_faces;
+use super::target::{DepthTest, TargetDesc};
+use super::error::RenderError;
+use super::options::RendererOptions;
+use super::pass::{FrameInputs, PassContext, Rebuild, RegisteredPass, RenderPass};
 use super::records::Vertex;
 use crate::gpu::{Access, DescriptorSet, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline};
-use crate::mesh::Enclosure;
 use ash::vk;
-use glam::{Mat4, Vec3};
 use std::sync::Arc;
 
 use super::targets::CAMERA_DEPTH_FORMAT;
@@ -49,187 +48,6 @@ pub struct ShadePush {
     /// x: the object's `ObjectRecord::eta`; y: its `norm`; zw: 0. In the push block, not read
     /// from the record: llvmpipe loads a storage buffer lane by lane in a fragment shader.
     pub material: [f32; 4],
-}
-
-/// What the shading pass draws into.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TargetDesc {
-    /// Its own linear HDR image (RGBA32F) and depth, tone-mapped by the tone-map pass.
-    Own,
-    /// A host engine's colour and depth images of these formats, given each frame as a
-    /// `HostTarget`. The pass writes linear radiance (alpha 1) and depth-tests against the host's
-    /// depth, depth written, as the renderer's `DepthTest` says (`RendererOptions::depth`: 0 near,
-    /// 1 far and LESS_OR_EQUAL unless the host chose reversed-Z).
-    Host {
-        /// Format of the host's colour image.
-        color_format: vk::Format,
-        /// Format of the host's depth image.
-        depth_format: vk::Format,
-    },
-}
-
-/// Which way depth runs in the target's depth image.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum DepthConvention {
-    /// 0 at the near plane, 1 at the far plane: cleared to 1, nearer is less.
-    #[default]
-    Standard,
-    /// Reversed-Z: 1 at the near plane, 0 at the far plane: cleared to 0, nearer is greater
-    /// (float depth's precision then spreads over distance). The camera's projection must map
-    /// so too (`CameraView::reversed_depth`).
-    Reversed,
-}
-
-/// The depth test shading makes against the target's depth (and writes it).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct DepthTest {
-    /// Which way depth runs: what `load: false` clears to, and which comparisons make sense.
-    pub convention: DepthConvention,
-    /// The comparison: one that passes nearer fragments under `convention` (LESS or
-    /// LESS_OR_EQUAL for standard depth, GREATER or GREATER_OR_EQUAL for reversed), or EQUAL
-    /// (after the host's depth pre-pass) or ALWAYS under either; `Renderer::with_options`
-    /// refuses the others (`RenderError::DepthCompare`).
-    pub compare: vk::CompareOp,
-}
-
-impl DepthTest {
-    /// 0 near, 1 far, LESS_OR_EQUAL: the default, and the CLI's.
-    pub const STANDARD: DepthTest =
-        DepthTest { convention: DepthConvention::Standard, compare: vk::CompareOp::LESS_OR_EQUAL };
-    /// Reversed-Z: 1 near, 0 far, GREATER_OR_EQUAL.
-    pub const REVERSED: DepthTest =
-        DepthTest { convention: DepthConvention::Reversed, compare: vk::CompareOp::GREATER_OR_EQUAL };
-
-    /// The far plane's depth, which `load: false` clears to.
-    pub fn far(self) -> f32 {
-        match self.convention {
-            DepthConvention::Standard => 1.0,
-            DepthConvention::Reversed => 0.0,
-        }
-    }
-
-    /// Whether `compare` passes nearer fragments under `convention` (see `compare`).
-    pub fn is_consistent(self) -> bool {
-        use vk::CompareOp as C;
-        match (self.convention, self.compare) {
-            (_, C::EQUAL | C::ALWAYS) => true,
-            (DepthConvention::Standard, c) => c == C::LESS || c == C::LESS_OR_EQUAL,
-            (DepthConvention::Reversed, c) => c == C::GREATER || c == C::GREATER_OR_EQUAL,
-        }
-    }
-}
-
-impl Default for DepthTest {
-    fn default() -> Self {
-        DepthTest::STANDARD
-    }
-}
-
-/// A host's attachments for one frame (`TargetDesc::Host`). By default (`HostSync::Attachments`)
-/// on entry and on exit the colour image is in COLOR_ATTACHMENT_OPTIMAL and the depth image in
-/// DEPTH_ATTACHMENT_OPTIMAL; the pass waits for earlier attachment writes, and its own writes
-/// are done at the colour-output and late-fragment-test stages, where the host's next barrier
-/// picks them up. With `HostSync::Declared` the pass records the barriers from and to the
-/// states the host declares instead.
-///
-/// Each attachment carries its image's format and size, because a view does not say them and
-/// Vulkan cannot be asked: `record_frame` checks them against the `TargetDesc` the pipelines
-/// were made for and the render area against both images and the device's framebuffer limits
-/// (an area past an image is `VUID-VkRenderingInfo-pNext-06079`, and a crash on some drivers).
-#[derive(Clone, Copy, Debug)]
-pub struct HostTarget {
-    /// The host's colour image.
-    pub color: HostAttachment,
-    /// The host's depth image.
-    pub depth: HostAttachment,
-    /// The render area's size, and the viewport's and scissor's: at least 1x1, and within both
-    /// images from `offset`. The camera's projection is for this size's aspect ratio, and
-    /// levels of detail follow it.
-    pub extent: vk::Extent2D,
-    /// The render area's top-left corner in both images (`vk::Offset2D::default()`: the
-    /// origin): not negative. Pixels outside the area are neither cleared nor drawn.
-    pub offset: vk::Offset2D,
-    /// With multisampled attachments (`RendererOptions::samples` above 1), the single-sampled
-    /// image of the colour format that shading resolves the colour into (averaged), in
-    /// COLOR_ATTACHMENT_OPTIMAL on entry and exit like the colour image (`HostSync::Attachments`
-    /// only); `None` leaves the resolve to the host.
-    pub resolve: Option<HostAttachment>,
-    /// How the images are handed over: in the attachment layouts (`HostSync::Attachments`,
-    /// the default), or in states the host declares for entry and exit (`HostSync::Declared`).
-    pub sync: HostSync,
-    /// Keep the host's colour and depth (`true`), or clear them to the scene's background and
-    /// the far plane (`false`).
-    pub load: bool,
-}
-
-/// One of the host's images, as `HostTarget` gives it: a 2D view of mip level 0, one layer.
-#[derive(Clone, Copy, Debug)]
-pub struct HostAttachment {
-    /// The view drawn through.
-    pub view: vk::ImageView,
-    /// The image's (and view's) format: must be the `TargetDesc::Host` format.
-    pub format: vk::Format,
-    /// The image's width and height at mip level 0.
-    pub extent: vk::Extent2D,
-    /// The image's samples per pixel: must be `RendererOptions::samples` for the colour and
-    /// depth images, TYPE_1 for a resolve image.
-    pub samples: vk::SampleCountFlags,
-}
-
-/// The faces of a level of detail (its `enclosure`, its vertices' `bounds`) that no ray from
-/// the eye reaches through `view_proj` (world -> clip, depth running as `convention` says), to
-/// cull: the inner side of a surface that encloses a volume, when the whole of it lies beyond
-/// the near plane (one the near plane cuts shows its inside); NONE for an open surface. On
-/// screen a face is front (counter-clockwise, with the viewport's positive height) when its
-/// winding's normal points towards the eye in clip space, which the sign of det(view_proj) (the
-/// sign of the map's Jacobian wherever w > 0) and the depth's direction decide.
-pub fn hidden_faces(
-    enclosure: Enclosure,
-    bounds: (Vec3, Vec3),
-    view_proj: Mat4,
-    convention: DepthConvention,
-) -> vk::CullModeFlags {
-    let outward = match enclosure {
-        Enclosure::Open => return vk::CullModeFlags::NONE,
-        Enclosure::Outward => true,
-        Enclosure::Inward => false,
-    };
-    let (lo, hi) = bounds;
-    let beyond_near = (0..8).all(|k| {
-        let corner = Vec3::new(
-            if k & 1 == 0 { lo.x } else { hi.x },
-            if k & 2 == 0 { lo.y } else { hi.y },
-            if k & 4 == 0 { lo.z } else { hi.z },
-        );
-        let clip = view_proj * corner.extend(1.0);
-        // Vulkan's clip volume runs 0 <= z <= w; the near plane is z = 0, or z = w reversed.
-        clip.w > 0.0
-            && match convention {
-                DepthConvention::Standard => clip.z > 0.0,
-                DepthConvention::Reversed => clip.z < clip.w,
-            }
-    });
-    let det = view_proj.determinant();
-    if !beyond_near || !det.is_finite() || det == 0.0 {
-        return vk::CullModeFlags::NONE;
-    }
-    let front_visible = (det > 0.0) == (convention == DepthConvention::Standard);
-    if front_visible == outward { vk::CullModeFlags::BACK } else { vk::CullModeFlags::FRONT }
-}
-
-/// The faces to cull when drawing `level` through `view_proj`: its `hidden_faces` where `plan`
-/// culls them (`Plan::cull_hidden_faces`), else none.
-pub fn culled_faces(
-    plan: &Plan,
-    level: &LevelRange,
-    view_proj: Mat4,
-    convention: DepthConvention,
-) -> vk::CullModeFlags {
-    if plan.cull_hidden_faces {
-        hidden_faces(level.enclosure, level.bounds, view_proj, convention)
-    } else {
-        vk::CullModeFlags::NONE
-    }
 }
 
 /// Key lights up to this many are a specialization constant of the shading and splat pipelines.
@@ -437,7 +255,7 @@ impl RenderPass for ShadePass {
         // SAFETY: `cmd` is recording; attachments are in the layouts the barriers above set.
         unsafe {
             device.cmd_begin_rendering(cmd, &info);
-            let streams = [scene.vertices.raw(), scene.exitance.raw(), scene.environment_irradiance.raw()];
+            let streams = [scene.buffers.vertices.raw(), scene.buffers.exitance.raw(), scene.buffers.environment_irradiance.raw()];
             device.cmd_bind_vertex_buffers(cmd, 0, &streams, &[0, 0, 0]);
             device.cmd_bind_index_buffer(cmd, scene.indices.raw(), 0, vk::IndexType::UINT32);
         }
@@ -453,9 +271,27 @@ impl RenderPass for ShadePass {
             pipeline.set_cull(cmd, hidden);
             pipeline.draw_indexed(cmd, level.draw.index_count, level.draw.first_index, level.draw.vertex_offset);
         }
+        // SAFETY: ends the render begun above in this function, in the same `cmd`.
         unsafe { device.cmd_end_rendering(cmd) };
         if let Some(t) = frame.target {
             super::host::record_exit(device, cmd, t);
         }
+    }
+}
+
+impl ShadeOptions {
+    /// What the shading pass takes of the host's choices.
+    pub fn of(options: &RendererOptions) -> ShadeOptions {
+        ShadeOptions { depth: options.depth, samples: options.samples }
+    }
+}
+
+impl RegisteredPass for ShadePass {
+    // It binds the lights buffer, which new scene data replaces.
+    const REBUILT_ON: &'static [Rebuild] = &[Rebuild::SceneData];
+
+    fn build(c: &PassContext) -> Result<Option<Self>, RenderError> {
+        let options = ShadeOptions::of(c.options);
+        Ok(Some(ShadePass::new(c.gpu, c.target, &c.resources, c.needs.pixel_gather, options)?))
     }
 }

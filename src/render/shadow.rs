@@ -5,9 +5,11 @@
 //! Vertex input: binding 0 = `records::Vertex`. Push: `ShadowPush`.
 
 use super::graph::{Resource, Use, overwrite, read, write};
-use super::pass::{FrameInputs, RenderPass};
+use super::error::RenderError;
+use super::pass::{FrameInputs, PassContext, Rebuild, RegisteredPass, RenderPass};
 use super::records::Vertex;
-use super::shade::{DepthConvention, culled_faces};
+use super::cull::culled_faces;
+use super::target::DepthConvention;
 use super::targets::SHADOW_FORMAT;
 use crate::gpu::{Access, Gpu, GpuResult, GraphicsDesc, GraphicsPipeline};
 use ash::vk;
@@ -104,8 +106,11 @@ impl RenderPass for ShadowPass {
             let push = ShadowPush { light_matrix: *matrix, layer: [layer as u32, 0, 0, 0] };
             let light_matrix = glam::Mat4::from_cols_array_2d(matrix);
             self.pipeline.bind(cmd, None, &push, extent);
+            // SAFETY: `cmd` is recording inside the render begun above; the scene's vertex and
+            // index buffers were made with VERTEX_BUFFER / INDEX_BUFFER usage and `frame` borrows
+            // them.
             unsafe {
-                device.cmd_bind_vertex_buffers(cmd, 0, &[scene.vertices.raw()], &[0]);
+                device.cmd_bind_vertex_buffers(cmd, 0, &[scene.buffers.vertices.raw()], &[0]);
                 device.cmd_bind_index_buffer(cmd, scene.indices.raw(), 0, vk::IndexType::UINT32);
             }
             for &(object, level) in &scene.casters {
@@ -118,6 +123,16 @@ impl RenderPass for ShadowPass {
                 self.pipeline.draw_indexed(cmd, d.index_count, d.first_index, d.vertex_offset);
             }
         }
+        // SAFETY: ends the render begun at the top of this function, in the same `cmd`.
         unsafe { device.cmd_end_rendering(cmd) };
+    }
+}
+
+impl RegisteredPass for ShadowPass {
+    // It binds no scene buffer: its draws take the vertex and index buffers each frame.
+    const REBUILT_ON: &'static [Rebuild] = &[];
+
+    fn build(context: &PassContext) -> Result<Option<Self>, RenderError> {
+        Ok(Some(ShadowPass::new(context.gpu, context.scene.shadow_layers)?))
     }
 }

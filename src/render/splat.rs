@@ -13,7 +13,8 @@
 //! `SplatPush`.
 
 use super::graph::{Resource, Resources, Use, compute_uses};
-use super::pass::{FrameInputs, RenderPass};
+use super::error::RenderError;
+use super::pass::{FrameInputs, PassContext, Rebuild, RegisteredPass, RenderPass};
 use super::plan::SplatLights;
 use crate::gpu::{ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use crate::scene::SplatVisibility;
@@ -115,5 +116,14 @@ impl RenderPass for SplatPass {
             };
             self.pipeline.dispatch(cmd, &self.set, &push, [r.sample_count, 1, 1]);
         }
+    }
+}
+
+impl RegisteredPass for SplatPass {
+    const REBUILT_ON: &'static [Rebuild] = &[Rebuild::SceneData];
+
+    fn build(context: &PassContext) -> Result<Option<Self>, RenderError> {
+        let visibility = context.scene.scene.file.render.splat_visibility;
+        Ok(Some(SplatPass::new(context.gpu, &context.resources, visibility)?))
     }
 }

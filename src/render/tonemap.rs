@@ -6,7 +6,8 @@
 //! Push: `TonemapPush`.
 
 use super::graph::{Resource, Resources, Use, read, write};
-use super::pass::{FrameInputs, RenderPass};
+use super::error::RenderError;
+use super::pass::{FrameInputs, PassContext, Rebuild, RegisteredPass, RenderPass};
 use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, DescriptorSet, Gpu, GpuError, GpuResult};
 use ash::vk;
 use std::sync::Arc;
@@ -92,5 +93,18 @@ impl RenderPass for TonemapPass {
         frame.before(cmd, &[write(Resource::TonemapCounters, Access::ComputeReadWrite)]);
         let push = TonemapPush { width: self.width, height: self.height, exposure: frame.exposure };
         self.pipeline.dispatch(cmd, &self.set, &push, [self.width, self.height, 1]);
+    }
+}
+
+impl RegisteredPass for TonemapPass {
+    // It binds the own HDR image, which a resize replaces.
+    const REBUILT_ON: &'static [Rebuild] = &[Rebuild::Resize];
+
+    fn build(context: &PassContext) -> Result<Option<Self>, RenderError> {
+        // A host target has no HDR image of the renderer's: the host tone-maps its own.
+        if context.resources.targets.hdr().is_none() {
+            return Ok(None);
+        }
+        Ok(Some(TonemapPass::new(context.gpu, &context.resources)?))
     }
 }

@@ -7,7 +7,8 @@
 //! vertex), bound in that order (`BINDINGS`). Push: `VertexLightPush`.
 
 use super::graph::{Resource, Resources, Use, compute_uses};
-use super::pass::{FrameInputs, RenderPass};
+use super::error::RenderError;
+use super::pass::{FrameInputs, PassContext, Rebuild, RegisteredPass, RenderPass};
 use crate::gpu::{ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use ash::vk;
 use std::sync::Arc;
@@ -63,5 +64,13 @@ impl RenderPass for VertexLightPass {
             };
             self.pipeline.dispatch(cmd, &self.set, &push, [r.vertex_count, 1, 1]);
         }
+    }
+}
+
+impl RegisteredPass for VertexLightPass {
+    const REBUILT_ON: &'static [Rebuild] = &[Rebuild::SceneData];
+
+    fn build(context: &PassContext) -> Result<Option<Self>, RenderError> {
+        Ok(Some(VertexLightPass::new(context.gpu, &context.resources)?))
     }
 }

@@ -17,7 +17,8 @@ use crate::reference::rte_cache::RteCacheError;
 use crate::reference::rte_mesh::MeshOptions;
 use crate::reference::truth::{self, LIT_FLOOR, Truth, TruthOptions};
 use crate::render::plan::{Change, Pass};
-use crate::render::renderer::{RenderError, Renderer};
+use crate::render::error::RenderError;
+use crate::render::renderer::Renderer;
 use crate::sampling::{self, Method, SampleOptions};
 use crate::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
 use crate::scene::{GatherMode, Scene, SceneError, TransportMode};
@@ -605,7 +606,7 @@ pub fn error_image(
     scale: f64,
 ) -> Result<(Vec<u8>, u32), String> {
     let [w, h] = scene.scene.file.camera.resolution;
-    let camera = crate::render::renderer::CameraView::of_scene(scene);
+    let camera = crate::render::camera::CameraView::of_scene(scene);
     let view_proj = camera.projection * camera.view;
     let (mut positions, mut triangles, mut colours) = (Vec::new(), Vec::new(), Vec::new());
     for (i, o) in scene.objects.iter().enumerate() {

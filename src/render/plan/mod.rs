@@ -52,23 +52,31 @@ pub const LOCAL_PIXELS: f64 = 1.0;
 /// gather at every spacing of 2.4 profile radii and more, and lost at every spacing of 1.7 and
 /// less; 4, the first choice, kept gathering where the gather was 1.4x to 3x worse.
 pub const LOCAL_SPACING: f64 = 2.0;
-/// A GPU pass the planner can schedule; `Renderer::pass` maps each to its `RenderPass`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Pass {
-    /// Shadow maps of the shadow-casting lights (`ShadowPass`, glsl/shadow.vert).
-    Shadow,
-    /// The environment light's irradiance cached per vertex (`VertexLightPass`).
-    VertexLight,
-    /// Irradiance transmitted into every sample point (`SplatPass`).
-    Splat,
-    /// Exitance summed from the samples' dipoles: per vertex, sparse or per pixel
-    /// (`render.gather`).
-    Gather,
-    /// The camera's view rasterised into the HDR image or the host's target (`ShadePass`).
-    Shade,
-    /// HDR to 8-bit sRGB for readback (`TonemapPass`); own target only.
-    Tonemap,
+/// Declares `Pass` from the registry's list (`registry::for_each_pass!`).
+macro_rules! declare_pass {
+    ($( $(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $variant:ident = $name:literal : $module:ident :: $ty:ident, )*) => {
+        /// A GPU pass the planner can schedule: one per line of `registry::for_each_pass!`,
+        /// which also gives the renderer the `RenderPass` that records it.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        pub enum Pass {
+            $( $(#[doc = $doc])* $(#[cfg($cfg)])? $variant, )*
+        }
+
+        impl Pass {
+            /// Every registered pass, in registration order.
+            pub const ALL: &[Pass] = &[ $( $(#[cfg($cfg)])? Pass::$variant, )* ];
+
+            /// The pass's name in plans, timer marks and `FrameTimings`, e.g. "vertex_light".
+            pub fn name(self) -> &'static str {
+                match self {
+                    $( $(#[cfg($cfg)])? Pass::$variant => $name, )*
+                }
+            }
+        }
+    };
 }
+
+super::registry::for_each_pass!(declare_pass);
 
 impl Change {
     /// The change covering both `self` and `other` (what a frame must redo after both). A
@@ -115,19 +123,6 @@ impl fmt::Display for Change {
     }
 }
 
-impl Pass {
-    /// The pass's name in plans, timer marks and `FrameTimings`, e.g. "vertex_light".
-    pub fn name(self) -> &'static str {
-        match self {
-            Pass::Shadow => "shadow",
-            Pass::VertexLight => "vertex_light",
-            Pass::Splat => "splat",
-            Pass::Gather => "gather",
-            Pass::Shade => "shade",
-            Pass::Tonemap => "tonemap",
-        }
-    }
-}
 
 /// What changed since the last frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -371,7 +366,7 @@ pub struct View {
 
 impl View {
     /// The view from `camera` onto an image `height` pixels high.
-    pub fn of_camera(camera: &crate::render::renderer::CameraView, height: u32) -> View {
+    pub fn of_camera(camera: &crate::render::camera::CameraView, height: u32) -> View {
         View { view_proj: camera.projection * camera.view, projection: camera.projection, eye: camera.eye, height }
     }
 
