@@ -157,7 +157,7 @@ fn module_of(relative: &Path) -> ModulePath {
 
 /// The code with every comment (doc comments included), string and character literal replaced
 /// by spaces, its line breaks kept so that lines still count the same. A string that is a path
-/// and nothing else, as in `#[serde(with = "super::rte_cache::infinite_as_null")]`, names a
+/// and nothing else, as in `#[serde(with = "super::json_null::infinite_as_null")]`, names a
 /// module the code uses: only its quotes are blanked.
 fn blank_comments_and_literals(text: &str) -> String {
     let chars: Vec<char> = text.chars().collect();

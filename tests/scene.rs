@@ -96,6 +96,26 @@ fn bad_values_name_the_key() {
 }
 
 #[test]
+fn a_fixed_size_array_of_the_wrong_length_is_refused_naming_file_line_and_key() {
+    let with_camera = |line: &str| MINIMAL.replace("target = [0.0, 0.0, 0.0]", &format!("target = [0.0, 0.0, 0.0]\n{line}"));
+    for (text, key, line) in [
+        (with_camera("resolution = [32, 32, 32]"), "camera.resolution", "line 5"),
+        (with_camera("resolution = [32]"), "camera.resolution", "line 5"),
+        (MINIMAL.replace("eye = [0.0, 1.0, 3.0]", "eye = [0.0, 1.0, 3.0, 4.0]"), "camera.eye", "line 3"),
+        (MINIMAL.replace("intensity = [1.0, 1.0, 1.0]", "intensity = [1.0, 1.0]"), "light[0]", "line 10"),
+        (
+            MINIMAL.replace("preset = \"skimmilk\"", "sigma_a = [0.1, 0.1, 0.1, 0.1], sigma_s_prime = [1.0, 1.0, 1.0]"),
+            "object[0].material",
+            "line 8",
+        ),
+    ] {
+        let e = error_of(&text);
+        assert!(e.contains("test.toml") && e.contains(key) && e.contains(line), "expected {key}, {line} in: {e}");
+        assert!(e.contains("invalid length"), "{e}");
+    }
+}
+
+#[test]
 fn syntax_error_names_the_line() {
     let e = error_of("[camera]\neye = [0.0, 1.0\n");
     assert!(e.contains("line 2"), "{e}");

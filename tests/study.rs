@@ -385,6 +385,20 @@ fn repeated_configurations_run_once_and_minus_zero_is_zero() {
     assert!(!md.contains("-0"), "{md}");
 }
 
+/// `--samplers random` on a scene whose own sampler is turk: the scene's own row stays, and
+/// the reference is timed on it rather than panicking on a sampler the filter removed.
+#[test]
+fn a_sampler_filter_that_leaves_out_the_scenes_own_sampler_still_times_the_reference() {
+    let dir = temp_dir("study-sampler-filter");
+    let scene = repo_path("tests/scenes/study-tiny.toml");
+    let args = ["--quick", "--samplers", "random", "--counts", "100"];
+    let run = study_cli(&dir, scene.to_str().unwrap(), &args);
+    assert!(run.status.success(), "exit {:?}: {}", run.status.code(), text(&run.stderr));
+    let rows = csv_rows(&std::fs::read_to_string(dir.join("out").join("study.csv")).unwrap());
+    let samplers: Vec<&str> = rows.iter().map(|r| r["sampler"].as_str()).collect();
+    assert!(samplers.contains(&"turk") && samplers.contains(&"random"), "{samplers:?}");
+}
+
 /// `--truth-levels` out of range: the note fits the value given.
 #[test]
 fn truth_levels_out_of_range_are_refused_with_a_fitting_note() {

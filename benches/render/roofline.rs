@@ -449,10 +449,10 @@ pub fn naive_gather(gpu: &Arc<Gpu>, renderer: &Renderer) -> (ComputePipeline, De
     let out = Buffer::new(gpu, &BufferDesc::gpu_only("naive exitance", size, usage)).expect("buffer");
     let set = naive
         .descriptor_set(&[
-            Resource::Vertices.bind(Binding::Buffer(&b.buffers().vertices())),
-            Resource::Samples.bind(Binding::Buffer(&b.buffers().samples())),
-            Resource::Splat.bind(Binding::Buffer(&b.buffers().splat())),
-            Resource::Objects.bind(Binding::Buffer(&b.buffers().objects())),
+            Resource::Vertices.bind(Binding::Buffer(b.buffers().vertices())),
+            Resource::Samples.bind(Binding::Buffer(b.buffers().samples())),
+            Resource::Splat.bind(Binding::Buffer(b.buffers().splat())),
+            Resource::Objects.bind(Binding::Buffer(b.buffers().objects())),
             Resource::Exitance.bind(Binding::Buffer(&out)),
         ])
         .expect("descriptor set");
@@ -520,7 +520,7 @@ impl Deferred {
         };
         let names = ["g_position", "g_normal", "g_exitance", "g_environment"];
         let mut bindings = vec![
-            Named { name: "Lights", binding: Binding::Buffer(&renderer.scene_data().buffers().lights()) },
+            Named { name: "Lights", binding: Binding::Buffer(renderer.scene_data().buffers().lights()) },
             Named { name: "shadow_maps", binding: sampled(shadow, &samplers[0]) },
         ];
         bindings.extend(names.iter().zip(&targets).map(|(&name, t)| Named { name, binding: sampled(t, &samplers[1]) }));

@@ -12,7 +12,7 @@ pub struct Args {
 pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> anyhow::Result<()> {
     let mut devices = gpu::list_devices()?;
     if devices.is_empty() {
-        return Err(gpu::GpuError::NoDevice(String::new()).into());
+        return Err(gpu::GpuError::NoDevice.into());
     }
     // `--device` (or TRANSLUCENT_DEVICE) narrows the list to the device it picks, with the
     // same error as every other command when nothing matches.

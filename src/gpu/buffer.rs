@@ -53,7 +53,7 @@ impl Buffer {
     /// was made so far is destroyed.
     pub fn new(gpu: &Arc<Gpu>, desc: &BufferDesc) -> GpuResult<Buffer> {
         if desc.size == 0 {
-            return Err(GpuError::Invalid(format!("buffer {:?} has size 0", desc.name)));
+            return Err(GpuError::EmptyBuffer { name: desc.name.clone() });
         }
         let device = gpu.device();
         let info = vk::BufferCreateInfo::default()
@@ -123,12 +123,12 @@ impl Buffer {
         let bytes: &[u8] = bytemuck::cast_slice(data);
         let end = offset + bytes.len() as u64;
         if end > self.size {
-            return Err(GpuError::Invalid(format!(
-                "write of {} bytes at {offset} overflows buffer {:?} of {} bytes",
-                bytes.len(),
-                self.name,
-                self.size
-            )));
+            return Err(GpuError::WriteOverflow {
+                name: self.name.clone(),
+                offset,
+                bytes: bytes.len() as u64,
+                size: self.size,
+            });
         }
         if let Some(mapped) = self.allocation.as_mut().and_then(|a| a.mapped_slice_mut()) {
             mapped[offset as usize..end as usize].copy_from_slice(bytes);
@@ -149,10 +149,7 @@ impl Buffer {
     pub fn read<T: bytemuck::Pod>(&self) -> GpuResult<Vec<T>> {
         let item = std::mem::size_of::<T>() as u64;
         if item == 0 || !self.size.is_multiple_of(item) {
-            return Err(GpuError::Invalid(format!(
-                "buffer {:?} of {} bytes is not a whole number of items",
-                self.name, self.size
-            )));
+            return Err(GpuError::ReadItems { name: self.name.clone(), size: self.size, item });
         }
         let mut out = vec![T::zeroed(); (self.size / item) as usize];
         if let Some(mapped) = self.allocation.as_ref().and_then(|a| a.mapped_slice()) {

@@ -6,8 +6,10 @@
 use super::GpuOptions;
 use super::debug::ValidationCounters;
 use super::device::{self, DeviceInfo};
-use super::error::{GpuError, GpuResult, VkContext};
+use super::error::{GpuError, GpuResult, Shortfall, VkContext};
+use super::features::EnabledFeatures;
 use super::instance::{self, OwnedInstance};
+use super::pipeline_cache;
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use std::mem::ManuallyDrop;
@@ -64,40 +66,6 @@ pub struct HostVulkan {
     /// Which of the required features the host enabled when it created `device` (Vulkan cannot
     /// be asked afterwards); `from_host` refuses a device that lacks one.
     pub enabled_features: EnabledFeatures,
-}
-
-/// The device features translucent needs, as the host enabled them.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct EnabledFeatures {
-    /// Vulkan 1.3 `dynamicRendering`: every raster pass renders without render-pass objects.
-    pub dynamic_rendering: bool,
-    /// Vulkan 1.3 `synchronization2`: every barrier and timestamp.
-    pub synchronization2: bool,
-    /// Vulkan 1.2 `shaderOutputLayer`: the shadow pass picks each light's layer with gl_Layer.
-    pub shader_output_layer: bool,
-}
-
-impl EnabledFeatures {
-    /// All of them, as `required_features` enables them.
-    pub const ALL: EnabledFeatures =
-        EnabledFeatures { dynamic_rendering: true, synchronization2: true, shader_output_layer: true };
-}
-
-/// The feature structs a host chains into its `VkDeviceCreateInfo` (`push_next` both) so that
-/// translucent can run on its device.
-pub struct RequiredFeatures {
-    /// `shaderOutputLayer`.
-    pub vulkan12: vk::PhysicalDeviceVulkan12Features<'static>,
-    /// `dynamicRendering`, `synchronization2`.
-    pub vulkan13: vk::PhysicalDeviceVulkan13Features<'static>,
-}
-
-/// The features translucent needs, to chain into a host's device creation.
-pub fn required_features() -> RequiredFeatures {
-    RequiredFeatures {
-        vulkan12: vk::PhysicalDeviceVulkan12Features::default().shader_output_layer(true),
-        vulkan13: vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true),
-    }
 }
 
 impl Gpu {
@@ -170,22 +138,20 @@ impl Gpu {
     /// from it, and `enabled_features` must say truly what the device was created with.
     pub unsafe fn from_host(host: HostVulkan, options: &GpuOptions) -> GpuResult<Arc<Gpu>> {
         let devices = device::enumerate(&host.instance)?;
-        let info = devices
-            .into_iter()
-            .find(|d| d.handle == host.physical_device)
-            .ok_or_else(|| GpuError::Invalid("the host's physical device is not one of its instance's".into()))?;
-        let unsuitable = |detail: String| GpuError::DeviceUnsuitable {
+        let info =
+            devices.into_iter().find(|d| d.handle == host.physical_device).ok_or(GpuError::ForeignPhysicalDevice)?;
+        let unsuitable = |detail: Shortfall| GpuError::DeviceUnsuitable {
             name: info.name.clone(),
             version: info.api_version.clone(),
             detail,
         };
         if info.api < vk::API_VERSION_1_3 {
-            return Err(unsuitable(String::new()));
+            return Err(unsuitable(Shortfall::Version));
         }
         device::check_features(&host.instance, &info)?;
         let f = host.enabled_features;
         // Every missing feature in one error: a host fixes its device creation once.
-        let missing: Vec<&str> = [
+        let missing: Vec<&'static str> = [
             (f.dynamic_rendering, "dynamicRendering"),
             (f.synchronization2, "synchronization2"),
             (f.shader_output_layer, "shaderOutputLayer"),
@@ -194,12 +160,7 @@ impl Gpu {
         .filter_map(|(enabled, name)| (!enabled).then_some(name))
         .collect();
         if !missing.is_empty() {
-            let (features, them) = if missing.len() == 1 { ("feature", "it") } else { ("features", "them") };
-            return Err(unsuitable(format!(
-                " with the {} {features} enabled at device creation; the host's device was created without \
-                 {them} (chain translucent::gpu::required_features() into VkDeviceCreateInfo)",
-                missing.join(", ")
-            )));
+            return Err(unsuitable(Shortfall::FeaturesNotEnabled(missing)));
         }
         // A device of an instance created for Vulkan 1.2 has no 1.3 commands, whatever the
         // hardware supports; ash would abort on the first call.
@@ -208,21 +169,14 @@ impl Gpu {
             let found =
                 unsafe { (host.instance.fp_v1_0().get_device_proc_addr)(host.device.handle(), command.as_ptr()) };
             if found.is_none() {
-                return Err(unsuitable(format!(
-                    " through an instance created with apiVersion 1.3 or later; {} is not available on the \
-                     host's device (its instance asked for an older version)",
-                    command.to_string_lossy()
-                )));
+                return Err(unsuitable(Shortfall::InstanceVersion(command)));
             }
         }
         // SAFETY: plain query.
         let families = unsafe { host.instance.get_physical_device_queue_family_properties(info.handle) };
         let flags = families.get(host.queue_family as usize).map(|f| f.queue_flags).unwrap_or_default();
         if !flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE) {
-            return Err(unsuitable(format!(
-                " and a queue that does graphics and compute; the host's queue family {} does not",
-                host.queue_family
-            )));
+            return Err(unsuitable(Shortfall::HostQueue(host.queue_family)));
         }
         let counters = Arc::new(ValidationCounters::default());
         Self::assemble(HostVulkan { physical_device: info.handle, ..host }, None, counters, options)
@@ -260,7 +214,7 @@ impl Gpu {
                 return Err(GpuError::Alloc { what: "allocator".into(), source });
             }
         };
-        let pipeline_cache = match super::pipeline_cache::create(&device) {
+        let pipeline_cache = match pipeline_cache::create(&device) {
             Ok(c) => c,
             Err(e) => {
                 drop(allocator);
@@ -361,6 +315,23 @@ impl Gpu {
     /// How long a submission may run before `one_shot` gives up.
     pub fn timeout(&self) -> Duration {
         self.timeout
+    }
+    /// The pipeline cache's contents (`vkGetPipelineCacheData`), to save and pass to
+    /// [`Gpu::seed_pipeline_cache`] in a later run on the same device and driver.
+    pub fn pipeline_cache_data(&self) -> GpuResult<Vec<u8>> {
+        // SAFETY: the cache was created on this `Gpu`'s device by `assemble`, and both live as
+        // long as `self`.
+        unsafe { pipeline_cache::data(&self.device, &self.pipeline_cache) }
+    }
+
+    /// Merge `data` (from [`Gpu::pipeline_cache_data`] of an earlier run) into this `Gpu`'s
+    /// pipeline cache, so that pipelines created afterwards reuse what it holds. Data from
+    /// another device or driver build, or not a pipeline cache, is refused with
+    /// [`GpuError::PipelineCacheRefused`] saying which, and the cache stays as it was.
+    pub fn seed_pipeline_cache(&self, data: &[u8]) -> GpuResult<()> {
+        // SAFETY: the cache was created on this `Gpu`'s device by `assemble`, both live as long
+        // as `self`, and `properties` were read from its physical device.
+        unsafe { pipeline_cache::seed(&self.device, &self.properties, &self.pipeline_cache, data) }
     }
     /// Bytes of device memory in use and reserved by the allocator.
     pub fn memory_usage(&self) -> (u64, u64) {

@@ -23,7 +23,7 @@ pub enum BindingKind {
 }
 
 impl BindingKind {
-    fn vk(self) -> vk::DescriptorType {
+    pub(super) fn vk(self) -> vk::DescriptorType {
         match self {
             BindingKind::StorageBuffer => vk::DescriptorType::STORAGE_BUFFER,
             BindingKind::UniformBuffer => vk::DescriptorType::UNIFORM_BUFFER,
@@ -85,12 +85,11 @@ impl SetInterface<'_> {
     /// optimiser removed as unused, is dropped unchecked.
     fn check(&self, bindings: &[Named<'_>]) -> GpuResult<()> {
         if let Some(missing) = self.kinds.iter().enumerate().skip(bindings.len()).find(|(_, k)| k.is_some()) {
-            return Err(GpuError::Invalid(format!(
-                "{}: the shader declares binding {}, only {} resources were given",
-                self.shader,
-                missing.0,
-                bindings.len()
-            )));
+            return Err(GpuError::MissingBinding {
+                shader: self.shader.to_string(),
+                binding: missing.0,
+                given: bindings.len(),
+            });
         }
         for (i, given) in bindings.iter().enumerate() {
             let declared = self.names.get(i).and_then(Option::as_deref);
@@ -183,7 +182,7 @@ impl DescriptorSet {
                     i,
                     [vk::DescriptorImageInfo { sampler: *sampler, image_view: *view, image_layout: *layout }],
                 )),
-                _ => return Err(GpuError::Invalid(format!("binding {i}: expected {kind:?}"))),
+                _ => return Err(GpuError::BindingType { binding: i, expected: kind.vk() }),
             }
         }
         let mut writes = Vec::new();

@@ -1,6 +1,6 @@
 //! Physical-device discovery and choice, and the logical device with one graphics+compute queue.
 
-use super::error::{GpuError, GpuResult, VkContext};
+use super::error::{GpuError, GpuResult, Shortfall, VkContext};
 use ash::vk;
 use std::fmt;
 
@@ -83,7 +83,7 @@ pub(crate) fn enumerate(instance: &ash::Instance) -> GpuResult<Vec<DeviceInfo>> 
 /// is one (discrete before integrated), else the CPU device (lavapipe).
 pub fn select(devices: &[DeviceInfo], wanted: Option<&str>) -> GpuResult<DeviceInfo> {
     if devices.is_empty() {
-        return Err(GpuError::NoDevice(String::new()));
+        return Err(GpuError::NoDevice);
     }
     let chosen = match wanted.map(str::trim).filter(|w| !w.is_empty()) {
         Some(w) => {
@@ -112,7 +112,7 @@ pub fn select(devices: &[DeviceInfo], wanted: Option<&str>) -> GpuResult<DeviceI
         return Err(GpuError::DeviceUnsuitable {
             name: chosen.name.clone(),
             version: chosen.api_version.clone(),
-            detail: String::new(),
+            detail: Shortfall::Version,
         });
     }
     Ok(chosen.clone())
@@ -131,7 +131,7 @@ pub(crate) fn queue_family(instance: &ash::Instance, device: &DeviceInfo) -> Gpu
         .ok_or_else(|| GpuError::DeviceUnsuitable {
             name: device.name.clone(),
             version: device.api_version.clone(),
-            detail: " and a queue that does graphics and compute; it has none".into(),
+            detail: Shortfall::NoQueue,
         })
 }
 
@@ -145,7 +145,7 @@ pub fn check_features(instance: &ash::Instance, device: &DeviceInfo) -> GpuResul
         return Err(GpuError::DeviceUnsuitable {
             name: device.name.clone(),
             version: device.api_version.clone(),
-            detail: " and the shaderOutputLayer feature (layered shadow maps); it lacks it".into(),
+            detail: Shortfall::ShaderOutputLayer,
         });
     }
     Ok(())
@@ -156,7 +156,7 @@ pub(crate) fn create_logical(instance: &ash::Instance, device: &DeviceInfo, fami
     let queues = [vk::DeviceQueueCreateInfo::default().queue_family_index(family).queue_priorities(&priorities)];
     // The same features a host enables (`required_features`): shaderOutputLayer lets the shadow
     // pass pick each light's array layer with gl_Layer in one layered render.
-    let mut features = super::context::required_features();
+    let mut features = super::features::required_features();
     let info = vk::DeviceCreateInfo::default()
         .queue_create_infos(&queues)
         .push_next(&mut features.vulkan13)

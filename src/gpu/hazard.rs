@@ -142,7 +142,13 @@ impl<K: Copy + Eq + Hash + std::fmt::Debug> Hazards<K> {
         let mut global = Sides::default();
         let mut images = Vec::new();
         for u in uses {
-            debug_assert_eq!(u.writes, u.access.writes(), "{:?} declared as a {}", u.access, ["read", "write"][usize::from(u.writes)]);
+            debug_assert_eq!(
+                u.writes,
+                u.access.writes(),
+                "{:?} declared as a {}",
+                u.access,
+                ["read", "write"][usize::from(u.writes)]
+            );
             let state = self.states.entry(u.resource).or_default();
             let next_layout = state.layout.map(|_| u.access.layout());
             let relayout = u.discard || next_layout.is_some() && next_layout != state.layout;

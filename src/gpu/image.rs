@@ -102,10 +102,10 @@ impl Image {
     /// extent or layer count.
     pub fn new(gpu: &Arc<Gpu>, desc: &ImageDesc) -> GpuResult<Image> {
         if desc.width == 0 || desc.height == 0 || desc.layers == 0 {
-            return Err(GpuError::Invalid(format!(
-                "image {:?} has an empty extent {}x{}x{}",
-                desc.name, desc.width, desc.height, desc.layers
-            )));
+            return Err(GpuError::EmptyImage {
+                name: desc.name.clone(),
+                extent: [desc.width, desc.height, desc.layers],
+            });
         }
         let device = gpu.device();
         let info = vk::ImageCreateInfo::default()
@@ -188,8 +188,7 @@ impl Image {
     /// `previous` is the last access to the image (its layout follows); it is left in
     /// TRANSFER_SRC_OPTIMAL.
     pub fn read(&self, previous: Access) -> GpuResult<Vec<u8>> {
-        let bytes_per_texel = bytes_per_texel(self.desc.format)
-            .ok_or_else(|| GpuError::Invalid(format!("reading back {:?} images is not supported", self.desc.format)))?;
+        let bytes_per_texel = bytes_per_texel(self.desc.format).ok_or(GpuError::ReadbackFormat(self.desc.format))?;
         let size = self.desc.width as u64 * self.desc.height as u64 * bytes_per_texel;
         let staging =
             Buffer::new(&self.gpu, &BufferDesc::readback("image readback", size, vk::BufferUsageFlags::TRANSFER_DST))?;

@@ -11,7 +11,7 @@ const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 /// Load `libvulkan.so.1` at run time, so a missing loader is an error, not a link failure.
 pub(crate) fn load_entry() -> GpuResult<ash::Entry> {
     // SAFETY: loading the system Vulkan loader runs its initialisers; nothing else is assumed.
-    unsafe { ash::Entry::load() }.map_err(|e| GpuError::LoaderMissing(e.to_string()))
+    unsafe { ash::Entry::load() }.map_err(GpuError::LoaderMissing)
 }
 
 /// An instance we created (and so destroy), with its messenger if validation is on.
@@ -65,7 +65,7 @@ pub(crate) fn create_instance(
     let instance = match unsafe { entry.create_instance(&info, None) } {
         Ok(i) => i,
         Err(vk::Result::ERROR_INCOMPATIBLE_DRIVER) => {
-            return Err(GpuError::NoDevice(" (the Vulkan loader found no driver)".into()));
+            return Err(GpuError::NoDriver);
         }
         Err(result) => {
             return Err(GpuError::Vk { what: "vkCreateInstance", result });

@@ -1,7 +1,8 @@
 //! The Vulkan core (ash), one Vulkan concept per file: instance (loader, validation), debug
-//! (messenger and message counts), device (choice and logical device), context (`Gpu`),
-//! buffer, image, sampler, descriptor, pipeline, command (one-shot submission), barrier, hazard
-//! (barriers derived from declared accesses), timer, shaders.
+//! (messenger and message counts), features (what a device must enable), device (choice and
+//! logical device), pipeline_cache (the cache every pipeline is created through), context
+//! (`Gpu`), buffer, image, sampler, descriptor, pipeline, command (one-shot submission), barrier,
+//! hazard (barriers derived from declared accesses), timer, shaders.
 //!
 //! Every Vulkan object is owned by a Rust value that destroys it on Drop and holds an
 //! `Arc<Gpu>`, so the device always outlives what was made from it.
@@ -15,6 +16,7 @@ mod debug;
 mod descriptor;
 mod device;
 mod error;
+mod features;
 mod hazard;
 mod image;
 mod instance;
@@ -28,12 +30,13 @@ mod timer;
 pub(crate) use barrier::image_transition;
 pub use barrier::{Access, ImageBarrier, memory_barrier};
 pub use buffer::{Buffer, BufferDesc};
-pub use context::{EnabledFeatures, Gpu, HostVulkan, RequiredFeatures, required_features};
+pub use context::{Gpu, HostVulkan};
 pub use counter::{RecordCounter, RecordCounts};
 pub use debug::ValidationCounters;
 pub use descriptor::{Binding, BindingKind, DescriptorSet, Named};
 pub use device::{DeviceInfo, select as select_device};
-pub use error::{GpuError, GpuResult};
+pub use error::{CacheRefusal, GpuError, GpuResult, Shortfall};
+pub use features::{EnabledFeatures, RequiredFeatures, required_features};
 pub use gpu_allocator::MemoryLocation;
 pub use hazard::{Hazards, Use};
 pub use image::{Image, ImageDesc, aspect_of};

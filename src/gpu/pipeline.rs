@@ -31,8 +31,9 @@ impl Layout {
         stages: vk::ShaderStageFlags,
     ) -> GpuResult<Layout> {
         let (kinds, push_bytes) = (&interface.bindings, interface.push_bytes);
-        if !push_bytes.is_multiple_of(4) || push_bytes > gpu.properties().limits.max_push_constants_size {
-            return Err(GpuError::Invalid(format!("push-constant block of {push_bytes} bytes is not allowed")));
+        let limit = gpu.properties().limits.max_push_constants_size;
+        if !push_bytes.is_multiple_of(4) || push_bytes > limit {
+            return Err(GpuError::PushConstants { bytes: push_bytes, limit });
         }
         let set_layout = create_set_layout(gpu, kinds, stages)?;
         let mut layout = Layout {

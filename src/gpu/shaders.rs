@@ -26,7 +26,7 @@ pub fn spirv(name: &str) -> GpuResult<Vec<u32>> {
     let (bytes, _) = entry(name)?;
     // read_spv copies into u32 words, so the bytes' alignment does not matter.
     ash::util::read_spv(&mut std::io::Cursor::new(bytes))
-        .map_err(|e| GpuError::Invalid(format!("embedded shader {name} is not SPIR-V: {e}")))
+        .map_err(|source| GpuError::NotSpirv { shader: name.into(), source })
 }
 
 /// A shader's interface as its SPIR-V declares it: set 0's bindings, the push-constant block
@@ -50,26 +50,28 @@ impl ShaderInterface {
     /// Reflect the embedded shader `name`.
     pub fn of(name: &str) -> GpuResult<ShaderInterface> {
         let (bytes, named) = entry(name)?;
-        let invalid = |e: &dyn std::fmt::Display| GpuError::Invalid(format!("reflecting shader {name}: {e}"));
-        let reflection = rspirv_reflect::Reflection::new_from_spirv(bytes).map_err(|e| invalid(&e))?;
-        let sets = reflection.get_descriptor_sets().map_err(|e| invalid(&e))?;
-        if let Some(set) = sets.keys().find(|s| **s != 0) {
-            return Err(invalid(&format!("uses descriptor set {set}; only set 0 is supported")));
+        let reflect = |source| GpuError::Reflection { shader: name.into(), source };
+        let reflection = rspirv_reflect::Reflection::new_from_spirv(bytes).map_err(reflect)?;
+        let sets = reflection.get_descriptor_sets().map_err(reflect)?;
+        if let Some(&set) = sets.keys().find(|s| **s != 0) {
+            return Err(GpuError::DescriptorSetNumber { shader: name.into(), set });
         }
         let mut bindings = Vec::new();
         for (binding, info) in sets.get(&0).into_iter().flatten() {
-            let kind = BindingKind::from_reflected(info.ty)
-                .ok_or_else(|| invalid(&format!("binding {binding} has unsupported descriptor type {:?}", info.ty)))?;
+            let kind = BindingKind::from_reflected(info.ty).ok_or_else(|| GpuError::DescriptorType {
+                shader: name.into(),
+                binding: *binding,
+                descriptor_type: info.ty,
+            })?;
             let i = *binding as usize;
             if bindings.len() <= i {
                 bindings.resize(i + 1, None);
             }
             bindings[i] = Some(kind);
         }
-        let push_bytes =
-            reflection.get_push_constant_range().map_err(|e| invalid(&e))?.map_or(0, |p| p.offset + p.size);
+        let push_bytes = reflection.get_push_constant_range().map_err(reflect)?.map_or(0, |p| p.offset + p.size);
         let local_size = reflection.get_compute_group_size().map_or([1, 1, 1], |(x, y, z)| [x, y, z]);
-        let names = binding_names(named).map_err(|e| invalid(&e))?;
+        let names = binding_names(named).map_err(reflect)?;
         Ok(ShaderInterface { bindings, names, push_bytes, local_size })
     }
 
@@ -88,9 +90,7 @@ impl ShaderInterface {
             for (i, name) in s.names.iter().enumerate() {
                 match (&merged.names[i], name) {
                     (Some(a), Some(b)) if a != b => {
-                        return Err(GpuError::Invalid(format!(
-                            "binding {i} is `{a}` in one stage and `{b}` in another"
-                        )));
+                        return Err(GpuError::StageBindingNames { binding: i, first: a.clone(), second: b.clone() });
                     }
                     (None, Some(b)) => merged.names[i] = Some(b.clone()),
                     _ => {}
@@ -99,9 +99,7 @@ impl ShaderInterface {
             for (i, kind) in s.bindings.iter().enumerate() {
                 match (merged.bindings[i], kind) {
                     (Some(a), Some(b)) if a != *b => {
-                        return Err(GpuError::Invalid(format!(
-                            "binding {i} is {a:?} in one stage and {b:?} in another"
-                        )));
+                        return Err(GpuError::StageBindingTypes { binding: i, first: a.vk(), second: b.vk() });
                     }
                     (None, Some(b)) => merged.bindings[i] = Some(*b),
                     _ => {}
@@ -116,10 +114,10 @@ impl ShaderInterface {
 /// The GLSL name of every set-0 binding of a SPIR-V module that kept its debug names, by binding
 /// number: for a buffer block the block's type name (an anonymous instance has an empty
 /// variable name), otherwise the variable's name.
-fn binding_names(named: &[u8]) -> Result<Vec<Option<String>>, String> {
+fn binding_names(named: &[u8]) -> Result<Vec<Option<String>>, rspirv_reflect::ReflectError> {
     use rspirv_reflect::rspirv::dr::Operand;
     use rspirv_reflect::spirv::{Decoration, Op};
-    let module = rspirv_reflect::Reflection::new_from_spirv(named).map_err(|e| e.to_string())?.0;
+    let module = rspirv_reflect::Reflection::new_from_spirv(named)?.0;
     let name_of = |id: u32| {
         module.debug_names.iter().find_map(|i| match (i.class.opcode, i.operands.as_slice()) {
             (Op::Name, [Operand::IdRef(target), Operand::LiteralString(name), ..]) if *target == id => {

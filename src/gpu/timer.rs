@@ -25,7 +25,7 @@ impl GpuTimer {
     pub fn new(gpu: &Arc<Gpu>, max_passes: u32) -> GpuResult<GpuTimer> {
         let (_, valid_bits) = gpu.timestamp_info();
         if valid_bits == 0 {
-            return Err(GpuError::Invalid(format!("device {} cannot write timestamps on its queue", gpu.info().name)));
+            return Err(GpuError::NoTimestamps { device: gpu.info().name.clone() });
         }
         let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(2 * max_passes);
         // SAFETY: valid create info; Drop destroys it.

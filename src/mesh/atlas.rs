@@ -348,12 +348,12 @@ mod tests {
     use super::*;
 
     fn square(n: u32) -> Mesh {
-        crate::scene::build::plane(1.0, n).unwrap()
+        crate::mesh::shapes::plane(1.0, n).unwrap()
     }
 
     #[test]
     fn texel_areas_sum_to_the_mesh_area_at_any_resolution() {
-        let sphere = crate::scene::build::sphere(1.0, 24).unwrap();
+        let sphere = crate::mesh::shapes::sphere(1.0, 24).unwrap();
         for mesh in [square(8), sphere] {
             for resolution in [16, 64, 256] {
                 let atlas = Atlas::new(&mesh, resolution).unwrap();
@@ -375,7 +375,7 @@ mod tests {
 
     #[test]
     fn the_index_map_and_the_texels_agree() {
-        let atlas = Atlas::new(&crate::scene::build::sphere(1.0, 16).unwrap(), 64).unwrap();
+        let atlas = Atlas::new(&crate::mesh::shapes::sphere(1.0, 16).unwrap(), 64).unwrap();
         for (i, t) in atlas.texels.iter().enumerate() {
             assert_eq!(atlas.texel_at(t.coord[0], t.coord[1]), Some(i as u32));
         }

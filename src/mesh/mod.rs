@@ -15,6 +15,7 @@ mod curvature;
 mod enclosure;
 mod lod;
 mod obj;
+pub mod shapes;
 mod topology;
 
 use std::path::PathBuf;
@@ -124,7 +125,18 @@ pub enum MeshError {
     },
     /// [`LoadOptions`] with a zero or non-finite scale, or a non-finite or singular transform.
     #[error("invalid mesh load options: {0}")]
-    InvalidOptions(String),
+    InvalidOptions(LoadOptionsError),
+}
+
+/// What is wrong with a [`LoadOptions`] ([`MeshError::InvalidOptions`]).
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum LoadOptionsError {
+    /// `scale` is zero, infinite or NaN.
+    #[error("scale must be finite and non-zero, got {0}")]
+    Scale(f32),
+    /// `transform` has a non-finite entry, or no inverse.
+    #[error("transform must be finite and invertible, got {0:?}")]
+    Transform(glam::Mat4),
 }
 
 /// What loading found and changed. Open boundaries and non-manifold edges are allowed; they are

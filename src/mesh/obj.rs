@@ -38,13 +38,10 @@ impl LoadOptions {
 
     fn validate(&self) -> Result<(), MeshError> {
         if !self.scale.is_finite() || self.scale == 0.0 {
-            return Err(MeshError::InvalidOptions(format!("scale must be finite and non-zero, got {}", self.scale)));
+            return Err(MeshError::InvalidOptions(super::LoadOptionsError::Scale(self.scale)));
         }
         if !self.transform.is_finite() || self.transform.determinant() == 0.0 {
-            return Err(MeshError::InvalidOptions(format!(
-                "transform must be finite and invertible, got {:?}",
-                self.transform
-            )));
+            return Err(MeshError::InvalidOptions(super::LoadOptionsError::Transform(self.transform)));
         }
         Ok(())
     }

@@ -45,7 +45,8 @@
 //! `glsl/common/beam_single.glsl`; `tests/optics_gpu.rs` compares the two.
 
 use super::fresnel::fresnel_transmittance;
-use super::single_scatter::{gauss_legendre, henyey_greenstein};
+use super::quadrature::gauss_legendre;
+use super::single_scatter::henyey_greenstein;
 use glam::DVec3;
 use std::f64::consts::FRAC_PI_2;
 use std::sync::OnceLock;

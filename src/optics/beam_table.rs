@@ -53,7 +53,8 @@
 //! is `beam_table_lookup` in `glsl/common/beam_table.glsl`.
 
 use super::beam_single::BeamSingle;
-use super::single_scatter::{gauss_legendre, reflectance};
+use super::quadrature::gauss_legendre;
+use super::single_scatter::reflectance;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;

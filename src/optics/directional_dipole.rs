@@ -218,7 +218,7 @@ impl DirectionalDipole {
         else {
             return 0.0;
         };
-        let (nodes, weights) = super::single_scatter::gauss_legendre(32);
+        let (nodes, weights) = super::quadrature::gauss_legendre(32);
         let scale = 1.0 / self.sigma_t_prime;
         // ln r from scale 1e-6 to 60 diffusion lengths (or 1e4 scales), in panels of one e-fold.
         let (lo, hi) = ((1e-6 * scale).ln(), (60.0 / self.sigma_tr).min(1e4 * scale).ln());

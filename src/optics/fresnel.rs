@@ -127,7 +127,7 @@ pub fn diffuse_transmittance(eta: f64) -> f64 {
 /// Integral of `f` over `[lo, hi]` on panels `lo + (hi - lo) 2^-k`, k = 0..40, with 16-point
 /// Gauss-Legendre on each: resolves features at any scale near `lo`.
 fn graded_integral(f: impl Fn(f64) -> f64, lo: f64, hi: f64) -> f64 {
-    let (nodes, weights) = super::single_scatter::gauss_legendre(16);
+    let (nodes, weights) = super::quadrature::gauss_legendre(16);
     let width = hi - lo;
     let mut sum = 0.0;
     let mut b = 1.0_f64;

@@ -20,6 +20,8 @@
 //! - [`presets`]: the measured materials of Jensen et al. 2001 and Narasimhan et al. 2006.
 //! - [`single_scatter`]: the single-scattering reflectance of a half-space (Jensen et al. 2001,
 //!   Eq. 3), the first-order term the dipole leaves out.
+//! - [`quadrature`]: Gauss-Legendre nodes and weights, the rule the integrals above are taken
+//!   with.
 //! - [`gpu`]: the std430 records shared with the shaders, mirrored with `#[repr(C)]` + bytemuck.
 
 pub mod beam_single;
@@ -31,6 +33,7 @@ pub mod gpu;
 pub mod kernel;
 pub mod material;
 pub mod presets;
+pub mod quadrature;
 pub mod single_scatter;
 
 pub use dipole::Dipole;

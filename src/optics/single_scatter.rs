@@ -45,6 +45,7 @@
 //! flat over a few mean free paths.
 
 use super::fresnel::fresnel_transmittance;
+pub use super::quadrature::gauss_legendre;
 use std::f64::consts::PI;
 
 /// Gauss-Legendre nodes per dimension of [`reflectance`] (and of the GLSL twin).
@@ -123,35 +124,6 @@ fn reflectance_with(albedo: f64, g: f64, eta: f64, cos_out: f64, rule: &(Vec<f64
 /// mu))`, `mu` the incidence cosine (Chandrasekhar 1960, the first order of the plane albedo).
 pub fn index_matched_isotropic(albedo: f64, mu: f64) -> f64 {
     0.5 * albedo * (1.0 - mu * ((1.0 + mu) / mu).ln())
-}
-
-/// Nodes and weights of `n`-point Gauss-Legendre quadrature on [-1, 1] (Newton's method on the
-/// Legendre polynomial from the Chebyshev-like initial guess).
-pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut nodes = vec![0.0; n];
-    let mut weights = vec![0.0; n];
-    for i in 0..n {
-        let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 1.0;
-        for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, x);
-            for k in 2..=n {
-                let k = k as f64;
-                let p2 = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-            let step = p1 / dp;
-            x -= step;
-            if step.abs() < 1e-16 {
-                break;
-            }
-        }
-        nodes[i] = x;
-        weights[i] = 2.0 / ((1.0 - x * x) * dp * dp);
-    }
-    (nodes, weights)
 }
 
 #[cfg(test)]

@@ -107,7 +107,7 @@ pub fn exitance_with(
                         .map(|t| {
                             let corners = o.mesh.corners(t);
                             let bary = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-                            receiver.piece(&o.mesh, t, corners, bary, 0, &source, &eval)
+                            receiver.piece(&o.mesh, Piece { triangle: t, corners, bary, depth: 0 }, &source, &eval)
                         })
                         .sum::<f64>()
                 })
@@ -137,6 +137,17 @@ impl Sources<'_> {
     }
 }
 
+/// A piece of one mesh triangle, split `depth` times from the whole: its corners and their
+/// barycentric coordinates in the triangle.
+#[derive(Clone, Copy)]
+struct Piece {
+    /// The mesh triangle it is a piece of.
+    triangle: usize,
+    corners: [DVec3; 3],
+    bary: [[f64; 3]; 3],
+    depth: u32,
+}
+
 /// One receiver and channel's quadrature settings.
 struct Receiver {
     x_o: DVec3,
@@ -147,19 +158,10 @@ struct Receiver {
 }
 
 impl Receiver {
-    /// The integral over the piece of triangle `t` with corners `corners` (at barycentric
-    /// coordinates `bary` of the triangle), split until fine (see the module's documentation).
-    #[allow(clippy::too_many_arguments)]
-    fn piece(
-        &self,
-        mesh: &Mesh,
-        t: usize,
-        corners: [DVec3; 3],
-        bary: [[f64; 3]; 3],
-        depth: u32,
-        source: &Sources,
-        eval: &dyn Fn(DVec3, DVec3, DVec3) -> f64,
-    ) -> f64 {
+    /// The integral over `piece` of a triangle of `mesh`, split until fine (see the module's
+    /// documentation).
+    fn piece(&self, mesh: &Mesh, piece: Piece, source: &Sources, eval: &dyn Fn(DVec3, DVec3, DVec3) -> f64) -> f64 {
+        let Piece { triangle: t, corners, bary, depth } = piece;
         let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
         let radius = corners.iter().map(|c| c.distance(centre)).fold(0.0, f64::max);
         let d = centre.distance(self.x_o);
@@ -190,6 +192,11 @@ impl Receiver {
             ([m20, m12, corners[2]], [b20, b12, bary[2]]),
             ([m01, m12, m20], [b01, b12, b20]),
         ];
-        children.iter().map(|(c, b)| self.piece(mesh, t, *c, *b, depth + 1, source, eval)).sum()
+        children
+            .iter()
+            .map(|(c, b)| {
+                self.piece(mesh, Piece { triangle: t, corners: *c, bary: *b, depth: depth + 1 }, source, eval)
+            })
+            .sum()
     }
 }

@@ -7,6 +7,7 @@
 pub use crate::mesh::bvh;
 pub mod clearance;
 pub mod directional;
+pub(crate) mod json_null;
 pub mod rte;
 pub mod rte_cache;
 pub mod rte_mesh;

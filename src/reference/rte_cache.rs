@@ -156,17 +156,3 @@ pub fn cached(
     std::fs::rename(&tmp, &path).map_err(|e| fail(e.to_string()))?;
     Ok((reference, false))
 }
-
-/// Serialises an infinite `f64` as JSON null (which plain `f64` cannot read back) and reads
-/// null back as infinity.
-pub(crate) mod infinite_as_null {
-    use serde::{Deserialize, Deserializer, Serialize, Serializer};
-
-    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
-        v.is_finite().then_some(*v).serialize(s)
-    }
-
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
-    }
-}

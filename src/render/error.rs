@@ -42,7 +42,7 @@ pub enum RenderError {
          use render.gather \"vertex\", \"hierarchical\", \"sparse\" or \"texture\", or material.model = \"dipole\""
     )]
     SingleScatteringOnPixelGather(usize),
-    /// `set_material` of an object whose `model` takes single scattering between points: its
+    /// `SceneEdit::Material` of an object whose `model` takes single scattering between points: its
     /// kernel tables are built with the scene's GPU data.
     #[error(
         "set_material: object {0}'s material.model takes single scattering between points, whose tables are built \
@@ -186,10 +186,10 @@ pub enum RenderError {
         /// How many objects the scene has.
         objects: usize,
     },
-    /// A translucent-only call (`set_material`) on an opaque object.
+    /// A translucent-only edit (`SceneEdit::Material`) on an opaque object.
     #[error("object {0} is opaque: it has no translucent material to replace")]
     OpaqueObject(usize),
-    /// `set_material` with coefficients the dipole model refuses.
+    /// `SceneEdit::Material` with coefficients the dipole model refuses.
     #[error("object {object}: invalid material: {source}")]
     InvalidMaterial {
         /// The object.
@@ -216,7 +216,7 @@ pub enum RenderError {
     /// A scene change could not be prepared (the error names the object and step).
     #[error(transparent)]
     Scene(#[from] SceneError),
-    /// `set_light` was given a light of another kind than scene light `index`, or an index past the
+    /// `SceneEdit::Light` was given a light of another kind than scene light `index`, or an index past the
     /// scene's lights.
     #[error("light {0} cannot be replaced by a light of another kind")]
     LightKindChanged(usize),

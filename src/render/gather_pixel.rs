@@ -42,7 +42,7 @@ impl GatherPixelPass {
     /// camera's HDR and surface images.
     pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<GatherPixelPass> {
         let pipeline = ComputePipeline::new(gpu, "gather_pixel.comp")?;
-        let missing = || GpuError::Invalid("the pixel gather needs the renderer's own HDR and surface images".into());
+        let missing = || GpuError::MissingImages { pass: "pixel gather", images: "HDR and surface images" };
         let hdr = resources.targets.hdr().ok_or_else(missing)?;
         let mut bindings = resources.bind_all(&BINDINGS[..4])?;
         bindings.push(Resource::Hdr.bind(resources.targets.storage_hdr().ok_or_else(missing)?));

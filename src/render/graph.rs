@@ -42,7 +42,7 @@ impl<'a> Resources<'a> {
         self.targets
             .binding(resource)
             .map(|b| resource.bind(b))
-            .ok_or_else(|| GpuError::Invalid(format!("{resource:?} is not a shared resource of this renderer")))
+            .ok_or_else(|| GpuError::NotShared { resource: resource.glsl_name() })
     }
 
     /// Every resource of `list` bound in order (binding i = `list[i]`).

@@ -3,7 +3,7 @@
 //! the passes that write them, in the registry (`graph::Resources`), so a pass that reads one
 //! binds it by name like any scene buffer.
 
-use super::graph::Resource;
+use super::resource::Resource;
 use crate::gpu::{Access, Binding, Gpu, GpuResult, Hazards, Image, ImageBarrier, ImageDesc, Sampler};
 use ash::vk;
 use std::sync::Arc;

@@ -55,7 +55,7 @@ impl TonemapPass {
     pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<TonemapPass> {
         let pipeline = ComputePipeline::new(gpu, "tonemap.comp")?;
         let hdr =
-            resources.targets.hdr().ok_or_else(|| GpuError::Invalid("the tone map needs an own HDR image".into()))?;
+            resources.targets.hdr().ok_or_else(|| GpuError::MissingImages { pass: "tone map", images: "HDR image" })?;
         let extent = hdr.extent();
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
         let pixels = extent.width as u64 * extent.height as u64;

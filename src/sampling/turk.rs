@@ -169,7 +169,7 @@ mod tests {
 
     #[test]
     fn relaxing_in_morton_order_gives_the_callers_order_result_bit_for_bit() {
-        let mesh = crate::scene::build::sphere(0.01, 8).unwrap();
+        let mesh = crate::mesh::shapes::sphere(0.01, 8).unwrap();
         let n = 600;
         let start = super::super::random::random_points(&mesh, n, &mut rand_pcg::Pcg64::seed_from_u64(3));
         let radius = Radius::Uniform(turk_radius(mesh.total_area(), n));

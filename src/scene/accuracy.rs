@@ -1,8 +1,9 @@
 //! From `render.max_error` to each translucent object's sample count: the surface facts the
 //! error model weighs (`sampling::density`), measured on the placed meshes.
 
-use super::build::{PreparedObject, ResolvedMaterial};
 use crate::mesh::bvh::Bvh;
+use crate::mesh::{LodLevel, Mesh};
+use crate::optics::Dipole;
 use crate::sampling::density::{self, ChannelError, SurfaceFacts};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -28,7 +29,7 @@ pub struct Density {
 
 impl Density {
     /// The same facts with `count` samples given rather than chosen (a study's configuration).
-    pub fn given(&self, dipoles: &[crate::optics::Dipole; 3], count: usize) -> Density {
+    pub fn given(&self, dipoles: &[Dipole; 3], count: usize) -> Density {
         let radii = dipoles.each_ref().map(|d| d.profile_radius());
         Density { count, target: None, facts: self.facts, predicted: density::predict(&self.facts, radii, count) }
     }
@@ -66,9 +67,9 @@ impl std::fmt::Display for Density {
     }
 }
 
-/// `object`'s surface facts, with `occluders` the scene's shadow casters.
-pub fn surface_facts(object: &PreparedObject, occluders: &Bvh, ray_offset: f64) -> SurfaceFacts {
-    let mesh = &object.mesh;
+/// The surface facts of an object's `mesh` with its levels of detail `levels` (finest first),
+/// with `occluders` the scene's shadow casters.
+pub fn surface_facts(mesh: &Mesh, levels: &[LodLevel], occluders: &Bvh, ray_offset: f64) -> SurfaceFacts {
     let (h, a) = (mesh.mean_curvature(), mesh.mixed_areas());
     let area: f64 = a.iter().sum();
     let h2 = h.iter().zip(a).map(|(h, a)| h * h * a).sum::<f64>() / area.max(f64::MIN_POSITIVE);
@@ -76,18 +77,17 @@ pub fn surface_facts(object: &PreparedObject, occluders: &Bvh, ray_offset: f64) 
     SurfaceFacts {
         area: mesh.total_area(),
         curvature_radius,
-        occlusion: occlusion(object, occluders, ray_offset),
+        occlusion: occlusion(mesh, occluders, ray_offset),
         // Level 0 is the whole mesh.
-        edge_length: object.levels.first().map_or(0.0, |l| l.mean_edge),
+        edge_length: levels.first().map_or(0.0, |l| l.mean_edge),
     }
 }
 
-/// The area-weighted share of the hemisphere above `object`'s surface that `occluders` block,
-/// ray cast at up to [`OCCLUSION_VERTICES`] vertices in [`OCCLUSION_DIRECTIONS`] fixed
+/// The area-weighted share of the hemisphere above `mesh` that `occluders` block, ray cast at
+/// up to [`OCCLUSION_VERTICES`] vertices ([`receiver_subset`]) in [`OCCLUSION_DIRECTIONS`] fixed
 /// directions each (a spherical Fibonacci set, so the answer is the same on every run).
-fn occlusion(object: &PreparedObject, occluders: &Bvh, eps: f64) -> f64 {
-    let mesh = &object.mesh;
-    let picks = crate::reference::truth::receiver_subset(mesh.positions().len(), Some(OCCLUSION_VERTICES));
+fn occlusion(mesh: &Mesh, occluders: &Bvh, eps: f64) -> f64 {
+    let picks = receiver_subset(mesh.positions().len(), Some(OCCLUSION_VERTICES));
     let directions = fibonacci_sphere(2 * OCCLUSION_DIRECTIONS);
     let (blocked, weight) = picks
         .par_iter()
@@ -122,20 +122,30 @@ fn fibonacci_sphere(n: usize) -> Vec<DVec3> {
         .collect()
 }
 
-/// The sample count for `object` and the prediction behind it: `given` (`sampling.count`) when
-/// set, else the fewest samples `sampling::density::count_for` finds for `max_error`. `None`
-/// for an opaque object.
+/// The sample count for a translucent object of `dipoles` and the prediction behind it:
+/// `given` (`sampling.count`) when set, else the fewest samples `sampling::density::count_for`
+/// finds for `max_error`.
 pub fn choose_count(
-    object: &PreparedObject,
+    dipoles: &[Dipole; 3],
     facts: SurfaceFacts,
     given: Option<usize>,
     max_error: f64,
-) -> Option<(usize, Density)> {
-    let ResolvedMaterial::Translucent { dipoles, .. } = &object.material else { return None };
+) -> (usize, Density) {
     let radii = dipoles.each_ref().map(|d| d.profile_radius());
     let count = given.unwrap_or_else(|| density::count_for(&facts, radii, max_error));
     let predicted = density::predict(&facts, radii, count);
-    Some((count, Density { count, target: given.is_none().then_some(max_error), facts, predicted }))
+    (count, Density { count, target: given.is_none().then_some(max_error), facts, predicted })
+}
+
+/// The vertices of a mesh of `count` vertices picked for work done at some of them: all of
+/// them, or `max` spread evenly over the vertex order (vertex `floor((i + 1/2) count / max)` for
+/// `i < max`), so the subset is the same on every run. Where occlusion is ray cast here, and
+/// where the truth is computed on a subset (`reference::truth`).
+pub fn receiver_subset(count: usize, max: Option<usize>) -> Vec<usize> {
+    match max {
+        Some(m) if m < count => (0..m).map(|i| ((2 * i + 1) * count) / (2 * m)).collect(),
+        _ => (0..count).collect(),
+    }
 }
 
 #[cfg(test)]

@@ -3,12 +3,19 @@
 //! prepared with shadow layers. Everything here is CPU work done once per scene.
 
 use super::lights::{self, Environment, PreparedLight};
-use super::{AssetSource, Camera, GatherMode, Light, MaterialSpec, Scene, SceneError, Shape};
+use super::{AssetSource, GatherMode, Light, MaterialSpec, Scene, SceneError, Shape};
 use crate::mesh::bvh::Bvh;
-use crate::mesh::{LoadOptions, Mesh, MeshError};
-use crate::optics::{Dipole, Material};
-use crate::sampling::{self, Method, SampleOptions, SamplePoint};
-use glam::{DVec3, EulerRot, Mat4, Quat, Vec3};
+use crate::mesh::{LoadOptions, Mesh};
+use crate::optics::Material;
+use crate::sampling::{self, Method, SampleOptions};
+use glam::{EulerRot, Mat4, Quat, Vec3};
+
+/// The prepared object and its material (`scene::object`).
+pub use super::object::{PreparedObject, ResolvedMaterial};
+/// The warnings preparing a scene gives per object (`scene::warnings`).
+pub use super::warnings::{near_plane_warning, precision_warning};
+/// The built-in shapes, built by the mesh floor (`mesh::shapes`).
+pub use crate::mesh::shapes::{plane, sphere};
 
 /// `.with_context(|| where)`: wrap an error in [`SceneError::Context`].
 trait WithContext<T> {
@@ -18,145 +25,6 @@ trait WithContext<T> {
 impl<T, E: Into<SceneError>> WithContext<T> for Result<T, E> {
     fn with_context(self, context: impl FnOnce() -> String) -> Result<T, SceneError> {
         self.map_err(|e| SceneError::Context { context: context(), source: Box::new(e.into()) })
-    }
-}
-
-/// An object's material, resolved.
-#[derive(Clone, Debug)]
-#[allow(clippy::large_enum_variant)] // one per object, never in a hot loop
-pub enum ResolvedMaterial {
-    /// A dipole-diffusion material with its three channels' dipoles in scene units.
-    Translucent {
-        /// Coefficients in 1/mm (preset or custom, `eta` overridden where the scene gives one).
-        material: Material,
-        /// The R, G, B dipoles, in scene units (`material` scaled by `mm_per_unit`).
-        dipoles: [Dipole; 3],
-        /// Millimetres per scene unit.
-        mm_per_unit: f64,
-        /// GGX roughness of the dielectric specular lobe (0 to 1).
-        roughness: f32,
-        /// Which model each channel takes (`material.model`).
-        model: super::ScatteringModel,
-    },
-    /// Lambertian with a GGX specular lobe.
-    Opaque {
-        /// Diffuse albedo per channel (0 to 1).
-        albedo: [f32; 3],
-        /// GGX roughness of the specular lobe (0 to 1).
-        roughness: f32,
-    },
-}
-
-/// One scene object ready to upload: world-space mesh, resolved material and sample points.
-#[derive(Clone, Debug)]
-pub struct PreparedObject {
-    /// For messages: the mesh path or the built-in shape.
-    pub name: String,
-    /// World-space mesh.
-    pub mesh: Mesh,
-    /// What it is made of.
-    pub material: ResolvedMaterial,
-    /// Whether it is drawn into the shadow maps (`casts_shadow` in the scene).
-    pub casts_shadow: bool,
-    /// World-space sample points with area weights (translucent objects only).
-    pub samples: Vec<SamplePoint>,
-    /// How many samples it got and the error predicted for them (translucent objects only).
-    pub density: Option<super::accuracy::Density>,
-    /// Its levels of detail, finest (the mesh itself) first; only the mesh itself when
-    /// `render.level_of_detail` is off or the object's shading rests on per-vertex data the
-    /// simplifier cannot see (`lod_allowed`).
-    pub levels: Vec<crate::mesh::LodLevel>,
-    /// The texture gather's atlas of its mesh, whose texels are then its samples (translucent
-    /// objects of a scene with `render.gather = "texture"` only).
-    pub atlas: Option<std::sync::Arc<crate::mesh::atlas::Atlas>>,
-}
-
-impl PreparedObject {
-    /// Per channel, whether it takes single scattering between points (`material.model`);
-    /// none for an opaque object.
-    pub fn single_channels(&self) -> [bool; 3] {
-        match &self.material {
-            ResolvedMaterial::Translucent { dipoles, model, .. } => {
-                model.single_channels(dipoles.map(|d| d.alpha_prime))
-            }
-            ResolvedMaterial::Opaque { .. } => [false; 3],
-        }
-    }
-
-    /// The hierarchy over its samples for the hierarchical gather (built on each call; the
-    /// renderer and the f64 reference each build it once, identically). Its reach is the widest
-    /// channel's near-blend radius.
-    pub fn sample_tree(&self) -> sampling::SampleTree {
-        let positions: Vec<glam::DVec3> = self.samples.iter().map(|s| s.position.as_dvec3()).collect();
-        let areas: Vec<f64> = self.samples.iter().map(|s| s.area).collect();
-        let widest = self.near_blend_radii().into_iter().fold(crate::optics::kernel::NEAR_BLEND_RADIUS, f64::max);
-        sampling::SampleTree::new(&positions, &areas, widest)
-    }
-
-    /// Per channel, the near-field blend's radius in units of `sqrt(dA)` for its samples
-    /// (`optics::kernel::near_blend_radii` at their mean area); the least radius for an opaque
-    /// object or one without samples.
-    pub fn near_blend_radii(&self) -> [f64; 3] {
-        use crate::optics::kernel;
-        match &self.material {
-            ResolvedMaterial::Translucent { dipoles, .. } if !self.samples.is_empty() => {
-                let mean_area = self.samples.iter().map(|s| s.area).sum::<f64>() / self.samples.len() as f64;
-                kernel::near_blend_radii(dipoles, mean_area)
-            }
-            _ => [kernel::NEAR_BLEND_RADIUS; 3],
-        }
-    }
-
-    /// The hierarchical gather's items for each receiver, in `groups.order` (receivers at
-    /// `positions`), at accuracy `epsilon`: each receiver's own cut (`sampling::SampleTree::cut`
-    /// about its point, nodes dropped by `optics::kernel::negligible_cluster`); empty lists for
-    /// an opaque object. Its own, not its group's: a group's cut lists one by one every sample
-    /// within reach of any of its receivers, which on a coarse level of detail is three times
-    /// what one receiver needs (docs/STUDY.md, "What a group's list costs").
-    pub fn gather_cuts(
-        &self,
-        tree: &sampling::SampleTree,
-        groups: &sampling::ReceiverGroups,
-        positions: &[glam::DVec3],
-        epsilon: f64,
-    ) -> sampling::Cuts {
-        let ResolvedMaterial::Translucent { dipoles, .. } = &self.material else {
-            return sampling::Cuts::build(groups.order.len(), |_, _| {});
-        };
-        let negligible =
-            |n: &sampling::TreeNode, dist: f64| crate::optics::kernel::negligible_cluster(dipoles, n.area as f64, dist);
-        sampling::Cuts::build(groups.order.len(), |k, items| {
-            let at = positions[groups.order[k] as usize].as_vec3().to_array();
-            tree.cut_into((at, 0.0), epsilon, negligible, items)
-        })
-    }
-
-    /// Make the texels of an atlas of its mesh at `resolution` its samples (the texture
-    /// gather's; `mesh::atlas`), its density judged for their count.
-    pub fn place_texels(&mut self, resolution: u32) -> Result<(), crate::mesh::atlas::AtlasError> {
-        let atlas = crate::mesh::atlas::Atlas::new(&self.mesh, resolution)?;
-        self.samples = atlas.texels.iter().map(texel_sample).collect();
-        if let ResolvedMaterial::Translucent { dipoles, .. } = &self.material {
-            self.density = self.density.as_ref().map(|d| d.given(dipoles, self.samples.len()));
-        }
-        self.atlas = Some(std::sync::Arc::new(atlas));
-        Ok(())
-    }
-
-    /// The texture gather's local window half-width in texels (`mesh::atlas::window_radius`
-    /// for its atlas and its widest channel's profile); `None` without an atlas.
-    pub fn window_radius(&self) -> Option<u32> {
-        let (Some(atlas), ResolvedMaterial::Translucent { dipoles, .. }) = (&self.atlas, &self.material) else {
-            return None;
-        };
-        let widest = dipoles.iter().map(|d| d.profile_radius()).fold(0.0, f64::max);
-        Some(crate::mesh::atlas::window_radius(atlas.scale, widest))
-    }
-
-    /// Its vertices as the hierarchical gather groups them (`sampling::ReceiverGroups`).
-    pub fn receiver_groups(&self) -> sampling::ReceiverGroups {
-        let positions: Vec<glam::DVec3> = self.mesh.positions().iter().map(|p| p.as_dvec3()).collect();
-        sampling::ReceiverGroups::new(&positions)
     }
 }
 
@@ -408,7 +276,7 @@ fn apply_overrides(scene: &mut Scene, overrides: &Overrides) -> Result<(), Scene
         render.texture_samples,
         render.texture_resolution,
     )
-    .map_err(|(flag, message)| SceneError::Flag(format!("{flag} {message}")))?;
+    .map_err(SceneError::Flag)?;
     if let Some(l) = overrides.level_of_detail {
         scene.file.render.level_of_detail = l;
     }
@@ -450,24 +318,24 @@ fn prepare_object(scene: &Scene, i: usize, environment_lit: bool) -> Result<Prep
 /// else as many as `render.max_error` needs (`super::accuracy`), judged with every shadow
 /// caster of `objects` in place.
 fn sample_objects(scene: &Scene, objects: &mut [PreparedObject], only: Option<usize>) -> Result<(), SceneError> {
-    let occluders = crate::reference::occluders_of(objects);
-    let eps = crate::reference::ray_offset_within(bounding_sphere(objects.iter().map(|o| &o.mesh)).1);
+    let occluders = occluders_of(objects);
+    let eps = ray_offset_within(bounding_sphere(objects.iter().map(|o| &o.mesh)).1);
     let file = &scene.file;
     for (i, o) in objects.iter_mut().enumerate().filter(|(i, _)| only.is_none_or(|j| j == *i)) {
-        let facts = super::accuracy::surface_facts(o, &occluders, eps);
-        if file.render.gather == GatherMode::Texture && matches!(o.material, ResolvedMaterial::Translucent { .. }) {
+        let facts = super::accuracy::surface_facts(&o.mesh, &o.levels, &occluders, eps);
+        // An opaque object takes no samples.
+        let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else { continue };
+        let dipoles = *dipoles;
+        if file.render.gather == GatherMode::Texture {
             o.place_texels(file.render.texture_resolution).map_err(|e| {
-                SceneError::Flag(format!("{}: object[{i}] ({}): texture atlas: {e}", scene.name, o.name))
+                SceneError::from(e).in_context(format!("{}: object[{i}] ({}): texture atlas", scene.name, o.name))
             })?;
             let count = Some(o.samples.len());
-            o.density = super::accuracy::choose_count(o, facts, count, file.render.max_error).map(|(_, d)| d);
+            o.density = Some(super::accuracy::choose_count(&dipoles, facts, count, file.render.max_error).1);
             continue;
         }
-        let Some((count, density)) =
-            super::accuracy::choose_count(o, facts, file.sampling.count, file.render.max_error)
-        else {
-            continue;
-        };
+        let (count, density) =
+            super::accuracy::choose_count(&dipoles, facts, file.sampling.count, file.render.max_error);
         let options =
             SampleOptions::new(file.sampling.method, count).with_seed(file.sampling.seed.wrapping_add(i as u64));
         o.samples = sampling::sample(&o.mesh, &options)
@@ -476,18 +344,6 @@ fn sample_objects(scene: &Scene, objects: &mut [PreparedObject], only: Option<us
         o.density = Some(density);
     }
     Ok(())
-}
-
-/// A texel of the texture gather's atlas as a sample point (`mesh::atlas`: it carries the area
-/// of the surface it stands for).
-fn texel_sample(t: &crate::mesh::atlas::Texel) -> SamplePoint {
-    SamplePoint {
-        position: t.position,
-        normal: t.normal,
-        triangle: t.triangle,
-        barycentric: t.barycentric.map(|b| b as f32),
-        area: t.area,
-    }
 }
 
 /// The gather a scene leaves to the sample count: the hierarchical one, at
@@ -651,136 +507,6 @@ fn transform_mesh(mesh: Mesh, t: &super::Transform) -> Result<Mesh, SceneError> 
     }
     let positions = mesh.positions().iter().map(|p| m.transform_point3(*p)).collect();
     Ok(Mesh::from_triangles(positions, mesh.triangles().to_vec())?)
-}
-
-/// A square in the xz plane at y = 0, facing +y.
-pub fn plane(size: f32, divisions: u32) -> Result<Mesh, MeshError> {
-    let n = divisions as usize;
-    let mut positions = Vec::with_capacity((n + 1) * (n + 1));
-    for j in 0..=n {
-        for i in 0..=n {
-            let u = i as f32 / n as f32 - 0.5;
-            let v = j as f32 / n as f32 - 0.5;
-            positions.push(Vec3::new(u * size, 0.0, v * size));
-        }
-    }
-    let mut triangles = Vec::with_capacity(2 * n * n);
-    let at = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    for j in 0..n {
-        for i in 0..n {
-            // Counter-clockwise seen from +y.
-            triangles.push([at(i, j), at(i, j + 1), at(i + 1, j)]);
-            triangles.push([at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)]);
-        }
-    }
-    Mesh::from_triangles(positions, triangles)
-}
-
-/// A UV sphere centred at the origin (outward-facing).
-pub fn sphere(radius: f32, divisions: u32) -> Result<Mesh, MeshError> {
-    let rings = divisions.max(3) as usize;
-    let segments = 2 * rings;
-    let mut positions = vec![Vec3::new(0.0, radius, 0.0)];
-    for r in 1..rings {
-        let theta = std::f32::consts::PI * r as f32 / rings as f32;
-        for s in 0..segments {
-            let phi = 2.0 * std::f32::consts::PI * s as f32 / segments as f32;
-            positions.push(radius * Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()));
-        }
-    }
-    positions.push(Vec3::new(0.0, -radius, 0.0));
-    let bottom = (positions.len() - 1) as u32;
-    let ring = |r: usize, s: usize| (1 + (r - 1) * segments + s % segments) as u32;
-    let mut triangles = Vec::new();
-    for s in 0..segments {
-        triangles.push([0, ring(1, s + 1), ring(1, s)]);
-        triangles.push([bottom, ring(rings - 1, s), ring(rings - 1, s + 1)]);
-    }
-    for r in 1..rings - 1 {
-        for s in 0..segments {
-            triangles.push([ring(r, s), ring(r, s + 1), ring(r + 1, s)]);
-            triangles.push([ring(r, s + 1), ring(r + 1, s + 1), ring(r + 1, s)]);
-        }
-    }
-    Mesh::from_triangles(positions, triangles)
-}
-
-/// A warning when the camera's near plane clips `mesh` where the camera looks at it: its
-/// nearest point to the eye lies inside the field of view (the cone through the image's
-/// corners) and nearer than the near plane, which the scene's depth sets (a camera 1e-5 units
-/// from a thin mesh in a large scene sees nothing of it). A grazing part of the mesh that is
-/// not its nearest point is not looked for.
-pub fn near_plane_warning(camera: &Camera, mesh: &Mesh, bounds: (Vec3, f32)) -> Option<String> {
-    let (near, _) = camera.depth_range(bounds.0, bounds.1);
-    let eye = Vec3::from(camera.eye).as_dvec3();
-    let forward = (Vec3::from(camera.target) - Vec3::from(camera.eye)).as_dvec3().normalize_or_zero();
-    let aspect = f64::from(camera.resolution[0]) / f64::from(camera.resolution[1].max(1));
-    let tan_corner = (f64::from(camera.fov_y).to_radians() / 2.0).tan() * (1.0 + aspect * aspect).sqrt();
-    let nearest = (0..mesh.triangles().len())
-        .map(|t| closest_on_triangle(eye, mesh.corners(t)))
-        .min_by(|a, b| a.distance_squared(eye).total_cmp(&b.distance_squared(eye)))?;
-    let (offset, depth) = (nearest - eye, (nearest - eye).dot(forward));
-    let lateral = (offset - forward * depth).length();
-    (depth >= 0.0 && lateral <= depth * tan_corner && offset.length() < f64::from(near)).then(|| {
-        format!(
-            "the camera is {:.3e} units from it, nearer than the near plane ({near:.3e} units, set by the \
-             scene's depth), which clips it from the image: move the camera back",
-            offset.length()
-        )
-    })
-}
-
-/// The point of the triangle `corners` nearest to `p` (Ericson, Real-Time Collision Detection
-/// 5.1.5: by the Voronoi region of `p`).
-fn closest_on_triangle(p: DVec3, corners: [DVec3; 3]) -> DVec3 {
-    let [a, b, c] = corners;
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    a + ab * (vb * denom) + ac * (vc * denom)
-}
-
-/// Positions are f32 in world space: an object far from the origin compared with its size has
-/// its vertices quantised to the f32 spacing there. A warning with the figures when that spacing
-/// is above 1e-4 of the object's size (the sample spacing of a few hundred samples is about
-/// 5e-2 of it, the dipole kernels' blend widths a fraction of that).
-pub fn precision_warning(mesh: &Mesh) -> Option<String> {
-    let (lo, hi) = mesh.bounds();
-    let size = (hi - lo).max_element();
-    let distance = lo.abs().max(hi.abs()).max_element();
-    let spacing = distance * f32::EPSILON;
-    (size > 0.0 && spacing > 1e-4 * size).then(|| {
-        format!(
-            "it is {distance:.3e} units from the origin and {size:.3e} across: f32 positions there are \
-             quantised to {spacing:.2e} units ({:.2}% of its size); move the scene near the origin",
-            100.0 * spacing / size
-        )
-    })
 }
 
 fn bounding_sphere<'a>(meshes: impl Iterator<Item = &'a Mesh>) -> (Vec3, f32) {

@@ -35,18 +35,20 @@ pub struct SceneFile {
 pub struct Camera {
     /// Position of the camera (scene units; required, finite, not equal to `target` and at most
     /// [`crate::mesh::MAX_COORDINATE`] units from it).
+    #[serde(deserialize_with = "exact_len")]
     pub eye: [f32; 3],
     /// The point looked at, at the centre of the image (scene units; required, finite).
+    #[serde(deserialize_with = "exact_len")]
     pub target: [f32; 3],
     /// Which way is up in the image (any length; default `[0, 1, 0]`; finite, non-zero and not
     /// parallel to the view direction).
-    #[serde(default = "up")]
+    #[serde(default = "up", deserialize_with = "exact_len")]
     pub up: [f32; 3],
     /// Vertical field of view in degrees (default 35; strictly between 0 and 180).
     #[serde(default = "fov")]
     pub fov_y: f32,
     /// Image size `[width, height]` in pixels (default `[512, 512]`; each 1 to 16384).
-    #[serde(default = "resolution")]
+    #[serde(default = "resolution", deserialize_with = "exact_len")]
     pub resolution: [u32; 2],
 }
 
@@ -124,8 +126,10 @@ pub struct Transform {
     /// Uniform scale factor (default none; positive).
     pub scale: Option<f32>,
     /// Rotation in degrees about x, then y, then z (default none; finite).
+    #[serde(default, deserialize_with = "exact_len_option")]
     pub rotate: Option<[f32; 3]>,
     /// Offset in scene units, applied last (default none; finite).
+    #[serde(default, deserialize_with = "exact_len_option")]
     pub translate: Option<[f32; 3]>,
 }
 
@@ -139,9 +143,11 @@ pub enum MaterialSpec {
         /// spaces and punctuation. Give either this or both `sigma_a` and `sigma_s_prime`.
         preset: Option<String>,
         /// Absorption coefficient per channel (R, G, B) in 1/mm; finite and non-negative.
+        #[serde(default, deserialize_with = "exact_len_option")]
         sigma_a: Option<[f64; 3]>,
         /// Reduced scattering coefficient `sigma_s'` per channel (R, G, B) in 1/mm; finite and
         /// non-negative, and not zero together with `sigma_a` in any channel.
+        #[serde(default, deserialize_with = "exact_len_option")]
         sigma_s_prime: Option<[f64; 3]>,
         /// Relative index of refraction (default: the preset's, or 1.3 for custom coefficients;
         /// from 1/3 to 3, where the `F_dr` fits hold).
@@ -159,6 +165,7 @@ pub enum MaterialSpec {
     /// Lambertian with a GGX specular lobe.
     Opaque {
         /// Diffuse albedo per channel (R, G, B) (required; each 0 to 1).
+        #[serde(deserialize_with = "exact_len")]
         albedo: [f32; 3],
         /// GGX roughness of the specular lobe (default 0.35; 0 to 1).
         #[serde(default = "roughness")]
@@ -179,8 +186,10 @@ pub enum Light {
     /// `irradiance` in W/m^2 per channel on a surface facing it.
     Directional {
         /// Towards the light, any length (required; finite, non-zero).
+        #[serde(deserialize_with = "exact_len")]
         direction: [f32; 3],
         /// W/m^2 per channel (R, G, B) on a surface facing the light (required; non-negative).
+        #[serde(deserialize_with = "exact_len")]
         irradiance: [f32; 3],
         /// Whether the light casts shadows (default true).
         #[serde(default = "yes")]
@@ -189,8 +198,10 @@ pub enum Light {
     /// `intensity` in W/sr per channel.
     Point {
         /// Position in scene units (required; finite).
+        #[serde(deserialize_with = "exact_len")]
         position: [f32; 3],
         /// W/sr per channel (R, G, B) (required; non-negative).
+        #[serde(deserialize_with = "exact_len")]
         intensity: [f32; 3],
         /// Whether the light casts shadows (default true).
         #[serde(default = "yes")]
@@ -200,11 +211,14 @@ pub enum Light {
     /// with a smooth falloff over the outer `softness` fraction.
     Spot {
         /// Position in scene units (required; finite).
+        #[serde(deserialize_with = "exact_len")]
         position: [f32; 3],
         /// Axis of the cone, pointing away from the light, any length (required; finite,
         /// non-zero).
+        #[serde(deserialize_with = "exact_len")]
         direction: [f32; 3],
         /// W/sr per channel (R, G, B) on the axis (required; non-negative).
+        #[serde(deserialize_with = "exact_len")]
         intensity: [f32; 3],
         /// Half-angle of the cone in degrees (required; strictly between 0 and 90).
         angle: f32,
@@ -324,6 +338,7 @@ pub struct RenderSettings {
     pub shadow_map_size: u32,
     /// Linear background radiance where nothing is hit, per channel (non-negative). Default:
     /// the environment light's radiance at the horizon, or black without one.
+    #[serde(default, deserialize_with = "exact_len_option")]
     pub background: Option<[f32; 3]>,
     /// Draw, shadow and gather each mesh at a level of detail chosen per frame from its size
     /// on screen (default true; `mesh::Mesh::levels_of_detail`, `render::plan`). False keeps
@@ -580,4 +595,28 @@ fn max_error() -> f64 {
 
 fn shadow_size() -> u32 {
     1024
+}
+
+/// A fixed-size array key read as a list of exactly `N` values: serde's own array reading
+/// stops after `N` and ignores the rest, so `resolution = [32, 32, 32]` would read as 32x32.
+/// The error ("invalid length 3, expected a list of 2 values") comes with the file, line and key.
+fn exact_len<'de, D, T, const N: usize>(deserializer: D) -> Result<[T; N], D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    let values = Vec::<T>::deserialize(deserializer)?;
+    let len = values.len();
+    values
+        .try_into()
+        .map_err(|_| serde::de::Error::invalid_length(len, &format!("a list of {N} values").as_str()))
+}
+
+/// `exact_len` for an optional key (absent is `None`).
+fn exact_len_option<'de, D, T, const N: usize>(deserializer: D) -> Result<Option<[T; N]>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    exact_len(deserializer).map(Some)
 }

@@ -7,6 +7,8 @@ mod camera;
 pub mod format;
 pub mod lights;
 pub mod needs;
+mod object;
+mod warnings;
 
 pub use format::*;
 use std::path::{Path, PathBuf};
@@ -49,10 +51,13 @@ pub enum SceneError {
     /// `--gather-epsilon` outside its range.
     #[error("--gather-epsilon {0} must be 0 to {MAX_GATHER_EPSILON} (as for render.gather_epsilon)")]
     GatherEpsilon(f32),
-    /// A command-line setting outside its range, or what it asks for impossible: the message
-    /// names the flag.
-    #[error("{0}")]
-    Flag(String),
+    /// `--texture-samples` or `--texture-resolution` outside its range.
+    #[error(transparent)]
+    Flag(#[from] OutOfRange),
+    /// A mesh got no texture atlas (`render.gather = "texture"`); `{:#}` shows where, by
+    /// [`SceneError::Context`], and this the cause.
+    #[error(transparent)]
+    Atlas(#[from] crate::mesh::atlas::AtlasError),
     /// `--max-error` outside its range.
     #[error("--max-error {0} must be {MIN_MAX_ERROR} to {MAX_MAX_ERROR} (as for render.max_error; 0.01 is 1%)")]
     MaxError(f64),
@@ -85,6 +90,28 @@ pub enum SceneError {
         /// The error itself.
         source: Box<SceneError>,
     },
+}
+
+impl SceneError {
+    /// This error as the source of a [`SceneError::Context`] that names where it happened.
+    pub(crate) fn in_context(self, context: String) -> SceneError {
+        SceneError::Context { context, source: Box::new(self) }
+    }
+}
+
+/// A whole-number setting outside its range, named by its key or flag: what
+/// [`check_texture`] refuses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{key} {value} must be {min} to {max}")]
+pub struct OutOfRange {
+    /// The scene key (`render.texture_samples`) or command-line flag (`--texture-samples`).
+    pub key: &'static str,
+    /// The value given.
+    pub value: u32,
+    /// The least allowed.
+    pub min: u32,
+    /// The most allowed.
+    pub max: u32,
 }
 
 /// Most sample points per translucent object (`sampling.count`, `--samples`).
@@ -451,19 +478,25 @@ fn check_render(r: &RenderSettings) -> Check {
         return Err(("render.shadow_map_size".into(), format!("{} must be 16 to 8192", r.shadow_map_size)));
     }
     non_negative("render.background", &r.background.unwrap_or_default())?;
-    check_texture("render.texture_samples", "render.texture_resolution", r.texture_samples, r.texture_resolution)?;
+    check_texture("render.texture_samples", "render.texture_resolution", r.texture_samples, r.texture_resolution)
+        .map_err(|e| (e.key.to_string(), format!("{} must be {} to {}", e.value, e.min, e.max)))?;
     check_max_error("render.max_error", r.max_error)
 }
 
 /// The texture gather's sample count (0 to [`format::MAX_TEXTURE_SAMPLES`]) and atlas
 /// resolution (`mesh::atlas::MIN_RESOLUTION` to `MAX_RESOLUTION`), under the keys or flags named.
-pub fn check_texture(samples_key: &str, resolution_key: &str, samples: u32, resolution: u32) -> Check {
+pub fn check_texture(
+    samples_key: &'static str,
+    resolution_key: &'static str,
+    samples: u32,
+    resolution: u32,
+) -> Result<(), OutOfRange> {
     use crate::mesh::atlas::{MAX_RESOLUTION, MIN_RESOLUTION};
     if samples > format::MAX_TEXTURE_SAMPLES {
-        return Err((samples_key.into(), format!("{samples} must be 0 to {}", format::MAX_TEXTURE_SAMPLES)));
+        return Err(OutOfRange { key: samples_key, value: samples, min: 0, max: format::MAX_TEXTURE_SAMPLES });
     }
     if !(MIN_RESOLUTION..=MAX_RESOLUTION).contains(&resolution) {
-        return Err((resolution_key.into(), format!("{resolution} must be {MIN_RESOLUTION} to {MAX_RESOLUTION}")));
+        return Err(OutOfRange { key: resolution_key, value: resolution, min: MIN_RESOLUTION, max: MAX_RESOLUTION });
     }
     Ok(())
 }

@@ -6,21 +6,21 @@
 
 use nv_flip::{DEFAULT_PIXELS_PER_DEGREE, FlipImageFloat, FlipImageRgb8};
 
-use super::plot::rgb_to_rgba;
+use super::plot::{PlotError, rgb_to_rgba};
 
 /// Checks the sizes and drops alpha, which FLIP does not use.
-fn to_rgb(name: &str, rgba: &[u8], width: u32, height: u32) -> Result<Vec<u8>, String> {
+fn to_rgb(image: &'static str, rgba: &[u8], width: u32, height: u32) -> Result<Vec<u8>, PlotError> {
     let expected = width as usize * height as usize * 4;
     if width == 0 || height == 0 {
-        return Err(format!("{name} image is empty ({width}x{height})"));
+        return Err(PlotError::EmptyImage { image, width, height });
     }
     if rgba.len() != expected {
-        return Err(format!("{name} image has {} bytes, {width}x{height} RGBA8 needs {expected}", rgba.len()));
+        return Err(PlotError::ImageBytes { image, bytes: rgba.len(), width, height, expected });
     }
     Ok(rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect())
 }
 
-fn error_map(reference: &[u8], test: &[u8], width: u32, height: u32) -> Result<FlipImageFloat, String> {
+fn error_map(reference: &[u8], test: &[u8], width: u32, height: u32) -> Result<FlipImageFloat, PlotError> {
     let reference = FlipImageRgb8::with_data(width, height, &to_rgb("reference", reference, width, height)?);
     let test = FlipImageRgb8::with_data(width, height, &to_rgb("test", test, width, height)?);
     Ok(nv_flip::flip(reference, test, DEFAULT_PIXELS_PER_DEGREE))
@@ -30,13 +30,13 @@ fn error_map(reference: &[u8], test: &[u8], width: u32, height: u32) -> Result<F
 ///
 /// The mean is the single figure FLIP's authors recommend; it is summed here in f64 from the map itself rather
 /// than read from nv-flip's histogram pool, so it is exact.
-pub fn flip_mean(reference: &[u8], test: &[u8], width: u32, height: u32) -> Result<f64, String> {
+pub fn flip_mean(reference: &[u8], test: &[u8], width: u32, height: u32) -> Result<f64, PlotError> {
     let map = error_map(reference, test, width, height)?.to_vec();
     Ok(map.iter().map(|&v| f64::from(v)).sum::<f64>() / map.len() as f64)
 }
 
 /// The FLIP error map coloured with FLIP's magma lookup table, as RGBA8, for looking at where the error is.
-pub fn flip_map(reference: &[u8], test: &[u8], width: u32, height: u32) -> Result<Vec<u8>, String> {
+pub fn flip_map(reference: &[u8], test: &[u8], width: u32, height: u32) -> Result<Vec<u8>, PlotError> {
     let coloured = error_map(reference, test, width, height)?.apply_color_lut(&nv_flip::magma_lut());
     Ok(rgb_to_rgba(&coloured.to_vec()))
 }

@@ -280,11 +280,7 @@ pub struct ReferenceTiming {
 
 /// Time the f64 reference on the swept configuration closest to the scene's own (its sampler
 /// and count if swept, with the vertex gather), so the GPU's speed-up is measured in one run.
-fn time_reference(
-    base: &PreparedScene,
-    config: &StudyConfig,
-    rows: &[Row],
-) -> Result<Option<ReferenceTiming>, StudyError> {
+fn time_reference(base: &PreparedScene, rows: &[Row]) -> Result<Option<ReferenceTiming>, StudyError> {
     let own = &base.scene.file.sampling;
     let own_count = base.objects.iter().find(|o| !o.samples.is_empty()).map(|o| o.samples.len());
     let vertex_rows = || rows.iter().enumerate().filter(|(_, r)| r.gather == GatherMode::Vertex.name());
@@ -292,7 +288,8 @@ fn time_reference(
         .find(|(_, r)| r.sampler == own.method.name() && Some(r.samples) == own_count)
         .or_else(|| vertex_rows().next());
     let Some((row, r)) = pick else { return Ok(None) };
-    let method = *config.samplers.iter().find(|m| m.name() == r.sampler).expect("a swept sampler");
+    // The scene's own row stays when `--samplers` leaves its sampler out, so look among all.
+    let Some(&method) = Method::ALL.iter().find(|m| m.name() == r.sampler) else { return Ok(None) };
     let run =
         Configuration { method, count: r.samples, seed: r.seed, gather: (GatherMode::Vertex, None), own: r.default };
     let (scene, _) = configure(base, run)?;
@@ -443,7 +440,7 @@ pub fn run(
         rows.push(row);
         exitances.push(exitance);
     }
-    let reference = time_reference(&base, config, &rows)?;
+    let reference = time_reference(&base, &rows)?;
     Ok(Study { rows, truth, truth_cached, truth_image, prepared: base, exitance: exitances, reference, physics })
 }
 
@@ -581,9 +578,8 @@ impl Bench<'_> {
             rte_noise: self.physics.map_or(nan, |p| p.noise),
             image_rel_rmse: self.truth_image.map_or(f64::NAN, |t| image_rel_rmse(&t.hdr, &image.hdr)),
             flip_mean: match self.truth_image {
-                Some(t) => {
-                    flip::flip_mean(&t.ldr, &image.ldr, image.size[0], image.size[1]).map_err(StudyError::Report)?
-                }
+                Some(t) => flip::flip_mean(&t.ldr, &image.ldr, image.size[0], image.size[1])
+                    .map_err(|e| StudyError::Report(e.to_string()))?,
                 None => f64::NAN,
             },
         };
@@ -639,6 +635,6 @@ pub fn error_image(
     for (dst, src) in rgba.chunks_exact_mut(width as usize * 4).zip(model.chunks_exact(w as usize * 4)) {
         dst[..src.len()].copy_from_slice(src);
     }
-    raster::legend_bar(&mut rgba, width, h, [&labels[0], &labels[1], &labels[2]])?;
+    raster::legend_bar(&mut rgba, width, h, [&labels[0], &labels[1], &labels[2]]).map_err(|e| e.to_string())?;
     Ok((rgba, width))
 }

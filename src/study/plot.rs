@@ -6,6 +6,7 @@
 use std::collections::BTreeMap;
 use std::sync::Once;
 
+use plotters::backend::DrawingBackend;
 use plotters::coord::CoordTranslate;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
@@ -24,6 +25,66 @@ pub(crate) fn ensure_font() {
         }
     });
 }
+
+/// What plotters' bitmap backend fails with.
+type DrawingError = DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>;
+
+/// Why a chart or a legend could not be drawn, or two images could not be compared (`flip`).
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// [`error_vs_time`] of no configurations.
+    #[error("no configurations to plot")]
+    NothingToPlot,
+    /// [`error_vs_time`] of configurations none of which has a finite frame time and error.
+    #[error("no configuration has a finite frame time and error")]
+    NothingFinite,
+    /// A chart smaller than [`MIN_CHART`] pixels either way.
+    #[error("chart size {width}x{height} is too small (at least {MIN_CHART}x{MIN_CHART})")]
+    ChartTooSmall {
+        /// The width asked for.
+        width: u32,
+        /// The height asked for.
+        height: u32,
+    },
+    /// An image too small for the legend's panel (`raster::legend_bar`).
+    #[error("image {width}x{height} is too small for a legend")]
+    LegendTooSmall {
+        /// The image's width.
+        width: u32,
+        /// The image's height.
+        height: u32,
+    },
+    /// An image without a pixel.
+    #[error("{image} image is empty ({width}x{height})")]
+    EmptyImage {
+        /// Which image: "reference", "test".
+        image: &'static str,
+        /// Its width.
+        width: u32,
+        /// Its height.
+        height: u32,
+    },
+    /// RGBA8 pixels whose length is not the image's size.
+    #[error("{image} image has {bytes} bytes, {width}x{height} RGBA8 needs {expected}")]
+    ImageBytes {
+        /// Which image: "reference", "test", "legend".
+        image: &'static str,
+        /// Bytes given.
+        bytes: usize,
+        /// The width given.
+        width: u32,
+        /// The height given.
+        height: u32,
+        /// Bytes of `width` x `height` RGBA8.
+        expected: usize,
+    },
+    /// plotters could not draw.
+    #[error(transparent)]
+    Drawing(#[from] DrawingError),
+}
+
+/// The smallest chart, in pixels each way.
+pub const MIN_CHART: u32 = 64;
 
 /// Smallest value drawn on a log axis; zero or negative measurements are clamped up to it.
 const LOG_FLOOR: f64 = 1e-6;
@@ -71,17 +132,17 @@ fn minor_ticks(lo: f64, hi: f64) -> Vec<f64> {
 
 /// Error (as a fraction) against median frame time, log-log, one line per (sampler, gather, epsilon) curve,
 /// the Pareto front and the error targets. Returns RGBA8 pixels, rows top to bottom.
-pub fn error_vs_time(summaries: &[Summary], title: &str, width: u32, height: u32) -> Result<Vec<u8>, String> {
+pub fn error_vs_time(summaries: &[Summary], title: &str, width: u32, height: u32) -> Result<Vec<u8>, PlotError> {
     if summaries.is_empty() {
-        return Err("no configurations to plot".into());
+        return Err(PlotError::NothingToPlot);
     }
-    if width < 64 || height < 64 {
-        return Err(format!("chart size {width}x{height} is too small"));
+    if width < MIN_CHART || height < MIN_CHART {
+        return Err(PlotError::ChartTooSmall { width, height });
     }
     ensure_font();
     let drawable: Vec<&Summary> = summaries.iter().filter(|s| s.frame_ms.is_finite() && s.error.is_finite()).collect();
     if drawable.is_empty() {
-        return Err("no configuration has a finite frame time and error".into());
+        return Err(PlotError::NothingFinite);
     }
     let (x, y) = axis_ranges(&drawable);
     let chart = Chart { title, x, y, curves: curves(&drawable), front: pareto_front(&drawable) };
@@ -141,17 +202,12 @@ struct Chart<'a> {
     front: Vec<(f64, f64)>,
 }
 
-/// A plotters error as the text this module returns.
-fn message<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> String {
-    e.to_string()
-}
-
 impl Chart<'_> {
     /// Draw it into `rgb` (RGB8, `width` x `height`): axes and grid, targets, front, curves, legend.
-    fn draw(&self, rgb: &mut [u8], width: u32, height: u32) -> Result<(), String> {
+    fn draw(&self, rgb: &mut [u8], width: u32, height: u32) -> Result<(), PlotError> {
         let ((x0, x1), (y0, y1)) = (self.x, self.y);
         let root = BitMapBackend::with_buffer(rgb, (width, height)).into_drawing_area();
-        root.fill(&WHITE).map_err(message)?;
+        root.fill(&WHITE)?;
         let mut chart = ChartBuilder::on(&root)
             .caption(self.title, ("sans-serif", 20))
             .margin(12)
@@ -160,8 +216,7 @@ impl Chart<'_> {
             .build_cartesian_2d(
                 (x0..x1).log_scale().with_key_points(ticks(x0, x1)).with_light_points(minor_ticks(x0, x1)),
                 (y0..y1).log_scale().with_key_points(ticks(y0, y1)).with_light_points(minor_ticks(y0, y1)),
-            )
-            .map_err(message)?;
+            )?;
         chart
             .configure_mesh()
             .x_desc("frame time, ms (median GPU time)")
@@ -171,41 +226,37 @@ impl Chart<'_> {
             .label_style(("sans-serif", 13))
             .axis_desc_style(("sans-serif", 14))
             .light_line_style(RGBColor(242, 242, 242))
-            .draw()
-            .map_err(message)?;
+            .draw()?;
         self.draw_targets(&mut chart)?;
         self.draw_front(&mut chart)?;
         self.draw_curves(&mut chart)?;
-        chart.draw_series(self.front.iter().map(|&p| Cross::new(p, 6, BLACK.stroke_width(2)))).map_err(message)?;
+        chart.draw_series(self.front.iter().map(|&p| Cross::new(p, 6, BLACK.stroke_width(2))))?;
         chart
             .configure_series_labels()
             .position(SeriesLabelPosition::UpperRight)
             .label_font(("sans-serif", 12))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
-            .draw()
-            .map_err(message)?;
-        root.present().map_err(message)
+            .draw()?;
+        Ok(root.present()?)
     }
 
     /// Each error target as a dashed line across the chart, labelled at its left end.
     fn draw_targets<CT: CoordTranslate<From = (f64, f64)>>(
         &self,
         chart: &mut ChartContext<'_, BitMapBackend<'_>, CT>,
-    ) -> Result<(), String> {
+    ) -> Result<(), PlotError> {
         let (x0, x1) = self.x;
         let guide = RGBColor(150, 150, 150);
         for t in TARGETS {
             let y = 100.0 * t;
-            chart
-                .draw_series(DashedLineSeries::new([(x0, y), (x1, y)], 6, 4, guide.stroke_width(1)))
-                .map_err(message)?;
+            chart.draw_series(DashedLineSeries::new([(x0, y), (x1, y)], 6, 4, guide.stroke_width(1)))?;
             let label = Text::new(
                 format!("{} %", tick(y)),
                 (x0 * 1.05, y * 1.04),
                 ("sans-serif", 12).into_font().color(&guide),
             );
-            chart.draw_series(std::iter::once(label)).map_err(message)?;
+            chart.draw_series(std::iter::once(label))?;
         }
         Ok(())
     }
@@ -214,7 +265,7 @@ impl Chart<'_> {
     fn draw_front<CT: CoordTranslate<From = (f64, f64)>>(
         &self,
         chart: &mut ChartContext<'_, BitMapBackend<'_>, CT>,
-    ) -> Result<(), String> {
+    ) -> Result<(), PlotError> {
         let mut steps = Vec::new();
         for (i, &(x, y)) in self.front.iter().enumerate() {
             if i > 0 {
@@ -224,8 +275,7 @@ impl Chart<'_> {
         }
         let grey = RGBColor(120, 120, 120).mix(0.6);
         chart
-            .draw_series(LineSeries::new(steps, grey.stroke_width(5)))
-            .map_err(message)?
+            .draw_series(LineSeries::new(steps, grey.stroke_width(5)))?
             .label("Pareto front")
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], grey.stroke_width(5)));
         Ok(())
@@ -235,13 +285,12 @@ impl Chart<'_> {
     fn draw_curves<CT: CoordTranslate<From = (f64, f64)>>(
         &self,
         chart: &mut ChartContext<'_, BitMapBackend<'_>, CT>,
-    ) -> Result<(), String> {
+    ) -> Result<(), PlotError> {
         for (i, (name, points)) in self.curves.iter().enumerate() {
             let colour = PALETTE[i % PALETTE.len()];
             let line: Vec<(f64, f64)> = points.iter().map(|s| point(s)).collect();
             chart
-                .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))
-                .map_err(message)?
+                .draw_series(LineSeries::new(line.clone(), colour.stroke_width(2)))?
                 .label(name.as_str())
                 .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2)));
             // Past ten curves the colours repeat, so the marker shape tells them apart.
@@ -249,8 +298,7 @@ impl Chart<'_> {
                 0 => chart.draw_series(line.iter().map(|&p| Circle::new(p, 4, colour.filled()))),
                 1 => chart.draw_series(line.iter().map(|&p| TriangleMarker::new(p, 5, colour.filled()))),
                 _ => chart.draw_series(line.iter().map(|&p| Circle::new(p, 4, colour.stroke_width(2)))),
-            }
-            .map_err(message)?;
+            }?;
         }
         Ok(())
     }

@@ -8,7 +8,7 @@ use glam::{Mat4, Vec3, Vec4, Vec4Swizzles};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::plot::{ensure_font, rgb_to_rgba};
+use super::plot::{PlotError, ensure_font, rgb_to_rgba};
 
 /// Draws triangles with per-vertex colours into an RGBA8 image (rows top to bottom).
 ///
@@ -123,37 +123,35 @@ pub fn colormap(t: f32) -> [f32; 3] {
 
 /// Draws a vertical [`colormap`] bar with three labelled ticks (bottom, middle, top: `labels[0..3]`) on a white
 /// panel at the right edge of an RGBA8 image, so the false colours can be read as numbers.
-pub fn legend_bar(rgba: &mut [u8], width: u32, height: u32, labels: [&str; 3]) -> Result<(), String> {
-    if rgba.len() != width as usize * height as usize * 4 {
-        return Err(format!("image has {} bytes, {width}x{height} RGBA8 needs {}", rgba.len(), width * height * 4));
+pub fn legend_bar(rgba: &mut [u8], width: u32, height: u32, labels: [&str; 3]) -> Result<(), PlotError> {
+    let expected = width as usize * height as usize * 4;
+    if rgba.len() != expected {
+        return Err(PlotError::ImageBytes { image: "legend", bytes: rgba.len(), width, height, expected });
     }
     const PANEL: i32 = 110;
     if width <= PANEL as u32 || height < 80 {
-        return Err(format!("image {width}x{height} is too small for a legend"));
+        return Err(PlotError::LegendTooSmall { width, height });
     }
     ensure_font();
     let (w, h) = (width as i32, height as i32);
     let mut rgb: Vec<u8> = rgba.chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
     {
-        let e = |e: DrawingAreaErrorKind<_>| e.to_string();
         let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
         let (top, bottom) = (h / 5, h - h / 5);
         let (left, bar_w) = (w - PANEL + 10, 18);
-        root.draw(&Rectangle::new([(w - PANEL, top - 14), (w - 4, bottom + 14)], WHITE.mix(0.85).filled()))
-            .map_err(e)?;
+        root.draw(&Rectangle::new([(w - PANEL, top - 14), (w - 4, bottom + 14)], WHITE.mix(0.85).filled()))?;
         for y in top..bottom {
             let t = (bottom - 1 - y) as f32 / (bottom - top - 1).max(1) as f32;
             let [r, g, b] = to_u8(colormap(t));
-            root.draw(&Rectangle::new([(left, y), (left + bar_w, y + 1)], RGBColor(r, g, b).filled())).map_err(e)?;
+            root.draw(&Rectangle::new([(left, y), (left + bar_w, y + 1)], RGBColor(r, g, b).filled()))?;
         }
-        root.draw(&Rectangle::new([(left, top), (left + bar_w, bottom)], BLACK.stroke_width(1))).map_err(e)?;
+        root.draw(&Rectangle::new([(left, top), (left + bar_w, bottom)], BLACK.stroke_width(1)))?;
         let style = ("sans-serif", 14).into_font().color(&BLACK).pos(Pos::new(HPos::Left, VPos::Center));
         for (label, y) in labels.iter().zip([bottom - 1, (top + bottom) / 2, top]) {
-            root.draw(&PathElement::new([(left + bar_w, y), (left + bar_w + 5, y)], BLACK.stroke_width(1)))
-                .map_err(e)?;
-            root.draw(&Text::new(label.to_string(), (left + bar_w + 8, y), style.clone())).map_err(e)?;
+            root.draw(&PathElement::new([(left + bar_w, y), (left + bar_w + 5, y)], BLACK.stroke_width(1)))?;
+            root.draw(&Text::new(label.to_string(), (left + bar_w + 8, y), style.clone()))?;
         }
-        root.present().map_err(e)?;
+        root.present()?;
     }
     for (dst, src) in rgba.chunks_exact_mut(4).zip(rgb_to_rgba(&rgb).chunks_exact(4)) {
         dst[..3].copy_from_slice(&src[..3]);

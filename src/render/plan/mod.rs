@@ -26,6 +26,7 @@
 //! rules for each object (objects.rs) and each pass (passes.rs); every decision carries a reason
 //! (reason.rs), text only when printed.
 
+mod frame;
 mod objects;
 mod passes;
 mod planner;

@@ -1,7 +1,7 @@
 //! The rules for one object: its level of detail, each channel's transport, and whether it is
 //! splatted and gathered this frame.
 
-use super::planner::Frame;
+use super::frame::Frame;
 use super::{
     Change, ChannelFigures, ChannelPlan, ChannelReason, LOCAL_PIXELS, LOCAL_SPACING, LOD_EDGE_PIXELS, LOD_ERROR_PIXELS,
     LevelReason, ObjectPlan, ObjectReason, SplatLights, Transport,

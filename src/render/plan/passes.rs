@@ -1,7 +1,7 @@
 //! The rules for each pass (shadows, the environment, splat and gather, shading and tone map)
 //! and the order they are recorded in.
 
-use super::planner::Frame;
+use super::frame::Frame;
 use super::{Change, ObjectPlan, Pass, PassReason, SHADOW_ONE_TAP_PIXELS, SceneNeeds, ShadowFilter, SkipReason, View};
 use glam::Vec3;
 

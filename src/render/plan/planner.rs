@@ -3,6 +3,7 @@
 //! recorded frame leaves. Also `needs`, the one place a renderer's `SceneNeeds` are computed.
 
 use super::objects::ObjectHistory;
+use super::frame::Frame;
 use super::passes::shadow_filter;
 use super::{Change, Pass, Plan, SceneNeeds, View};
 use crate::scene::build::PreparedScene;
@@ -33,31 +34,6 @@ pub fn needs(scene: &PreparedScene, host_target: bool, baked: BakedLevels) -> Sc
         }
     }
     needs
-}
-
-/// One frame's inputs to the rules (objects.rs, passes.rs): the scene, the view, the change, and
-/// what the change makes stale scene-wide.
-pub(super) struct Frame<'a> {
-    pub needs: &'a SceneNeeds,
-    pub view: &'a View,
-    pub change: Change,
-    /// Visibility and irradiance are stale: lights or geometry changed.
-    pub lights_stale: bool,
-    /// The environment's per-vertex cache is stale (when the scene has one).
-    pub environment_stale: bool,
-}
-
-impl<'a> Frame<'a> {
-    fn new(needs: &'a SceneNeeds, view: &'a View, change: Change) -> Frame<'a> {
-        let lights_stale =
-            matches!(change, Change::Everything | Change::Lights | Change::Light(_) | Change::Geometry(_));
-        let environment_stale = match change {
-            Change::Everything | Change::Lights | Change::Geometry(_) => true,
-            Change::Light(i) => needs.environment == Some(i),
-            Change::Camera | Change::Material(_) => false,
-        };
-        Frame { needs, view, change, lights_stale, environment_stale }
-    }
 }
 
 /// The frame's history as the planner needs it: what changed since the last recorded frame,

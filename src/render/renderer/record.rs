@@ -69,7 +69,7 @@ impl Renderer {
     /// none after. No submission and no wait; `read_timings` and the lifetime rule are those
     /// of `record_frame`.
     ///
-    /// `extent` is the size in pixels the host draws the view at (set with `set_camera`): the
+    /// `extent` is the size in pixels the host draws the view at (set with `SceneEdit::Camera`): the
     /// levels of detail follow it, as they follow a `HostTarget`'s extent. `readers` are the
     /// accesses the host will read the output with (`Access::VertexAttributeRead` for a vertex
     /// stream, `ComputeRead`, `FragmentRead`, `TransferRead`, `HostRead`): the call ends with

@@ -42,21 +42,21 @@
 //! Photons whose walk meets the surface from outside (a ray through a crack the f64
 //! intersection test leaves between triangles) are dropped and counted in `lost`.
 
-use super::bvh::intersect_uv;
-use super::bvh::{Bvh, Hit};
-use super::clearance::{Clearance, Flight};
-use super::rte::{
-    Budget, Medium, Progress, RteError, after_collision, after_reflection, chunk_rng, run_rounds, sample_hg_cos,
-};
-use super::truth::LIT_FLOOR;
-use super::{light_incidence, occluders, ray_offset, reaching};
+mod geometry;
+mod sources;
+mod tally;
+mod walk;
+
+pub use tally::relative_stderr;
+
+use super::rte::{Budget, Medium, Progress, RteError, chunk_rng, run_rounds};
+use super::{occluders, ray_offset};
 use crate::mesh::Mesh;
-use crate::optics::fresnel;
 use crate::scene::build::{PreparedScene, ResolvedMaterial};
-use crate::scene::lights::PreparedLight;
-use glam::DVec3;
-use rand::RngExt;
-use rand_pcg::Pcg64;
+use geometry::Geometry;
+use sources::{Lighting, Sources};
+use tally::{Tally, add_exits, cell_areas, summarize};
+use walk::ObjectWalk;
 
 /// Photons per chunk (one random stream each).
 const CHUNK: u64 = 256;
@@ -85,7 +85,7 @@ pub struct ObjectExitance {
     /// The precision reached: per channel, the RMS standard error over the lit vertices
     /// (exitance at least `truth::LIT_FLOOR` of the brightest) over their mean exitance; the
     /// largest of the three (infinite, stored as JSON null, where a channel lights nothing).
-    #[serde(with = "super::rte_cache::infinite_as_null")]
+    #[serde(with = "super::json_null::infinite_as_null")]
     pub relative_stderr: f64,
     /// Walks per channel dropped because they met the surface from outside.
     pub lost: [u64; 3],
@@ -106,144 +106,6 @@ struct Method {
 
 /// This module's walk.
 const WALK: Method = Method { split: true, clearance: true };
-
-/// The object as the walk sees it.
-struct Geometry<'a> {
-    mesh: &'a Mesh,
-    bvh: Bvh,
-    /// Outward unit face normals.
-    normals: Vec<DVec3>,
-    /// Per face, its plane's offset along its normal.
-    offsets: Vec<f64>,
-    /// A small length, far above the rounding of the hit test: the plane test's slack.
-    slack: f64,
-    /// A lower bound of the distance to the surface, if the method uses one.
-    clearance: Option<Clearance>,
-}
-
-impl<'a> Geometry<'a> {
-    fn new(mesh: &'a Mesh, clearance: bool) -> Geometry<'a> {
-        let triangles: Vec<[DVec3; 3]> = (0..mesh.triangles().len()).map(|t| mesh.corners(t)).collect();
-        // Six times the enclosed volume: negative when the winding faces inwards.
-        let volume: f64 = triangles.iter().map(|[a, b, c]| a.dot(b.cross(*c))).sum();
-        let sign = if volume < 0.0 { -1.0 } else { 1.0 };
-        let normals: Vec<DVec3> =
-            triangles.iter().map(|[a, b, c]| sign * (*b - *a).cross(*c - *a).normalize()).collect();
-        let offsets = triangles.iter().zip(&normals).map(|(t, n)| n.dot(t[0])).collect();
-        let size = triangles.iter().flatten().fold(0.0f64, |m, p| m.max(p.abs().max_element()));
-        let bvh = Bvh::new(triangles);
-        let clearance = clearance.then(|| {
-            let (min, max) = mesh.positions().iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(p.as_dvec3()), hi.max(p.as_dvec3()))
-            });
-            Clearance::new(&bvh, min, max)
-        });
-        Geometry { mesh, bvh, normals, offsets, slack: 1e-9 * size, clearance }
-    }
-
-    /// The first face a flight from `p` along `d` meets within `s`, other than `skip`: what
-    /// the BVH's query answers, without it where the clearance grid rules a hit out or lists
-    /// the faces the flight can meet.
-    fn closest_hit(&self, p: DVec3, d: DVec3, s: f64, skip: Option<usize>) -> Option<Hit> {
-        match self.clearance.as_ref().map_or(Flight::Far, |c| c.flight(p, s)) {
-            Flight::Clear => None,
-            Flight::Near(faces) => self.closest_among(faces, p, d, s, skip),
-            Flight::Far => self.bvh.closest_hit(p, d, 0.0, s, skip),
-        }
-    }
-
-    /// [`Geometry::closest_hit`] among `faces`, by the BVH's own hit test. A face whose plane
-    /// the flight does not cross within `(0, s)` (give or take the slack) is passed over
-    /// first: two dot products instead of the full test, for most of the list.
-    fn closest_among(&self, faces: &[u32], p: DVec3, d: DVec3, s: f64, skip: Option<usize>) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        let mut t_far = s;
-        for &f in faces {
-            let f = f as usize;
-            let (n, offset) = (self.normals[f], self.offsets[f]);
-            // The plane is met at t = num / den; within (0, s) iff num lies between 0 and s den.
-            let (num, den) = (offset - n.dot(p), n.dot(d));
-            if (num - 0.5 * s * den).abs() > 0.5 * s * den.abs() + self.slack || skip == Some(f) {
-                continue;
-            }
-            if let Some((t, u, v)) = intersect_uv(self.bvh.triangle(f), p, d)
-                && t > 0.0
-                && t < t_far
-            {
-                t_far = t;
-                best = Some(Hit { t, triangle: f, u, v });
-            }
-        }
-        best
-    }
-
-    /// The vertex whose cell holds the point of barycentric coordinates `(1 - u - v, u, v)` on
-    /// `triangle`: the corner of the largest.
-    fn cell_vertex(&self, triangle: usize, u: f64, v: f64) -> usize {
-        let w = 1.0 - u - v;
-        let corner = if w >= u && w >= v {
-            0
-        } else if u >= v {
-            1
-        } else {
-            2
-        };
-        self.mesh.triangles()[triangle][corner] as usize
-    }
-}
-
-/// Where photons start: (light, triangle) pairs with the cumulative share of the flux.
-struct Sources {
-    pairs: Vec<(usize, usize)>,
-    cdf: Vec<f64>,
-    total: f64,
-}
-
-impl Sources {
-    /// Each pair's weight: the triangle's area times the largest `E cos` (summed over channels)
-    /// at its corners. It is zero only where the light cannot reach the face: for a plane
-    /// triangle `cos` is affine in the point, so it is nowhere positive if at no corner. (A spot
-    /// light's cone narrower than a triangle and between its corners is missed.)
-    fn new(geometry: &Geometry, lights: &[PreparedLight]) -> Sources {
-        let (mut pairs, mut cdf, mut total) = (Vec::new(), Vec::new(), 0.0);
-        for (l, light) in lights.iter().enumerate() {
-            for (t, n) in geometry.normals.iter().enumerate() {
-                let best = geometry
-                    .mesh
-                    .corners(t)
-                    .iter()
-                    .map(|p| {
-                        let (wi, e, _) = light_incidence(light, *p);
-                        n.dot(wi).max(0.0) * e.element_sum()
-                    })
-                    .fold(0.0, f64::max);
-                let weight = best * geometry.mesh.triangle_areas()[t];
-                if weight > 0.0 {
-                    total += weight;
-                    pairs.push((l, t));
-                    cdf.push(total);
-                }
-            }
-        }
-        Sources { pairs, cdf, total }
-    }
-
-    /// The pair at `u` in [0, 1) and its probability.
-    fn pick(&self, u: f64) -> ((usize, usize), f64) {
-        let x = u * self.total;
-        let k = self.cdf.partition_point(|&c| c <= x).min(self.pairs.len() - 1);
-        let below = if k == 0 { 0.0 } else { self.cdf[k - 1] };
-        (self.pairs[k], (self.cdf[k] - below) / self.total)
-    }
-}
-
-/// What a scene's lights and shadow casters are to one object.
-struct Lighting<'a> {
-    lights: &'a [PreparedLight],
-    occluders: &'a Bvh,
-    /// Visibility rays start this far off the surface.
-    eps: f64,
-}
 
 /// Radiant exitance by Monte Carlo at every vertex of every translucent object of `scene`
 /// (`None` for opaque objects), each object under the budget of `options`, with the object's
@@ -283,14 +145,6 @@ fn exitance_by(
         .collect()
 }
 
-/// Per vertex and channel, the sums of the photons' scores and of their squares; per channel,
-/// the walks lost.
-struct Tally {
-    sum: Vec<[f64; 3]>,
-    sum2: Vec<[f64; 3]>,
-    lost: [u64; 3],
-}
-
 /// One object's exitance (see the module's documentation).
 fn object_exitance(
     mesh: &Mesh,
@@ -320,11 +174,12 @@ fn object_exitance(
             seconds: 0.0,
         });
     }
+    let object = ObjectWalk { geometry: &geometry, sources: &sources, lighting, media, split: method.split };
     let walk_chunk = |chunk: u64, _first: u64, n: u64| {
         let mut rng = chunk_rng(options.seed, chunk);
         let (mut exits, mut lost) = (Vec::new(), [0; 3]);
         for _ in 0..n {
-            photon(&geometry, &sources, lighting, media, method.split, &mut rng, &mut exits, &mut lost);
+            object.photon(&mut rng, &mut exits, &mut lost);
         }
         (exits, lost)
     };
@@ -352,223 +207,14 @@ fn object_exitance(
     })
 }
 
-/// Adds one chunk's exits (each photon's score at a vertex and channel once) and lost walks to
-/// the tally.
-fn add_exits(tally: &mut Tally, (exits, lost): (Vec<Exit>, [u64; 3])) {
-    for Exit { vertex, channel, weight } in exits {
-        tally.sum[vertex][channel] += weight;
-        tally.sum2[vertex][channel] += weight * weight;
-    }
-    (0..3).for_each(|c| tally.lost[c] += lost[c]);
-}
-
-/// Per-vertex exitance and standard error after `n` photons, and the precision reached
-/// ([`ObjectExitance::relative_stderr`]).
-fn summarize(tally: &Tally, cells: &[f64], n: u64) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, f64) {
-    let nf = n.max(1) as f64;
-    let mut exitance = vec![[0.0; 3]; cells.len()];
-    let mut stderr = vec![[0.0; 3]; cells.len()];
-    for v in 0..cells.len() {
-        for c in 0..3 {
-            let mean = tally.sum[v][c] / nf;
-            let var = ((tally.sum2[v][c] / nf - mean * mean) * nf / (nf - 1.0).max(1.0)).max(0.0);
-            exitance[v][c] = mean / cells[v];
-            stderr[v][c] = (var / nf).sqrt() / cells[v];
-        }
-    }
-    let rel = relative_stderr(&exitance, &stderr);
-    (exitance, stderr, rel)
-}
-
-/// Per channel, the RMS standard error over the lit vertices over their mean exitance; the
-/// largest of the three (infinite where nothing is lit yet).
-pub fn relative_stderr(exitance: &[[f64; 3]], stderr: &[[f64; 3]]) -> f64 {
-    (0..3)
-        .map(|c| {
-            let floor = LIT_FLOOR * exitance.iter().map(|m| m[c]).fold(0.0, f64::max);
-            let (mut n, mut sum, mut sum2) = (0usize, 0.0, 0.0);
-            for (m, s) in exitance.iter().zip(stderr) {
-                if m[c] > 0.0 && m[c] >= floor {
-                    n += 1;
-                    sum += m[c];
-                    sum2 += s[c] * s[c];
-                }
-            }
-            if n == 0 { f64::INFINITY } else { (sum2 / n as f64).sqrt() / (sum / n as f64) }
-        })
-        .fold(0.0, f64::max)
-}
-
-/// Each vertex's barycentric dual cell area: a third of each of its triangles.
-fn cell_areas(mesh: &Mesh) -> Vec<f64> {
-    let mut cells = vec![0.0; mesh.positions().len()];
-    for (t, tri) in mesh.triangles().iter().enumerate() {
-        for &v in tri {
-            cells[v as usize] += mesh.triangle_areas()[t] / 3.0;
-        }
-    }
-    cells
-}
-
-/// Weight that left through the cell of `vertex` in `channel` (scene units: flux).
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Exit {
-    vertex: usize,
-    channel: usize,
-    weight: f64,
-}
-
-/// One photon: an entry point, then a walk per channel; its exits are pushed to `exits` (one
-/// per vertex and channel, [`merge_photon`]), the walks that met the surface from outside are
-/// counted in `lost`.
-#[allow(clippy::too_many_arguments)] // what one photon needs and where it goes
-fn photon(
-    geometry: &Geometry,
-    sources: &Sources,
-    lighting: &Lighting,
-    media: &[Medium; 3],
-    split: bool,
-    rng: &mut Pcg64,
-    exits: &mut Vec<Exit>,
-    lost: &mut [u64; 3],
-) {
-    let ((l, t), p_pair) = sources.pick(rng.random::<f64>());
-    let (r1, r2) = (rng.random::<f64>().sqrt(), rng.random::<f64>());
-    let bary = [1.0 - r1, r1 * (1.0 - r2), r1 * r2];
-    let p = geometry.mesh.point(t, bary);
-    let n = geometry.normals[t];
-    let light = &lighting.lights[l];
-    let Some((wi, e, cos_i)) = reaching(light, lighting.occluders, p, n, lighting.eps) else {
-        return;
-    };
-    let eta = media[0].eta;
-    let f_t = fresnel::fresnel_transmittance(cos_i, eta);
-    if f_t <= 0.0 {
-        return;
-    }
-    // Snell: the tangential part shrinks by 1 / eta, the normal part points inwards.
-    let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (eta * eta)).max(0.0).sqrt();
-    let d = (-wi / eta + n * (cos_i / eta - cos_t)).normalize();
-    let density = p_pair / geometry.mesh.triangle_areas()[t];
-    let first = exits.len();
-    for (channel, medium) in media.iter().enumerate() {
-        let weight = e[channel] * cos_i * f_t / density;
-        let start = Start { p, d, triangle: t, channel, weight };
-        if weight > 0.0 && walk(geometry, medium, &start, split, rng, exits) {
-            lost[channel] += 1;
-        }
-    }
-    merge_photon(exits, first);
-}
-
-/// Sums the exits from `first` on (one photon's) that share a vertex and channel into one: the
-/// photon's score there, whose square the variance needs.
-fn merge_photon(exits: &mut Vec<Exit>, first: usize) {
-    if exits.len() - first < 2 {
-        return;
-    }
-    exits[first..].sort_unstable_by_key(|e| (e.channel, e.vertex));
-    let mut last = first;
-    for k in first + 1..exits.len() {
-        if (exits[k].channel, exits[k].vertex) == (exits[last].channel, exits[last].vertex) {
-            exits[last].weight += exits[k].weight;
-        } else {
-            last += 1;
-            exits[last] = exits[k];
-        }
-    }
-    exits.truncate(last + 1);
-}
-
-/// Where one channel's walk starts: at `p` on `triangle`, inwards along `d`, with `weight`
-/// (scene units).
-struct Start {
-    p: DVec3,
-    d: DVec3,
-    triangle: usize,
-    channel: usize,
-    weight: f64,
-}
-
-/// One channel's walk from `start`: its exits are pushed to `exits`; true if it met the surface
-/// from outside (and was dropped there). With `split`, expected-value splitting at the boundary
-/// (see the module's documentation), else the analog choice between reflecting and leaving.
-fn walk(
-    geometry: &Geometry,
-    medium: &Medium,
-    start: &Start,
-    split: bool,
-    rng: &mut Pcg64,
-    exits: &mut Vec<Exit>,
-) -> bool {
-    let (sigma_t, albedo) = (medium.sigma_t(), medium.albedo());
-    // The split walk's weights are relative to the entry's (see the module's documentation).
-    let (scale, mut weight) = if split { (start.weight, 1.0) } else { (1.0, start.weight) };
-    let (mut p, mut d, mut skip) = (start.p, start.d, Some(start.triangle));
-    loop {
-        let s = -(1.0 - rng.random::<f64>()).ln() / sigma_t;
-        let Some(Hit { t, triangle, u, v }) = geometry.closest_hit(p, d, s, skip) else {
-            p += d * s;
-            skip = None;
-            let Some(w) = after_collision(weight, albedo, rng) else { return false };
-            weight = w;
-            d = scatter(d, medium.g, rng);
-            continue;
-        };
-        p += d * t;
-        skip = Some(triangle);
-        let n = geometry.normals[triangle];
-        let cos = d.dot(n);
-        if cos <= 0.0 {
-            return true;
-        }
-        let r = fresnel::fresnel_reflectance(cos, 1.0 / medium.eta);
-        let channel = start.channel;
-        if split {
-            if r < 1.0 {
-                exits.push(Exit {
-                    vertex: geometry.cell_vertex(triangle, u, v),
-                    channel,
-                    weight: scale * weight * (1.0 - r),
-                });
-            }
-            let Some(w) = after_reflection(weight, r, albedo, rng) else { return false };
-            weight = w;
-        } else if rng.random::<f64>() >= r {
-            exits.push(Exit { vertex: geometry.cell_vertex(triangle, u, v), channel, weight });
-            return false;
-        }
-        d -= n * (2.0 * cos);
-    }
-}
-
-/// The direction after a scattering of `d` by the Henyey-Greenstein phase function of mean
-/// cosine `g`. Isotropic (`g` 0, every reduced medium's, `Medium::reduced`) it does not depend
-/// on `d`: a uniform direction by Marsaglia's method (1972), without the sine and cosine of an
-/// azimuth that were a tenth of the walk's time in marble.
-fn scatter(d: DVec3, g: f64, rng: &mut Pcg64) -> DVec3 {
-    if g == 0.0 {
-        loop {
-            let (x, y) = (2.0 * rng.random::<f64>() - 1.0, 2.0 * rng.random::<f64>() - 1.0);
-            let s = x * x + y * y;
-            if s < 1.0 {
-                let r = 2.0 * (1.0 - s).sqrt();
-                return DVec3::new(x * r, y * r, 1.0 - 2.0 * s);
-            }
-        }
-    }
-    let cos = sample_hg_cos(g, rng.random::<f64>());
-    let (a, b) = d.any_orthonormal_pair();
-    let sin = (1.0 - cos * cos).max(0.0).sqrt();
-    let phi = std::f64::consts::TAU * rng.random::<f64>();
-    (d * cos + (a * phi.cos() + b * phi.sin()) * sin).normalize()
-}
-
 #[cfg(test)]
 mod tests {
+    use super::tally::{Exit, merge_photon};
+    use super::walk::scatter;
     use super::*;
     use crate::scene::Scene;
     use crate::scene::build::Overrides;
+    use glam::DVec3;
 
     fn quiet(_: super::super::rte::RteProgress) {}
 
