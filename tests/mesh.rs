@@ -503,6 +503,30 @@ fn bad_face_indices_report_their_line() {
 }
 
 #[test]
+fn parse_errors_are_typed() {
+    use translucent::mesh::{Element, ObjProblem};
+    let problem = |text: &str| match Mesh::from_obj_text(text, "m.obj", &LoadOptions::default()) {
+        Err(MeshError::Parse { problem, .. }) => problem,
+        other => panic!("expected a parse error, got {other:?}"),
+    };
+    let defined = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    assert_eq!(
+        problem(&format!("{defined}f 1 2 7\n")),
+        ObjProblem::OutOfRange { element: Element::Vertex, index: 7, defined: 3 }
+    );
+    assert_eq!(
+        problem(&format!("{defined}vn 0 0 1\nf 1//-2 2 3\n")),
+        ObjProblem::BeforeFirst { element: Element::Normal, index: -2, defined: 1 }
+    );
+    assert_eq!(
+        problem("vt 1\n"),
+        ObjProblem::TooFewNumbers { element: Element::TextureCoordinate, needed: 2, found: 1 }
+    );
+    assert_eq!(problem("v 0 1e39 0\n"), ObjProblem::NotFinite("1e39".into()));
+    assert_eq!(problem(&format!("{defined}f 1 2\n")), ObjProblem::TooFewFaceVertices(2));
+}
+
+#[test]
 fn relative_and_forward_indices_are_accepted() {
     let dir = temp_dir("relative");
     // Negative indices count back from the latest vertex; positive ones may point forward.

@@ -53,7 +53,8 @@ pub struct Args {
     #[arg(long, value_name = "N")]
     pub truth_receivers: Option<usize>,
     /// The most memory one level of the truth may take, e.g. 4G or 500M (binary units; default:
-    /// the memory available when the level starts); a level estimated over it is refused
+    /// a quarter of the memory available when the level starts, at most 4G); a level estimated
+    /// over it is refused
     #[arg(long, value_name = "SIZE")]
     pub truth_memory: Option<String>,
     /// Where the truth is cached, keyed by the scene's content (default: the user's cache
@@ -301,8 +302,7 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
         None => Scene::builtin(),
     };
     if let Some(e) = args.max_error {
-        translucent::scene::check_max_error("--max-error", e)
-            .map_err(|(key, message)| anyhow::anyhow!("{key} {message}"))?;
+        translucent::scene::check_max_error("--max-error", e)?;
         scene.file.render.max_error = e;
     }
     if let Some(v) = args.splat_visibility {
@@ -380,9 +380,17 @@ fn run_with_progress(gpu: &Arc<Gpu>, scene: &Scene, config: &StudyConfig, cache:
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} eta {eta} {msg}")
             .expect("a valid template"),
     );
+    // The clock and spinner move while one long step (a truth level, a walk) reports nothing.
+    bar.enable_steady_tick(std::time::Duration::from_millis(250));
+    let level_clock = TruthClock::default();
     let study = study::run(gpu, scene, config, cache, &|e| match e {
         Event::Truth(level, done, of) => {
-            bar.set_message(format!("exact integral, level {level}: {done}/{of} receivers"))
+            let left = level_clock.left(level, done, of);
+            if let Some(warning) = level_clock.warning(level, left) {
+                bar.println(warning);
+            }
+            let left = left.map_or(String::new(), |s| format!(", about {} left", human_duration(s)));
+            bar.set_message(format!("exact integral, level {level}: {done}/{of} receivers{left}"));
         }
         Event::TruthCached => bar.set_message("exact integral from the cache".to_string()),
         Event::Rte(p) => bar.set_message(format!(
@@ -397,6 +405,54 @@ fn run_with_progress(gpu: &Arc<Gpu>, scene: &Scene, config: &StudyConfig, cache:
     })?;
     bar.finish_and_clear();
     Ok(study)
+}
+
+/// When the exact integral's current level started, to estimate what is left of it from the
+/// receivers done so far, and whether it was already said that the level is long.
+#[derive(Default)]
+struct TruthClock {
+    state: std::sync::Mutex<Option<(u32, std::time::Instant, bool)>>,
+}
+
+/// A level estimated to take longer than this is announced, with the options that cut it.
+const LONG_TRUTH_LEVEL_SECONDS: f64 = 600.0;
+
+impl TruthClock {
+    /// Seconds left in `level` with `done` of `of` receivers finished (None before the first).
+    fn left(&self, level: u32, done: usize, of: usize) -> Option<f64> {
+        let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        if state.is_none_or(|(l, _, _)| l != level) {
+            *state = Some((level, std::time::Instant::now(), false));
+        }
+        let (_, start, _) = state.expect("set above");
+        (done > 0).then(|| start.elapsed().as_secs_f64() / done as f64 * of.saturating_sub(done) as f64)
+    }
+
+    /// The one line saying that `level` will take long, the first time its estimate says so.
+    fn warning(&self, level: u32, left: Option<f64>) -> Option<String> {
+        let left = left.filter(|&s| s > LONG_TRUTH_LEVEL_SECONDS)?;
+        let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        let (_, _, said) = state.as_mut().filter(|(l, _, said)| *l == level && !*said)?;
+        *said = true;
+        let stop = match level {
+            0 => String::new(),
+            l => format!("--truth-levels {} stops before it, ", l - 1),
+        };
+        Some(format!(
+            "note: the exact integral's level {level} will take about {} more; {stop}--truth-receivers N \
+             computes it at fewer vertices",
+            human_duration(left)
+        ))
+    }
+}
+
+/// `95 s`, `12 min`, `3.4 h`.
+fn human_duration(seconds: f64) -> String {
+    match seconds {
+        s if s < 120.0 => format!("{s:.0} s"),
+        s if s < 7200.0 => format!("{:.0} min", s / 60.0),
+        s => format!("{:.1} h", s / 3600.0),
+    }
 }
 
 /// study.md's text above the results: the scene, device and timing method, then the truth
@@ -505,8 +561,7 @@ fn write_outputs(
             })
             .expect("checked to be in the sweep");
         let estimate = study.exitance[i].as_ref().expect("not the pixel gather");
-        let (rgba, width) =
-            study::error_image(&study.prepared, &study.truth.exitance, estimate, 0.1).map_err(anyhow::Error::msg)?;
+        let (rgba, width) = study::error_image(&study.prepared, &study.truth.exitance, estimate, 0.1)?;
         set.png(&outputs[4], width, h, &rgba)?;
     }
     for p in set.commit()? {

@@ -25,7 +25,7 @@ use glam::{DVec3, Vec3};
 pub use boundary::NO_BOUNDARY;
 pub use enclosure::{Enclosure, enclosure};
 pub use lod::{LodLevel, MIN_LEVEL_TRIANGLES};
-pub use obj::LoadOptions;
+pub use obj::{Element, LoadOptions, ObjProblem};
 
 /// Marks an edge with no single neighbouring triangle (an open boundary or a non-manifold edge).
 pub const NO_NEIGHBOUR: u32 = u32::MAX;
@@ -53,14 +53,14 @@ pub enum MeshError {
         source: std::io::Error,
     },
     /// A malformed OBJ line, found by the pre-scan.
-    #[error("{source_name}:{line}: {message} (line: `{text}`)")]
+    #[error("{source_name}:{line}: {problem} (line: `{text}`)")]
     Parse {
         /// The file name, or `<memory>`.
         source_name: String,
         /// 1-based line number.
         line: usize,
         /// What is wrong with the line.
-        message: String,
+        problem: ObjProblem,
         /// The line itself, trimmed and cut to 80 characters.
         text: String,
     },

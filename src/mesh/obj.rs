@@ -96,17 +96,115 @@ pub(super) fn parse(text: &str, source_name: &str, options: &LoadOptions) -> Res
     Ok(Loaded { positions, triangles, flip_winding: options.mirrors() })
 }
 
-fn parse_error(source_name: &str, line: usize, message: String, text: &str) -> MeshError {
+fn parse_error(source_name: &str, line: usize, problem: ObjProblem, text: &str) -> MeshError {
     // Long lines are cut so one bad line cannot flood the terminal.
     let mut shown: String = text.trim().chars().take(80).collect();
     if text.trim().chars().count() > 80 {
         shown.push('…');
     }
-    MeshError::Parse { source_name: source_name.to_string(), line, message, text: shown }
+    MeshError::Parse { source_name: source_name.to_string(), line, problem, text: shown }
 }
 
-/// What a face vertex's `v/vt/vn` indices refer to, in that order, for messages.
-const KINDS: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+/// An element an OBJ file lists and faces index: a face vertex's `v/vt/vn` indices refer to
+/// them in that order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Element {
+    /// A position, `v`.
+    Vertex,
+    /// A texture coordinate, `vt`.
+    TextureCoordinate,
+    /// A normal, `vn`.
+    Normal,
+}
+
+impl Element {
+    /// In the order of a face vertex's indices.
+    const ALL: [Element; 3] = [Element::Vertex, Element::TextureCoordinate, Element::Normal];
+
+    /// The statement that defines one.
+    pub fn keyword(self) -> &'static str {
+        match self {
+            Element::Vertex => "v",
+            Element::TextureCoordinate => "vt",
+            Element::Normal => "vn",
+        }
+    }
+}
+
+impl std::fmt::Display for Element {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Element::Vertex => "vertex",
+            Element::TextureCoordinate => "texture coordinate",
+            Element::Normal => "normal",
+        })
+    }
+}
+
+/// What is wrong with an OBJ line ([`MeshError::Parse`]). The words quoted are the line's own.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ObjProblem {
+    /// A `v`, `vt` or `vn` value (this) that does not parse as a number.
+    #[error("`{0}` is not a number")]
+    NotANumber(String),
+    /// A coordinate (this) that is not finite as an f32 (NaN, infinite, or too large).
+    #[error("coordinate `{0}` is not a finite f32 number")]
+    NotFinite(String),
+    /// A `v`, `vt` or `vn` statement with too few numbers.
+    #[error("`{}` needs {needed} numbers, found {found}", element.keyword())]
+    TooFewNumbers {
+        /// What the statement defines.
+        element: Element,
+        /// How many numbers it needs.
+        needed: usize,
+        /// How many it has.
+        found: usize,
+    },
+    /// A `v` statement's fourth number, the weight w (this), does not parse.
+    #[error("weight `{0}` is not a number")]
+    WeightNotANumber(String),
+    /// A `v` statement's weight w (this) is zero or not finite: positions are divided by it.
+    #[error("weight w = `{0}` must be finite and non-zero")]
+    BadWeight(String),
+    /// A `v` statement with this many numbers: neither 3, 4 (a weight) nor 6 (a colour).
+    #[error("`v` takes 3, 4 or 6 numbers, found {0}")]
+    VertexNumbers(usize),
+    /// A face with this many vertices, under 3.
+    #[error("a face needs at least 3 vertices, this one has {0}")]
+    TooFewFaceVertices(usize),
+    /// A face vertex (this) with more than `v/vt/vn`.
+    #[error("face vertex `{0}` has more than three indices")]
+    TooManyIndices(String),
+    /// A face vertex (this) without its position index.
+    #[error("face vertex `{0}` has no position index")]
+    NoPositionIndex(String),
+    /// A face index (this) that is not an integer.
+    #[error("face index `{0}` is not an integer")]
+    IndexNotAnInteger(String),
+    /// A face index of 0.
+    #[error("face index 0 is invalid (OBJ indices start at 1)")]
+    ZeroIndex,
+    /// A negative (relative) index reaching before the first element.
+    #[error("relative {element} index {index} reaches before the first of the {defined} defined so far")]
+    BeforeFirst {
+        /// What it indexes.
+        element: Element,
+        /// The index.
+        index: i64,
+        /// How many of them the file defines before this line.
+        defined: i64,
+    },
+    /// A positive index beyond the elements of the whole file.
+    #[error("{element} index {index} is out of range: the file defines {defined}")]
+    OutOfRange {
+        /// What it indexes.
+        element: Element,
+        /// The index.
+        index: i64,
+        /// How many of them the file defines.
+        defined: i64,
+    },
+}
 
 /// One line of the file, to quote in its errors.
 #[derive(Clone, Copy)]
@@ -118,8 +216,8 @@ struct Line<'a> {
 }
 
 impl Line<'_> {
-    fn error(self, message: String) -> MeshError {
-        parse_error(self.source_name, self.no, message, self.text)
+    fn error(self, problem: ObjProblem) -> MeshError {
+        parse_error(self.source_name, self.no, problem, self.text)
     }
 }
 
@@ -128,11 +226,11 @@ impl Line<'_> {
 struct ForwardRef<'a> {
     line: Line<'a>,
     index: i64,
-    /// Index into [`KINDS`].
-    kind: usize,
+    /// What it indexes.
+    element: Element,
 }
 
-/// The pre-scan's state: elements of each of [`KINDS`] defined so far, and the forward
+/// The pre-scan's state: elements of each [`Element`] (in [`Element::ALL`]'s order) defined so far, and the forward
 /// references still to check.
 struct Prescan<'a> {
     counts: [i64; 3],
@@ -149,21 +247,21 @@ fn prescan(text: &str, source_name: &str) -> Result<(), MeshError> {
         let line = Line { source_name, no: n + 1, text };
         let mut words = text.split_whitespace();
         let Some(keyword) = words.next() else { continue };
-        let (kind, needed) = match keyword {
-            "v" => (0, 3),
-            "vt" => (1, 2),
-            "vn" => (2, 3),
+        let (element, needed) = match keyword {
+            "v" => (Element::Vertex, 3),
+            "vt" => (Element::TextureCoordinate, 2),
+            "vn" => (Element::Normal, 3),
             "f" | "l" => {
                 scan.face(line, keyword == "f", words)?;
                 continue;
             }
             _ => continue,
         };
-        check_numbers(line, keyword, needed, &mut words)?;
-        if keyword == "v" {
+        check_numbers(line, element, needed, &mut words)?;
+        if element == Element::Vertex {
             check_vertex_extras(line, words)?;
         }
-        scan.counts[kind] += 1;
+        scan.counts[element as usize] += 1;
     }
     scan.finish()
 }
@@ -180,7 +278,7 @@ impl<'a> Prescan<'a> {
             }
         }
         if is_face && vertices < 3 {
-            return Err(line.error(format!("a face needs at least 3 vertices, this one has {vertices}")));
+            return Err(line.error(ObjProblem::TooFewFaceVertices(vertices)));
         }
         Ok(())
     }
@@ -189,61 +287,57 @@ impl<'a> Prescan<'a> {
     /// the position, a non-zero integer, a relative one reaching no further back than the
     /// first element, a positive one beyond those defined so far kept for [`Self::finish`].
     fn face_index(&mut self, line: Line<'a>, word: &str, kind: usize, part: &str) -> Result<(), MeshError> {
-        if kind >= 3 {
-            return Err(line.error(format!("face vertex `{word}` has more than three indices")));
-        }
+        let Some(&element) = Element::ALL.get(kind) else {
+            return Err(line.error(ObjProblem::TooManyIndices(word.to_string())));
+        };
         if part.is_empty() {
-            if kind == 0 {
-                return Err(line.error(format!("face vertex `{word}` has no position index")));
+            if element == Element::Vertex {
+                return Err(line.error(ObjProblem::NoPositionIndex(word.to_string())));
             }
             return Ok(());
         }
-        let index: i64 = part.parse().map_err(|_| line.error(format!("face index `{part}` is not an integer")))?;
+        let index: i64 = part.parse().map_err(|_| line.error(ObjProblem::IndexNotAnInteger(part.to_string())))?;
         if index == 0 {
-            return Err(line.error("face index 0 is invalid (OBJ indices start at 1)".into()));
+            return Err(line.error(ObjProblem::ZeroIndex));
         }
-        if index < 0 && -index > self.counts[kind] {
-            return Err(line.error(format!(
-                "relative {} index {index} reaches before the first of the {} defined so far",
-                KINDS[kind], self.counts[kind]
-            )));
+        let defined = self.counts[kind];
+        if index < 0 && -index > defined {
+            return Err(line.error(ObjProblem::BeforeFirst { element, index, defined }));
         }
-        if index > self.counts[kind] {
-            self.forward.push(ForwardRef { line, index, kind });
+        if index > defined {
+            self.forward.push(ForwardRef { line, index, element });
         }
         Ok(())
     }
 
     /// Positive indices may point forward in the file; check them against the final counts.
     fn finish(self) -> Result<(), MeshError> {
-        if let Some(bad) = self.forward.iter().find(|f| f.index > self.counts[f.kind]) {
-            return Err(bad.line.error(format!(
-                "{} index {} is out of range: the file defines {}",
-                KINDS[bad.kind], bad.index, self.counts[bad.kind]
-            )));
+        if let Some(bad) = self.forward.iter().find(|f| f.index > self.counts[f.element as usize]) {
+            let (element, index, defined) = (bad.element, bad.index, self.counts[bad.element as usize]);
+            return Err(bad.line.error(ObjProblem::OutOfRange { element, index, defined }));
         }
         Ok(())
     }
 }
 
-/// The first `needed` numbers after `keyword` (`v`, `vt`, `vn`): present, parsing and finite
-/// in f32. Leaves `words` at what follows them.
+/// The first `needed` numbers of the statement that defines `element` (`v`, `vt`, `vn`):
+/// present, parsing and finite in f32. Leaves `words` at what follows them.
 fn check_numbers<'a>(
     line: Line<'_>,
-    keyword: &str,
+    element: Element,
     needed: usize,
     words: &mut impl Iterator<Item = &'a str>,
 ) -> Result<(), MeshError> {
     let mut values = 0;
     for word in words.by_ref().take(needed) {
-        let value: f32 = word.parse().map_err(|_| line.error(format!("`{word}` is not a number")))?;
+        let value: f32 = word.parse().map_err(|_| line.error(ObjProblem::NotANumber(word.to_string())))?;
         if !value.is_finite() {
-            return Err(line.error(format!("coordinate `{word}` is not a finite f32 number")));
+            return Err(line.error(ObjProblem::NotFinite(word.to_string())));
         }
         values += 1;
     }
     if values < needed {
-        return Err(line.error(format!("`{keyword}` needs {needed} numbers, found {values}")));
+        return Err(line.error(ObjProblem::TooFewNumbers { element, needed, found: values }));
     }
     Ok(())
 }
@@ -255,12 +349,12 @@ fn check_vertex_extras<'a>(line: Line<'_>, words: impl Iterator<Item = &'a str>)
     match rest.len() {
         0 | 3 => Ok(()),
         1 => {
-            let w: f32 = rest[0].parse().map_err(|_| line.error(format!("weight `{}` is not a number", rest[0])))?;
+            let w: f32 = rest[0].parse().map_err(|_| line.error(ObjProblem::WeightNotANumber(rest[0].to_string())))?;
             if !w.is_finite() || w == 0.0 {
-                return Err(line.error(format!("weight w = `{}` must be finite and non-zero", rest[0])));
+                return Err(line.error(ObjProblem::BadWeight(rest[0].to_string())));
             }
             Ok(())
         }
-        k => Err(line.error(format!("`v` takes 3, 4 or 6 numbers, found {}", 3 + k))),
+        k => Err(line.error(ObjProblem::VertexNumbers(3 + k))),
     }
 }

@@ -83,6 +83,9 @@ pub enum SamplingError {
         /// The mesh's total area.
         area: f64,
     },
+    /// [`sample_in_frame`] given a frame whose triangles are not the mesh's.
+    #[error("the frame to place samples in has other triangles than the mesh")]
+    FrameTopology,
 }
 
 /// Everything a sampler needs; [`SampleOptions::new`] fills in the defaults.
@@ -262,7 +265,26 @@ pub fn finish(mesh: &Mesh, points: &[SurfacePoint], areas: &[f64]) -> Vec<Sample
 
 /// Place points and weigh them: the whole pipeline behind `translucent sample`.
 pub fn sample(mesh: &Mesh, options: &SampleOptions) -> Result<SampleSet, SamplingError> {
-    let points = place(mesh, options)?;
-    let areas = weights::area_weights(mesh, &points, &options.weights);
+    sample_in_frame(mesh, mesh, options)
+}
+
+/// Place and weigh points on `frame`, and put them on `mesh`, the same triangles after a
+/// similarity transform (uniform scale, rotation, translation): each point keeps its triangle
+/// and barycentric weights, and its area is scaled by `mesh`'s total area over `frame`'s.
+///
+/// Why: the relaxing samplers (Turk's repulsion, the feature sampler) are chaotic in the last
+/// bits of the positions, since a point that crosses an edge or not goes on differently. The
+/// same object at another scale or place differs in those bits after its transform, so it
+/// would get other samples. Placed in the object's own frame (the mesh as loaded), it gets the
+/// same ones in any units and at any position.
+pub fn sample_in_frame(frame: &Mesh, mesh: &Mesh, options: &SampleOptions) -> Result<SampleSet, SamplingError> {
+    if frame.triangles() != mesh.triangles() {
+        return Err(SamplingError::FrameTopology);
+    }
+    let points = place(frame, options)?;
+    // Exactly 1 where the two are one mesh.
+    let scale = mesh.total_area() / frame.total_area();
+    let mut areas = weights::area_weights(frame, &points, &options.weights);
+    areas.iter_mut().for_each(|a| *a *= scale);
     Ok(SampleSet { method: options.method, seed: options.seed, points: finish(mesh, &points, &areas) })
 }

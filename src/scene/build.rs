@@ -9,6 +9,7 @@ use crate::mesh::{LoadOptions, Mesh};
 use crate::optics::Material;
 use crate::sampling::{self, Method, SampleOptions};
 use glam::{EulerRot, Mat4, Quat, Vec3};
+use std::sync::Arc;
 
 /// The prepared object and its material (`scene::object`).
 pub use super::object::{PreparedObject, ResolvedMaterial};
@@ -180,10 +181,8 @@ impl PreparedScene {
         };
         Err(SceneError::Invalid {
             file: self.scene.name.clone(),
-            message: format!(
-                "`light[{}].{key}`: the light is not finite once prepared ({:?}); lower it",
-                light.source, light.kind
-            ),
+            location: super::Location::key(format!("light[{}].{key}", light.source)),
+            problem: super::BadValue::LightNotFinite(light.kind).into(),
         })
     }
 
@@ -292,7 +291,7 @@ fn apply_overrides(scene: &mut Scene, overrides: &Overrides) -> Result<(), Scene
 fn prepare_object(scene: &Scene, i: usize, environment_lit: bool) -> Result<PreparedObject, SceneError> {
     let o = &scene.file.objects[i];
     let (name, mesh) = load_shape(scene, &o.shape).with_context(|| format!("{}: object[{i}]", scene.name))?;
-    let mesh = transform_mesh(mesh, &o.transform)
+    let (mesh, frame) = transform_mesh(mesh, &o.transform)
         .with_context(|| format!("{}: object[{i}] ({name}): transform", scene.name))?;
     check_reach(scene, i, &name, &mesh)?;
     let material = resolve_material(&o.material, &format!("{}: object[{i}].material", scene.name))?;
@@ -304,6 +303,7 @@ fn prepare_object(scene: &Scene, i: usize, environment_lit: bool) -> Result<Prep
     Ok(PreparedObject {
         name,
         mesh,
+        frame,
         material,
         casts_shadow: o.casts_shadow,
         samples: Vec::new(),
@@ -338,7 +338,10 @@ fn sample_objects(scene: &Scene, objects: &mut [PreparedObject], only: Option<us
             super::accuracy::choose_count(&dipoles, facts, file.sampling.count, file.render.max_error);
         let options =
             SampleOptions::new(file.sampling.method, count).with_seed(file.sampling.seed.wrapping_add(i as u64));
-        o.samples = sampling::sample(&o.mesh, &options)
+        // The transform keeps the triangles; where cleaning a degenerate one changed them,
+        // the samples are placed in world space.
+        let frame = o.frame.as_deref().filter(|f| f.triangles() == o.mesh.triangles()).unwrap_or(&o.mesh);
+        o.samples = sampling::sample_in_frame(frame, &o.mesh, &options)
             .with_context(|| format!("{}: object[{i}] ({}): sampling", scene.name, o.name))?
             .points;
         o.density = Some(density);
@@ -380,11 +383,8 @@ fn check_reach(scene: &Scene, i: usize, name: &str, mesh: &Mesh) -> Result<(), S
     if reach > super::MAX_SCENE_COORDINATE {
         return Err(SceneError::Invalid {
             file: scene.name.clone(),
-            message: format!(
-                "`object[{i}]` ({name}): placed by its shape and transform it reaches {reach:e} scene units \
-                 from the origin, beyond the limit of {:e}",
-                super::MAX_SCENE_COORDINATE
-            ),
+            location: super::Location::key(format!("object[{i}]")),
+            problem: super::BadValue::BeyondReach { object: name.to_string(), reach }.into(),
         });
     }
     Ok(())
@@ -480,8 +480,9 @@ fn load_shape(scene: &Scene, shape: &Shape) -> Result<(String, Mesh), SceneError
     }
 }
 
-/// Apply fit, scale, rotation (degrees, x then y then z) and translation, in that order.
-fn transform_mesh(mesh: Mesh, t: &super::Transform) -> Result<Mesh, SceneError> {
+/// Apply fit, scale, rotation (degrees, x then y then z) and translation, in that order; also
+/// the mesh as it was, where the transform is not the identity (`PreparedObject::frame`).
+fn transform_mesh(mesh: Mesh, t: &super::Transform) -> Result<(Mesh, Option<Arc<Mesh>>), SceneError> {
     let mut m = Mat4::IDENTITY;
     if let Some(fit) = t.fit {
         let (lo, hi) = mesh.bounds();
@@ -503,10 +504,11 @@ fn transform_mesh(mesh: Mesh, t: &super::Transform) -> Result<Mesh, SceneError> 
         m = Mat4::from_translation(Vec3::from(tr)) * m;
     }
     if m == Mat4::IDENTITY {
-        return Ok(mesh);
+        return Ok((mesh, None));
     }
     let positions = mesh.positions().iter().map(|p| m.transform_point3(*p)).collect();
-    Ok(Mesh::from_triangles(positions, mesh.triangles().to_vec())?)
+    let placed = Mesh::from_triangles(positions, mesh.triangles().to_vec())?;
+    Ok((placed, Some(Arc::new(mesh))))
 }
 
 fn bounding_sphere<'a>(meshes: impl Iterator<Item = &'a Mesh>) -> (Vec3, f32) {
@@ -520,5 +522,7 @@ fn bounding_sphere<'a>(meshes: impl Iterator<Item = &'a Mesh>) -> (Vec3, f32) {
     if !lo.is_finite() {
         return (Vec3::ZERO, 1.0);
     }
-    ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-6))
+    // Any positive radius is a scale (the scene may be in micrometres); none, a unit one.
+    let radius = ((hi - lo) * 0.5).length();
+    ((lo + hi) * 0.5, if radius > 0.0 && radius.is_finite() { radius } else { 1.0 })
 }

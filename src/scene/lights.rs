@@ -414,7 +414,9 @@ struct ShadowFrame {
 
 impl ShadowFrame {
     fn new(bounds: (Vec3, f32), shadow_map_size: u32) -> ShadowFrame {
-        let (center, radius) = (bounds.0, bounds.1.max(1e-6));
+        // Any positive radius is a scale (the scene may be in micrometres); none, a unit one.
+        let radius = if bounds.1 > 0.0 && bounds.1.is_finite() { bounds.1 } else { 1.0 };
+        let center = bounds.0;
         let texel = 1.0 / shadow_map_size as f32;
         // Half a texel's world size: the normal offset of lookups (glsl/common/lights.glsl); for
         // local lights taken at the casters' centre. Measured on the default scene against ray
@@ -471,7 +473,7 @@ impl ShadowFrame {
     fn local(&self, position: Vec3, axis: Option<(Vec3, f32)>) -> (Mat4, f32) {
         let (center, radius) = (self.center, self.radius);
         let to_center = center - position;
-        let dist = to_center.length().max(1e-6);
+        let dist = to_center.length().max(radius * 1e-6);
         let (forward, half_angle) = match axis {
             Some((a, angle)) => (unit(a), angle),
             None => {
@@ -492,7 +494,7 @@ impl ShadowFrame {
         };
         // Along the view axis: a spot looks along its own axis, not at the casters' centre.
         let axial = to_center.dot(forward);
-        let near = (axial - radius).max(dist * 1e-3).max(1e-5);
+        let near = (axial - radius).max(dist * 1e-3).max(radius * 1e-5);
         let far = (axial + radius).max(near * 2.0);
         let view = look_at_mat4(position, position + forward, any_up(forward));
         let proj = vulkan::perspective(2.0 * half_angle, 1.0, near, far);

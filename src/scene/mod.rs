@@ -4,12 +4,14 @@
 pub mod accuracy;
 pub mod build;
 mod camera;
+mod check;
 pub mod format;
 pub mod lights;
 pub mod needs;
 mod object;
 mod warnings;
 
+pub use check::{BadValue, Check, CheckError, Number, check_max_error, check_texture};
 pub use format::*;
 use std::path::{Path, PathBuf};
 
@@ -35,12 +37,23 @@ pub enum SceneError {
     },
     /// The text is not a valid scene: TOML syntax, an unknown key, a wrong type or a value out
     /// of range.
-    #[error("{file}: {message}")]
+    #[error("{file}: {}", Located(location, problem))]
     Invalid {
         /// The scene's name: its path or "built-in scene".
         file: String,
-        /// What is wrong, with the line and key path where they are known.
-        message: String,
+        /// The line and key path, where they are known.
+        location: Location,
+        /// What is wrong (boxed: toml's errors are large, and every error of a prepared scene
+        /// and of a renderer carries this type).
+        problem: Box<Problem>,
+    },
+    /// The built-in scene names an asset that is not embedded in the binary.
+    #[error("{file}: no embedded asset named {name:?}")]
+    NoEmbeddedAsset {
+        /// The scene's name ("built-in scene").
+        file: String,
+        /// The asset's path as the scene gives it.
+        name: String,
     },
     /// `--samples 0` on the command line.
     #[error("--samples must be at least 1")]
@@ -99,6 +112,84 @@ impl SceneError {
     }
 }
 
+/// Where in a scene file a [`Problem`] is: the 1-based line and the key path, where known.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Location {
+    /// The 1-based line.
+    pub line: Option<usize>,
+    /// The key path, e.g. `object[0].material.roughness`.
+    pub key: Option<String>,
+}
+
+impl Location {
+    /// At key path `key`, on the line of `text` that assigns its last segment if one does.
+    fn of_key(text: &str, key: String) -> Location {
+        Location { line: line_of(text, &key), key: Some(key) }
+    }
+
+    /// At key path `key`, line unknown.
+    pub(crate) fn key(key: String) -> Location {
+        Location { line: None, key: Some(key) }
+    }
+}
+
+/// What makes a scene text invalid ([`SceneError::Invalid`]).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum Problem {
+    /// Not TOML; toml's error shows the line and an excerpt.
+    #[error("{0}")]
+    Syntax(toml::de::Error),
+    /// TOML, but not a scene: an unknown key or variant, a missing key, a value of the wrong
+    /// type or length.
+    #[error("{}", deserialize_message(error, *brief))]
+    Deserialize {
+        /// toml's (serde's) error.
+        error: toml::de::Error,
+        /// Show only its last line, the message: the line was found by the offending value,
+        /// and toml's excerpt (of the table's header) says nothing more.
+        brief: bool,
+    },
+    /// A value out of range.
+    #[error(transparent)]
+    Value(#[from] BadValue),
+}
+
+impl From<BadValue> for Box<Problem> {
+    fn from(value: BadValue) -> Box<Problem> {
+        Box::new(Problem::Value(value))
+    }
+}
+
+/// A deserialisation error as shown: all of toml's text, or (`brief`) its last line.
+fn deserialize_message(error: &toml::de::Error, brief: bool) -> String {
+    let text = error.to_string();
+    match text.lines().last() {
+        Some(last) if brief => last.to_string(),
+        _ => text,
+    }
+}
+
+/// A [`Problem`] after its [`Location`]: `line N: ` where known, then the key path as the kind
+/// of problem reads it (``at key `k`: `` for deserialisation, `` `k`: `` for a value, with the
+/// object's name after it where it has one).
+struct Located<'a>(&'a Location, &'a Problem);
+
+impl std::fmt::Display for Located<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let Located(location, problem) = *self;
+        if let Some(line) = location.line {
+            write!(f, "line {line}: ")?;
+        }
+        match (&location.key, problem) {
+            (Some(key), Problem::Deserialize { .. }) => write!(f, "at key `{key}`: ")?,
+            (Some(key), Problem::Value(BadValue::BeyondReach { object, .. })) => write!(f, "`{key}` ({object}): ")?,
+            (Some(key), _) => write!(f, "`{key}`: ")?,
+            (None, _) => {}
+        }
+        write!(f, "{problem}")
+    }
+}
+
 /// A whole-number setting outside its range, named by its key or flag: what
 /// [`check_texture`] refuses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
@@ -152,47 +243,18 @@ impl Scene {
 
     /// Parse and check `text`; `name` appears in errors.
     pub fn parse(text: &str, name: &str, base: Option<PathBuf>) -> Result<Scene, SceneError> {
-        let invalid = |message: String| SceneError::Invalid { file: name.to_string(), message };
-        let deserializer = toml::Deserializer::parse(text).map_err(|e| invalid(e.to_string()))?;
+        let invalid =
+            |location, problem| SceneError::Invalid { file: name.to_string(), location, problem: Box::new(problem) };
+        let deserializer =
+            toml::Deserializer::parse(text).map_err(|e| invalid(Location::default(), Problem::Syntax(e)))?;
         let mut file: SceneFile = serde_path_to_error::deserialize(deserializer).map_err(|e| {
-            let path = e.path().to_string();
-            let inner = e.into_inner().to_string();
-            // Inside internally tagged tables toml can only point at the table header; find
-            // the offending key's own line (an unknown key by its name, a value of the wrong
-            // type by its text).
-            let unknown = inner
-                .split("unknown field `")
-                .nth(1)
-                .and_then(|rest| rest.split('`').next())
-                .and_then(|key| line_of(text, key))
-                .map(|l| (l, None));
-            let wrong = wrong_value(text, &inner);
-            // Found by its value: toml's excerpt of the table header says nothing more.
-            let inner = match (&wrong, inner.lines().last()) {
-                (Some(_), Some(last)) if unknown.is_none() => last.to_string(),
-                _ => inner,
-            };
-            let (line, key) = unknown.or(wrong).unzip();
-            let line = line.map(|l| format!("line {l}: ")).unwrap_or_default();
-            let path = match key.flatten() {
-                // A plain table's path already ends with the key; a tagged table's stops at it.
-                Some(key) if path == key || path.ends_with(&format!(".{key}")) => path,
-                Some(key) if !path.is_empty() && path != "." => format!("{path}.{key}"),
-                Some(key) => key,
-                None => path,
-            };
-            if path.is_empty() || path == "." {
-                invalid(format!("{line}{inner}"))
-            } else {
-                invalid(format!("{line}at key `{path}`: {inner}"))
-            }
+            let (location, problem) = deserialize_error(text, e);
+            invalid(location, problem)
         })?;
         file.render.gather = file.render.gather_given.unwrap_or_default();
         file.render.gather_epsilon = file.render.gather_epsilon_given.unwrap_or(DEFAULT_GATHER_EPSILON);
-        check(&file).map_err(|(key, message)| {
-            let line = line_of(text, &key).map(|l| format!("line {l}: ")).unwrap_or_default();
-            invalid(format!("{line}`{key}`: {message}"))
-        })?;
+        check::check(&file)
+            .map_err(|CheckError { key, value }| invalid(Location::of_key(text, key), Problem::Value(value)))?;
         Ok(Scene { file, base, name: name.to_string() })
     }
 
@@ -204,12 +266,37 @@ impl Scene {
                 .iter()
                 .find(|(n, _)| *n == relative)
                 .map(|(_, bytes)| AssetSource::Embedded(bytes))
-                .ok_or_else(|| SceneError::Invalid {
-                    file: self.name.clone(),
-                    message: format!("no embedded asset named {relative:?}"),
-                }),
+                .ok_or_else(|| SceneError::NoEmbeddedAsset { file: self.name.clone(), name: relative.to_string() }),
         }
     }
+}
+
+/// Where a deserialisation error of `text` is and what it says. Inside internally tagged tables
+/// toml can only point at the table header; the offending key's own line is found instead (an
+/// unknown key by its name, a value of the wrong type by its text), and then toml's excerpt of
+/// the header is left out.
+fn deserialize_error(text: &str, e: serde_path_to_error::Error<toml::de::Error>) -> (Location, Problem) {
+    let path = e.path().to_string();
+    let error = e.into_inner();
+    let inner = error.to_string();
+    let unknown = inner
+        .split("unknown field `")
+        .nth(1)
+        .and_then(|rest| rest.split('`').next())
+        .and_then(|key| line_of(text, key))
+        .map(|l| (l, None));
+    let wrong = wrong_value(text, &inner);
+    let brief = wrong.is_some() && unknown.is_none();
+    let (line, key) = unknown.or(wrong).unzip();
+    let path = match key.flatten() {
+        // A plain table's path already ends with the key; a tagged table's stops at it.
+        Some(key) if path == key || path.ends_with(&format!(".{key}")) => path,
+        Some(key) if !path.is_empty() && path != "." => format!("{path}.{key}"),
+        Some(key) => key,
+        None => path,
+    };
+    let key = (!path.is_empty() && path != ".").then_some(path);
+    (Location { line, key }, Problem::Deserialize { error, brief })
 }
 
 /// The 1-based line where the last segment of a dotted key path is assigned, if it is found.
@@ -243,8 +330,6 @@ fn line_of(text: &str, key: &str) -> Option<usize> {
         .map(|i| i + 1)
 }
 
-type Check = Result<(), (String, String)>;
-
 /// The largest coordinate (and camera distance) a scene may use, in scene units: squared
 /// lengths of positions and distances up to this stay finite in f32 (they overflow near
 /// 1.8e19), so the camera, the light frusta and the bounding spheres stay finite.
@@ -256,263 +341,97 @@ pub const MIN_CAMERA_DISTANCE: f32 = 1e-18;
 /// is not finite.
 pub const MIN_FOV_Y: f32 = 1e-3;
 
-/// Finite, and within [`MAX_SCENE_COORDINATE`] of the origin on every axis.
-fn coordinates(key: &str, values: &[f32]) -> Check {
-    finite(key, values)?;
-    match values.iter().find(|v| v.abs() > MAX_SCENE_COORDINATE) {
-        Some(v) => Err((key.into(), format!("{v} is beyond the limit of {MAX_SCENE_COORDINATE:e} scene units"))),
-        None => Ok(()),
-    }
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-fn finite(key: &str, values: &[f32]) -> Check {
-    match values.iter().find(|v| !v.is_finite()) {
-        Some(v) => Err((key.into(), format!("{v} is not a finite number"))),
-        None => Ok(()),
-    }
-}
+    const MINIMAL: &str = r#"
+[camera]
+eye = [0.0, 1.0, 3.0]
+target = [0.0, 0.0, 0.0]
 
-fn nonzero(key: &str, v: [f32; 3]) -> Check {
-    finite(key, &v)?;
-    if v.iter().all(|c| *c == 0.0) { Err((key.into(), "must not be the zero vector".into())) } else { Ok(()) }
-}
+[[object]]
+shape = { type = "sphere", radius = 1.0 }
+material = { type = "translucent", preset = "skimmilk", mm_per_unit = 10.0 }
+"#;
 
-fn non_negative(key: &str, values: &[f32]) -> Check {
-    finite(key, values)?;
-    match values.iter().find(|v| **v < 0.0) {
-        Some(v) => Err((key.into(), format!("{v} is negative"))),
-        None => Ok(()),
-    }
-}
-
-fn unit_interval(key: &str, v: f32) -> Check {
-    if (0.0..=1.0).contains(&v) { Ok(()) } else { Err((key.into(), format!("{v} must be between 0 and 1"))) }
-}
-
-/// Every value of a parsed scene in range, section by section; the first that is not, as its
-/// key path and what is wrong.
-fn check(scene: &SceneFile) -> Check {
-    check_camera(&scene.camera)?;
-    if scene.objects.is_empty() {
-        return Err(("object".into(), "the scene has no [[object]]".into()));
-    }
-    for (i, o) in scene.objects.iter().enumerate() {
-        let key = |k: &str| format!("object[{i}].{k}");
-        check_shape(&key, &o.shape)?;
-        check_transform(&key, &o.transform)?;
-        check_material(&key, &o.material)?;
-    }
-    check_lights(&scene.lights)?;
-    let s = &scene.sampling;
-    if let Some(count) = s.count
-        && (count == 0 || count > MAX_SAMPLE_COUNT)
-    {
-        return Err(("sampling.count".into(), format!("{count} must be 1 to {MAX_SAMPLE_COUNT}")));
-    }
-    check_render(&scene.render)
-}
-
-/// `[camera]`: eye and target apart by a distance f32 can square, an up vector off the view
-/// direction, a field of view a projection can use, 1 to 16384 pixels each way.
-fn check_camera(c: &Camera) -> Check {
-    coordinates("camera.eye", &c.eye)?;
-    coordinates("camera.target", &c.target)?;
-    nonzero("camera.up", c.up)?;
-    if c.eye == c.target {
-        return Err(("camera.target".into(), "equals camera.eye".into()));
-    }
-    // In f64: the f32 difference of two allowed points can still overflow when squared.
-    let view = glam::Vec3::from(c.target).as_dvec3() - glam::Vec3::from(c.eye).as_dvec3();
-    let distance = view.length();
-    if !(MIN_CAMERA_DISTANCE as f64..=MAX_SCENE_COORDINATE as f64).contains(&distance) {
-        return Err((
-            "camera.target".into(),
-            format!(
-                "is {distance:e} from camera.eye; the distance must be {MIN_CAMERA_DISTANCE:e} to {MAX_SCENE_COORDINATE:e} \
-                 scene units"
-            ),
-        ));
-    }
-    if view.normalize().cross(glam::Vec3::from(c.up).as_dvec3().normalize()).length() < 1e-4 {
-        return Err(("camera.up".into(), format!("{:?} is parallel to the view direction", c.up)));
-    }
-    if !(c.fov_y >= MIN_FOV_Y && c.fov_y < 180.0) {
-        return Err(("camera.fov_y".into(), format!("{} must be at least {MIN_FOV_Y} and below 180 degrees", c.fov_y)));
-    }
-    if c.resolution.iter().any(|r| *r == 0 || *r > 16384) {
-        return Err(("camera.resolution".into(), format!("{:?} must be 1 to 16384 pixels each", c.resolution)));
-    }
-    Ok(())
-}
-
-/// An object's `shape`, `key` making its key paths: a mesh path that names something, a
-/// built-in shape's size positive and within [`crate::mesh::MAX_COORDINATE`], 1 to 2048
-/// divisions.
-fn check_shape(key: &impl Fn(&str) -> String, shape: &Shape) -> Check {
-    match shape {
-        Shape::Mesh { path } if path.trim().is_empty() => Err((key("shape.path"), "is empty".into())),
-        Shape::Plane { size, divisions } | Shape::Sphere { radius: size, divisions } => {
-            if !(size.is_finite() && *size > 0.0) {
-                return Err((key("shape"), format!("size/radius {size} must be positive")));
+    fn invalid(text: &str) -> (Location, Problem, String) {
+        match Scene::parse(text, "t.toml", None) {
+            Err(e @ SceneError::Invalid { .. }) => {
+                let message = e.to_string();
+                let SceneError::Invalid { location, problem, .. } = e else { unreachable!() };
+                (location, *problem, message)
             }
-            if *size > crate::mesh::MAX_COORDINATE {
-                return Err((key("shape"), format!("size/radius {size:e} is above {:e}", crate::mesh::MAX_COORDINATE)));
-            }
-            if *divisions == 0 || *divisions > 2048 {
-                return Err((key("shape.divisions"), format!("{divisions} must be 1 to 2048")));
-            }
-            Ok(())
-        }
-        _ => Ok(()),
-    }
-}
-
-/// An object's `transform`: fit and scale positive, rotation finite, translation a coordinate.
-fn check_transform(key: &impl Fn(&str) -> String, t: &Transform) -> Check {
-    for (name, v) in [("transform.fit", t.fit), ("transform.scale", t.scale)] {
-        if let Some(v) = v
-            && !(v.is_finite() && v > 0.0)
-        {
-            return Err((key(name), format!("{v} must be positive")));
+            other => panic!("expected SceneError::Invalid, got {other:?}"),
         }
     }
-    finite(&key("transform.rotate"), &t.rotate.unwrap_or_default())?;
-    coordinates(&key("transform.translate"), &t.translate.unwrap_or_default())
-}
 
-/// An object's `material`: a translucent one given by a preset or by both coefficients (not
-/// both ways) with a positive scale, an opaque one's albedo at most 1 (it reflects no more
-/// than it receives); roughness 0 to 1 for either.
-fn check_material(key: &impl Fn(&str) -> String, material: &MaterialSpec) -> Check {
-    match material {
-        MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, mm_per_unit, roughness, .. } => {
-            if preset.is_none() && (sigma_a.is_none() || sigma_s_prime.is_none()) {
-                return Err((key("material"), "needs `preset` or both `sigma_a` and `sigma_s_prime`".into()));
-            }
-            if preset.is_some() && (sigma_a.is_some() || sigma_s_prime.is_some()) {
-                return Err((key("material"), "give `preset` or coefficients, not both".into()));
-            }
-            if !(mm_per_unit.is_finite() && *mm_per_unit > 0.0) {
-                return Err((key("material.mm_per_unit"), format!("{mm_per_unit} must be positive")));
-            }
-            unit_interval(&key("material.roughness"), *roughness)
-        }
-        MaterialSpec::Opaque { albedo, roughness } => {
-            non_negative(&key("material.albedo"), albedo)?;
-            if albedo.iter().any(|a| *a > 1.0) {
-                return Err((key("material.albedo"), format!("{albedo:?} must be at most 1 (energy)")));
-            }
-            unit_interval(&key("material.roughness"), *roughness)
-        }
+    #[test]
+    fn a_value_out_of_range_is_typed_with_its_line_and_key() {
+        let (location, problem, message) =
+            invalid(&MINIMAL.replace("target = [0.0, 0.0, 0.0]", "target = [0.0, 0.0, 0.0]\nfov_y = 190.0"));
+        assert_eq!(location, Location { line: Some(5), key: Some("camera.fov_y".into()) });
+        assert_eq!(problem, Problem::Value(BadValue::FieldOfView(190.0)));
+        assert_eq!(message, "t.toml: line 5: `camera.fov_y`: 190 must be at least 0.001 and below 180 degrees");
     }
-}
 
-/// `[[light]]`: each light's values in range, and at most one environment light (there is one
-/// environment map).
-fn check_lights(lights: &[Light]) -> Check {
-    let mut environments = 0;
-    for (i, l) in lights.iter().enumerate() {
-        let key = |k: &str| format!("light[{i}].{k}");
-        match l {
-            Light::Directional { direction, irradiance, .. } => {
-                nonzero(&key("direction"), *direction)?;
-                non_negative(&key("irradiance"), irradiance)?;
-            }
-            Light::Point { position, intensity, .. } => {
-                coordinates(&key("position"), position)?;
-                non_negative(&key("intensity"), intensity)?;
-            }
-            Light::Spot { position, direction, intensity, angle, softness, .. } => {
-                coordinates(&key("position"), position)?;
-                nonzero(&key("direction"), *direction)?;
-                non_negative(&key("intensity"), intensity)?;
-                if !(*angle > 0.0 && *angle < 90.0) {
-                    return Err((key("angle"), format!("{angle} must be between 0 and 90 degrees")));
-                }
-                if !(*softness > 0.0 && *softness <= 1.0) {
-                    return Err((key("softness"), format!("{softness} must be above 0 and at most 1")));
-                }
-            }
-            Light::Environment { scale, directions, .. } => {
-                environments += 1;
-                non_negative(&key("scale"), &[*scale])?;
-                if *directions == 0 || *directions > 256 {
-                    return Err((key("directions"), format!("{directions} must be 1 to 256")));
-                }
-            }
-        }
-    }
-    if environments > 1 {
-        return Err(("light".into(), "at most one environment light".into()));
-    }
-    Ok(())
-}
+    #[test]
+    fn syntax_and_deserialisation_errors_carry_toml_s_error() {
+        let (location, problem, message) = invalid("[camera]\neye = [0.0, 1.0\n");
+        assert_eq!(location, Location::default());
+        assert!(matches!(problem, Problem::Syntax(_)), "{problem:?}");
+        assert!(message.starts_with("t.toml: TOML parse error at line 2"), "{message}");
 
-/// `[render]`: exposure positive, gather epsilon 0 to [`format::MAX_GATHER_EPSILON`], beam
-/// opening 0 to [`format::MAX_BEAM_OPENING`], beam walks' memory at most
-/// [`format::MAX_BEAM_WALK_MIB`], a shadow-map size of 16 to 8192 texels, a background that
-/// emits nothing negative.
-fn check_render(r: &RenderSettings) -> Check {
-    if !(r.exposure.is_finite() && r.exposure > 0.0) {
-        return Err(("render.exposure".into(), format!("{} must be positive", r.exposure)));
-    }
-    if !(r.gather_epsilon >= 0.0 && r.gather_epsilon <= format::MAX_GATHER_EPSILON) {
-        return Err((
-            "render.gather_epsilon".into(),
-            format!("{} must be 0 to {}", r.gather_epsilon, format::MAX_GATHER_EPSILON),
-        ));
-    }
-    if !(r.beam_opening >= 0.0 && r.beam_opening <= format::MAX_BEAM_OPENING) {
-        return Err((
-            "render.beam_opening".into(),
-            format!("{} must be 0 to {}", r.beam_opening, format::MAX_BEAM_OPENING),
-        ));
-    }
-    if r.beam_walk_mib > format::MAX_BEAM_WALK_MIB {
-        return Err((
-            "render.beam_walk_mib".into(),
-            format!("{} must be 0 to {}", r.beam_walk_mib, format::MAX_BEAM_WALK_MIB),
-        ));
-    }
-    if !(16..=8192).contains(&r.shadow_map_size) {
-        return Err(("render.shadow_map_size".into(), format!("{} must be 16 to 8192", r.shadow_map_size)));
-    }
-    non_negative("render.background", &r.background.unwrap_or_default())?;
-    check_texture("render.texture_samples", "render.texture_resolution", r.texture_samples, r.texture_resolution)
-        .map_err(|e| (e.key.to_string(), format!("{} must be {} to {}", e.value, e.min, e.max)))?;
-    check_max_error("render.max_error", r.max_error)
-}
+        // A wrong type in an inline table: found by its value, so only toml's message is shown.
+        let (location, problem, message) = invalid(&MINIMAL.replace("radius = 1.0", "radius = \"big\""));
+        assert_eq!(location, Location { line: Some(7), key: Some("object[0].shape.radius".into()) });
+        assert!(matches!(problem, Problem::Deserialize { brief: true, .. }), "{problem:?}");
+        assert_eq!(
+            message,
+            "t.toml: line 7: at key `object[0].shape.radius`: invalid type: string \"big\", expected f32"
+        );
 
-/// The texture gather's sample count (0 to [`format::MAX_TEXTURE_SAMPLES`]) and atlas
-/// resolution (`mesh::atlas::MIN_RESOLUTION` to `MAX_RESOLUTION`), under the keys or flags named.
-pub fn check_texture(
-    samples_key: &'static str,
-    resolution_key: &'static str,
-    samples: u32,
-    resolution: u32,
-) -> Result<(), OutOfRange> {
-    use crate::mesh::atlas::{MAX_RESOLUTION, MIN_RESOLUTION};
-    if samples > format::MAX_TEXTURE_SAMPLES {
-        return Err(OutOfRange { key: samples_key, value: samples, min: 0, max: format::MAX_TEXTURE_SAMPLES });
+        // An unknown key: its own line, and toml's whole text.
+        let (location, problem, message) =
+            invalid(&MINIMAL.replace("target = [0.0, 0.0, 0.0]", "target = [0.0, 0.0, 0.0]\nfov = 1.0"));
+        assert_eq!(location, Location { line: Some(5), key: Some("camera.fov".into()) });
+        assert!(matches!(problem, Problem::Deserialize { brief: false, .. }), "{problem:?}");
+        assert!(message.starts_with("t.toml: line 5: at key `camera.fov`: TOML parse error"), "{message}");
+        assert!(message.contains("unknown field `fov`"), "{message}");
     }
-    if !(MIN_RESOLUTION..=MAX_RESOLUTION).contains(&resolution) {
-        return Err(OutOfRange { key: resolution_key, value: resolution, min: MIN_RESOLUTION, max: MAX_RESOLUTION });
-    }
-    Ok(())
-}
 
-/// A relative error target (`render.max_error`, `--max-error`) within
-/// [`format::MIN_MAX_ERROR`] to [`format::MAX_MAX_ERROR`].
-pub fn check_max_error(key: &str, e: f64) -> Check {
-    if !(format::MIN_MAX_ERROR..=format::MAX_MAX_ERROR).contains(&e) {
-        return Err((
-            key.into(),
-            format!(
-                "{e} must be {} to {} (a relative error: 0.01 is 1%)",
-                format::MIN_MAX_ERROR,
-                format::MAX_MAX_ERROR
-            ),
-        ));
+    #[test]
+    fn problems_found_when_prepared_read_as_before() {
+        let reach = SceneError::Invalid {
+            file: "s.toml".into(),
+            location: Location::key("object[2]".into()),
+            problem: BadValue::BeyondReach { object: "bunny.obj".into(), reach: 2e18 }.into(),
+        };
+        assert_eq!(
+            reach.to_string(),
+            "s.toml: `object[2]` (bunny.obj): placed by its shape and transform it reaches 2e18 scene units from \
+             the origin, beyond the limit of 1e18"
+        );
+        let light = SceneError::Invalid {
+            file: "s.toml".into(),
+            location: Location::key("light[1].scale".into()),
+            problem: BadValue::LightNotFinite(lights::LightKind::Point {
+                position: glam::Vec3::ZERO,
+                intensity: glam::Vec3::INFINITY,
+            })
+            .into(),
+        };
+        assert_eq!(
+            light.to_string(),
+            "s.toml: `light[1].scale`: the light is not finite once prepared (Point { position: Vec3(0.0, 0.0, 0.0), \
+             intensity: Vec3(inf, inf, inf) }); lower it"
+        );
     }
-    Ok(())
+
+    #[test]
+    fn a_missing_embedded_asset_is_its_own_error() {
+        let e = Scene::builtin().resolve("missing.obj").err().expect("not embedded");
+        assert!(matches!(&e, SceneError::NoEmbeddedAsset { name, .. } if name == "missing.obj"), "{e:?}");
+        assert_eq!(e.to_string(), "built-in scene: no embedded asset named \"missing.obj\"");
+    }
 }

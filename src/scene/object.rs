@@ -39,6 +39,10 @@ pub struct PreparedObject {
     pub name: String,
     /// World-space mesh.
     pub mesh: Mesh,
+    /// The mesh as loaded, before its transform, where the samples are placed
+    /// (`sampling::sample_in_frame`, so that the same object gets the same samples in any units
+    /// and at any place); `None` where the transform is the identity.
+    pub frame: Option<std::sync::Arc<Mesh>>,
     /// What it is made of.
     pub material: ResolvedMaterial,
     /// Whether it is drawn into the shadow maps (`casts_shadow` in the scene).

@@ -139,10 +139,16 @@ pub enum StudyError {
     Truth(#[from] truth::TruthError),
     #[error(transparent)]
     Rte(#[from] RteCacheError),
-    #[error("sampling {object}: {message}")]
-    Sampling { object: String, message: String },
-    #[error("{0}")]
-    Report(String),
+    // The cause is the source, shown after it by `{:#}` and error reporters.
+    /// Sample points for object `object` could not be placed.
+    #[error("sampling {object}")]
+    Sampling { object: String, source: sampling::SamplingError },
+    /// Texels for object `object` (the texture gather's samples) could not be placed.
+    #[error("sampling {object}")]
+    Atlas { object: String, source: crate::mesh::atlas::AtlasError },
+    /// A picture or comparison of the report (a FLIP score) could not be made.
+    #[error(transparent)]
+    Plot(#[from] plot::PlotError),
     #[error("the scene has no translucent object: there is nothing to study")]
     NothingTranslucent,
     #[error(
@@ -332,7 +338,7 @@ fn configure(base: &PreparedScene, run: Configuration) -> Result<(PreparedScene,
             // The seed of object i is sampling.seed + i, as `PreparedScene::new` places them.
             let options = SampleOptions::new(method, count).with_seed(seed.wrapping_add(i as u64));
             o.samples = sampling::sample(&o.mesh, &options)
-                .map_err(|e| StudyError::Sampling { object: o.name.clone(), message: e.to_string() })?
+                .map_err(|source| StudyError::Sampling { object: o.name.clone(), source })?
                 .points;
         }
     }
@@ -354,8 +360,7 @@ fn configure_texture(
     let start = std::time::Instant::now();
     for o in &mut scene.objects {
         if matches!(o.material, ResolvedMaterial::Translucent { .. }) {
-            o.place_texels(resolution)
-                .map_err(|e| StudyError::Sampling { object: o.name.clone(), message: e.to_string() })?;
+            o.place_texels(resolution).map_err(|source| StudyError::Atlas { object: o.name.clone(), source })?;
         }
     }
     Ok((scene, start.elapsed().as_secs_f64() * 1e3))
@@ -578,8 +583,7 @@ impl Bench<'_> {
             rte_noise: self.physics.map_or(nan, |p| p.noise),
             image_rel_rmse: self.truth_image.map_or(f64::NAN, |t| image_rel_rmse(&t.hdr, &image.hdr)),
             flip_mean: match self.truth_image {
-                Some(t) => flip::flip_mean(&t.ldr, &image.ldr, image.size[0], image.size[1])
-                    .map_err(|e| StudyError::Report(e.to_string()))?,
+                Some(t) => flip::flip_mean(&t.ldr, &image.ldr, image.size[0], image.size[1])?,
                 None => f64::NAN,
             },
         };
@@ -600,7 +604,7 @@ pub fn error_image(
     truth: &[Vec<[f64; 3]>],
     estimate: &[Vec<[f32; 3]>],
     scale: f64,
-) -> Result<(Vec<u8>, u32), String> {
+) -> Result<(Vec<u8>, u32), plot::PlotError> {
     let [w, h] = scene.scene.file.camera.resolution;
     let camera = crate::render::camera::CameraView::of_scene(scene);
     let view_proj = camera.projection * camera.view;
@@ -635,6 +639,6 @@ pub fn error_image(
     for (dst, src) in rgba.chunks_exact_mut(width as usize * 4).zip(model.chunks_exact(w as usize * 4)) {
         dst[..src.len()].copy_from_slice(src);
     }
-    raster::legend_bar(&mut rgba, width, h, [&labels[0], &labels[1], &labels[2]]).map_err(|e| e.to_string())?;
+    raster::legend_bar(&mut rgba, width, h, [&labels[0], &labels[1], &labels[2]])?;
     Ok((rgba, width))
 }

@@ -51,8 +51,8 @@ pub(super) fn level_memory(scene: &PreparedScene, plans: &[Option<Vec<TrianglePl
     LevelMemory { bytes: peak + exitance, points }
 }
 
-/// Refuse `level` when [`level_memory`] exceeds the limit ([`TruthOptions::memory`], else the
-/// memory available now, [`available_memory`]; no check where neither is known).
+/// Refuse `level` when [`level_memory`] exceeds the limit ([`TruthOptions::memory`], else
+/// [`default_memory_limit`]).
 pub(super) fn check_memory(
     scene: &PreparedScene,
     plans: &[Option<Vec<TrianglePlan>>],
@@ -62,10 +62,7 @@ pub(super) fn check_memory(
 ) -> Result<(), TruthError> {
     let (limit, kind) = match options.memory {
         Some(bytes) => (bytes, MemoryLimitKind::Given),
-        None => match available_memory() {
-            Some(bytes) => (bytes, MemoryLimitKind::Available),
-            None => return Ok(()),
-        },
+        None => (default_memory_limit(available_memory()), MemoryLimitKind::Default),
     };
     let need = level_memory(scene, plans, level);
     if need.bytes <= limit {
@@ -90,13 +87,24 @@ pub fn available_memory() -> Option<u64> {
     Some(kib * 1024)
 }
 
+/// The most a truth level may use unless told (`--truth-memory`): 4 GiB.
+pub const DEFAULT_MEMORY_CAP: u64 = 4 << 30;
+
+/// The limit a truth level is held to when none is given: a quarter of the memory available
+/// when it starts ([`available_memory`]), and at most [`DEFAULT_MEMORY_CAP`]; the cap alone
+/// where the available memory is not known. A modest share, so that the study leaves the
+/// machine usable and a level that would take it all is refused before it starts.
+pub fn default_memory_limit(available: Option<u64>) -> u64 {
+    available.map_or(DEFAULT_MEMORY_CAP, |bytes| (bytes / 4).min(DEFAULT_MEMORY_CAP))
+}
+
 /// Where a truth's memory limit came from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MemoryLimitKind {
     /// [`TruthOptions::memory`].
     Given,
-    /// The memory available when the level was to start ([`available_memory`]).
-    Available,
+    /// None was given: [`default_memory_limit`].
+    Default,
 }
 
 /// `bytes` for a reader: `4.70 GiB`, `312.0 MiB`, `64.0 KiB`.
@@ -106,5 +114,18 @@ pub fn human_bytes(bytes: u64) -> String {
         b if b >= 1024f64.powi(3) => format!("{:.2} GiB", b / 1024f64.powi(3)),
         b if b >= 1024f64.powi(2) => format!("{:.1} MiB", b / 1024f64.powi(2)),
         b => format!("{:.1} KiB", b / 1024.0),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_truth_memory_limit_is_a_quarter_of_what_is_available_and_at_most_4_gib() {
+        assert_eq!(default_memory_limit(Some(8 << 30)), 2 << 30);
+        assert_eq!(default_memory_limit(Some(23 << 30)), DEFAULT_MEMORY_CAP);
+        assert_eq!(default_memory_limit(Some(1000)), 250);
+        assert_eq!(default_memory_limit(None), DEFAULT_MEMORY_CAP);
     }
 }

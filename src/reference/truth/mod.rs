@@ -60,7 +60,10 @@ mod source;
 pub use crate::scene::accuracy::receiver_subset;
 pub(crate) use cache::{Fnv, folder_problem};
 pub use cache::{cached, content_key, default_cache_dir};
-pub use memory::{LevelMemory, MemoryLimitKind, available_memory, human_bytes, memory_estimate};
+pub use memory::{
+    DEFAULT_MEMORY_CAP, LevelMemory, MemoryLimitKind, available_memory, default_memory_limit, human_bytes,
+    memory_estimate,
+};
 
 use super::{occluders, ray_offset};
 use crate::mesh::bvh::Bvh;
@@ -158,8 +161,9 @@ pub struct TruthOptions {
     /// At most this many receivers per translucent object, spread evenly over its vertex order
     /// ([`receiver_subset`]); `None`: every vertex. The others hold NaN.
     pub receivers: Option<usize>,
-    /// The most memory (bytes) one level may take ([`LevelMemory`]); `None`: the memory
-    /// available when the level starts ([`available_memory`]). A level over it is refused.
+    /// The most memory (bytes) one level may take ([`LevelMemory`]); `None`:
+    /// [`default_memory_limit`] of the memory available when the level starts. A level over it
+    /// is refused.
     /// Not part of the content key: it changes whether a truth is computed, not its values.
     pub memory: Option<u64>,
 }
@@ -176,7 +180,7 @@ pub type Progress<'a> = &'a (dyn Fn(u32, usize, usize) + Sync);
 
 /// Compute the truth for every translucent object of `scene`, level after level until it
 /// converges (or `options.max_level`). Before each level its memory is estimated
-/// ([`level_memory`](memory::level_memory)) and checked against `options.memory` (or the memory available): a level
+/// ([`level_memory`](memory::level_memory)) and checked against `options.memory` (or [`default_memory_limit`]): a level
 /// that would not fit is refused with [`TruthError::Memory`] rather than run out of memory.
 pub fn compute(scene: &PreparedScene, options: &TruthOptions, progress: Progress) -> Result<Truth, TruthError> {
     let occluders = occluders(scene);
@@ -301,7 +305,11 @@ pub enum TruthError {
          the {} {}{}",
         human_bytes(*bytes),
         human_bytes(*limit),
-        match kind { MemoryLimitKind::Given => "limit given", MemoryLimitKind::Available => "available (MemAvailable, /proc/meminfo)" },
+        match kind {
+            MemoryLimitKind::Given => "limit given",
+            MemoryLimitKind::Default =>
+                "default limit (a quarter of the memory available, at most 4 GiB; --truth-memory sets another)",
+        },
         last_change.map_or(String::new(), |c| format!(
             "; level {} changed by {c:.2e} RMS from the one before, not yet converged",
             level - 1

@@ -49,34 +49,29 @@ pub(super) fn exitance_at_vertices(
         })
         .collect();
     let floor = [0, 1, 2].map(|c| LIT_FLOOR * coarse.iter().map(|m| m[c]).fold(0.0, f64::max));
-    let chunk = 64;
+    // One task per receiver: a receiver's recursion can take minutes (a large object in
+    // diffusion lengths), so chunks would leave cores idle and the progress bar still.
     let at_subset: Vec<[f64; 3]> = positions
-        .par_chunks(chunk)
-        .zip(coarse.par_chunks(chunk))
-        .flat_map_iter(|(xs, m0)| {
-            let out: Vec<[f64; 3]> = xs
-                .iter()
-                .zip(m0)
-                .map(|(x, m0)| {
-                    let x = x.as_dvec3();
-                    let m_ref = [0, 1, 2].map(|c| m0[c].max(floor[c]));
-                    let q = Quadrature { x, dipoles, eta, m_ref };
-                    let mut m = [0.0; 3];
-                    // A cluster that is fine as a whole is one multipole; a triangle that is not
-                    // is integrated piece by piece.
-                    let fine = |c: &Cluster| {
-                        let d = (x.distance(c.centre) - c.radius).max(0.0);
-                        c.source.is_none() && q.fine(d, c.radius, &c.moments.flux, eta / 2.0)
-                    };
-                    tree.walk(fine, |c| match c.source {
-                        Some(s) => q.piece(lit[s], WHOLE, 0, 0, &mut m),
-                        None => q.multipole(&c.moments.flux, &c.centroid, &c.quadrupole, &mut m),
-                    });
-                    m
-                })
-                .collect();
-            progress(xs.len());
-            out
+        .par_iter()
+        .zip(&coarse)
+        .with_max_len(1)
+        .map(|(x, m0)| {
+            let x = x.as_dvec3();
+            let m_ref = [0, 1, 2].map(|c| m0[c].max(floor[c]));
+            let q = Quadrature { x, dipoles, eta, m_ref };
+            let mut m = [0.0; 3];
+            // A cluster that is fine as a whole is one multipole; a triangle that is not is
+            // integrated piece by piece.
+            let fine = |c: &Cluster| {
+                let d = (x.distance(c.centre) - c.radius).max(0.0);
+                c.source.is_none() && q.fine(d, c.radius, &c.moments.flux, eta / 2.0)
+            };
+            tree.walk(fine, |c| match c.source {
+                Some(s) => q.piece(lit[s], WHOLE, 0, 0, &mut m),
+                None => q.multipole(&c.moments.flux, &c.centroid, &c.quadrupole, &mut m),
+            });
+            progress(1);
+            m
         })
         .collect();
     if subset.len() == all.len() {
