@@ -12,8 +12,8 @@ use translucent::gpu::{Gpu, RecordCounts};
 use translucent::optics::Material;
 use translucent::render::plan::{BakedLevels, Change, LevelReason, SplatLights, Transport};
 use translucent::render::renderer::Renderer;
-use translucent::scene::build::{Overrides, PreparedScene};
-use translucent::scene::{Scene, Transform, TransportMode, lights};
+use translucent::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
+use translucent::scene::{MaterialSpec, Scene, Transform, TransportMode, lights};
 
 /// Whole meshes unless the test asks for levels of detail: the counts below are of the passes a
 /// change calls for, and the exitance read back is every vertex's.
@@ -243,6 +243,14 @@ fn a_material_change_regathers_the_same_samples_and_a_transform_change_resamples
         let shift = resampled[0].position - samples[0].position;
         assert!((shift - Vec3::new(0.002, 0.0, 0.0)).length() < 1e-6, "samples did not move with the object");
         assert_ne!(renderer.exitance(0).unwrap(), marble, "the move lost the new material");
+        // One copy of the material, the prepared object's: the move kept it, and the file as
+        // read still says marble.
+        let ResolvedMaterial::Translucent { material, .. } = &renderer.scene().objects[0].material else {
+            panic!("the sphere is translucent")
+        };
+        assert_eq!(*material, Material::preset("skimmilk").unwrap());
+        let file = &renderer.scene().scene.file.objects[0].material;
+        assert!(matches!(file, MaterialSpec::Translucent { preset: Some(p), .. } if p == "marble"), "{file:?}");
     });
 }
 

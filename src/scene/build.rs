@@ -195,7 +195,13 @@ impl PreparedScene {
         scene.file.objects[object].transform = transform;
         let environment_lit = scene.file.lights.iter().any(|l| matches!(l, Light::Environment { .. }));
         let mut objects = self.objects.clone();
-        objects[object] = prepare_object(&scene, object, environment_lit)?;
+        // The mesh as loaded and the material as it is now (a material edit is kept; the file
+        // is not read again).
+        let old = &self.objects[object];
+        let loaded = old.frame.as_deref().unwrap_or(&old.mesh).clone();
+        let (mesh, frame) = place_mesh(&scene, object, &old.name, loaded)?;
+        let placed = (old.name.clone(), mesh, frame);
+        objects[object] = placed_object(&scene, object, placed, old.material.clone(), environment_lit);
         sample_objects(&scene, &mut objects, Some(object))?;
         self.scene = scene;
         self.objects = objects;
@@ -291,26 +297,45 @@ fn apply_overrides(scene: &mut Scene, overrides: &Overrides) -> Result<(), Scene
 fn prepare_object(scene: &Scene, i: usize, environment_lit: bool) -> Result<PreparedObject, SceneError> {
     let o = &scene.file.objects[i];
     let (name, mesh) = load_shape(scene, &o.shape).with_context(|| format!("{}: object[{i}]", scene.name))?;
-    let (mesh, frame) = transform_mesh(mesh, &o.transform)
-        .with_context(|| format!("{}: object[{i}] ({name}): transform", scene.name))?;
-    check_reach(scene, i, &name, &mesh)?;
+    let (mesh, frame) = place_mesh(scene, i, &name, mesh)?;
     let material = resolve_material(&o.material, &format!("{}: object[{i}].material", scene.name))?;
+    Ok(placed_object(scene, i, (name, mesh, frame), material, environment_lit))
+}
+
+/// Object `i`'s mesh as loaded, `mesh`, placed by its transform and checked against
+/// [`super::MAX_SCENE_COORDINATE`]; with the mesh as loaded where the transform moved it.
+fn place_mesh(scene: &Scene, i: usize, name: &str, mesh: Mesh) -> Result<(Mesh, Option<Arc<Mesh>>), SceneError> {
+    let (mesh, frame) = transform_mesh(mesh, &scene.file.objects[i].transform)
+        .with_context(|| format!("{}: object[{i}] ({name}): transform", scene.name))?;
+    check_reach(scene, i, name, &mesh)?;
+    Ok((mesh, frame))
+}
+
+/// Object `i` from its name and placed meshes and its material: its levels of detail built,
+/// no samples yet.
+fn placed_object(
+    scene: &Scene,
+    i: usize,
+    (name, mesh, frame): (String, Mesh, Option<Arc<Mesh>>),
+    material: ResolvedMaterial,
+    environment_lit: bool,
+) -> PreparedObject {
     let levels = if scene.file.render.level_of_detail && lod_allowed(&material, environment_lit) {
         mesh.levels_of_detail()
     } else {
         vec![mesh.full_level()]
     };
-    Ok(PreparedObject {
+    PreparedObject {
         name,
         mesh,
         frame,
         material,
-        casts_shadow: o.casts_shadow,
+        casts_shadow: scene.file.objects[i].casts_shadow,
         samples: Vec::new(),
         density: None,
         levels,
         atlas: None,
-    })
+    }
 }
 
 /// Place the samples of every translucent object of `objects` (only object `only`, when given),

@@ -93,13 +93,8 @@ impl Renderer {
         *dipoles = material
             .dipoles(*mm_per_unit)
             .map_err(|source| RenderError::InvalidMaterial { object, source })?;
-        // The scene file says so too, so that a later resampling (`set_transform`) keeps it.
-        if let crate::scene::MaterialSpec::Translucent { preset, sigma_a, sigma_s_prime, eta, .. } =
-            &mut self.scene.scene.file.objects[object].material
-        {
-            (*preset, *sigma_a, *sigma_s_prime, *eta) =
-                (None, Some(material.sigma_a), Some(material.sigma_s_prime), Some(material.eta));
-        }
+        // The one copy: the prepared object's. A later move (`SceneEdit::Transform`) keeps it,
+        // and `scene().scene.file` stays the file as it was read.
         *m = material;
         self.gpu_scene.set_material(&self.scene, object);
         self.needs = Self::needs_of(&self.scene, self.target, &self.planner);
