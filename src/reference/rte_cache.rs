@@ -13,7 +13,7 @@
 
 use super::rte::{Progress, RteError};
 use super::rte_mesh::{self, MeshOptions, ObjectExitance};
-use super::truth::{Fnv, folder_problem};
+use super::truth::{Fnv, FolderProblem, folder_problem};
 use crate::scene::build::{PreparedScene, ResolvedMaterial};
 use std::path::{Path, PathBuf};
 
@@ -91,7 +91,11 @@ pub enum RteCacheError {
     #[error(transparent)]
     Rte(#[from] RteError),
     #[error("radiative-transfer cache {}: {why}", path.display())]
-    Cache { path: PathBuf, why: String },
+    Folder { path: PathBuf, why: FolderProblem },
+    #[error("radiative-transfer cache {}: {error}", path.display())]
+    Io { path: PathBuf, error: std::io::Error },
+    #[error("radiative-transfer cache {}: {error}", path.display())]
+    Json { path: PathBuf, error: serde_json::Error },
 }
 
 /// A hash (FNV-1a, 64 bits, hex) of everything the walk depends on (see the module's
@@ -142,17 +146,17 @@ pub fn cached(
             Err(e) => log::warn!("radiative-transfer cache {}: unreadable ({e}); walking it anew", path.display()),
         }
     }
-    let fail = |why: String| RteCacheError::Cache { path: dir.to_path_buf(), why };
     if let Some(why) = folder_problem(dir) {
-        return Err(fail(why));
+        return Err(RteCacheError::Folder { path: dir.to_path_buf(), why });
     }
     let objects = rte_mesh::exitance(scene, options, progress)?;
     let mut reference = RteReference { version: VERSION, key: key.clone(), objects, checksum: String::new() };
     reference.checksum = reference.digest();
-    let json = serde_json::to_vec(&reference).map_err(|e| fail(e.to_string()))?;
+    let json = serde_json::to_vec(&reference).map_err(|error| RteCacheError::Json { path: path.clone(), error })?;
     // Write then rename, so a run cut short never leaves half a reference behind.
     let tmp = dir.join(format!(".rte-{key}.json.tmp"));
-    std::fs::write(&tmp, json).map_err(|e| fail(e.to_string()))?;
-    std::fs::rename(&tmp, &path).map_err(|e| fail(e.to_string()))?;
+    let io = |error| RteCacheError::Io { path: path.clone(), error };
+    std::fs::write(&tmp, json).map_err(io)?;
+    std::fs::rename(&tmp, &path).map_err(io)?;
     Ok((reference, false))
 }

@@ -94,14 +94,14 @@ fn writable_folder(dir: &Path) -> Result<(), TruthError> {
 
 /// What keeps `dir` (made if missing) from being a folder a file can be written in, if
 /// anything: a file of its own is made and removed to find out.
-pub(crate) fn folder_problem(dir: &Path) -> Option<String> {
+pub(crate) fn folder_problem(dir: &Path) -> Option<FolderProblem> {
     if let Some(existing) = dir.ancestors().find(|a| a.exists())
         && !existing.is_dir()
     {
-        return Some(format!("{} is a file, not a folder", existing.display()));
+        return Some(FolderProblem::IsAFile(existing.to_path_buf()));
     }
     if let Err(e) = std::fs::create_dir_all(dir) {
-        return Some(format!("cannot make the folder ({e})"));
+        return Some(FolderProblem::Create(e));
     }
     let probe = dir.join(format!(".truth-probe-{}.tmp", std::process::id()));
     match std::fs::write(&probe, b"") {
@@ -109,8 +109,22 @@ pub(crate) fn folder_problem(dir: &Path) -> Option<String> {
             let _ = std::fs::remove_file(&probe);
             None
         }
-        Err(e) => Some(format!("cannot write a file in the folder ({e})")),
+        Err(e) => Some(FolderProblem::Write(e)),
     }
+}
+
+/// Why a cache folder cannot hold a cached result.
+#[derive(Debug, thiserror::Error)]
+pub enum FolderProblem {
+    /// A path on the way to it is a file.
+    #[error("{} is a file, not a folder", .0.display())]
+    IsAFile(PathBuf),
+    /// It could not be made.
+    #[error("cannot make the folder ({0})")]
+    Create(#[source] std::io::Error),
+    /// No file can be written in it.
+    #[error("cannot write a file in the folder ({0})")]
+    Write(#[source] std::io::Error),
 }
 
 /// Where truths are cached unless told otherwise: `$XDG_CACHE_HOME/translucent/truth`, else

@@ -60,6 +60,7 @@ mod source;
 pub use crate::scene::accuracy::receiver_subset;
 pub(crate) use cache::{Fnv, folder_problem};
 pub use cache::{cached, content_key, default_cache_dir};
+pub use cache::FolderProblem;
 pub use memory::{
     DEFAULT_MEMORY_CAP, LevelMemory, MemoryLimitKind, available_memory, default_memory_limit, human_bytes,
     memory_estimate,
@@ -297,7 +298,7 @@ pub enum TruthError {
     #[error("truth cache {}: {error}", path.display())]
     Io { path: PathBuf, error: std::io::Error },
     #[error("truth cache {}: {why}", path.display())]
-    Folder { path: PathBuf, why: String },
+    Folder { path: PathBuf, why: FolderProblem },
     #[error("truth cache {}: {error}", path.display())]
     Json { path: PathBuf, error: serde_json::Error },
     #[error(
