@@ -209,6 +209,26 @@ fn a_host_device_lacking_several_features_gets_all_of_them_named() {
     });
 }
 
+/// Issue 47, defect 5: a queue family past the device's is named as not existing, with the
+/// families there are, not as one that "does not do graphics and compute".
+#[test]
+fn a_host_queue_family_that_does_not_exist_is_named_with_the_families_there_are() {
+    common::with_gpu(|gpu| {
+        let host = HostVulkan {
+            entry: gpu.entry().clone(),
+            instance: gpu.instance().clone(),
+            physical_device: gpu.physical_device(),
+            device: gpu.device().clone(),
+            queue: *gpu.queue(),
+            queue_family: 7,
+            enabled_features: EnabledFeatures::ALL,
+        };
+        // SAFETY: the handles are the live `gpu`'s; the call fails before it makes anything.
+        let error = unsafe { Gpu::from_host(host, &GpuOptions::default()) }.err().expect("refused").to_string();
+        assert!(error.contains("queue family 7 does not exist (the device has"), "{error}");
+    });
+}
+
 /// The messages of a validated `Gpu` with synchronisation validation on, after `f` and the
 /// device are done.
 fn sync_messages(f: impl FnOnce(&Arc<Gpu>)) -> Vec<String> {

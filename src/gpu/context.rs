@@ -174,8 +174,11 @@ impl Gpu {
         }
         // SAFETY: plain query.
         let families = unsafe { host.instance.get_physical_device_queue_family_properties(info.handle) };
-        let flags = families.get(host.queue_family as usize).map(|f| f.queue_flags).unwrap_or_default();
-        if !flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE) {
+        let Some(family) = families.get(host.queue_family as usize) else {
+            let families = families.len() as u32;
+            return Err(unsuitable(Shortfall::NoSuchQueueFamily { given: host.queue_family, families }));
+        };
+        if !family.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE) {
             return Err(unsuitable(Shortfall::HostQueue(host.queue_family)));
         }
         let counters = Arc::new(ValidationCounters::default());

@@ -295,6 +295,19 @@ pub enum Shortfall {
     /// A host's queue family that does not do graphics and compute.
     #[error(" and a queue that does graphics and compute; the host's queue family {0} does not")]
     HostQueue(u32),
+    /// A host's queue family index past the device's families.
+    #[error(
+        " and a queue that does graphics and compute; the host's queue family {given} does not exist (the device has \
+         {families} {}, 0 to {})",
+        if *families == 1 { "family" } else { "families" },
+        families.saturating_sub(1)
+    )]
+    NoSuchQueueFamily {
+        /// The family index the host gave.
+        given: u32,
+        /// How many families the device has.
+        families: u32,
+    },
 }
 
 /// Why `Gpu::seed_pipeline_cache` refused its data (`VkPipelineCacheHeaderVersionOne` read from

@@ -172,9 +172,17 @@ pub enum RenderError {
         /// How many frames may be in flight.
         in_flight: usize,
     },
-    /// `read_timings` of a frame another renderer recorded.
+    /// `read_timings` or `discard` of a frame another renderer recorded.
     #[error("this frame was recorded by another renderer")]
     ForeignFrame,
+    /// `discard` of a frame after which another was recorded (which counted on it).
+    #[error("discard: frame {frame} is not the last recorded ({last} is); discard a frame before recording the next")]
+    DiscardNotLast {
+        /// The frame given.
+        frame: u64,
+        /// The last frame recorded.
+        last: u64,
+    },
     /// `image` or `hdr_image` of a renderer drawing into a host's target.
     #[error("a host target has no image of the renderer's own: the host reads its own")]
     NoOwnImage,

@@ -155,6 +155,14 @@ pub struct GpuScene {
     pending_objects: bool,
 }
 
+/// The records a frame uploads before its passes (`GpuScene::uploads`).
+#[derive(Clone, Debug)]
+pub(in crate::render) struct PendingUploads {
+    lights: Option<Vec<LightGpu>>,
+    objects: Vec<ObjectRecord>,
+    objects_pending: bool,
+}
+
 /// Every object's levels of detail packed (`pack_levels`).
 struct PackedLevels {
     /// The shared index buffer's contents.
@@ -638,6 +646,23 @@ impl GpuScene {
         record.local_channels = old.local_channels;
         self.object_records[object] = record;
         self.pending_objects = true;
+    }
+
+    /// What the next `record_uploads` would write, to put back (`restore_uploads`) when the
+    /// frame that recorded it is discarded unsubmitted.
+    pub(in crate::render) fn uploads(&self) -> PendingUploads {
+        PendingUploads {
+            lights: self.pending_lights.clone(),
+            objects: self.object_records.clone(),
+            objects_pending: self.pending_objects,
+        }
+    }
+
+    /// Put back what `uploads` returned: the next recorded frame uploads it again.
+    pub(in crate::render) fn restore_uploads(&mut self, uploads: PendingUploads) {
+        self.pending_lights = uploads.lights;
+        self.object_records = uploads.objects;
+        self.pending_objects = uploads.objects_pending;
     }
 
     /// The buffers the next `record_uploads` writes (by transfer): the lights and the object

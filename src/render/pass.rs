@@ -57,8 +57,9 @@ impl FrameInputs<'_> {
 
 /// A GPU pass: built once over the frame's resources, then recorded into the command buffer of
 /// every frame whose plan runs it. The registry (`registry::for_each_pass!`) maps each
-/// `plan::Pass` to one.
-pub trait RenderPass {
+/// `plan::Pass` to one. `Send`, so that the renderer holding it moves to an engine's render
+/// thread.
+pub trait RenderPass: Send {
     /// Every access this frame's recording makes: what it reads and writes, and how. The pass
     /// loop records the barriers these need before `record`.
     fn uses(&self, frame: &FrameInputs) -> Vec<Use>;

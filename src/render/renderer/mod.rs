@@ -3,6 +3,7 @@
 //! back `readback`, editing the scene `edit`, and the table of passes `passes`.
 
 mod edit;
+mod marks;
 mod passes;
 mod readback;
 mod record;
@@ -28,15 +29,21 @@ use std::sync::Arc;
 /// Renders one prepared scene: its passes over its GPU data, recording the passes each frame
 /// needs into a command buffer (the host's, or its own for `frame`).
 ///
-/// **Lifetime.** Frames recorded with `record_frame` or `record_exitance` into a host's
-/// command buffer use the renderer's pipelines, buffers and images until their submission
-/// finishes. Dropping the renderer (and `set_transform`, `bake_static_levels`, `resize`, which
-/// replace some of them) therefore first waits for the `Gpu`'s queue to go idle
-/// (`vkQueueWaitIdle`) unless every frame it recorded was seen finished: by `read_timings`
-/// succeeding on the last one (of at least one pass), or by `frame`. So no order of safe calls destroys what a frame in flight uses; a host that does
-/// not want the wait reads the last frame's timings after its fence first. A host must submit
-/// the command buffers it recorded into before dropping the renderer, or never (a buffer
-/// recorded against a dropped renderer is invalid, as after any destroyed object).
+/// **Lifetime.** Frames recorded with `record_frame`, `record_exitance` or `record_plan` into a
+/// host's command buffer use the renderer's pipelines, buffers and images until their
+/// submission finishes, and the host's own commands after them may too. Dropping the renderer
+/// (and the edits that replace some of them: a resize, a transform, `bake_static_levels`)
+/// therefore first waits for the `Gpu`'s queue to go idle (`vkQueueWaitIdle`) whenever a frame
+/// was recorded into a host's command buffer since the last such wait, whatever the order the
+/// host submitted them in. So no order of safe calls destroys what a frame in flight uses. A
+/// host must submit the command buffers it recorded into before dropping the renderer, or never
+/// (a buffer recorded against a dropped renderer is invalid, as after any destroyed object);
+/// one it will never submit it hands to `discard`.
+///
+/// **Threads.** A renderer is `Send`, not `Sync`: it moves to the thread an engine records on,
+/// and one thread uses it at a time. The `Gpu` it shares locks its queue for its own
+/// submissions; a host that submits on the same queue from other threads locks it too
+/// (docs/GPU.md).
 pub struct Renderer {
     gpu: Arc<Gpu>,
     scene: PreparedScene,
@@ -46,12 +53,17 @@ pub struct Renderer {
     passes: Passes,
     /// One timer per frame that may be in flight (empty without timestamps).
     timers: Vec<GpuTimer>,
-    /// The generation of the frame each timer holds.
+    /// The generation of the frame each slot (of `frames_in_flight`) holds.
     slot_frames: Vec<u64>,
+    /// Each frame's mark of having run, per slot: what `read_timings` trusts.
+    marks: marks::FrameMarks,
     /// Frames recorded so far (the last one's generation).
     generation: u64,
-    /// The last generation seen finished (`read_timings`, `frame`); what Drop need not wait for.
-    finished: std::cell::Cell<u64>,
+    /// A frame was recorded into a host's command buffer since the queue was last waited for:
+    /// Drop and the edits that replace resources wait for it.
+    host_frames: bool,
+    /// The state before the last frame was recorded, for `discard`.
+    undo: Option<record::Undo>,
     /// The extent of the last `HostTarget`: the planner's levels of detail follow it.
     host_extent: Option<vk::Extent2D>,
     /// Tells its `RecordedFrame`s from another renderer's (`NEXT_RENDERER`).
@@ -139,10 +151,12 @@ impl Renderer {
         Ok(Renderer {
             gpu: gpu.clone(),
             passes,
-            slot_frames: vec![0; timers.len()],
+            slot_frames: vec![0; options.frames_in_flight],
+            marks: marks::FrameMarks::new(gpu, options.frames_in_flight)?,
             timers,
             generation: 0,
-            finished: std::cell::Cell::new(0),
+            host_frames: false,
+            undo: None,
             host_extent: None,
             id: NEXT_RENDERER.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
             targets,
@@ -238,12 +252,12 @@ impl Renderer {
         self.gpu.memory_usage().0
     }
 
-    /// Before destroying what recorded frames use: wait for the queue unless every frame
-    /// recorded was seen finished (the lifetime rule on `Renderer`).
-    fn wait_for_recorded(&self) -> Result<(), RenderError> {
-        if self.finished.get() < self.generation {
+    /// Wait for the queue to go idle if a frame was recorded into a host's command buffer since
+    /// the last wait (the lifetime rule on `Renderer`).
+    fn wait_for_recorded(&mut self) -> Result<(), RenderError> {
+        if self.host_frames {
             self.gpu.wait_queue_idle()?;
-            self.finished.set(self.generation);
+            self.host_frames = false;
         }
         Ok(())
     }
@@ -264,3 +278,9 @@ impl Drop for Renderer {
     }
 }
 
+
+/// A renderer moves to the thread an engine records on (issue 47): every field is `Send`.
+const _: fn() = || {
+    fn send<T: Send>() {}
+    send::<Renderer>();
+};

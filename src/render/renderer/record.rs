@@ -96,6 +96,7 @@ impl Renderer {
         self.follow_extent(extent);
         let mut plan = self.planner.plan(&self.needs, &self.view());
         plan.passes.retain(|(p, _)| !matches!(p, Pass::Shade | Pass::Tonemap));
+        self.host_frames = true;
         let frame = self.record_checked(cmd, &plan, None);
         let uses: Vec<_> = [Resource::Exitance, Resource::EnvironmentIrradiance]
             .iter()
@@ -130,17 +131,31 @@ impl Renderer {
             (_, Some(t)) => crate::render::host::check_target(&self.gpu, self.target, self.options.samples, t)?,
             _ => {}
         }
+        self.host_frames = true;
         Ok(self.record_checked(cmd, plan, target))
+    }
+
+    /// `record_plan` into a command buffer of the renderer's own, which its caller submits and
+    /// waits for (`frame`, `frame_isolated`): not a host's frame to wait for at Drop.
+    fn record_own(&mut self, cmd: vk::CommandBuffer, plan: &Plan) -> Result<RecordedFrame, RenderError> {
+        if let TargetDesc::Host { .. } = self.target {
+            return Err(RenderError::MissingHostTarget);
+        }
+        Ok(self.record_checked(cmd, plan, None))
     }
 
     /// `record_plan` after its checks: `target` suits this renderer, or `plan` does not shade.
     fn record_checked(&mut self, cmd: vk::CommandBuffer, plan: &Plan, target: Option<&HostTarget>) -> RecordedFrame {
-        self.generation += 1;
-        let slot = (!self.timers.is_empty()).then(|| {
-            let slot = (self.generation - 1) as usize % self.timers.len();
-            self.slot_frames[slot] = self.generation;
-            slot
+        self.undo = Some(Undo {
+            hazards: self.hazards.get_mut().clone(),
+            planner: self.planner.clone(),
+            needs: self.needs.clone(),
+            uploads: self.gpu_scene.uploads(),
         });
+        self.generation += 1;
+        let mark_slot = self.marks.slot(self.generation);
+        self.slot_frames[mark_slot] = self.generation;
+        let slot = (!self.timers.is_empty()).then_some(mark_slot);
         for o in &plan.objects {
             self.gpu_scene.set_local_channels(o.object, o.local_mask());
         }
@@ -156,6 +171,7 @@ impl Renderer {
             t.reset(cmd);
         }
         let recorded = self.record(cmd, plan, timer, target);
+        self.marks.record(self.gpu.device(), cmd, self.generation);
         self.timers = timers;
         let baked = self.planner.baked_levels();
         // Only the vertex gather works at a level's vertices; the others reach every vertex.
@@ -175,35 +191,55 @@ impl Renderer {
 
     /// GPU milliseconds of each pass of `frame`, from its timestamps: call after the host's
     /// fence for the submission holding it, and before `frames_in_flight` more frames were
-    /// recorded (`RendererOptions`; they reuse its queries). Never blocks: before the submission
-    /// has finished it answers `FrameNotDone`, after its queries were reused
-    /// `TimingsOverwritten`. Empty on a queue without timestamps, and for a frame of no pass
-    /// (then nothing tells whether the frame finished). Before the fence, `FrameNotDone` is
-    /// certain only for a slot's first frame: until the GPU begins a later one, the slot's
-    /// queries still hold the results of the frame `frames_in_flight` before it (docs/GPU.md,
-    /// "Timestamps").
+    /// recorded (`RendererOptions`; they reuse its slot). Never blocks: until the frame has run
+    /// (its mark, written after everything it recorded, is there: `marks`) it answers
+    /// `FrameNotDone`, never an earlier frame's timestamps; after its slot was reused,
+    /// `TimingsOverwritten`. Empty on a queue without timestamps.
     pub fn read_timings(&self, frame: &RecordedFrame) -> Result<FrameTimings, RenderError> {
         if frame.renderer != self.id() {
             return Err(RenderError::ForeignFrame);
         }
+        let slot = self.marks.slot(frame.generation);
+        if self.slot_frames[slot] != frame.generation {
+            return Err(RenderError::TimingsOverwritten {
+                frame: frame.generation,
+                by: self.slot_frames[slot],
+                in_flight: self.slot_frames.len(),
+            });
+        }
+        if !self.marks.ran(frame.generation)? {
+            return Err(RenderError::FrameNotDone(frame.generation));
+        }
         let marks = match frame.slot {
-            Some(slot) if self.slot_frames[slot] != frame.generation => {
-                return Err(RenderError::TimingsOverwritten {
-                    frame: frame.generation,
-                    by: self.slot_frames[slot],
-                    in_flight: self.timers.len(),
-                });
-            }
             Some(slot) => self.timers[slot].results_if_done()?.ok_or(RenderError::FrameNotDone(frame.generation))?,
             None => Vec::new(),
         };
-        // A frame of no pass wrote no query, so its answer says nothing of its submission.
-        if frame.slot.is_some() && !frame.passes.is_empty() {
-            // Frames finish in the order they were recorded (the host's contract).
-            self.finished.set(self.finished.get().max(frame.generation));
-        }
         // One mark per recorded pass, in order (`record`).
         Ok(FrameTimings { passes: frame.passes.iter().zip(marks).map(|(&p, (_, ms))| (p, ms)).collect() })
+    }
+
+    /// Forget `frame`, the last frame recorded, whose command buffer will never be submitted (a
+    /// swapchain went out of date before the host submitted it, say): the renderer goes back
+    /// to the state before it was recorded (what the planner thinks is current, the barrier
+    /// tracker's states, the uploads it took), so the next frame redoes what it did. An earlier
+    /// frame cannot be discarded (`DiscardNotLast`): frames recorded after it counted on it.
+    /// Submitting a discarded frame's command buffer is the host's error.
+    pub fn discard(&mut self, frame: RecordedFrame) -> Result<(), RenderError> {
+        if frame.renderer != self.id() {
+            return Err(RenderError::ForeignFrame);
+        }
+        let undo = match self.undo.take() {
+            Some(undo) if frame.generation == self.generation => undo,
+            other => {
+                self.undo = other;
+                return Err(RenderError::DiscardNotLast { frame: frame.generation, last: self.generation });
+            }
+        };
+        *self.hazards.get_mut() = undo.hazards;
+        self.planner = undo.planner;
+        self.needs = undo.needs;
+        self.gpu_scene.restore_uploads(undo.uploads);
+        Ok(())
     }
 
     /// Record the passes of `plan` into `cmd`, each after the barrier its declaration needs and
@@ -277,8 +313,7 @@ impl Renderer {
     /// timestamps). A thin wrapper over `record_plan`.
     pub fn frame(&mut self, plan: &Plan) -> Result<FrameTimings, RenderError> {
         let gpu = self.gpu.clone();
-        let recorded = gpu.one_shot("frame", |cmd| self.record_plan(cmd, plan, None))??;
-        self.finished.set(recorded.generation);
+        let recorded = gpu.one_shot("frame", |cmd| self.record_own(cmd, plan))??;
         let timings = self.read_timings(&recorded)?;
         self.bake_after(plan)?;
         Ok(timings)
@@ -294,8 +329,7 @@ impl Renderer {
         for (pass, why) in &plan.passes {
             let alone = Plan { passes: vec![(*pass, why.clone())], skipped: Vec::new(), ..plan.clone() };
             let start = std::time::Instant::now();
-            let recorded = gpu.one_shot(pass.name(), |cmd| self.record_plan(cmd, &alone, None))??;
-            self.finished.set(recorded.generation);
+            gpu.one_shot(pass.name(), |cmd| self.record_own(cmd, &alone))??;
             passes.push((*pass, start.elapsed().as_secs_f64() * 1e3));
         }
         self.bake_after(plan)?;
@@ -309,4 +343,12 @@ impl Renderer {
         }
         Ok(())
     }
+}
+
+/// The renderer's state before a frame was recorded, put back by `Renderer::discard`.
+pub(super) struct Undo {
+    hazards: crate::gpu::Hazards<Resource>,
+    planner: crate::render::plan::Planner,
+    needs: crate::scene::needs::SceneNeeds,
+    uploads: crate::render::gpu_scene::PendingUploads,
 }
