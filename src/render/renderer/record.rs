@@ -146,14 +146,15 @@ impl Renderer {
 
     /// `record_plan` after its checks: `target` suits this renderer, or `plan` does not shade.
     fn record_checked(&mut self, cmd: vk::CommandBuffer, plan: &Plan, target: Option<&HostTarget>) -> RecordedFrame {
+        let mark_slot = self.marks.slot(self.generation + 1);
         self.undo = Some(Undo {
             hazards: self.hazards.get_mut().clone(),
             planner: self.planner.clone(),
             needs: self.needs.clone(),
             uploads: self.gpu_scene.uploads(),
+            slot_frame: self.slot_frames[mark_slot],
         });
         self.generation += 1;
-        let mark_slot = self.marks.slot(self.generation);
         self.slot_frames[mark_slot] = self.generation;
         let slot = (!self.timers.is_empty()).then_some(mark_slot);
         for o in &plan.objects {
@@ -221,7 +222,8 @@ impl Renderer {
     /// Forget `frame`, the last frame recorded, whose command buffer will never be submitted (a
     /// swapchain went out of date before the host submitted it, say): the renderer goes back
     /// to the state before it was recorded (what the planner thinks is current, the barrier
-    /// tracker's states, the uploads it took), so the next frame redoes what it did. An earlier
+    /// tracker's states, the uploads it took, its number and timer slot), so the next frame
+    /// redoes what it did and takes its number. An earlier
     /// frame cannot be discarded (`DiscardNotLast`): frames recorded after it counted on it.
     /// Submitting a discarded frame's command buffer is the host's error.
     pub fn discard(&mut self, frame: RecordedFrame) -> Result<(), RenderError> {
@@ -239,6 +241,9 @@ impl Renderer {
         self.planner = undo.planner;
         self.needs = undo.needs;
         self.gpu_scene.restore_uploads(undo.uploads);
+        // Its slot and number go back too: the frame before it in that slot stays readable.
+        self.slot_frames[self.marks.slot(frame.generation)] = undo.slot_frame;
+        self.generation -= 1;
         Ok(())
     }
 
@@ -351,4 +356,6 @@ pub(super) struct Undo {
     planner: crate::render::plan::Planner,
     needs: crate::scene::needs::SceneNeeds,
     uploads: crate::render::gpu_scene::PendingUploads,
+    /// The generation its slot held before it.
+    slot_frame: u64,
 }
