@@ -2,7 +2,7 @@
 //! - the host-facing types and decisions: `target` (where shading draws, the host's
 //!   attachments), `camera`, `options`, `error`, `frame` (what recording gives back), `edit`;
 //! - the frame's resources, declared once (`resource`), and the passes' list (`registry`);
-//! - the scene's GPU data (`records`, `beam_tables`, `gpu_scene`), the frame targets
+//! - the scene's GPU data (`records`, `ranges`, `beam_tables`, `gpu_scene`), the frame targets
 //!   (`targets`), and the registry binding both by name (`graph`);
 //! - the planner (`plan`), and the checks of the device and the host's target (`fit`, `host`);
 //! - the passes: each one module here and one GLSL file of the same name in `glsl/`, built and
@@ -33,6 +33,7 @@ pub mod pass;
 pub mod plan;
 #[cfg(test)]
 mod probe;
+pub mod ranges;
 pub mod records;
 pub mod registry;
 pub mod renderer;
