@@ -73,6 +73,22 @@ fn the_crate_s_modules_import_one_another_without_a_cycle() {
     assert!(cycles.is_empty(), "the module imports form {} cycle(s):\n{}", cycles.len(), describe(&graph, &cycles));
 }
 
+/// The most lines a source file may have: past it, a file holds more than one concept.
+const MAX_FILE_LINES: usize = 700;
+
+#[test]
+fn no_source_file_is_over_700_lines() {
+    let mut files = Vec::new();
+    rust_files(&repository_root().join("src"), &mut files);
+    let long: Vec<String> = files
+        .iter()
+        .map(|f| (f, fs::read_to_string(f).expect("a readable source file").lines().count()))
+        .filter(|(_, lines)| *lines > MAX_FILE_LINES)
+        .map(|(f, lines)| format!("{}: {lines} lines", f.display()))
+        .collect();
+    assert!(long.is_empty(), "over {MAX_FILE_LINES} lines:\n{}", long.join("\n"));
+}
+
 /// The repository root: cargo's manifest folder, or the current folder when the test was built
 /// with plain `rustc`.
 fn repository_root() -> PathBuf {
