@@ -15,7 +15,7 @@ pub enum RenderError {
     DoesNotFit {
         /// The scene setting that is too large, or the quantity it leads to (e.g. the bytes of the
         /// HDR image at camera.resolution).
-        setting: String,
+        setting: Quantity,
         /// How large it is.
         value: u64,
         /// The device limit it exceeds (a VkPhysicalDeviceLimits name, or the largest device-local
@@ -233,3 +233,69 @@ pub enum RenderError {
     Gpu(#[from] GpuError),
 }
 
+/// What of a scene a device limit is checked against, named by the scene setting it follows
+/// from (`RenderError::DoesNotFit`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    /// The hierarchical gather's item lists at epsilon 0, in bytes.
+    FlatGatherLists,
+    /// Vertices of every mesh together.
+    Vertices,
+    /// Samples of every translucent object together.
+    Samples,
+    /// The image's larger side.
+    ResolutionSide,
+    /// The tone-mapped output, in bytes.
+    ToneMapped,
+    /// `render.shadow_map_size`.
+    ShadowMapSize,
+    /// Shadow-map layers.
+    ShadowLayers,
+    /// The HDR image at this resolution, in bytes.
+    HdrBytes([u64; 2]),
+    /// This many shadow maps of this size, in bytes.
+    ShadowBytes {
+        /// Layers.
+        layers: u64,
+        /// Texels per side.
+        size: u64,
+    },
+    /// Everything the scene needs on the device, in bytes.
+    SceneBytes {
+        /// `camera.resolution`.
+        resolution: [u64; 2],
+        /// Shadow-map layers.
+        layers: u64,
+        /// Texels per side of each.
+        size: u64,
+    },
+}
+
+impl std::fmt::Display for Quantity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Quantity::FlatGatherLists => write!(
+                f,
+                "bytes of the hierarchical gather's item lists at render.gather_epsilon 0 (every sample for every \
+                 group of 8 vertices)"
+            ),
+            Quantity::Vertices => write!(f, "the meshes' vertex count"),
+            Quantity::Samples => write!(f, "sampling.count x translucent objects"),
+            Quantity::ResolutionSide => write!(f, "camera.resolution (largest side)"),
+            Quantity::ToneMapped => write!(f, "camera.resolution (width x height x 4 bytes of tone-mapped output)"),
+            Quantity::ShadowMapSize => write!(f, "render.shadow_map_size"),
+            Quantity::ShadowLayers => {
+                write!(f, "shadow maps (one per shadow-casting light, environment directions included)")
+            }
+            Quantity::HdrBytes([w, h]) => write!(f, "bytes of the HDR image at camera.resolution {w}x{h}"),
+            Quantity::ShadowBytes { layers, size } => {
+                write!(f, "bytes of {layers} shadow maps of render.shadow_map_size {size}")
+            }
+            Quantity::SceneBytes { resolution: [w, h], layers, size } => write!(
+                f,
+                "bytes of device memory the scene needs (images at camera.resolution {w}x{h}, {layers} shadow maps \
+                 of {size}^2, meshes and samples)"
+            ),
+        }
+    }
+}

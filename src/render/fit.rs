@@ -2,7 +2,7 @@
 //! layers, storage-buffer ranges, memory, and the host's formats. Each refusal names the scene
 //! setting and the device limit (`RenderError::DoesNotFit`).
 
-use super::error::RenderError;
+use super::error::{Quantity, RenderError};
 use crate::gpu::{Gpu, ShaderInterface};
 use crate::scene::GatherMode;
 use crate::scene::build::PreparedScene;
@@ -23,8 +23,8 @@ pub(in crate::render) fn check_fits(gpu: &Gpu, scene: &PreparedScene) -> Result<
     Ok(())
 }
 
-/// (scene setting, its value, the device limit's name, the limit).
-type Check = (String, u64, &'static str, u64);
+/// (what is measured, its value, the device limit's name, the limit).
+type Check = (Quantity, u64, &'static str, u64);
 
 /// Dispatch sizes, image sides and layers, and storage ranges against the device's limits.
 fn dispatch_checks(gpu: &Gpu, scene: &PreparedScene) -> Result<Vec<Check>, RenderError> {
@@ -50,30 +50,28 @@ fn dispatch_checks(gpu: &Gpu, scene: &PreparedScene) -> Result<Vec<Check>, Rende
     };
     Ok(vec![
         (
-            "bytes of the hierarchical gather's item lists at render.gather_epsilon 0 (every sample for every \
-             group of 8 vertices)"
-                .to_string(),
+            Quantity::FlatGatherLists,
             flat_lists,
             "maxStorageBufferRange",
             range,
         ),
-        ("the meshes' vertex count".into(), scene.vertex_count() as u64, dispatch, dispatchable("vertex_light.comp")?),
+        (Quantity::Vertices, scene.vertex_count() as u64, dispatch, dispatchable("vertex_light.comp")?),
         (
-            "sampling.count x translucent objects".into(),
+            Quantity::Samples,
             scene.sample_count() as u64,
             dispatch,
             dispatchable("splat.comp")?,
         ),
-        ("camera.resolution (largest side)".into(), width.max(height), "maxImageDimension2D", image_side),
+        (Quantity::ResolutionSide, width.max(height), "maxImageDimension2D", image_side),
         (
-            "camera.resolution (width x height x 4 bytes of tone-mapped output)".into(),
+            Quantity::ToneMapped,
             4 * width * height,
             "maxStorageBufferRange",
             range,
         ),
-        ("render.shadow_map_size".into(), file.render.shadow_map_size as u64, "maxImageDimension2D", image_side),
+        (Quantity::ShadowMapSize, file.render.shadow_map_size as u64, "maxImageDimension2D", image_side),
         (
-            "shadow maps (one per shadow-casting light, environment directions included)".into(),
+            Quantity::ShadowLayers,
             scene.shadow_layers as u64,
             "maxImageArrayLayers",
             limits.max_image_array_layers as u64,
@@ -99,22 +97,19 @@ fn memory_checks(gpu: &Gpu, scene: &PreparedScene) -> Vec<Check> {
     let total = hdr_bytes + surface + 24 * pixels + shadow_bytes + vertex_bytes;
     vec![
         (
-            format!("bytes of the HDR image at camera.resolution {width}x{height}"),
+            Quantity::HdrBytes([width, height]),
             hdr_bytes,
             "maxMemoryAllocationSize",
             max_allocation,
         ),
         (
-            format!("bytes of {layers} shadow maps of render.shadow_map_size {map}"),
+            Quantity::ShadowBytes { layers, size: map },
             shadow_bytes,
             "maxMemoryAllocationSize",
             max_allocation,
         ),
         (
-            format!(
-                "bytes of device memory the scene needs (images at camera.resolution {width}x{height}, {layers} \
-                 shadow maps of {map}^2, meshes and samples)"
-            ),
+            Quantity::SceneBytes { resolution: [width, height], layers, size: map },
             total,
             "largest device-local memory heap",
             heap,
