@@ -187,24 +187,27 @@ fn levels_of_detail_follow_the_host_targets_extent_not_the_scene_resolution() {
     });
 }
 
+/// The error `Gpu::from_host` gives for `gpu`'s own handles declared with `queue_family` and
+/// `enabled_features` (which the test makes wrong).
+fn refused_host(gpu: &Arc<Gpu>, queue_family: u32, enabled_features: EnabledFeatures) -> String {
+    let host = HostVulkan {
+        entry: gpu.entry().clone(),
+        instance: gpu.instance().clone(),
+        physical_device: gpu.physical_device(),
+        device: gpu.device().clone(),
+        queue: *gpu.queue(),
+        queue_family,
+        enabled_features,
+    };
+    // SAFETY: the handles are the live `gpu`'s; the call fails before it makes anything.
+    unsafe { Gpu::from_host(host, &GpuOptions::default()) }.err().expect("refused").to_string()
+}
+
 #[test]
 fn a_host_device_lacking_several_features_gets_all_of_them_named() {
     common::with_gpu(|gpu| {
-        let host = HostVulkan {
-            entry: gpu.entry().clone(),
-            instance: gpu.instance().clone(),
-            physical_device: gpu.physical_device(),
-            device: gpu.device().clone(),
-            queue: *gpu.queue(),
-            queue_family: gpu.queue_family(),
-            enabled_features: EnabledFeatures {
-                synchronization2: false,
-                shader_output_layer: false,
-                ..EnabledFeatures::ALL
-            },
-        };
-        // SAFETY: the handles are the live `gpu`'s; the call fails before it makes anything.
-        let error = unsafe { Gpu::from_host(host, &GpuOptions::default()) }.err().expect("refused").to_string();
+        let features = EnabledFeatures { synchronization2: false, shader_output_layer: false, ..EnabledFeatures::ALL };
+        let error = refused_host(gpu, gpu.queue_family(), features);
         assert!(error.contains("synchronization2, shaderOutputLayer features"), "{error}");
     });
 }
@@ -214,17 +217,7 @@ fn a_host_device_lacking_several_features_gets_all_of_them_named() {
 #[test]
 fn a_host_queue_family_that_does_not_exist_is_named_with_the_families_there_are() {
     common::with_gpu(|gpu| {
-        let host = HostVulkan {
-            entry: gpu.entry().clone(),
-            instance: gpu.instance().clone(),
-            physical_device: gpu.physical_device(),
-            device: gpu.device().clone(),
-            queue: *gpu.queue(),
-            queue_family: 7,
-            enabled_features: EnabledFeatures::ALL,
-        };
-        // SAFETY: the handles are the live `gpu`'s; the call fails before it makes anything.
-        let error = unsafe { Gpu::from_host(host, &GpuOptions::default()) }.err().expect("refused").to_string();
+        let error = refused_host(gpu, 7, EnabledFeatures::ALL);
         assert!(error.contains("queue family 7 does not exist (the device has"), "{error}");
     });
 }
