@@ -76,6 +76,51 @@ impl<'a> Geometry<'a> {
         best
     }
 
+    /// The first face a ray from `p` along `d` meets, however far.
+    pub(super) fn first_hit(&self, p: DVec3, d: DVec3) -> Option<Hit> {
+        self.bvh.closest_hit(p, d, 0.0, f64::INFINITY, None)
+    }
+
+    /// The outward unit shading normal at barycentric coordinates `bary` of `triangle`: the
+    /// vertex normals interpolated in f64 (the beam's derivatives are taken by finite
+    /// differences, finer than f32 resolves) and turned to the outward face normal's side, or
+    /// the face normal where they cancel.
+    pub(super) fn shading_normal(&self, triangle: usize, bary: [f64; 3]) -> DVec3 {
+        let normals = self.mesh.vertex_normals();
+        let n: DVec3 = self.mesh.triangles()[triangle]
+            .iter()
+            .zip(bary)
+            .map(|(&v, b)| normals[v as usize].as_dvec3() * b)
+            .sum();
+        let len = n.length();
+        let face = self.normals[triangle];
+        if len <= 1e-9 {
+            face
+        } else if n.dot(face) < 0.0 {
+            -n / len
+        } else {
+            n / len
+        }
+    }
+
+    /// The barycentric coordinates of `p` (projected on the plane of `triangle`), outside
+    /// [0, 1] where it lies outside the triangle.
+    pub(super) fn barycentric(&self, triangle: usize, p: DVec3) -> [f64; 3] {
+        let [a, b, c] = self.mesh.corners(triangle);
+        let (e1, e2, w) = (b - a, c - a, p - a);
+        let (d00, d01, d11) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+        let (d20, d21) = (w.dot(e1), w.dot(e2));
+        let denom = d00 * d11 - d01 * d01;
+        let u = (d11 * d20 - d01 * d21) / denom;
+        let v = (d00 * d21 - d01 * d20) / denom;
+        [1.0 - u - v, u, v]
+    }
+
+    /// A small length, far above the rounding of the hit test.
+    pub(super) fn slack(&self) -> f64 {
+        self.slack
+    }
+
     /// The vertex whose cell holds the point of barycentric coordinates `(1 - u - v, u, v)` on
     /// `triangle`: the corner of the largest.
     pub(super) fn cell_vertex(&self, triangle: usize, u: f64, v: f64) -> usize {

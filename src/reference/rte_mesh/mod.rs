@@ -42,11 +42,14 @@
 //! Photons whose walk meets the surface from outside (a ray through a crack the f64
 //! intersection test leaves between triangles) are dropped and counted in `lost`.
 
+mod adjoint;
+mod beam;
 mod geometry;
 mod sources;
 mod tally;
 mod walk;
 
+pub use adjoint::{AdjointOptions, ReceiverExitance, adjoint_exitance};
 pub use tally::relative_stderr;
 
 use super::rte::{Budget, Medium, Progress, RteError, chunk_rng, run_rounds};

@@ -1,6 +1,7 @@
 //! One photon's life: its entry through the surface, then a random walk per channel inside the
 //! mesh until it leaves or dies.
 
+use super::beam::refract_in;
 use super::geometry::Geometry;
 use super::sources::{Lighting, Sources};
 use super::tally::{Exit, merge_photon};
@@ -45,9 +46,7 @@ impl ObjectWalk<'_> {
         if f_t <= 0.0 {
             return;
         }
-        // Snell: the tangential part shrinks by 1 / eta, the normal part points inwards.
-        let cos_t = (1.0 - (1.0 - cos_i * cos_i) / (eta * eta)).max(0.0).sqrt();
-        let d = (-wi / eta + n * (cos_i / eta - cos_t)).normalize();
+        let Some((d, _)) = refract_in(wi, n, eta) else { return };
         let density = p_pair / geometry.mesh.triangle_areas()[t];
         let first = exits.len();
         for (channel, medium) in media.iter().enumerate() {
