@@ -4,7 +4,7 @@
 //! relative standard error (RMS over the lit vertices over their mean, as
 //! `rte_mesh::relative_stderr`) with that figure extrapolated to 600 s by `1 / sqrt(time)`.
 use translucent::reference::rte::{Budget, RteProgress};
-use translucent::reference::rte_mesh::{self, MeshOptions};
+use translucent::reference::rte_mesh::{self, MeshOptions, Walk};
 use translucent::reference::truth::LIT_FLOOR;
 use translucent::scene::Scene;
 use translucent::scene::build::{Overrides, PreparedScene};
@@ -23,7 +23,7 @@ fn main() {
             Some(n) => Budget::photons(n),
             None => Budget { max_photons: u64::MAX / 2, relative_stderr: None, max_seconds: Some(seconds) },
         };
-        let result = rte_mesh::exitance(&scene, &MeshOptions { budget, seed }, &quiet).unwrap();
+        let result = rte_mesh::exitance(&scene, &MeshOptions { budget, seed, walk: Walk::Photons }, &quiet).unwrap();
         let r = result[0].as_ref().unwrap();
         let per_channel: Vec<f64> = (0..3).map(|c| channel_rel(&r.exitance, &r.stderr, c)).collect();
         let scale = (r.seconds / 600.0).sqrt();

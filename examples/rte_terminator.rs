@@ -6,7 +6,7 @@
 //! the direction to the scene's one directional light: RMS, mean, count, and each band's share
 //! of the total squared error; with the reference's own relative noise in each band.
 use translucent::reference::rte::{Budget, RteProgress};
-use translucent::reference::rte_mesh::{self, MeshOptions};
+use translucent::reference::rte_mesh::{self, MeshOptions, Walk};
 use translucent::reference::truth::{self, LIT_FLOOR};
 use translucent::scene::Scene;
 use translucent::scene::build::{Overrides, PreparedScene};
@@ -23,7 +23,7 @@ fn main() {
         PreparedScene::new(&Scene::load(std::path::Path::new(&args[1])).unwrap(), &Overrides::default()).unwrap();
     let seconds: f64 = args[2].parse().unwrap();
     let budget = Budget { max_photons: u64::MAX / 2, relative_stderr: None, max_seconds: Some(seconds) };
-    let rte = rte_mesh::exitance(&scene, &MeshOptions { budget, seed: 1 }, &quiet).unwrap();
+    let rte = rte_mesh::exitance(&scene, &MeshOptions { budget, seed: 1, walk: Walk::Photons }, &quiet).unwrap();
     let rte = rte[0].as_ref().unwrap();
     let t = truth::compute(&scene, &truth::TruthOptions::default(), &|_, _, _| {}).unwrap();
     let LightKind::Directional { direction, .. } = scene.lights[0].kind else { panic!("one directional light") };

@@ -6,7 +6,7 @@
 
 use translucent::optics::{Dipole, fresnel};
 use translucent::reference::rte::{self, Budget, Medium, RteProgress};
-use translucent::reference::rte_mesh::{self, MeshOptions};
+use translucent::reference::rte_mesh::{self, MeshOptions, Walk};
 use translucent::scene::Scene;
 use translucent::scene::build::{Overrides, PreparedScene};
 
@@ -331,7 +331,7 @@ fn uniformly_lit_box_exitance_matches_the_half_space_reflectance() {
     // half-space's, E F_t(1) R per channel, to well under a part in a thousand.
     let (albedo, eta) = ([0.7, 0.9, 0.97], 1.3);
     let scene = lit_box(albedo, eta);
-    let options = MeshOptions { budget: Budget::photons(500_000), seed: 5 };
+    let options = MeshOptions { budget: Budget::photons(500_000), seed: 5, walk: Walk::Photons };
     let result = rte_mesh::exitance(&scene, &options, &quiet).unwrap();
     let rte = result[0].as_ref().unwrap();
     assert_eq!(rte.lost, [0; 3], "no walk may slip through the surface");
@@ -369,7 +369,7 @@ fn sphere_reference_precision_and_the_dipoles_error_against_it() {
         let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("assets/scenes/{name}.toml"));
         let scene = PreparedScene::new(&Scene::load(&path).unwrap(), &Overrides::default()).unwrap();
         let budget = Budget { max_photons: u64::MAX / 2, relative_stderr: None, max_seconds: Some(seconds) };
-        let rte = rte_mesh::exitance(&scene, &MeshOptions { budget, seed: 1 }, &quiet).unwrap();
+        let rte = rte_mesh::exitance(&scene, &MeshOptions { budget, seed: 1, walk: Walk::Photons }, &quiet).unwrap();
         let rte = rte[0].as_ref().unwrap();
         let start = std::time::Instant::now();
         let t = truth::compute(&scene, &truth::TruthOptions::default(), &|_, _, _| {}).expect("the truth");
@@ -448,7 +448,7 @@ fn the_mesh_reference_is_cached_by_content_and_an_edited_file_is_walked_anew() {
     let scene = PreparedScene::new(&Scene::load(&path).unwrap(), &Overrides::default()).unwrap();
     let dir = std::env::temp_dir().join(format!("translucent-rte-cache-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let options = MeshOptions { budget: Budget::photons(3000), seed: 2 };
+    let options = MeshOptions { budget: Budget::photons(3000), seed: 2, walk: Walk::Photons };
     let (first, cached) = rte_cache::cached(&scene, &options, &dir, &quiet).unwrap();
     assert!(!cached, "nothing was cached yet");
     let (second, cached) = rte_cache::cached(&scene, &options, &dir, &quiet).unwrap();

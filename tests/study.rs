@@ -187,6 +187,9 @@ fn study_rejects_a_bad_sweep_selection_naming_the_flag_and_writes_nothing() {
         ("--rte-photons", "1000", "only with --physics"),
         ("--rte-stderr", "0.01", "only with --physics"),
         ("--rte-seconds", "5", "only with --physics"),
+        ("--rte-walk", "photons", "only with --physics"),
+        ("--rte-receivers", "100", "only with --physics"),
+        ("--models", "single", "only with --physics"),
     ] {
         let run = translucent(&["study", "-o", out.to_str().unwrap(), flag, value], &[]);
         let err = text(&run.stderr);
@@ -466,13 +469,25 @@ fn study_with_physics_splits_each_rows_error_into_model_discretisation_and_total
     for pass in ["walked", "cached"] {
         let out = dir.join(format!("out-{pass}"));
         let (scene, out_s, cache_s) = (scene.to_str().unwrap(), out.to_str().unwrap(), cache.to_str().unwrap());
-        let args =
-            ["study", scene, "-o", out_s, "--quick", "--physics", "--rte-photons", "40000", "--truth-cache", cache_s];
+        let args = [
+            "study",
+            scene,
+            "-o",
+            out_s,
+            "--quick",
+            "--physics",
+            "--rte-photons",
+            "256",
+            "--models",
+            "between,per-channel",
+            "--truth-cache",
+            cache_s,
+        ];
         let run = translucent(&args, &[]);
         assert!(run.status.success(), "{pass}: {}", text(&run.stderr));
         let md = std::fs::read_to_string(out.join("study.md")).unwrap();
         assert!(md.contains("Against the physics") && md.contains("stop paying"), "{md}");
-        assert!(md.contains("40000 photons, "), "{md}");
+        assert!(md.contains("256 walks per receiver, "), "{md}");
         // The models beside the dipole, single scattering between points and the choice per channel among them.
         assert!(md.contains("| single scattering between points |"), "{md}");
         assert!(md.contains("| per channel: between points under albedo 0.3, else dipole |"), "{md}");
@@ -520,8 +535,15 @@ fn study_physics_refuses_an_empty_budget_naming_the_flag_and_writes_nothing() {
     let dir = temp_dir("study-physics-bad");
     let out = dir.join("out");
     for (flag, value) in
-        [("--rte-stderr", "0"), ("--rte-stderr", "nan"), ("--rte-photons", "0"), ("--rte-seconds", "-1")]
-    {
+    [
+        ("--rte-stderr", "0"),
+        ("--rte-stderr", "nan"),
+        ("--rte-photons", "0"),
+        ("--rte-seconds", "-1"),
+        ("--rte-walk", "sideways"),
+        ("--rte-receivers", "0"),
+        ("--models", "nonsense"),
+    ] {
         let run = translucent(&["study", "-o", out.to_str().unwrap(), "--physics", flag, value], &[]);
         let err = text(&run.stderr);
         assert_eq!(run.status.code(), Some(1), "{flag} {value}: {err}");

@@ -8,10 +8,11 @@ use std::sync::Arc;
 use translucent::gpu::Gpu;
 use translucent::output::OutputSet;
 use translucent::reference::rte::Budget;
-use translucent::reference::rte_mesh::MeshOptions;
+use translucent::reference::rte_mesh::{MeshOptions, Walk};
 use translucent::reference::truth;
 use translucent::sampling::Method;
 use translucent::scene::{GatherMode, MAX_GATHER_EPSILON, MAX_SAMPLE_COUNT, Scene, SplatVisibility};
+use translucent::study::physics::Model;
 use translucent::study::{self, Event, StudyConfig, report};
 
 #[derive(clap::Args, Debug)]
@@ -79,13 +80,30 @@ pub struct Args {
     /// renderer against the reference). The reference is cached beside the truth.
     #[arg(long)]
     pub physics: bool,
-    /// With --physics: stop the reference once its relative standard error (RMS over lit
-    /// vertices over their mean, worst channel) is at most this (default 0.01)
+    /// With --physics: stop the reference once its precision (worst channel) is at most this
+    /// (default 0.01): for the adjoint walk the RMS over lit receivers of each one's relative
+    /// standard error, for the photon walk the RMS standard error over lit vertices over their
+    /// mean
     #[arg(long, allow_hyphen_values = true, value_name = "REL")]
     pub rte_stderr: Option<f64>,
-    /// With --physics: walk at most this many photons per object (default 1000000000)
+    /// With --physics: walk at most this many walks per receiver (adjoint) or photons per
+    /// object (photons) (default 1000000000)
     #[arg(long, value_name = "N")]
     pub rte_photons: Option<u64>,
+    /// With --physics: how the reference walks: `adjoint` (default; backwards from each
+    /// receiver to the lights' beams, each receiver to its own precision) or `photons` (from
+    /// the lights, tallied at every vertex)
+    #[arg(long, value_name = "adjoint|photons")]
+    pub rte_walk: Option<String>,
+    /// With --physics and the adjoint walk: receivers per object, spread over the mesh as
+    /// --truth-receivers spreads them (default: --truth-receivers if given, else 1000)
+    #[arg(long, value_name = "N")]
+    pub rte_receivers: Option<usize>,
+    /// With --physics: the models measured beside the dipole against the reference,
+    /// comma-separated (default: none): between, per-channel, dipole+single, single,
+    /// directional, directional-grosjean, directional-alpha; `all` for every one
+    #[arg(long, value_delimiter = ',', value_name = "MODEL,...")]
+    pub models: Vec<String>,
     /// With --physics: stop the reference after this many seconds per object (default 600; the
     /// photon count, and so the reference, then depends on the machine)
     #[arg(long, allow_hyphen_values = true, value_name = "SECONDS")]
@@ -104,9 +122,12 @@ fn physics(args: &Args) -> Result<Option<MeshOptions>> {
             ("--rte-stderr", args.rte_stderr.is_some()),
             ("--rte-photons", args.rte_photons.is_some()),
             ("--rte-seconds", args.rte_seconds.is_some()),
+            ("--rte-walk", args.rte_walk.is_some()),
+            ("--rte-receivers", args.rte_receivers.is_some()),
+            ("--models", !args.models.is_empty()),
         ];
         if let Some((flag, _)) = given.into_iter().find(|g| g.1) {
-            bail!("{flag}: only with --physics (it sets the radiative-transfer reference's budget)");
+            bail!("{flag}: only with --physics (it sets the radiative-transfer reference and its comparisons)");
         }
         return Ok(None);
     }
@@ -121,8 +142,32 @@ fn physics(args: &Args) -> Result<Option<MeshOptions>> {
     if !(seconds.is_finite() && seconds > 0.0) {
         bail!("--rte-seconds {seconds}: must be a time > 0 in seconds, e.g. 600");
     }
+    let walk = match args.rte_walk.as_deref().unwrap_or("adjoint") {
+        "adjoint" => {
+            let receivers = args.rte_receivers.or(args.truth_receivers).unwrap_or(1000);
+            if receivers == 0 {
+                bail!("--rte-receivers 0: the adjoint walk needs at least one receiver, e.g. 1000");
+            }
+            Walk::Adjoint { receivers: Some(receivers) }
+        }
+        "photons" if args.rte_receivers.is_some() => {
+            bail!("--rte-receivers: only with --rte-walk adjoint (the photon walk tallies every vertex)")
+        }
+        "photons" => Walk::Photons,
+        other => bail!("--rte-walk {other}: one of adjoint, photons"),
+    };
     let budget = Budget { max_photons: photons, relative_stderr: Some(stderr), max_seconds: Some(seconds) };
-    Ok(Some(MeshOptions { budget, seed: RTE_SEED }))
+    Ok(Some(MeshOptions { budget, seed: RTE_SEED, walk }))
+}
+
+/// `--models`: the models named (every one for `all`), each once, in the report's order.
+fn models(args: &Args) -> Result<Vec<Model>> {
+    if args.models.iter().any(|m| m == "all") {
+        return Ok(Model::ALL.to_vec());
+    }
+    let named = args.models.iter().map(|m| m.parse::<Model>().map_err(|e| anyhow::anyhow!("--models: {e}")));
+    let named = named.collect::<Result<Vec<Model>>>()?;
+    Ok(Model::ALL.into_iter().filter(|m| named.contains(m)).collect())
 }
 
 /// `--error-image SAMPLER:COUNT[:GATHER]`, the gather written as `--gathers` writes it
@@ -284,6 +329,7 @@ fn config(args: &Args) -> Result<StudyConfig> {
         config.seeds = (1..=n).collect();
     }
     config.physics = physics(args)?;
+    config.models = models(args)?;
     Ok(config)
 }
 
@@ -394,7 +440,7 @@ fn run_with_progress(gpu: &Arc<Gpu>, scene: &Scene, config: &StudyConfig, cache:
         }
         Event::TruthCached => bar.set_message("exact integral from the cache".to_string()),
         Event::Rte(p) => bar.set_message(format!(
-            "radiative transfer: {} photons, {:.1} s, relative standard error {:.4}",
+            "radiative transfer: {} walks, {:.1} s, precision {:.4}",
             p.photons, p.seconds, p.relative_stderr
         )),
         Event::RteCached => bar.set_message("radiative transfer from the cache".to_string()),

@@ -4,7 +4,8 @@
 //!
 //! The file `rte-KEY.json` sits beside the truths. Its key hashes everything the walk depends
 //! on: each object's placed mesh and coefficients, which objects cast shadows, the prepared
-//! lights, the budget, the seed and [`VERSION`]. It carries a checksum of its values; a file
+//! lights, the walk (photons, or adjoint and its receivers), the budget, the seed and
+//! [`VERSION`]. It carries a checksum of its values; a file
 //! that is unreadable, foreign, edited or damaged, or whose vertex counts are not the meshes',
 //! is walked anew and replaced, with a warning naming the file and why.
 //!
@@ -12,14 +13,14 @@
 //! then keeps the first machine's walk for that key.
 
 use super::rte::{Progress, RteError};
-use super::rte_mesh::{self, MeshOptions, ObjectExitance};
+use super::rte_mesh::{self, MeshOptions, ObjectExitance, Walk};
 use super::truth::{Fnv, FolderProblem, folder_problem};
 use crate::scene::build::{PreparedScene, ResolvedMaterial};
 use std::path::{Path, PathBuf};
 
 /// The version of the walk: a change to what `rte_mesh` computes bumps it, so older files are
 /// walked anew.
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 4;
 
 /// The reference of every object of a scene, as cached.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -47,6 +48,7 @@ impl RteReference {
                 Some(o) => {
                     h.u64(o.exitance.len() as u64);
                     h.u64(o.photons);
+                    o.receivers.iter().flatten().for_each(|&v| h.u64(v as u64));
                     o.exitance.iter().chain(&o.stderr).flatten().for_each(|&v| h.f64(v));
                 }
             }
@@ -69,10 +71,14 @@ impl RteReference {
         for (i, (m, o)) in self.objects.iter().zip(&scene.objects).enumerate() {
             let translucent = matches!(o.material, ResolvedMaterial::Translucent { .. });
             let vertices = o.mesh.positions().len();
+            let expected = |m: &ObjectExitance| m.receivers.as_ref().map_or(vertices, Vec::len);
             match m {
                 None if translucent => return Some(format!("object {i} is translucent but has no values")),
-                Some(m) if m.exitance.len() != vertices || m.stderr.len() != vertices => {
-                    return Some(format!("object {i} has {} values, its mesh {vertices} vertices", m.exitance.len()));
+                Some(m) if m.exitance.len() != expected(m) || m.stderr.len() != expected(m) => {
+                    return Some(format!("object {i} has {} values for {} vertices", m.exitance.len(), expected(m)));
+                }
+                Some(m) if m.receivers.iter().flatten().any(|&v| v >= vertices) => {
+                    return Some(format!("object {i} names a receiver past its mesh's {vertices} vertices"));
                 }
                 Some(m) if m.exitance.iter().chain(&m.stderr).flatten().any(|x| !x.is_finite() || *x < 0.0) => {
                     return Some(format!("object {i} holds a negative or non-finite value"));
@@ -108,6 +114,13 @@ pub fn content_key(scene: &PreparedScene, options: &MeshOptions) -> String {
     h.u64(b.max_photons);
     h.f64(b.relative_stderr.unwrap_or(-1.0));
     h.f64(b.max_seconds.unwrap_or(-1.0));
+    match options.walk {
+        Walk::Photons => h.u64(0),
+        Walk::Adjoint { receivers } => {
+            h.u64(1);
+            h.u64(receivers.map_or(u64::MAX, |r| r as u64));
+        }
+    }
     for o in &scene.objects {
         h.u64(o.mesh.positions().len() as u64);
         o.mesh.positions().iter().for_each(|p| p.to_array().iter().for_each(|c| h.u64(u64::from(c.to_bits()))));

@@ -53,6 +53,8 @@ pub struct StudyConfig {
     /// Split the error against the physics (`--physics`): the radiative-transfer reference's
     /// budget and seed (`reference::rte_mesh`); `None` measures against the dipole alone.
     pub physics: Option<MeshOptions>,
+    /// With `physics`: the models measured beside the dipole.
+    pub models: Vec<physics::Model>,
 }
 
 impl StudyConfig {
@@ -79,6 +81,7 @@ impl StudyConfig {
             own: true,
             sweep: true,
             physics: None,
+            models: Vec::new(),
         }
     }
 
@@ -95,6 +98,7 @@ impl StudyConfig {
             own: true,
             sweep: true,
             physics: None,
+            models: Vec::new(),
         }
     }
 
@@ -422,7 +426,7 @@ pub fn run(
         return Err(StudyError::NothingLit);
     }
     let physics = match &config.physics {
-        Some(options) => Some(physics::Physics::measure(&base, &truth, options, truth_dir, progress)?),
+        Some(options) => Some(physics::Physics::measure(&base, &truth, options, &config.models, truth_dir, progress)?),
         None => None,
     };
     let truth_image = truth_image(gpu, &base, &truth)?;

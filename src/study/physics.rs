@@ -82,6 +82,7 @@ impl Physics {
         base: &PreparedScene,
         truth: &Truth,
         options: &MeshOptions,
+        models: &[Model],
         dir: &Path,
         progress: &(dyn Fn(Event) + Sync),
     ) -> Result<Physics, StudyError> {
@@ -95,8 +96,9 @@ impl Physics {
             let zero = vec![[0.0; 3]; object.mesh.positions().len()];
             match o {
                 Some(o) => {
-                    exitance.push(o.exitance.clone());
-                    stderr.push(o.stderr.clone());
+                    let (m, s) = o.per_vertex(object.mesh.positions().len());
+                    exitance.push(m);
+                    stderr.push(s);
                     photons += o.photons;
                     seconds += o.seconds;
                     relative_stderr = relative_stderr.max(o.relative_stderr);
@@ -110,7 +112,8 @@ impl Physics {
         }
         let model = vertex_error_f64(&exitance, &truth.exitance);
         let noise = noise(&exitance, &stderr);
-        let models = alternative_models(base, &truth.exitance);
+        let walks = reference.objects.iter().flatten().map(|o| o.photons).max().unwrap_or(1);
+        let models = alternative_models(base, &truth.exitance, models, (options, walks))?;
         let alternatives =
             models.iter().skip(1).map(|(name, m)| (name.clone(), vertex_error_f64(&exitance, m))).collect();
         let cosines = light_cosines(base);
@@ -132,35 +135,136 @@ impl Physics {
     }
 }
 
-/// Every model's exitance per object and vertex, named: the dipole's truth first, then the
-/// alternatives (see [`Physics::alternatives`]).
-fn alternative_models(base: &PreparedScene, truth: &[Vec<[f64; 3]>]) -> Vec<(String, Vec<Vec<[f64; 3]>>)> {
+/// A model measured beside the dipole against the same reference (`study --physics --models`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Model {
+    /// Single scattering between points (`reference::single::between_points`).
+    Between,
+    /// Per channel: single scattering between points under `beam_single::ALBEDO_BELOW`, else
+    /// the dipole.
+    PerChannel,
+    /// The dipole with the single-scattering exitance added (Jensen et al. 2001's sum).
+    DipoleSingle,
+    /// Single scattering alone (what leaves a dark medium: nearly all of it).
+    Single,
+    /// The directional dipole of Frisvad et al. 2014, `D = 1/(3 sigma_t')`.
+    Directional,
+    /// The directional dipole with Grosjean's `D`.
+    DirectionalGrosjean,
+    /// The directional dipole with Grosjean's `D` and the source scaled by `alpha'`.
+    DirectionalAlpha,
+    /// The radiative transfer in the mesh with the light entering along the normal
+    /// (`rte_mesh::normal_entry_exitance`): what a transport kernel precomputed without the
+    /// lights converges to. Walked by the reference's own walks, so its gap to the reference
+    /// is measured through their shared noise.
+    Transport,
+}
+
+impl Model {
+    /// Every model, in the report's order.
+    pub const ALL: [Model; 8] = [
+        Model::Between,
+        Model::PerChannel,
+        Model::DipoleSingle,
+        Model::Single,
+        Model::Directional,
+        Model::DirectionalGrosjean,
+        Model::DirectionalAlpha,
+        Model::Transport,
+    ];
+
+    /// Its name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Model::Between => "between",
+            Model::PerChannel => "per-channel",
+            Model::DipoleSingle => "dipole+single",
+            Model::Single => "single",
+            Model::Directional => "directional",
+            Model::DirectionalGrosjean => "directional-grosjean",
+            Model::DirectionalAlpha => "directional-alpha",
+            Model::Transport => "transport",
+        }
+    }
+
+    /// Its name in the report.
+    fn label(self) -> String {
+        use crate::optics::beam_single::ALBEDO_BELOW;
+        match self {
+            Model::Between => "single scattering between points".into(),
+            Model::PerChannel => format!("per channel: between points under albedo {ALBEDO_BELOW}, else dipole"),
+            Model::DipoleSingle => "dipole + single scattering".into(),
+            Model::Single => "single scattering alone".into(),
+            Model::Directional => "directional dipole, D = 1/(3 sigma_t')".into(),
+            Model::DirectionalGrosjean => "directional dipole, Grosjean's D".into(),
+            Model::DirectionalAlpha => "directional dipole, Grosjean's D, source alpha'".into(),
+            Model::Transport => "transport in the mesh, light entering along the normal".into(),
+        }
+    }
+}
+
+impl std::str::FromStr for Model {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Model, String> {
+        Model::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = Model::ALL.iter().map(|m| m.name()).collect();
+            format!("unknown model {s:?}: one of {}", names.join(", "))
+        })
+    }
+}
+
+/// Every model's exitance per object and vertex, named: the dipole's truth first, then those of
+/// `models` (see [`Model`]), each computed only if asked for (the directional dipole's integral
+/// over a large mesh takes many minutes).
+fn alternative_models(
+    base: &PreparedScene,
+    truth: &[Exitance],
+    models: &[Model],
+    reference: (&MeshOptions, u64),
+) -> Result<Vec<(String, Vec<Exitance>)>, StudyError> {
     use crate::optics::directional_dipole::{Diffusion, Strength};
     use crate::reference::directional;
-    let single = crate::reference::single::exitance(base);
-    let sum = truth
-        .iter()
-        .zip(&single)
-        .map(|(t, s)| t.iter().zip(s).map(|(t, s)| [0, 1, 2].map(|c| t[c] + s[c])).collect())
-        .collect();
     let fineness = directional::FINENESS;
+    let single = || crate::reference::single::exitance(base);
+    let beam = || crate::reference::single::between_points(base, fineness);
     let variant = |d, s| directional::exitance_with(base, d, s, fineness, None);
-    use crate::optics::beam_single;
-    let beam = crate::reference::single::between_points(base, fineness);
-    let chosen = per_channel_choice(base, truth, &beam);
-    vec![
-        ("dipole".to_string(), truth.to_vec()),
-        ("single scattering between points".to_string(), beam),
-        (format!("per channel: between points under albedo {}, else dipole", beam_single::ALBEDO_BELOW), chosen),
-        ("dipole + single scattering".to_string(), sum),
-        ("single scattering alone".to_string(), single),
-        ("directional dipole, D = 1/(3 sigma_t')".to_string(), variant(Diffusion::Classical, Strength::Paper)),
-        ("directional dipole, Grosjean's D".to_string(), variant(Diffusion::Grosjean, Strength::Paper)),
-        (
-            "directional dipole, Grosjean's D, source alpha'".to_string(),
-            variant(Diffusion::Grosjean, Strength::ReducedAlbedo),
-        ),
-    ]
+    let mut out = vec![("dipole".to_string(), truth.to_vec())];
+    for &m in models {
+        let exitance = match m {
+            Model::Between => beam(),
+            Model::PerChannel => per_channel_choice(base, truth, &beam()),
+            Model::DipoleSingle => truth
+                .iter()
+                .zip(&single())
+                .map(|(t, s)| t.iter().zip(s).map(|(t, s)| [0, 1, 2].map(|c| t[c] + s[c])).collect())
+                .collect(),
+            Model::Single => single(),
+            Model::Directional => variant(Diffusion::Classical, Strength::Paper),
+            Model::DirectionalGrosjean => variant(Diffusion::Grosjean, Strength::Paper),
+            Model::DirectionalAlpha => variant(Diffusion::Grosjean, Strength::ReducedAlbedo),
+            Model::Transport => transport(base, reference)?,
+        };
+        out.push((m.label(), exitance));
+    }
+    Ok(out)
+}
+
+/// [`Model::Transport`]'s exitance per vertex (NaN off the receivers), walked with the
+/// reference's options and its walk count (so by the same walks where the reference was
+/// stopped by time or precision).
+fn transport(base: &PreparedScene, (options, walks): (&MeshOptions, u64)) -> Result<Vec<Exitance>, StudyError> {
+    use crate::reference::rte::Budget;
+    let options = MeshOptions { budget: Budget::photons(walks.max(1)), ..*options };
+    let objects = crate::reference::rte_mesh::normal_entry_exitance(base, &options, &|_| {})
+        .map_err(|e| StudyError::Rte(crate::reference::rte_cache::RteCacheError::Rte(e)))?;
+    Ok(objects
+        .iter()
+        .zip(&base.objects)
+        .map(|(o, object)| {
+            let count = object.mesh.positions().len();
+            o.as_ref().map_or_else(|| vec![[0.0; 3]; count], |o| o.per_vertex(count).0)
+        })
+        .collect())
 }
 
 /// Per object, vertex and channel: `single` where the channel's reduced albedo is under
@@ -372,10 +476,29 @@ fn bands_table(out: &mut String, p: &Physics) {
 
 /// What the reference is, how far it got and what it cost.
 fn reference_paragraph(out: &mut String, p: &Physics) {
+    use crate::reference::rte_mesh::Walk;
     let b = &p.options.budget;
+    let (unit, walk, precision) = match p.options.walk {
+        Walk::Photons => (
+            "photons",
+            "photons from the lights tallied in each vertex's cell, refracting at the flat faces \
+             (`reference::rte_mesh`)"
+                .to_string(),
+            "RMS standard error over lit vertices / their mean",
+        ),
+        Walk::Adjoint { receivers } => (
+            "walks per receiver",
+            format!(
+                "walks backwards from {} per object to the lights' beams, refracting with the shading \
+                 normals (`rte_mesh::adjoint`)",
+                receivers.map_or("every vertex".to_string(), |r| format!("at most {r} receivers"))
+            ),
+            "RMS over lit receivers of the relative standard error",
+        ),
+    };
     let budget = [
-        Some(format!("at most {} photons", b.max_photons)),
-        b.relative_stderr.map(|s| format!("to {s} relative standard error")),
+        Some(format!("at most {} {unit}", b.max_photons)),
+        b.relative_stderr.map(|s| format!("to {s} precision")),
         b.max_seconds.map(|s| format!("at most {s} s")),
     ]
     .into_iter()
@@ -385,10 +508,9 @@ fn reference_paragraph(out: &mut String, p: &Physics) {
     let _ = writeln!(
         out,
         "\n## Against the physics: model, discretisation and total error\n\n\
-         Reference: the radiative transfer equation by Monte Carlo inside each translucent mesh \
-         (`reference::rte_mesh`: Fresnel refraction in and out at the faces, isotropic scattering with \
-         `sigma_s = sigma_s'`; budget {budget} per object, seed {}): {} photons, {:.1} s when walked{}; \
-         precision reached (RMS standard error over lit vertices / their mean, worst channel) {}, walks lost \
+         Reference: the radiative transfer equation by Monte Carlo inside each translucent mesh, {walk} \
+         (Fresnel transmittance in and out, isotropic scattering with `sigma_s = sigma_s'`; budget {budget} per object, seed {}): {} {unit}, {:.1} s when walked{}; \
+         precision reached ({precision}, worst channel) {}, walks lost \
          {:?}. Model error: the dipole's exact integral against it; discretisation error: the renderer \
          against the dipole's exact integral (the study's `rel_rms`); total error: the renderer against it. \
          Relative RMS over the vertices lit in the reference. The reference noise is the RMS of its relative \

@@ -23,17 +23,16 @@
 //! stops on the per-vertex noise: per channel, the RMS over the lit receivers of each one's
 //! relative standard error.
 
-use super::beam::{Beam, Beams};
+use super::beam::{Beam, Beams, Entry, Way};
 use super::geometry::Geometry;
 use super::sources::Lighting;
 use super::walk::scatter;
 use crate::mesh::Mesh;
 use crate::optics::fresnel;
-use crate::reference::rte::{Budget, Medium, Progress, RteError, RteProgress, after_collision, after_reflection, chunk_rng};
+use crate::reference::rte::{Medium, Progress, RteError, RteProgress, after_collision, after_reflection, chunk_rng};
 use crate::reference::truth::LIT_FLOOR;
-use crate::reference::{light_incidence, occluders, ray_offset};
-use crate::scene::accuracy::receiver_subset;
-use crate::scene::build::{PreparedScene, ResolvedMaterial};
+use super::{MeshOptions, ObjectExitance};
+use crate::reference::light_incidence;
 use crate::scene::lights::PreparedLight;
 use glam::DVec3;
 use rand::RngExt;
@@ -45,81 +44,9 @@ use std::f64::consts::PI;
 const FIRST_ROUND: u64 = 16;
 /// The most walks per receiver and channel in one round.
 const MAX_ROUND: u64 = 1024;
-
-/// How long to walk and where.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct AdjointOptions {
-    /// Per object: walks per receiver (each in all three channels), the target per-vertex noise
-    /// ([`ReceiverExitance::noise`]) and the time.
-    pub budget: Budget,
-    /// The seed of the random streams.
-    pub seed: u64,
-    /// At most this many receivers per object, spread over its vertices as
-    /// `scene::accuracy::receiver_subset` spreads them; `None`: every vertex.
-    pub receivers: Option<usize>,
-}
-
-/// One object's exitance at its receivers by adjoint Monte Carlo.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct ReceiverExitance {
-    /// The receivers' vertex indices.
-    pub receivers: Vec<usize>,
-    /// Per receiver, RGB: the exitance at the vertex (flux per area).
-    pub exitance: Vec<[f64; 3]>,
-    /// Per receiver, RGB: its standard error.
-    pub stderr: Vec<[f64; 3]>,
-    /// Walks per receiver (each in all three channels).
-    pub walks: u64,
-    /// Per channel, the per-vertex noise: the RMS over the lit receivers (at least
-    /// `truth::LIT_FLOOR` of the brightest) of the relative standard error (0 where none is lit).
-    pub noise: [f64; 3],
-    /// Walks per channel dropped because they met the surface from outside.
-    pub lost: [u64; 3],
-    /// Wall time, seconds.
-    pub seconds: f64,
-}
-
-impl ReceiverExitance {
-    /// The exitance per vertex of a mesh of `count` vertices: NaN off the receivers (which the
-    /// study's error measures skip).
-    pub fn per_vertex(&self, count: usize) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
-        let (mut m, mut s) = (vec![[f64::NAN; 3]; count], vec![[f64::NAN; 3]; count]);
-        for (k, &v) in self.receivers.iter().enumerate() {
-            m[v] = self.exitance[k];
-            s[v] = self.stderr[k];
-        }
-        (m, s)
-    }
-}
-
-/// The exitance by adjoint walks at the receivers of every translucent object of `scene`
-/// (`None` for opaque objects), each object under the budget of `options`, its index added to
-/// the seed.
-pub fn adjoint_exitance(
-    scene: &PreparedScene,
-    options: &AdjointOptions,
-    progress: Progress,
-) -> Result<Vec<Option<ReceiverExitance>>, RteError> {
-    let casters = occluders(scene);
-    scene
-        .objects
-        .iter()
-        .enumerate()
-        .map(|(i, o)| match &o.material {
-            ResolvedMaterial::Translucent { dipoles, .. } => {
-                if !o.mesh.report().is_closed_manifold() {
-                    return Err(RteError::OpenMesh { name: o.name.clone() });
-                }
-                let media = dipoles.each_ref().map(Medium::reduced);
-                let options = AdjointOptions { seed: options.seed.wrapping_add(i as u64), ..*options };
-                let light = Lighting { lights: &scene.lights, occluders: &casters, eps: ray_offset(scene) };
-                let receivers = receiver_subset(o.mesh.positions().len(), options.receivers);
-                Ok(Some(object_adjoint(&o.mesh, &media, &light, receivers, &options, progress)?))
-            }
-            ResolvedMaterial::Opaque { .. } => Ok(None),
-        })
-        .collect()
-}
+/// Within this many mean free paths of the surface (by the clearance grid's bound) every
+/// collision takes a next event; deeper, a chance of it (see `Adjoint::next_event`).
+const NEAR_FREE_PATHS: f64 = 2.0;
 
 /// Where a receiver's walks start: just inside its vertex, with the vertex's outward shading
 /// normal, and the light that reaches it without scattering (per channel, exitance).
@@ -137,24 +64,34 @@ struct Adjoint<'a> {
     /// Per light, the chance a next event picks it (by its irradiance at the object).
     chances: Vec<f64>,
     media: &'a [Medium; 3],
+    /// How light enters: refracted for the reference.
+    entry: Entry,
 }
 
-/// One object's exitance at the vertices `receivers` (see the module's documentation).
-fn object_adjoint(
+/// One object's exitance at the vertices `receivers` (see the module's documentation), under
+/// the budget of `options`: walks per receiver, the per-vertex noise, the time.
+pub(super) fn object_adjoint(
     mesh: &Mesh,
     media: &[Medium; 3],
     light: &Lighting,
     receivers: Vec<usize>,
-    options: &AdjointOptions,
+    (options, entry): (&MeshOptions, Entry),
     progress: Progress,
-) -> Result<ReceiverExitance, RteError> {
+) -> Result<ObjectExitance, RteError> {
     if options.budget.max_photons == 0 {
         return Err(RteError::NoPhotons);
     }
     let start = std::time::Instant::now();
     let geometry = Geometry::new(mesh, true);
     let beams = Beams { geometry: &geometry, occluders: light.occluders, eps: light.eps };
-    let adjoint = Adjoint { chances: chances(mesh, light.lights), geometry: &geometry, beams, lights: light.lights, media };
+    let adjoint = Adjoint {
+        chances: chances(mesh, light.lights),
+        geometry: &geometry,
+        beams,
+        lights: light.lights,
+        media,
+        entry,
+    };
     let starts: Vec<Receiver> = receivers.par_iter().map(|&v| adjoint.receiver(v)).collect();
     let n = starts.len();
     let (mut sum, mut sum2, mut lost) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n], [0u64; 3]);
@@ -162,7 +99,15 @@ fn object_adjoint(
     let budget = options.budget;
     let mut summary = summarize(&sum, &sum2, &starts, 0);
     while walks < budget.max_photons {
-        let k = batch.min(budget.max_photons - walks);
+        let mut k = batch.min(budget.max_photons - walks);
+        // A round that would run past the time budget (at the pace so far) is cut to fit.
+        if let Some(limit) = budget.max_seconds
+            && walks > 0
+        {
+            let pace = start.elapsed().as_secs_f64() / walks as f64;
+            let left = (limit - start.elapsed().as_secs_f64()).max(0.0);
+            k = k.min(((left / pace) as u64).max(1));
+        }
         let tallies: Vec<([f64; 3], [f64; 3], [u64; 3])> = starts
             .par_iter()
             .enumerate()
@@ -190,7 +135,15 @@ fn object_adjoint(
         }
     }
     let (exitance, stderr, noise) = summary;
-    Ok(ReceiverExitance { receivers, exitance, stderr, walks, noise, lost, seconds: start.elapsed().as_secs_f64() })
+    Ok(ObjectExitance {
+        exitance,
+        stderr,
+        receivers: Some(receivers),
+        photons: walks,
+        relative_stderr: noise.into_iter().fold(0.0, f64::max),
+        lost,
+        seconds: start.elapsed().as_secs_f64(),
+    })
 }
 
 /// Per light, the chance a next event picks it: its irradiance (summed over channels) at the
@@ -261,7 +214,7 @@ impl Adjoint<'_> {
         let mut direct = [0.0; 3];
         for light in self.lights {
             for (c, m) in self.media.iter().enumerate() {
-                if let Some(beam) = self.beams.at(light, p, m.eta)
+                if let Some(beam) = self.beams.at(light, p, Way { eta: m.eta, entry: self.entry })
                     && beam.d.dot(n) > 0.0
                 {
                     let cos = beam.d.dot(n);
@@ -331,10 +284,20 @@ impl Adjoint<'_> {
     /// uncollided beam, the light drawn by [`Adjoint::chances`], over its chance; per unit of
     /// the walk's weight times the albedo.
     fn next_event(&self, q: DVec3, d: DVec3, c: usize, rng: &mut Pcg64) -> f64 {
-        let Some(l) = pick(&self.chances, rng.random::<f64>()) else { return 0.0 };
         let medium = &self.media[c];
-        let Some(Beam { irradiance, s, d: along }) = self.beams.at(&self.lights[l], q, medium.eta) else { return 0.0 };
-        irradiance[c] * (-medium.sigma_t() * s).exp() * phase(along.dot(-d), medium.g) / self.chances[l]
+        // Every beam reaching q has crossed at least the clearance: its attenuation is at most
+        // exp(-sigma_t clearance). Deep inside, the next event is taken with that chance (times
+        // e^NEAR_FREE_PATHS) and weighted by its inverse, which keeps it unbiased and spares
+        // the root-finding where it would find almost nothing.
+        let bound = (NEAR_FREE_PATHS - medium.sigma_t() * self.geometry.clearance_at(q)).exp();
+        if bound < 1.0 && rng.random::<f64>() >= bound {
+            return 0.0;
+        }
+        let chance = bound.min(1.0);
+        let Some(l) = pick(&self.chances, rng.random::<f64>()) else { return 0.0 };
+        let way = Way { eta: medium.eta, entry: self.entry };
+        let Some(Beam { irradiance, s, d: along }) = self.beams.at(&self.lights[l], q, way) else { return 0.0 };
+        irradiance[c] * (-medium.sigma_t() * s).exp() * phase(along.dot(-d), medium.g) / (self.chances[l] * chance)
     }
 }
 
@@ -369,6 +332,7 @@ fn cosine_inwards(n: DVec3, rng: &mut Pcg64) -> (DVec3, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::reference::rte::Budget;
     use crate::scene::lights::LightKind;
     use glam::{Mat4, Vec3};
     use std::collections::HashMap;
@@ -426,15 +390,19 @@ mod tests {
 
     /// The exitance at the centre of the top of a wide, deep slab (lengths in mean free paths)
     /// of three media under one directional light towards `towards`.
-    fn top_centre(media: [Medium; 3], towards: DVec3, walks: u64) -> ReceiverExitance {
+    fn top_centre(media: [Medium; 3], towards: DVec3, walks: u64) -> ObjectExitance {
+        top_centre_entering(media, towards, walks, Entry::Refracted)
+    }
+
+    fn top_centre_entering(media: [Medium; 3], towards: DVec3, walks: u64, entry: Entry) -> ObjectExitance {
         let half = DVec3::new(40.0, 40.0, 25.0);
         let mesh = slab(half, 8);
         let lights = [directional(towards)];
         let occluders = crate::mesh::bvh::Bvh::new(Vec::new());
         let lighting = Lighting { lights: &lights, occluders: &occluders, eps: 1e-6 };
         let receiver = vertex_at(&mesh, DVec3::new(0.0, 0.0, half.z));
-        let options = AdjointOptions { budget: Budget::photons(walks), seed: 7, receivers: None };
-        object_adjoint(&mesh, &media, &lighting, vec![receiver], &options, &quiet).unwrap()
+        let options = MeshOptions { budget: Budget::photons(walks), seed: 7, walk: super::super::Walk::Adjoint { receivers: None } };
+        object_adjoint(&mesh, &media, &lighting, vec![receiver], (&options, entry), &quiet).unwrap()
     }
 
     #[test]
@@ -473,6 +441,25 @@ mod tests {
     }
 
     #[test]
+    fn light_entering_along_the_normal_is_the_refracted_light_at_normal_incidence_and_not_otherwise() {
+        // The same walks: at normal incidence on a flat face the two entries are one beam, so
+        // the scores agree (to 1e-5: under the slab's rim, tens of free paths away, the shading
+        // normals tilt and the two beams part); at cosine 0.6 the refracted beam runs shallower and
+        // leaves more light near the entry (eta 1.3: cos_t 0.79), which the normal entry misses.
+        let media = [0.5, 0.9, 0.99].map(|a| Medium::new(1.0 - a, a, 0.0, 1.3).unwrap());
+        let run = |towards, entry| top_centre_entering(media, towards, 2000, entry);
+        let (refracted, normal) = (run(DVec3::Z, Entry::Refracted), run(DVec3::Z, Entry::Normal));
+        for c in 0..3 {
+            let (a, b) = (refracted.exitance[0][c], normal.exitance[0][c]);
+            assert!((a - b).abs() <= 1e-5 * a, "channel {c}: {a} against {b}");
+        }
+        let towards = DVec3::new(0.8, 0.0, 0.6);
+        let (refracted, normal) = (run(towards, Entry::Refracted), run(towards, Entry::Normal));
+        let (a, b) = (refracted.exitance[0][0], normal.exitance[0][0]);
+        assert!(a > b * 1.02, "albedo 0.5 at cosine 0.6: refracted {a}, normal {b}");
+    }
+
+    #[test]
     fn a_beam_through_a_flat_face_is_the_collimated_transmitted_irradiance() {
         // Under a flat face the refracted beam is parallel: E cos_i F_t / cos_t across it, and
         // the point at depth h is s = h / cos_t along it.
@@ -483,7 +470,8 @@ mod tests {
         let eta = 1.4;
         let beams = Beams { geometry: &geometry, occluders: &occluders, eps: 1e-6 };
         let towards = DVec3::new(0.6, 0.0, 0.8);
-        let beam = beams.at(&directional(towards), DVec3::new(0.1, 0.2, half.z - 0.5), eta).unwrap();
+        let way = Way { eta, entry: Entry::Refracted };
+        let beam = beams.at(&directional(towards), DVec3::new(0.1, 0.2, half.z - 0.5), way).unwrap();
         let cos_t = (1.0 - 0.36 / (eta * eta)).sqrt();
         let expected = 0.8 * fresnel::fresnel_transmittance(0.8, eta) / cos_t;
         assert!((beam.irradiance.x - expected).abs() < 1e-6 * expected, "{} against {expected}", beam.irradiance.x);
@@ -514,7 +502,8 @@ mod tests {
             for j in 0..sectors {
                 let phi = std::f64::consts::TAU * (j as f64 + 0.5) / sectors as f64;
                 let q = DVec3::new(r * phi.cos(), r * phi.sin(), z0);
-                let beam = beams.at(&light, q, eta).expect("every point of the section is lit");
+                let way = Way { eta, entry: Entry::Refracted };
+                let beam = beams.at(&light, q, way).expect("every point of the section is lit");
                 let area = 0.5 * (r1 * r1 - r0 * r0) * std::f64::consts::TAU / sectors as f64;
                 crossing += beam.irradiance.x * (-beam.d.z) * area;
             }

@@ -55,6 +55,35 @@ pub(super) fn refract_in(wi: DVec3, n: DVec3, eta: f64) -> Option<(DVec3, f64)> 
     Some(((-wi / eta + n * (cos_i / eta - cos_t)).normalize(), cos_i))
 }
 
+/// Which way light goes once it has entered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Entry {
+    /// Refracted by Snell's law: the light transport itself.
+    Refracted,
+    /// Straight in along the inward shading normal, whatever the light's direction, with the
+    /// same transmitted irradiance: the assumption of the dipole (Jensen et al. 2001 put its
+    /// source below the entry point), and of a kernel precomputed without the lights.
+    Normal,
+}
+
+/// How light goes in: the medium's relative index and the [`Entry`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Way {
+    pub(super) eta: f64,
+    pub(super) entry: Entry,
+}
+
+impl Way {
+    /// The direction inside of light from `wi` through a surface of outward normal `n`; `None`
+    /// where the light is behind it.
+    fn inwards(self, wi: DVec3, n: DVec3) -> Option<DVec3> {
+        match self.entry {
+            Entry::Refracted => refract_in(wi, n, self.eta).map(|(d, _)| d),
+            Entry::Normal => (n.dot(wi) > 0.0).then_some(-n),
+        }
+    }
+}
+
 /// What finding beams needs: the object, the shadow casters and how far visibility rays start
 /// off the surface.
 pub(super) struct Beams<'a> {
@@ -64,9 +93,9 @@ pub(super) struct Beams<'a> {
 }
 
 impl Beams<'_> {
-    /// The beam of `light` through `q` in a medium of relative index `eta` (see the module's
-    /// documentation), if one reaches it.
-    pub(super) fn at(&self, light: &PreparedLight, q: DVec3, eta: f64) -> Option<Beam> {
+    /// The beam of `light` through `q`, entering by `way` (see the module's documentation), if
+    /// one reaches it.
+    pub(super) fn at(&self, light: &PreparedLight, q: DVec3, way: Way) -> Option<Beam> {
         let geometry = self.geometry;
         let mut d = -light_incidence(light, q).0;
         for _ in 0..MAX_STEPS {
@@ -77,9 +106,9 @@ impl Beams<'_> {
             }
             let y = q - d * hit.t;
             let bary = [1.0 - hit.u - hit.v, hit.u, hit.v];
-            let (next, _) = refract_in(light_incidence(light, y).0, geometry.shading_normal(face, bary), eta)?;
+            let next = way.inwards(light_incidence(light, y).0, geometry.shading_normal(face, bary))?;
             if (next - d).length() < TOLERANCE {
-                return self.entered(light, face, y, hit.t, next, eta);
+                return self.entered(light, face, (y, hit.t, next), way);
             }
             d = next;
         }
@@ -88,18 +117,18 @@ impl Beams<'_> {
 
     /// The beam that entered at `y` on `face` and travelled `s` along `d`: its irradiance over
     /// the spread `J(s)`, where the light reaches `y` unshadowed.
-    fn entered(&self, light: &PreparedLight, face: usize, y: DVec3, s: f64, d: DVec3, eta: f64) -> Option<Beam> {
+    fn entered(&self, light: &PreparedLight, face: usize, (y, s, d): (DVec3, f64, DVec3), way: Way) -> Option<Beam> {
         let geometry = self.geometry;
         let n = geometry.shading_normal(face, geometry.barycentric(face, y));
         let (_, e, cos_i) = reaching(light, self.occluders, y, n, self.eps)?;
-        let f_t = fresnel::fresnel_transmittance(cos_i, eta);
+        let f_t = fresnel::fresnel_transmittance(cos_i, way.eta);
         let [a, b, _] = geometry.mesh.corners(face);
         let e1 = (b - a).normalize();
         let e2 = geometry.normals[face].cross(e1);
         let h = 1e-5 * geometry.mesh.triangle_areas()[face].sqrt();
         let direction = |p: DVec3| {
             let n = geometry.shading_normal(face, geometry.barycentric(face, p));
-            refract_in(light_incidence(light, p).0, n, eta).map(|(d, _)| d)
+            way.inwards(light_incidence(light, p).0, n)
         };
         let da = (direction(y + e1 * h)? - direction(y - e1 * h)?) / (2.0 * h);
         let db = (direction(y + e2 * h)? - direction(y - e2 * h)?) / (2.0 * h);

@@ -116,6 +116,11 @@ impl<'a> Geometry<'a> {
         [1.0 - u - v, u, v]
     }
 
+    /// A lower bound of the distance from `p` to the surface (0 without the clearance grid).
+    pub(super) fn clearance_at(&self, p: DVec3) -> f64 {
+        self.clearance.as_ref().map_or(0.0, |c| c.at(p))
+    }
+
     /// A small length, far above the rounding of the hit test.
     pub(super) fn slack(&self) -> f64 {
         self.slack

@@ -49,13 +49,14 @@ mod sources;
 mod tally;
 mod walk;
 
-pub use adjoint::{AdjointOptions, ReceiverExitance, adjoint_exitance};
 pub use tally::relative_stderr;
 
 use super::rte::{Budget, Medium, Progress, RteError, chunk_rng, run_rounds};
 use super::{occluders, ray_offset};
 use crate::mesh::Mesh;
 use crate::scene::build::{PreparedScene, ResolvedMaterial};
+use crate::scene::accuracy::receiver_subset;
+use beam::Entry;
 use geometry::Geometry;
 use sources::{Lighting, Sources};
 use tally::{Tally, add_exits, cell_areas, summarize};
@@ -66,34 +67,70 @@ const CHUNK: u64 = 256;
 /// The most chunks walked in parallel between two looks at the budget.
 const MAX_CHUNKS_PER_ROUND: u64 = 32;
 
-/// How long to walk and with which random numbers.
+/// How long to walk, which way and with which random numbers.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MeshOptions {
-    /// Per object: photons (entries, each walked in all three channels), the target relative
-    /// standard error ([`ObjectExitance::relative_stderr`]) and the time.
+    /// Per object: photons (entries, each walked in all three channels) or walks per receiver,
+    /// the target precision ([`ObjectExitance::relative_stderr`]) and the time.
     pub budget: Budget,
     /// The seed of the random streams.
     pub seed: u64,
+    /// Forwards from the lights to every vertex, or backwards from some.
+    pub walk: Walk,
+}
+
+/// Which way the reference walks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Walk {
+    /// Photons from the lights, tallied in every vertex's cell (this module's walk).
+    Photons,
+    /// Walks from each receiver back to the lights' beams (`adjoint`), at `receivers` vertices
+    /// per object spread as `scene::accuracy::receiver_subset` spreads them (`None`: all).
+    Adjoint {
+        /// At most this many receivers per object.
+        receivers: Option<usize>,
+    },
 }
 
 /// One object's radiant exitance by Monte Carlo.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ObjectExitance {
-    /// Per vertex, RGB: the mean exitance over the vertex's cell (flux per area).
+    /// Per vertex (or per receiver, in the order of `receivers`), RGB: the photon walk's mean
+    /// exitance over the vertex's cell, the adjoint walk's exitance at the vertex (flux per
+    /// area).
     pub exitance: Vec<[f64; 3]>,
-    /// Per vertex, RGB: its standard error.
+    /// Alike, RGB: its standard error.
     pub stderr: Vec<[f64; 3]>,
-    /// Photons walked (each in all three channels).
+    /// The vertices the values are at (the adjoint walk's receivers); `None`: every vertex.
+    #[serde(default)]
+    pub receivers: Option<Vec<usize>>,
+    /// Photons walked, or walks per receiver (each in all three channels).
     pub photons: u64,
-    /// The precision reached: per channel, the RMS standard error over the lit vertices
-    /// (exitance at least `truth::LIT_FLOOR` of the brightest) over their mean exitance; the
-    /// largest of the three (infinite, stored as JSON null, where a channel lights nothing).
+    /// The precision reached, the largest over the channels of: for the photon walk, the RMS
+    /// standard error over the lit vertices (exitance at least `truth::LIT_FLOOR` of the
+    /// brightest) over their mean exitance; for the adjoint walk, the RMS over the lit receivers
+    /// of each one's relative standard error (infinite, stored as JSON null, where a channel
+    /// lights nothing).
     #[serde(with = "super::json_null::infinite_as_null")]
     pub relative_stderr: f64,
     /// Walks per channel dropped because they met the surface from outside.
     pub lost: [u64; 3],
     /// Wall time, seconds.
     pub seconds: f64,
+}
+
+impl ObjectExitance {
+    /// The exitance and standard error per vertex of the object's `count` vertices: NaN off
+    /// the receivers, which every statistic over lit vertices skips.
+    pub fn per_vertex(&self, count: usize) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+        let Some(receivers) = &self.receivers else { return (self.exitance.clone(), self.stderr.clone()) };
+        let (mut m, mut s) = (vec![[f64::NAN; 3]; count], vec![[f64::NAN; 3]; count]);
+        for (k, &v) in receivers.iter().enumerate() {
+            m[v] = self.exitance[k];
+            s[v] = self.stderr[k];
+        }
+        (m, s)
+    }
 }
 
 /// How the walk is done: this module's walk ([`WALK`]), or, for the tests that compare them,
@@ -118,15 +155,35 @@ pub fn exitance(
     options: &MeshOptions,
     progress: Progress,
 ) -> Result<Vec<Option<ObjectExitance>>, RteError> {
-    exitance_by(scene, options, progress, WALK)
+    exitance_by(scene, options, progress, WALK, Entry::Refracted)
 }
 
-/// [`exitance`] walked by `method`.
+/// The exitance of the radiative transfer in each mesh with the light entering straight along
+/// the inward shading normal, whatever its direction (with the transmitted irradiance it
+/// brings): the limit of a transport kernel precomputed without the lights, whose gap to
+/// [`exitance`] is what ignoring the entry direction costs. Walked by the adjoint walk, with
+/// every vertex as a receiver where `options` asks for photons. With the same options as an
+/// [`exitance`] by the adjoint walk and a walk budget (not a time or precision one), the walks
+/// are the same ones, so the two differ by much less than their noise.
+pub fn normal_entry_exitance(
+    scene: &PreparedScene,
+    options: &MeshOptions,
+    progress: Progress,
+) -> Result<Vec<Option<ObjectExitance>>, RteError> {
+    let walk = match options.walk {
+        Walk::Photons => Walk::Adjoint { receivers: None },
+        adjoint => adjoint,
+    };
+    exitance_by(scene, &MeshOptions { walk, ..*options }, progress, WALK, Entry::Normal)
+}
+
+/// [`exitance`] walked by `method`, the light entering by `entry` in the adjoint walk.
 fn exitance_by(
     scene: &PreparedScene,
     options: &MeshOptions,
     progress: Progress,
     method: Method,
+    entry: Entry,
 ) -> Result<Vec<Option<ObjectExitance>>, RteError> {
     let casters = occluders(scene);
     let lighting = Lighting { lights: &scene.lights, occluders: &casters, eps: ray_offset(scene) };
@@ -141,7 +198,13 @@ fn exitance_by(
                 }
                 let media = dipoles.each_ref().map(Medium::reduced);
                 let options = MeshOptions { seed: options.seed.wrapping_add(i as u64), ..*options };
-                Ok(Some(object_exitance(&o.mesh, &media, &lighting, &options, progress, method)?))
+                Ok(Some(match options.walk {
+                    Walk::Photons => object_exitance(&o.mesh, &media, &lighting, &options, progress, method)?,
+                    Walk::Adjoint { receivers } => {
+                        let receivers = receiver_subset(o.mesh.positions().len(), receivers);
+                        adjoint::object_adjoint(&o.mesh, &media, &lighting, receivers, (&options, entry), progress)?
+                    }
+                }))
             }
             ResolvedMaterial::Opaque { .. } => Ok(None),
         })
@@ -171,6 +234,7 @@ fn object_exitance(
         return Ok(ObjectExitance {
             exitance: zero.clone(),
             stderr: zero,
+            receivers: None,
             photons: 0,
             relative_stderr: 0.0,
             lost: [0; 3],
@@ -203,6 +267,7 @@ fn object_exitance(
     Ok(ObjectExitance {
         exitance,
         stderr,
+        receivers: None,
         photons,
         relative_stderr,
         lost: tally.lost,
@@ -251,8 +316,8 @@ irradiance = [1.0, 1.0, 1.0]
     }
 
     fn run(scene: &PreparedScene, photons: u64, seed: u64, method: Method) -> Vec<ObjectExitance> {
-        let options = MeshOptions { budget: Budget::photons(photons), seed };
-        exitance_by(scene, &options, &quiet, method).unwrap().into_iter().map(Option::unwrap).collect()
+        let options = MeshOptions { budget: Budget::photons(photons), seed, walk: Walk::Photons };
+        exitance_by(scene, &options, &quiet, method, Entry::Refracted).unwrap().into_iter().map(Option::unwrap).collect()
     }
 
     /// Per object and channel, the flux that left (exitance times cell area, summed).
