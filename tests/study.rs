@@ -476,6 +476,8 @@ fn study_with_physics_splits_each_rows_error_into_model_discretisation_and_total
             out_s,
             "--quick",
             "--physics",
+            "--rte-walk",
+            "adjoint",
             "--rte-photons",
             "256",
             "--models",

@@ -90,13 +90,14 @@ pub struct Args {
     /// object (photons) (default 1000000000)
     #[arg(long, value_name = "N")]
     pub rte_photons: Option<u64>,
-    /// With --physics: how the reference walks: `adjoint` (default; backwards from each
-    /// receiver to the lights' beams, each receiver to its own precision) or `photons` (from
-    /// the lights, tallied at every vertex)
-    #[arg(long, value_name = "adjoint|photons")]
+    /// With --physics: how the reference walks: `adjoint` (backwards from each receiver to the
+    /// lights' beams, each receiver to its own precision), `photons` (from the lights, tallied
+    /// at every vertex) or `auto` (default: adjoint where a mesh has more than 16 vertices per
+    /// receiver, which it then reaches sooner)
+    #[arg(long, value_name = "auto|adjoint|photons")]
     pub rte_walk: Option<String>,
-    /// With --physics and the adjoint walk: receivers per object, spread over the mesh as
-    /// --truth-receivers spreads them (default: --truth-receivers if given, else 1000)
+    /// With --physics and the adjoint or auto walk: receivers per object, spread over the mesh
+    /// as --truth-receivers spreads them (default: --truth-receivers if given, else 1000)
     #[arg(long, value_name = "N")]
     pub rte_receivers: Option<usize>,
     /// With --physics: the models measured beside the dipole against the reference,
@@ -142,19 +143,18 @@ fn physics(args: &Args) -> Result<Option<MeshOptions>> {
     if !(seconds.is_finite() && seconds > 0.0) {
         bail!("--rte-seconds {seconds}: must be a time > 0 in seconds, e.g. 600");
     }
-    let walk = match args.rte_walk.as_deref().unwrap_or("adjoint") {
-        "adjoint" => {
-            let receivers = args.rte_receivers.or(args.truth_receivers).unwrap_or(1000);
-            if receivers == 0 {
-                bail!("--rte-receivers 0: the adjoint walk needs at least one receiver, e.g. 1000");
-            }
-            Walk::Adjoint { receivers: Some(receivers) }
-        }
+    let receivers = args.rte_receivers.or(args.truth_receivers).unwrap_or(1000);
+    if receivers == 0 {
+        bail!("--rte-receivers 0: the adjoint walk needs at least one receiver, e.g. 1000");
+    }
+    let walk = match args.rte_walk.as_deref().unwrap_or("auto") {
+        "adjoint" => Walk::Adjoint { receivers: Some(receivers) },
+        "auto" => Walk::Auto { receivers },
         "photons" if args.rte_receivers.is_some() => {
             bail!("--rte-receivers: only with --rte-walk adjoint (the photon walk tallies every vertex)")
         }
         "photons" => Walk::Photons,
-        other => bail!("--rte-walk {other}: one of adjoint, photons"),
+        other => bail!("--rte-walk {other}: one of auto, adjoint, photons"),
     };
     let budget = Budget { max_photons: photons, relative_stderr: Some(stderr), max_seconds: Some(seconds) };
     Ok(Some(MeshOptions { budget, seed: RTE_SEED, walk }))

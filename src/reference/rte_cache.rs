@@ -114,8 +114,8 @@ pub fn content_key(scene: &PreparedScene, options: &MeshOptions) -> String {
     h.u64(b.max_photons);
     h.f64(b.relative_stderr.unwrap_or(-1.0));
     h.f64(b.max_seconds.unwrap_or(-1.0));
-    match options.walk {
-        Walk::Photons => h.u64(0),
+    match options.resolved(scene).walk {
+        Walk::Photons | Walk::Auto { .. } => h.u64(0),
         Walk::Adjoint { receivers } => {
             h.u64(1);
             h.u64(receivers.map_or(u64::MAX, |r| r as u64));

@@ -86,6 +86,7 @@ impl Physics {
         dir: &Path,
         progress: &(dyn Fn(Event) + Sync),
     ) -> Result<Physics, StudyError> {
+        let options = &options.resolved(base);
         let (reference, cached) = rte_cache::cached(base, options, dir, &|p| progress(Event::Rte(p)))?;
         if cached {
             progress(Event::RteCached);
@@ -479,7 +480,7 @@ fn reference_paragraph(out: &mut String, p: &Physics) {
     use crate::reference::rte_mesh::Walk;
     let b = &p.options.budget;
     let (unit, walk, precision) = match p.options.walk {
-        Walk::Photons => (
+        Walk::Photons | Walk::Auto { .. } => (
             "photons",
             "photons from the lights tallied in each vertex's cell, refracting at the flat faces \
              (`reference::rte_mesh`)"
