@@ -30,7 +30,7 @@ enum Command {
     /// Measure what accuracy costs in time: every sampler, sample count and gather against the
     /// exact dipole integral (CSV, Markdown, a plot)
     #[cfg(feature = "study")]
-    Study(cli::study::Args),
+    Study(Box<cli::study::Args>),
 }
 
 fn main() -> ExitCode {

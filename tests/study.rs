@@ -481,7 +481,7 @@ fn study_with_physics_splits_each_rows_error_into_model_discretisation_and_total
             "--rte-photons",
             "256",
             "--models",
-            "between,per-channel",
+            "between,per-channel,transport",
             "--truth-cache",
             cache_s,
         ];
@@ -493,6 +493,7 @@ fn study_with_physics_splits_each_rows_error_into_model_discretisation_and_total
         // The models beside the dipole, single scattering between points and the choice per channel among them.
         assert!(md.contains("| single scattering between points |"), "{md}");
         assert!(md.contains("| per channel: between points under albedo 0.3, else dipole |"), "{md}");
+        assert!(md.contains("| transport in the mesh, light entering along the normal |"), "{md}");
         assert_eq!(md.contains("when walked, read from the cache"), pass == "cached", "{pass}: {md}");
         csvs.push(std::fs::read_to_string(out.join("study.csv")).unwrap());
     }

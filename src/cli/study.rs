@@ -102,7 +102,8 @@ pub struct Args {
     pub rte_receivers: Option<usize>,
     /// With --physics: the models measured beside the dipole against the reference,
     /// comma-separated (default: none): between, per-channel, dipole+single, single,
-    /// directional, directional-grosjean, directional-alpha; `all` for every one
+    /// directional, directional-grosjean, directional-alpha, transport, transport-slanted; `all`
+    /// for every one
     #[arg(long, value_delimiter = ',', value_name = "MODEL,...")]
     pub models: Vec<String>,
     /// With --physics: stop the reference after this many seconds per object (default 600; the

@@ -141,6 +141,22 @@ pub enum RteError {
     /// The budget has no photons.
     #[error("the photon budget is 0")]
     NoPhotons,
+    /// The object asked for is opaque: there is no transport inside it.
+    #[error("object {name:?} is opaque: no light travels inside it")]
+    NotTranslucent {
+        /// The object's name.
+        name: String,
+    },
+    /// A receiver names a vertex the mesh does not have.
+    #[error("object {name:?}: receiver {vertex} is not one of its {vertices} vertices")]
+    NoSuchVertex {
+        /// The object's name.
+        name: String,
+        /// The vertex asked for.
+        vertex: usize,
+        /// How many the mesh has.
+        vertices: usize,
+    },
 }
 
 /// How far a reference computation is, for a progress bar.

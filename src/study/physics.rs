@@ -26,7 +26,7 @@
 use super::report::{Row, curve_gather, md_cell, percent, sampler_label};
 use super::{Event, StudyError, VertexError, vertex_error_f64};
 use crate::reference::rte_cache;
-use crate::reference::rte_mesh::MeshOptions;
+use crate::reference::rte_mesh::{MeshOptions, ModelEntry};
 use crate::reference::truth::{LIT_FLOOR, Truth};
 use crate::scene::build::PreparedScene;
 use std::collections::BTreeMap;
@@ -155,15 +155,18 @@ pub enum Model {
     /// The directional dipole with Grosjean's `D` and the source scaled by `alpha'`.
     DirectionalAlpha,
     /// The radiative transfer in the mesh with the light entering along the normal
-    /// (`rte_mesh::normal_entry_exitance`): what a transport kernel precomputed without the
+    /// (`rte_mesh::model_exitance`, `ModelEntry::Normal`): what a transport kernel precomputed without the
     /// lights converges to. Walked by the reference's own walks, so its gap to the reference
     /// is measured through their shared noise.
     Transport,
+    /// As [`Model::Transport`], the light attenuated with depth as the refracted beam is: the
+    /// limit of kernels precomputed at a few entry cosines (`rte_mesh::ModelEntry::Slanted`).
+    TransportSlanted,
 }
 
 impl Model {
     /// Every model, in the report's order.
-    pub const ALL: [Model; 8] = [
+    pub const ALL: [Model; 9] = [
         Model::Between,
         Model::PerChannel,
         Model::DipoleSingle,
@@ -172,6 +175,7 @@ impl Model {
         Model::DirectionalGrosjean,
         Model::DirectionalAlpha,
         Model::Transport,
+        Model::TransportSlanted,
     ];
 
     /// Its name on the command line.
@@ -185,6 +189,7 @@ impl Model {
             Model::DirectionalGrosjean => "directional-grosjean",
             Model::DirectionalAlpha => "directional-alpha",
             Model::Transport => "transport",
+            Model::TransportSlanted => "transport-slanted",
         }
     }
 
@@ -200,6 +205,7 @@ impl Model {
             Model::DirectionalGrosjean => "directional dipole, Grosjean's D".into(),
             Model::DirectionalAlpha => "directional dipole, Grosjean's D, source alpha'".into(),
             Model::Transport => "transport in the mesh, light entering along the normal".into(),
+            Model::TransportSlanted => "transport in the mesh, along the normal at the refracted depth".into(),
         }
     }
 }
@@ -243,20 +249,30 @@ fn alternative_models(
             Model::Directional => variant(Diffusion::Classical, Strength::Paper),
             Model::DirectionalGrosjean => variant(Diffusion::Grosjean, Strength::Paper),
             Model::DirectionalAlpha => variant(Diffusion::Grosjean, Strength::ReducedAlbedo),
-            Model::Transport => transport(base, reference)?,
+            Model::Transport => transport(base, reference, ModelEntry::Normal)?,
+            Model::TransportSlanted => transport(base, reference, ModelEntry::Slanted)?,
         };
         out.push((m.label(), exitance));
     }
     Ok(out)
 }
 
-/// [`Model::Transport`]'s exitance per vertex (NaN off the receivers), walked with the
-/// reference's options and its walk count (so by the same walks where the reference was
-/// stopped by time or precision).
-fn transport(base: &PreparedScene, (options, walks): (&MeshOptions, u64)) -> Result<Vec<Exitance>, StudyError> {
+/// [`Model::Transport`]'s exitance per vertex (NaN off the receivers). Behind an adjoint
+/// reference it is walked with the reference's options and walk count, so by the same walks
+/// even where the reference was stopped by time or precision; behind a photon reference, by
+/// the adjoint walk at every vertex under the reference's budget, with noise of its own.
+fn transport(
+    base: &PreparedScene,
+    (options, walks): (&MeshOptions, u64),
+    entry: ModelEntry,
+) -> Result<Vec<Exitance>, StudyError> {
     use crate::reference::rte::Budget;
-    let options = MeshOptions { budget: Budget::photons(walks.max(1)), ..*options };
-    let objects = crate::reference::rte_mesh::normal_entry_exitance(base, &options, &|_| {})
+    use crate::reference::rte_mesh::Walk;
+    let options = match options.walk {
+        Walk::Adjoint { .. } => MeshOptions { budget: Budget::photons(walks.max(1)), ..*options },
+        _ => *options,
+    };
+    let objects = crate::reference::rte_mesh::model_exitance(base, &options, entry, &|_| {})
         .map_err(|e| StudyError::Rte(crate::reference::rte_cache::RteCacheError::Rte(e)))?;
     Ok(objects
         .iter()

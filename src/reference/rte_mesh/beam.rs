@@ -36,7 +36,8 @@ const TOLERANCE: f64 = 1e-11;
 pub(super) struct Beam {
     /// Irradiance perpendicular to the beam, before attenuation in the medium (scene units).
     pub(super) irradiance: DVec3,
-    /// The distance the beam travelled inside, from its entry.
+    /// The distance the beam travelled inside, from its entry (for the slanted entry, the
+    /// refracted beam's path to the same depth).
     pub(super) s: f64,
     /// Its direction of travel.
     pub(super) d: DVec3,
@@ -64,6 +65,11 @@ pub(super) enum Entry {
     /// same transmitted irradiance: the assumption of the dipole (Jensen et al. 2001 put its
     /// source below the entry point), and of a kernel precomputed without the lights.
     Normal,
+    /// Straight in along the inward normal, but attenuated with depth as the refracted beam
+    /// is: `exp(-sigma_t z / cos_t)` with its perpendicular irradiance `E_t / cos_t`, so its
+    /// first collisions lie at the refracted beam's depths, without its sideways travel. What
+    /// a kernel precomputed at a few entry cosines and interpolated per sample converges to.
+    Slanted,
 }
 
 /// How light goes in: the medium's relative index and the [`Entry`].
@@ -79,7 +85,7 @@ impl Way {
     fn inwards(self, wi: DVec3, n: DVec3) -> Option<DVec3> {
         match self.entry {
             Entry::Refracted => refract_in(wi, n, self.eta).map(|(d, _)| d),
-            Entry::Normal => (n.dot(wi) > 0.0).then_some(-n),
+            Entry::Normal | Entry::Slanted => (n.dot(wi) > 0.0).then_some(-n),
         }
     }
 }
@@ -133,6 +139,11 @@ impl Beams<'_> {
         let da = (direction(y + e1 * h)? - direction(y - e1 * h)?) / (2.0 * h);
         let db = (direction(y + e2 * h)? - direction(y - e2 * h)?) / (2.0 * h);
         let spread = (e1 + da * s).cross(e2 + db * s).dot(d).abs();
-        (spread > 1e-12).then(|| Beam { irradiance: e * (cos_i * f_t / spread), s, d })
+        // The slanted entry's depth scale: its path to depth s is s / cos_t (Snell).
+        let slant = match way.entry {
+            Entry::Slanted => (1.0 - (1.0 - cos_i * cos_i) / (way.eta * way.eta)).max(1e-6).sqrt(),
+            Entry::Refracted | Entry::Normal => 1.0,
+        };
+        (spread > 1e-12).then(|| Beam { irradiance: e * (cos_i * f_t / (spread * slant)), s: s / slant, d })
     }
 }

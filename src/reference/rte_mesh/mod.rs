@@ -200,23 +200,67 @@ pub fn exitance(
     exitance_by(scene, options, progress, WALK, Entry::Refracted)
 }
 
-/// The exitance of the radiative transfer in each mesh with the light entering straight along
-/// the inward shading normal, whatever its direction (with the transmitted irradiance it
-/// brings): the limit of a transport kernel precomputed without the lights, whose gap to
-/// [`exitance`] is what ignoring the entry direction costs. Walked by the adjoint walk, with
-/// every vertex as a receiver where `options` asks for photons. With the same options as an
-/// [`exitance`] by the adjoint walk and a walk budget (not a time or precision one), the walks
-/// are the same ones, so the two differ by much less than their noise.
-pub fn normal_entry_exitance(
+/// The exitance by the adjoint walk at the given `receivers` (vertex indices) of translucent
+/// object `object` of `scene`, under the budget and seed of `options` (its walk is not read):
+/// for comparing meshes at the same points, such as a mesh and its refinement.
+pub fn adjoint_at(
+    scene: &PreparedScene,
+    object: usize,
+    receivers: Vec<usize>,
+    options: &MeshOptions,
+    progress: Progress,
+) -> Result<ObjectExitance, RteError> {
+    let o = &scene.objects[object];
+    let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else {
+        return Err(RteError::NotTranslucent { name: o.name.clone() });
+    };
+    if !o.mesh.report().is_closed_manifold() {
+        return Err(RteError::OpenMesh { name: o.name.clone() });
+    }
+    if let Some(&v) = receivers.iter().find(|&&v| v >= o.mesh.positions().len()) {
+        return Err(RteError::NoSuchVertex { name: o.name.clone(), vertex: v, vertices: o.mesh.positions().len() });
+    }
+    let media = dipoles.each_ref().map(Medium::reduced);
+    let casters = occluders(scene);
+    let lighting = Lighting { lights: &scene.lights, occluders: &casters, eps: ray_offset(scene) };
+    adjoint::object_adjoint(&o.mesh, &media, &lighting, receivers, (options, Entry::Refracted), progress)
+}
+
+/// How a model of the transport lets light in, where the reference refracts it (see
+/// [`model_exitance`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ModelEntry {
+    /// Straight in along the inward shading normal, whatever the light's direction, with the
+    /// transmitted irradiance it brings: the limit of a transport kernel precomputed without
+    /// the lights.
+    Normal,
+    /// Along the normal, attenuated with depth as the refracted beam is (`exp(-sigma_t z /
+    /// cos_t)`): the limit of kernels precomputed at a few entry cosines and interpolated per
+    /// sample by its light's.
+    Slanted,
+}
+
+/// The exitance of the radiative transfer in each mesh with the light entering by `entry`
+/// instead of refracting: what ignoring the entry direction costs, against [`exitance`].
+/// Walked by the adjoint walk, with every vertex as a receiver where `options` asks for
+/// photons. With the same options as an [`exitance`] by the adjoint walk and a walk budget (not
+/// a time or precision one), the walks are the same ones, so the two differ by much less than
+/// their noise.
+pub fn model_exitance(
     scene: &PreparedScene,
     options: &MeshOptions,
+    entry: ModelEntry,
     progress: Progress,
 ) -> Result<Vec<Option<ObjectExitance>>, RteError> {
     let walk = match options.resolved(scene).walk {
         Walk::Photons | Walk::Auto { .. } => Walk::Adjoint { receivers: None },
         adjoint => adjoint,
     };
-    exitance_by(scene, &MeshOptions { walk, ..*options }, progress, WALK, Entry::Normal)
+    let entry = match entry {
+        ModelEntry::Normal => Entry::Normal,
+        ModelEntry::Slanted => Entry::Slanted,
+    };
+    exitance_by(scene, &MeshOptions { walk, ..*options }, progress, WALK, entry)
 }
 
 /// [`exitance`] walked by `method`, the light entering by `entry` in the adjoint walk.
@@ -386,6 +430,17 @@ irradiance = [1.0, 1.0, 1.0]
         assert_eq!(choose_walk(&scene, few), Walk::Adjoint { receivers: Some(few) });
         let auto = MeshOptions { budget: Budget::photons(1), seed: 1, walk: Walk::Auto { receivers: few } };
         assert_eq!(auto.resolved(&scene).walk, Walk::Adjoint { receivers: Some(few) });
+    }
+
+    #[test]
+    fn a_receiver_past_the_mesh_is_refused_naming_the_vertex() {
+        let scene = spheres();
+        let count = scene.objects[0].mesh.positions().len();
+        let options = MeshOptions { budget: Budget::photons(4), seed: 1, walk: Walk::Photons };
+        let err = adjoint_at(&scene, 0, vec![0, count], &options, &quiet).unwrap_err();
+        assert_eq!(err, RteError::NoSuchVertex { name: scene.objects[0].name.clone(), vertex: count, vertices: count });
+        assert!(err.to_string().contains(&format!("receiver {count} is not one of its {count} vertices")), "{err}");
+        assert_eq!(adjoint_at(&scene, 0, vec![0, 1], &options, &quiet).unwrap().exitance.len(), 2);
     }
 
     #[test]
