@@ -441,7 +441,7 @@ mod tests {
     }
 
     #[test]
-    fn light_entering_along_the_normal_is_the_refracted_light_at_normal_incidence_and_not_otherwise() {
+    fn light_entering_along_the_normal_is_the_refracted_light_at_normal_incidence_and_at_its_depth_on_a_slab() {
         // The same walks: at normal incidence on a flat face the two entries are one beam, so
         // the scores agree (to 1e-5: under the slab's rim, tens of free paths away, the shading
         // normals tilt and the two beams part); at cosine 0.6 the refracted beam runs shallower and
@@ -457,6 +457,13 @@ mod tests {
         let (refracted, normal) = (run(towards, Entry::Refracted), run(towards, Entry::Normal));
         let (a, b) = (refracted.exitance[0][0], normal.exitance[0][0]);
         assert!(a > b * 1.02, "albedo 0.5 at cosine 0.6: refracted {a}, normal {b}");
+        // Under uniform light on a flat face the beam's fluence depends on depth alone, so the
+        // slanted entry's equals the refracted one's at every point, and so do the scores.
+        let slanted = run(towards, Entry::Slanted);
+        for c in 0..3 {
+            let (a, b) = (refracted.exitance[0][c], slanted.exitance[0][c]);
+            assert!((a - b).abs() <= 1e-5 * a, "channel {c}: refracted {a}, slanted {b}");
+        }
     }
 
     #[test]
