@@ -49,11 +49,13 @@ const MAX_ROUND: u64 = 1024;
 const NEAR_FREE_PATHS: f64 = 2.0;
 
 /// Where a receiver's walks start: just inside its vertex, with the vertex's outward shading
-/// normal, and the light that reaches it without scattering (per channel, exitance).
+/// normal; the light that reaches it without scattering (per channel, exitance); and per light
+/// the chance its walks' next events pick it ([`Adjoint::receiver_chances`]).
 struct Receiver {
     p: DVec3,
     n: DVec3,
     direct: [f64; 3],
+    chances: Vec<f64>,
 }
 
 /// What every walk of one object shares.
@@ -61,7 +63,7 @@ struct Adjoint<'a> {
     geometry: &'a Geometry<'a>,
     beams: Beams<'a>,
     lights: &'a [PreparedLight],
-    /// Per light, the chance a next event picks it (by its irradiance at the object).
+    /// Per light, its chance at the object (by its irradiance at the object's centre).
     chances: Vec<f64>,
     media: &'a [Medium; 3],
     /// How light enters: refracted for the reference.
@@ -223,7 +225,27 @@ impl Adjoint<'_> {
                 }
             }
         }
-        Receiver { p, n, direct }
+        let chances = self.receiver_chances(p, n);
+        Receiver { p, n, direct, chances }
+    }
+
+    /// Per light, the chance a next event of a walk from the vertex at `p` (outward normal `n`)
+    /// picks it: half by the light's share of what reaches the vertex itself (irradiance times
+    /// the cosine, where unshadowed), since most of a walk's score is gathered near its start,
+    /// half by the object's chances, so that every light that reaches the object somewhere
+    /// keeps a chance (unbiased). With no light at the vertex, the object's chances.
+    fn receiver_chances(&self, p: DVec3, n: DVec3) -> Vec<f64> {
+        let local: Vec<f64> = self
+            .lights
+            .iter()
+            .map(|l| crate::reference::reaching(l, self.beams.occluders, p, n, self.beams.eps))
+            .map(|r| r.map_or(0.0, |(_, e, cos)| e.element_sum() * cos))
+            .collect();
+        let total: f64 = local.iter().sum();
+        if total <= 0.0 {
+            return self.chances.clone();
+        }
+        local.iter().zip(&self.chances).map(|(l, g)| 0.5 * l / total + 0.5 * g).collect()
     }
 
     /// `k` walks from `r` in every channel: per channel the sums of the scores and of their
@@ -257,7 +279,7 @@ impl Adjoint<'_> {
             let Some(hit) = self.geometry.closest_hit(p, d, s, skip) else {
                 p += d * s;
                 skip = None;
-                score += w * albedo * self.next_event(p, d, c, rng);
+                score += w * albedo * self.next_event(p, d, (c, &r.chances), rng);
                 let Some(next) = after_collision(w, albedo, rng) else { return Some(score) };
                 w = next;
                 d = scatter(d, medium.g, rng);
@@ -281,9 +303,9 @@ impl Adjoint<'_> {
     }
 
     /// The light scattered at `q` towards `-d` (the walk looks along `d`) out of one light's
-    /// uncollided beam, the light drawn by [`Adjoint::chances`], over its chance; per unit of
-    /// the walk's weight times the albedo.
-    fn next_event(&self, q: DVec3, d: DVec3, c: usize, rng: &mut Pcg64) -> f64 {
+    /// uncollided beam, the light drawn by the receiver's `chances`, over its chance; per unit
+    /// of the walk's weight times the albedo, in channel `c`.
+    fn next_event(&self, q: DVec3, d: DVec3, (c, chances): (usize, &[f64]), rng: &mut Pcg64) -> f64 {
         let medium = &self.media[c];
         // Every beam reaching q has crossed at least the clearance: its attenuation is at most
         // exp(-sigma_t clearance). Deep inside, the next event is taken with that chance (times
@@ -294,10 +316,10 @@ impl Adjoint<'_> {
             return 0.0;
         }
         let chance = bound.min(1.0);
-        let Some(l) = pick(&self.chances, rng.random::<f64>()) else { return 0.0 };
+        let Some(l) = pick(chances, rng.random::<f64>()) else { return 0.0 };
         let way = Way { eta: medium.eta, entry: self.entry };
         let Some(Beam { irradiance, s, d: along }) = self.beams.at(&self.lights[l], q, way) else { return 0.0 };
-        irradiance[c] * (-medium.sigma_t() * s).exp() * phase(along.dot(-d), medium.g) / (self.chances[l] * chance)
+        irradiance[c] * (-medium.sigma_t() * s).exp() * phase(along.dot(-d), medium.g) / (chances[l] * chance)
     }
 }
 
