@@ -14,8 +14,8 @@
 //! a walk that meets the surface never looks straight at one. So at every collision `q` the
 //! walk scores the light scattered there out of the lights' uncollided beams (next-event
 //! estimation): `albedo p(cos) E_beam(q) exp(-sigma_t s)`, `p` the phase function, `E_beam` one
-//! light's beam through `q` ([`beam`](super::beam)), the light drawn in proportion to its
-//! irradiance at the object. Light that crosses the object without scattering and leaves at `x`
+//! light's beam through `q` ([`beam`](super::beam)), the light drawn half by what it brings
+//! the receiver and half by its irradiance at the object. Light that crosses the object without scattering and leaves at `x`
 //! is added once per receiver, exactly; the same light after internal reflections (a few
 //! percent of an `exp(-sigma_t L)` across the object) is left out.
 //!
