@@ -94,7 +94,17 @@ pub(super) fn object_adjoint(
         media,
         entry,
     };
-    let starts: Vec<Receiver> = receivers.par_iter().map(|&v| adjoint.receiver(v)).collect();
+    // Each vertex's first triangle and its corner there, once (not a search per receiver).
+    let mut corners = vec![None; mesh.positions().len()];
+    for (t, tri) in mesh.triangles().iter().enumerate() {
+        for (k, &v) in tri.iter().enumerate() {
+            corners[v as usize].get_or_insert((t, k));
+        }
+    }
+    let starts: Vec<Receiver> = receivers
+        .par_iter()
+        .map(|&v| adjoint.receiver(v, corners[v].expect("a vertex of a closed mesh is a corner of some triangle")))
+        .collect();
     let n = starts.len();
     let (mut sum, mut sum2, mut lost) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n], [0u64; 3]);
     let (mut walks, mut round, mut batch) = (0u64, 0u64, FIRST_ROUND);
@@ -199,16 +209,9 @@ pub(crate) fn per_vertex_noise(exitance: &[[f64; 3]], stderr: &[[f64; 3]], c: us
 }
 
 impl Adjoint<'_> {
-    /// Receiver `v`: its start and its direct light.
-    fn receiver(&self, v: usize) -> Receiver {
+    /// Receiver `v`, corner `corner` of triangle `t`: its start and its direct light.
+    fn receiver(&self, v: usize, (t, corner): (usize, usize)) -> Receiver {
         let geometry = self.geometry;
-        let (t, corner) = geometry
-            .mesh
-            .triangles()
-            .iter()
-            .enumerate()
-            .find_map(|(t, tri)| tri.iter().position(|&c| c as usize == v).map(|k| (t, k)))
-            .expect("a vertex of a closed mesh is a corner of some triangle");
         let mut bary = [0.0; 3];
         bary[corner] = 1.0;
         let n = geometry.shading_normal(t, bary);
