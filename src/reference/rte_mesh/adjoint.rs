@@ -29,6 +29,7 @@ use super::sources::Lighting;
 use super::walk::scatter;
 use crate::mesh::Mesh;
 use crate::optics::fresnel;
+use crate::optics::single_scatter::henyey_greenstein;
 use crate::reference::rte::{Medium, Progress, RteError, RteProgress, after_collision, after_reflection, chunk_rng};
 use crate::reference::truth::LIT_FLOOR;
 use super::{MeshOptions, ObjectExitance};
@@ -322,7 +323,7 @@ impl Adjoint<'_> {
         let Some(l) = pick(chances, rng.random::<f64>()) else { return 0.0 };
         let way = Way { eta: medium.eta, entry: self.entry };
         let Some(Beam { irradiance, s, d: along }) = self.beams.at(&self.lights[l], q, way) else { return 0.0 };
-        irradiance[c] * (-medium.sigma_t() * s).exp() * phase(along.dot(-d), medium.g) / (chances[l] * chance)
+        irradiance[c] * (-medium.sigma_t() * s).exp() * henyey_greenstein(along.dot(-d), medium.g) / (chances[l] * chance)
     }
 }
 
@@ -336,12 +337,6 @@ fn pick(chances: &[f64], u: f64) -> Option<usize> {
         }
     }
     chances.len().checked_sub(1)
-}
-
-/// The Henyey-Greenstein phase function at scattering cosine `cos` (per steradian).
-fn phase(cos: f64, g: f64) -> f64 {
-    let denom = 1.0 + g * g - 2.0 * g * cos;
-    (1.0 - g * g) / (4.0 * PI * denom * denom.sqrt())
 }
 
 /// A direction into the medium below the outward normal `n`, drawn by its cosine to `-n`

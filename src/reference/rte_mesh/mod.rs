@@ -54,7 +54,7 @@ pub use tally::relative_stderr;
 use super::rte::{Budget, Medium, Progress, RteError, chunk_rng, run_rounds};
 use super::{occluders, ray_offset};
 use crate::mesh::Mesh;
-use crate::scene::build::{PreparedScene, ResolvedMaterial};
+use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
 use crate::scene::accuracy::receiver_subset;
 use beam::Entry;
 use geometry::Geometry;
@@ -211,16 +211,10 @@ pub fn adjoint_at(
     progress: Progress,
 ) -> Result<ObjectExitance, RteError> {
     let o = &scene.objects[object];
-    let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else {
-        return Err(RteError::NotTranslucent { name: o.name.clone() });
-    };
-    if !o.mesh.report().is_closed_manifold() {
-        return Err(RteError::OpenMesh { name: o.name.clone() });
-    }
+    let media = media_of(o)?.ok_or_else(|| RteError::NotTranslucent { name: o.name.clone() })?;
     if let Some(&v) = receivers.iter().find(|&&v| v >= o.mesh.positions().len()) {
         return Err(RteError::NoSuchVertex { name: o.name.clone(), vertex: v, vertices: o.mesh.positions().len() });
     }
-    let media = dipoles.each_ref().map(Medium::reduced);
     let casters = occluders(scene);
     let lighting = Lighting { lights: &scene.lights, occluders: &casters, eps: ray_offset(scene) };
     adjoint::object_adjoint(&o.mesh, &media, &lighting, receivers, (options, Entry::Refracted), progress)
@@ -278,26 +272,30 @@ fn exitance_by(
         .objects
         .iter()
         .enumerate()
-        .map(|(i, o)| match &o.material {
-            ResolvedMaterial::Translucent { dipoles, .. } => {
-                if !o.mesh.report().is_closed_manifold() {
-                    return Err(RteError::OpenMesh { name: o.name.clone() });
+        .map(|(i, o)| {
+            let Some(media) = media_of(o)? else { return Ok(None) };
+            let options = MeshOptions { seed: options.seed.wrapping_add(i as u64), ..*options };
+            Ok(Some(match options.walk {
+                Walk::Photons | Walk::Auto { .. } => {
+                    object_exitance(&o.mesh, &media, &lighting, &options, progress, method)?
                 }
-                let media = dipoles.each_ref().map(Medium::reduced);
-                let options = MeshOptions { seed: options.seed.wrapping_add(i as u64), ..*options };
-                Ok(Some(match options.walk {
-                    Walk::Photons | Walk::Auto { .. } => {
-                        object_exitance(&o.mesh, &media, &lighting, &options, progress, method)?
-                    }
-                    Walk::Adjoint { receivers } => {
-                        let receivers = receiver_subset(o.mesh.positions().len(), receivers);
-                        adjoint::object_adjoint(&o.mesh, &media, &lighting, receivers, (&options, entry), progress)?
-                    }
-                }))
-            }
-            ResolvedMaterial::Opaque { .. } => Ok(None),
+                Walk::Adjoint { receivers } => {
+                    let receivers = receiver_subset(o.mesh.positions().len(), receivers);
+                    adjoint::object_adjoint(&o.mesh, &media, &lighting, receivers, (&options, entry), progress)?
+                }
+            }))
         })
         .collect()
+}
+
+/// The media the walks see in object `o`'s three channels (`Medium::reduced`), `None` for an
+/// opaque object; an object whose mesh has no inside is refused.
+fn media_of(o: &PreparedObject) -> Result<Option<[Medium; 3]>, RteError> {
+    let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else { return Ok(None) };
+    if !o.mesh.report().is_closed_manifold() {
+        return Err(RteError::OpenMesh { name: o.name.clone() });
+    }
+    Ok(Some(dipoles.each_ref().map(Medium::reduced)))
 }
 
 /// One object's exitance (see the module's documentation).
