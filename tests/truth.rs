@@ -349,9 +349,9 @@ fn an_edited_truth_cache_is_recomputed_never_trusted() {
 }
 
 /// Each level's memory is estimated before it runs, from its grids' sizes: the estimate counts
-/// exactly the `E_t` points the level then casts, grows with the level, and a limit under a
-/// level's estimate refuses that level (naming it, the estimate and the limit) while the same
-/// limit lets the levels before it run.
+/// exactly the `E_t` points the level then casts, its floor grows with the level, and a limit
+/// under a level's floor refuses that level (naming it, the estimate and the limit) while the
+/// same limit lets the levels before it run.
 #[test]
 fn a_truth_level_is_estimated_before_it_runs_and_refused_over_the_memory_limit() {
     let scene = prepare(&lit_marble_sphere(0.3));
@@ -363,8 +363,8 @@ fn a_truth_level_is_estimated_before_it_runs_and_refused_over_the_memory_limit()
         assert_eq!(estimate.points, level.irradiance_points, "level {}", level.level);
     }
     assert!(estimates.windows(2).all(|w| w[1].bytes > w[0].bytes), "{estimates:?}");
-    // At least 24 bytes (an f64 RGB) a point.
-    assert!(estimates.iter().all(|e| e.bytes >= 24 * e.points as u64), "{estimates:?}");
+    // Held whole, at least 24 bytes (an f64 RGB) a point; the floor is less.
+    assert!(estimates.iter().all(|e| e.whole >= 24 * e.points as u64), "{estimates:?}");
 
     let limit = estimates[2].bytes - 1;
     let limited = truth::TruthOptions { memory: Some(limit), ..options };
@@ -382,4 +382,26 @@ fn a_truth_level_is_estimated_before_it_runs_and_refused_over_the_memory_limit()
     assert!(truth::compute(&scene, &fits, &quiet).is_ok());
     let unlimited = truth::TruthOptions { max_level: 1, memory: None, ..options };
     assert_eq!(truth::content_key(&scene, &fits), truth::content_key(&scene, &unlimited));
+}
+
+/// Issue 47: the truth streams. A level whose grids do not fit the memory limit keeps their
+/// summaries and the rays' verdicts, and makes the grids again a chunk at a time as receivers
+/// need them; the truth it gives is the same, bit for bit, as with no limit, and a limit that
+/// holds no verdicts either (every grid ray cast again) gives the same bits too.
+#[test]
+fn the_truth_streams_its_grids_within_a_memory_limit_and_gives_the_same_bits() {
+    let scene = prepare(&lit_marble_sphere(0.3));
+    let options = truth::TruthOptions { max_level: 2, tolerance: 0.0, memory: Some(16 << 30), ..Default::default() };
+    let whole = truth::compute(&scene, &options, &quiet).unwrap();
+    let estimate = truth::memory_estimate(&scene, 2);
+    // Room for a few grids at a time: far less than the level's grids held whole.
+    let streamed_limit = estimate.bytes + estimate.whole / 8;
+    assert!(streamed_limit < estimate.whole, "{estimate:?}");
+    for limit in [streamed_limit, estimate.bytes + 1] {
+        let streamed = truth::compute(&scene, &truth::TruthOptions { memory: Some(limit), ..options }, &quiet).unwrap();
+        assert_eq!(streamed.checksum, whole.checksum, "limit {limit}");
+        for (a, b) in streamed.exitance.iter().flatten().zip(whole.exitance.iter().flatten()) {
+            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits), "limit {limit}");
+        }
+    }
 }

@@ -54,7 +54,7 @@ pub struct Args {
     #[arg(long, value_name = "N")]
     pub truth_receivers: Option<usize>,
     /// The most memory one level of the truth may take, e.g. 4G or 500M (binary units; default:
-    /// a quarter of the memory available when the level starts, at most 4G); a level estimated
+    /// a quarter of the memory available when the level starts, at most 1G); a level estimated
     /// over it is refused
     #[arg(long, value_name = "SIZE")]
     pub truth_memory: Option<String>,

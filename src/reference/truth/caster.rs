@@ -63,6 +63,12 @@ impl TrianglePlan {
     pub(super) fn depth(&self, level: u32) -> u32 {
         self.base + level + self.extra
     }
+
+    /// What the grid at `level` knows without a ray: nothing on the base grid, the base grid's
+    /// verdicts on the finer ones.
+    pub(super) fn known(&self, level: u32) -> Visibility {
+        if self.depth(level) == self.base { Visibility::TRACE_ALL } else { self.finer }
+    }
 }
 
 impl<'a> Caster<'a> {
@@ -96,7 +102,7 @@ impl<'a> Caster<'a> {
         // shadows; back-facing points cost no ray). The others keep the base grid's
         // verdict, so a shadow narrower than the base grid that touches none of its points
         // is missed at every level.
-        let (_, reached, blocked) = self.grid(&corners, normals, base, Visibility::TRACE_ALL);
+        let (reached, blocked) = self.verdicts(&corners, normals, base);
         let edges = reached & blocked;
         let unknown = !(reached | blocked);
         TrianglePlan {
@@ -106,37 +112,129 @@ impl<'a> Caster<'a> {
         }
     }
 
-    /// Triangle `t` of `mesh` as a source at `level`, refined as `plan` says.
-    pub(super) fn source(&self, mesh: &Mesh, t: usize, plan: &TrianglePlan, level: u32) -> Source {
+    /// Triangle `t` of `mesh` as a source at `level`, refined as `plan` says, and with `keep`
+    /// what its rays found ([`Shadows`]), so that the same source can be made again without a
+    /// ray ([`Caster::source_again`]); none where the scene has more lights than a mask holds.
+    pub(super) fn source_and_shadows(
+        &self,
+        mesh: &Mesh,
+        t: usize,
+        plan: &TrianglePlan,
+        level: u32,
+        keep: bool,
+    ) -> (Source, Option<Shadows>) {
         let corners = mesh.corners(t);
         let normals = mesh.triangles()[t].map(|i| self.normals[i as usize].as_dvec3());
         let depth = plan.depth(level);
-        let known = if depth == plan.base { Visibility::TRACE_ALL } else { plan.finer };
-        let grid = self.grid(&corners, normals, depth, known).0;
-        Source::new(corners, depth, grid, mesh.triangle_areas()[t])
+        let known = plan.known(level);
+        let (grid, blocked) = self.grid(&corners, normals, depth, |_| known);
+        let shadows = (keep && self.scene.lights.len() <= 64).then(|| Shadows::pack(known.trace, &blocked));
+        (Source::new(corners, depth, grid, mesh.triangle_areas()[t]), shadows)
     }
 
-    /// `E_t` at the grid points of a triangle's grid at `depth` (at [`grid_index`]), with the
-    /// lights that reached and that were blocked at any of them or at the centroid. Normals are
-    /// interpolated from the corners'; `known` says which lights need no ray.
-    fn grid(&self, corners: &[DVec3; 3], normals: [DVec3; 3], depth: u32, known: Visibility) -> (Vec<DVec3>, u64, u64) {
-        let [a, b, c] = normals;
+    /// The source [`Caster::source_and_shadows`] made, made again for its pieces (without the
+    /// second moments, which its summary keeps): from its `shadows` without a ray, else ray
+    /// cast again. The same bits.
+    pub(super) fn source_again(
+        &self,
+        mesh: &Mesh,
+        t: usize,
+        plan: &TrianglePlan,
+        level: u32,
+        shadows: Option<&Shadows>,
+    ) -> Source {
+        let corners = mesh.corners(t);
+        let normals = mesh.triangles()[t].map(|i| self.normals[i as usize].as_dvec3());
+        let depth = plan.depth(level);
+        let known = plan.known(level);
+        let at = |k: usize| match shadows {
+            Some(shadows) => Visibility { trace: 0, blocked: (known.blocked & !known.trace) | shadows.blocked(k) },
+            None => known,
+        };
+        let (grid, _) = self.grid(&corners, normals, depth, at);
+        Source::pieces_only(corners, depth, grid, mesh.triangle_areas()[t])
+    }
+
+    /// `E_t` at the grid points of a triangle's grid at `depth` (at [`grid_index`]), and the
+    /// lights blocked at each. Normals are interpolated from the corners'; `known(k)` says which
+    /// lights need no ray at point `k`.
+    fn grid(
+        &self,
+        corners: &[DVec3; 3],
+        normals: [DVec3; 3],
+        depth: u32,
+        known: impl Fn(usize) -> Visibility,
+    ) -> (Vec<DVec3>, Vec<u64>) {
         let n = 1usize << depth;
         let mut grid = vec![DVec3::ZERO; (n + 1) * (n + 2) / 2];
-        let at = |u: f64, v: f64| {
-            let p = triangle_point(corners, u, v);
-            let normal = a * (1.0 - u - v) + b * u + c * v;
-            transmitted_irradiance_known(self.scene, self.occluders, p, normal, self.eta, self.eps, known)
-        };
-        let (mut reached, mut blocked) = (0u64, 0u64);
+        let mut blocked = vec![0u64; grid.len()];
         for i in 0..=n {
             for j in 0..=n - i {
-                let (e, r, b) = at(i as f64 / n as f64, j as f64 / n as f64);
-                grid[grid_index(i, j, n)] = e;
-                (reached, blocked) = (reached | r, blocked | b);
+                let k = grid_index(i, j, n);
+                let (e, _, b) = self.at(corners, normals, i as f64 / n as f64, j as f64 / n as f64, known(k));
+                (grid[k], blocked[k]) = (e, b);
             }
         }
-        let (_, r, b) = at(1.0 / 3.0, 1.0 / 3.0);
-        (grid, reached | r, blocked | b)
+        (grid, blocked)
+    }
+
+    /// The lights that reached and that were blocked at any point of the grid at `depth` or at
+    /// the centroid, every light ray cast.
+    fn verdicts(&self, corners: &[DVec3; 3], normals: [DVec3; 3], depth: u32) -> (u64, u64) {
+        let n = 1usize << depth;
+        let (mut reached, mut blocked) = (0u64, 0u64);
+        let centroid = [(n as f64 / 3.0, n as f64 / 3.0)];
+        let points = (0..=n).flat_map(|i| (0..=n - i).map(move |j| (i as f64, j as f64))).chain(centroid);
+        for (i, j) in points {
+            let (_, r, b) = self.at(corners, normals, i / n as f64, j / n as f64, Visibility::TRACE_ALL);
+            (reached, blocked) = (reached | r, blocked | b);
+        }
+        (reached, blocked)
+    }
+
+    /// `E_t` at `(u, v)` of a triangle, with the lights that reached and that were blocked.
+    fn at(&self, corners: &[DVec3; 3], [a, b, c]: [DVec3; 3], u: f64, v: f64, known: Visibility) -> (DVec3, u64, u64) {
+        let p = triangle_point(corners, u, v);
+        let normal = a * (1.0 - u - v) + b * u + c * v;
+        transmitted_irradiance_known(self.scene, self.occluders, p, normal, self.eta, self.eps, known)
+    }
+}
+
+/// What the rays of one triangle's grid found: per grid point, which of the lights it ray cast
+/// were blocked, packed a bit a light (`known.trace`'s lights only; the others the plan knows).
+pub(super) struct Shadows {
+    /// The traced lights' bits, in order.
+    lights: Vec<u64>,
+    bits: Vec<u64>,
+}
+
+impl Shadows {
+    fn pack(trace: u64, blocked: &[u64]) -> Shadows {
+        let lights: Vec<u64> = (0..64).map(|i| 1u64 << i).filter(|b| trace & b != 0).collect();
+        let k = lights.len();
+        let mut bits = vec![0u64; (blocked.len() * k).div_ceil(64)];
+        for (p, mask) in blocked.iter().enumerate() {
+            for (j, light) in lights.iter().enumerate() {
+                if mask & light != 0 {
+                    let at = p * k + j;
+                    bits[at / 64] |= 1 << (at % 64);
+                }
+            }
+        }
+        Shadows { lights, bits }
+    }
+
+    /// The traced lights blocked at grid point `p`.
+    fn blocked(&self, p: usize) -> u64 {
+        let k = self.lights.len();
+        self.lights.iter().enumerate().fold(0, |m, (j, light)| {
+            let at = p * k + j;
+            if self.bits[at / 64] >> (at % 64) & 1 != 0 { m | light } else { m }
+        })
+    }
+
+    /// Bytes these shadows take for a grid of `points` points and `traced` lights.
+    pub(super) fn bytes(points: usize, traced: u64) -> u64 {
+        ((points * traced.count_ones() as usize).div_ceil(64) * 8 + size_of::<Shadows>()) as u64
     }
 }

@@ -1,7 +1,7 @@
 //! A binary tree over an object's lit triangles, each node carrying the moments of the
 //! triangles below it, so that a receiver takes a far group of them as one multipole.
 
-use super::source::{Moments, Source};
+use super::source::{Moments, Summary};
 use glam::DVec3;
 
 /// A node of the tree of lit triangles: their moments about each channel's centroid and a
@@ -9,7 +9,7 @@ use glam::DVec3;
 pub(super) struct Cluster {
     pub(super) moments: Moments,
     pub(super) centroid: [DVec3; 3],
-    /// Second moments about `centroid`, as [`Source::quadrupole`].
+    /// Second moments about `centroid`, as [`Summary::quadrupole`].
     pub(super) quadrupole: [[f64; 6]; 3],
     pub(super) centre: DVec3,
     pub(super) radius: f64,
@@ -27,7 +27,7 @@ pub(super) struct Clusters {
 }
 
 impl Clusters {
-    pub(super) fn new(lit: &[&Source]) -> Clusters {
+    pub(super) fn new(lit: &[Summary]) -> Clusters {
         let mut nodes = Vec::with_capacity(2 * lit.len());
         let mut members: Vec<usize> = (0..lit.len()).collect();
         Self::build(lit, &mut members, &mut nodes);
@@ -35,9 +35,9 @@ impl Clusters {
     }
 
     /// Append the subtree over `members` (post-order) and return its root's index.
-    fn build(lit: &[&Source], members: &mut [usize], nodes: &mut Vec<Cluster>) -> usize {
+    fn build(lit: &[Summary], members: &mut [usize], nodes: &mut Vec<Cluster>) -> usize {
         if let [only] = members {
-            let s = lit[*only];
+            let s = &lit[*only];
             nodes.push(Cluster {
                 moments: Moments { flux: s.flux, moment: [0, 1, 2].map(|c| s.centroid[c] * s.flux[c]) },
                 centroid: s.centroid,

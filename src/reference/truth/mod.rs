@@ -41,6 +41,16 @@
 //! its RMS is under the tolerance (1e-4), and the finer level is kept. `Truth::levels` reports
 //! every step, so a reader can see it converge.
 //!
+//! # Memory
+//!
+//! A level's grids grow four times a level, so they are not all held ([`store`]): a first pass
+//! ray casts them all and keeps each triangle's summary (its moments as a whole), and within
+//! three quarters of the memory limit its rays' verdicts or its whole grid; receivers then take
+//! their far field from the summaries and integrate the triangles they need piece by piece,
+//! those grids made again a chunk at a time. The result does not depend on the limit, bit for
+//! bit; only a level whose floor (what grows with the mesh and the receivers, [`LevelMemory`])
+//! is over the limit is refused.
+//!
 //! # Receivers
 //!
 //! On a large mesh the truth may be asked for at a subset of the vertices
@@ -55,12 +65,13 @@ mod clusters;
 mod memory;
 mod quadrature;
 mod source;
+mod store;
 
 /// The vertices the truth is computed at (`scene::accuracy`, where occlusion picks them too).
 pub use crate::scene::accuracy::receiver_subset;
+pub use cache::FolderProblem;
 pub(crate) use cache::{Fnv, folder_problem};
 pub use cache::{cached, content_key, default_cache_dir};
-pub use cache::FolderProblem;
 pub use memory::{
     DEFAULT_MEMORY_CAP, LevelMemory, MemoryLimitKind, available_memory, default_memory_limit, human_bytes,
     memory_estimate,
@@ -70,12 +81,11 @@ use super::{occluders, ray_offset};
 use crate::mesh::bvh::Bvh;
 use crate::scene::build::{PreparedScene, ResolvedMaterial};
 use caster::{Caster, TrianglePlan, plans};
-use memory::check_memory;
+use memory::{Budget, check_memory};
 use quadrature::exitance_at_vertices;
-use rayon::prelude::*;
-use source::Source;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
+use store::Sources;
 
 /// Relative RMS change between two levels, over lit receivers, under which the truth counts
 /// as converged.
@@ -191,10 +201,11 @@ pub fn compute(scene: &PreparedScene, options: &TruthOptions, progress: Progress
     let mut previous: Option<Vec<Vec<[f64; 3]>>> = None;
     let mut converged = false;
     for level in 0..=options.max_level {
-        check_memory(scene, &plans, level, options, &levels)?;
+        let budget = check_memory(scene, &plans, level, options, &levels)?;
         let start = std::time::Instant::now();
         let eta = 0.4 * 0.5f64.powf(f64::from(level) / 2.0);
-        let (exitance, points) = level_exitance(scene, &occluders, eps, &plans, level, options, progress);
+        let cast = Cast { occluders: &occluders, eps, plans: &plans };
+        let (exitance, points) = level_exitance(scene, &cast, level, options.receivers, budget, progress);
         let (change_rms, change_max) = match &previous {
             Some(p) => {
                 let (rms, max) = relative_change(p, &exitance);
@@ -231,44 +242,53 @@ pub fn compute(scene: &PreparedScene, options: &TruthOptions, progress: Progress
 }
 
 /// Every object's exitance at `level` (all zero for an opaque one), and the `E_t` points ray
-/// cast for it. One object's sources at a time: they are dropped before the next object's.
+/// cast for it, at `receivers` per object at most. One object's sources at a time, held within
+/// `budget`: they are dropped before the next object's.
 fn level_exitance(
     scene: &PreparedScene,
-    occluders: &Bvh,
-    eps: f64,
-    plans: &[Option<Vec<TrianglePlan>>],
+    cast: &Cast,
     level: u32,
-    options: &TruthOptions,
+    receivers: Option<usize>,
+    budget: Budget,
     progress: Progress,
 ) -> (Vec<Vec<[f64; 3]>>, usize) {
     let eta = 0.4 * 0.5f64.powf(f64::from(level) / 2.0);
     let mut points = 0;
-    let receivers: usize =
-        scene.objects.iter().map(|o| receiver_subset(o.mesh.positions().len(), options.receivers).len()).sum();
+    let total: usize = scene.objects.iter().map(|o| receiver_subset(o.mesh.positions().len(), receivers).len()).sum();
     let done = AtomicUsize::new(0);
+    let tick = |n| {
+        let d = done.fetch_add(n, Ordering::Relaxed) + n;
+        progress(level, d, total);
+    };
     let exitance = scene
         .objects
         .iter()
-        .zip(plans)
-        .map(|(o, plan)| match (&o.material, plan) {
-            (ResolvedMaterial::Translucent { material, dipoles, .. }, Some(plan)) => {
-                let caster = Caster::new(scene, occluders, o, material.eta, eps);
-                let sources: Vec<Source> =
-                    plan.par_iter().enumerate().map(|(t, p)| caster.source(&o.mesh, t, p, level)).collect();
-                points += sources.iter().map(|s| s.grid.len()).sum::<usize>();
-                let subset = receiver_subset(o.mesh.positions().len(), options.receivers);
-                exitance_at_vertices(o, &subset, dipoles, &sources, eta, &|n| {
-                    let d = done.fetch_add(n, Ordering::Relaxed) + n;
-                    progress(level, d, receivers);
-                })
-            }
-            _ => {
-                done.fetch_add(receiver_subset(o.mesh.positions().len(), options.receivers).len(), Ordering::Relaxed);
-                vec![[0.0; 3]; o.mesh.positions().len()]
+        .zip(cast.plans)
+        .map(|(o, plan)| {
+            let subset = receiver_subset(o.mesh.positions().len(), receivers);
+            match (&o.material, plan) {
+                (ResolvedMaterial::Translucent { material, dipoles, .. }, Some(plan)) => {
+                    let caster = Caster::new(scene, cast.occluders, o, material.eta, cast.eps);
+                    let sources = Sources::build(&caster, &o.mesh, plan, level, budget.sources);
+                    points += sources.points;
+                    exitance_at_vertices(o, &subset, dipoles, &sources, eta, budget.notes, &tick)
+                }
+                _ => {
+                    tick(subset.len());
+                    vec![[0.0; 3]; o.mesh.positions().len()]
+                }
             }
         })
         .collect();
     (exitance, points)
+}
+
+/// What ray casting needs of the scene, made once for every level: the shadow casters, the
+/// rays' offset and each object's triangle plans.
+struct Cast<'a> {
+    occluders: &'a Bvh,
+    eps: f64,
+    plans: &'a [Option<Vec<TrianglePlan>>],
 }
 
 /// Relative change from `a` to `b` over the receivers lit in `b` ([`LIT_FLOOR`]): RMS and
@@ -309,7 +329,7 @@ pub enum TruthError {
         match kind {
             MemoryLimitKind::Given => "limit given",
             MemoryLimitKind::Default =>
-                "default limit (a quarter of the memory available, at most 4 GiB; --truth-memory sets another)",
+                "default limit (a quarter of the memory available, at most 1 GiB; --truth-memory sets another)",
         },
         last_change.map_or(String::new(), |c| format!(
             "; level {} changed by {c:.2e} RMS from the one before, not yet converged",

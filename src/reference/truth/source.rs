@@ -28,6 +28,25 @@ pub(super) struct Source {
     pyramid: Vec<Moments>,
 }
 
+/// What the cluster tree and a receiver's first look need of a triangle at one level: its
+/// moments as a whole and its bounding sphere (a few hundred bytes, where its grid and pyramid
+/// may take megabytes).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Summary {
+    /// The mesh triangle.
+    pub(super) triangle: usize,
+    /// Its grid's depth and point count.
+    pub(super) depth: u32,
+    pub(super) points: usize,
+    /// As [`Source::flux`], [`Source::centroid`], [`Source::quadrupole`], [`Source::centre`]
+    /// and [`Source::radius`].
+    pub(super) flux: [f64; 3],
+    pub(super) centroid: [DVec3; 3],
+    pub(super) quadrupole: [[f64; 6]; 3],
+    pub(super) centre: DVec3,
+    pub(super) radius: f64,
+}
+
 /// The pyramid leaves out the pieces this many splits above a grid cell (4 cells each): its
 /// last level held 3/4 of it, twice the grid's own memory, and a receiver asks for those
 /// pieces only where the kernel is not smooth over them. (Leaving out two levels saved a third
@@ -127,6 +146,20 @@ impl Source {
         sum
     }
 
+    /// This source as a whole, for triangle `triangle`.
+    pub(super) fn summary(&self, triangle: usize) -> Summary {
+        Summary {
+            triangle,
+            depth: self.depth,
+            points: self.grid.len(),
+            flux: self.flux,
+            centroid: self.centroid,
+            quadrupole: self.quadrupole,
+            centre: self.centre,
+            radius: self.radius,
+        }
+    }
+
     /// Heap and inline bytes of a source whose grid is at `depth`.
     pub(super) fn bytes(depth: u32) -> u64 {
         (grid_points(depth) * std::mem::size_of::<DVec3>()
@@ -181,6 +214,14 @@ impl Source {
     /// A triangle's source from its `E_t` grid at `depth`: its moment pyramid, flux, centroid
     /// and second moments, and its bounding sphere.
     pub(super) fn new(corners: [DVec3; 3], depth: u32, grid: Vec<DVec3>, area: f64) -> Source {
+        let mut s = Source::pieces_only(corners, depth, grid, area);
+        s.quadrupole = s.second_moments();
+        s
+    }
+
+    /// [`Source::new`] without the second moments: what [`Source::moments`] and
+    /// [`Source::irradiance`] need of a triangle integrated piece by piece.
+    pub(super) fn pieces_only(corners: [DVec3; 3], depth: u32, grid: Vec<DVec3>, area: f64) -> Source {
         let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
         let radius = corners.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
         let mut s = Source {
@@ -198,7 +239,6 @@ impl Source {
         let whole = s.build_pyramid(WHOLE, 0, 0);
         s.centroid = whole.centroid(centre);
         s.flux = whole.flux;
-        s.quadrupole = s.second_moments();
         s
     }
 
