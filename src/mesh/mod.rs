@@ -14,6 +14,7 @@ pub mod bvh;
 mod curvature;
 mod enclosure;
 mod lod;
+mod gltf;
 mod obj;
 pub mod shapes;
 mod topology;
@@ -25,6 +26,7 @@ use glam::{DVec3, Vec3};
 pub use boundary::NO_BOUNDARY;
 pub use enclosure::{Enclosure, enclosure};
 pub use lod::{LodLevel, MIN_LEVEL_TRIANGLES};
+pub use gltf::{GltfProblem, glb_bytes};
 pub use obj::{Element, LoadOptions, ObjProblem};
 
 /// Marks an edge with no single neighbouring triangle (an open boundary or a non-manifold edge).
@@ -123,9 +125,23 @@ pub enum MeshError {
         /// How many triangles were dropped as degenerate.
         degenerate: usize,
     },
+    /// A glTF file that cannot be read as a mesh.
+    #[error("{source_name}: {problem}")]
+    Gltf {
+        /// The file name, or `<memory>`.
+        source_name: String,
+        /// What is wrong with it.
+        problem: Box<GltfProblem>,
+    },
     /// [`LoadOptions`] with a zero or non-finite scale, or a non-finite or singular transform.
     #[error("invalid mesh load options: {0}")]
     InvalidOptions(LoadOptionsError),
+}
+
+/// Whether `path` names a glTF file (`.gltf` or `.glb`, any case); every other mesh is read
+/// as OBJ.
+pub fn is_gltf(path: &std::path::Path) -> bool {
+    path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
 }
 
 /// What is wrong with a [`LoadOptions`] ([`MeshError::InvalidOptions`]).
@@ -201,7 +217,7 @@ impl Mesh {
     /// recomputed from the geometry.
     pub fn load(path: impl AsRef<std::path::Path>, options: &LoadOptions) -> Result<Mesh, MeshError> {
         let path = path.as_ref();
-        let loaded = obj::load(path, options)?;
+        let loaded = if is_gltf(path) { gltf::load(path, options)? } else { obj::load(path, options)? };
         Mesh::build(path.display().to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
     }
 
@@ -209,6 +225,18 @@ impl Mesh {
     /// validation as [`Mesh::load`]; `source_name` names it in errors.
     pub fn from_obj_text(text: &str, source_name: &str, options: &LoadOptions) -> Result<Mesh, MeshError> {
         let loaded = obj::parse(text, source_name, options)?;
+        Mesh::build(source_name.to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
+    }
+
+    /// Parse a glTF 2.0 file in memory (a `.glb`, or a `.gltf` whose buffers are files in
+    /// `base`), with the same validation as [`Mesh::load`]; `source_name` names it in errors.
+    pub fn from_gltf_slice(
+        bytes: &[u8],
+        source_name: &str,
+        base: Option<&std::path::Path>,
+        options: &LoadOptions,
+    ) -> Result<Mesh, MeshError> {
+        let loaded = gltf::parse(bytes, source_name, base, options)?;
         Mesh::build(source_name.to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
     }
 

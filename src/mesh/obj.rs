@@ -36,7 +36,7 @@ impl LoadOptions {
         self
     }
 
-    fn validate(&self) -> Result<(), MeshError> {
+    pub(super) fn validate(&self) -> Result<(), MeshError> {
         if !self.scale.is_finite() || self.scale == 0.0 {
             return Err(MeshError::InvalidOptions(super::LoadOptionsError::Scale(self.scale)));
         }
@@ -48,7 +48,7 @@ impl LoadOptions {
 
     /// A mirroring placement turns counter-clockwise triangles clockwise; the loader swaps
     /// their winding back so normals keep pointing outwards.
-    fn mirrors(&self) -> bool {
+    pub(super) fn mirrors(&self) -> bool {
         (self.transform.determinant() as f64) * (self.scale as f64).powi(3) < 0.0
     }
 }

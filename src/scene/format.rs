@@ -86,10 +86,11 @@ fn yes() -> bool {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields, tag = "type", rename_all = "lowercase")]
 pub enum Shape {
-    /// An OBJ file; `path` is relative to the scene file (the built-in scene resolves it among
-    /// the embedded assets).
+    /// An OBJ file, or a glTF 2.0 file (`.gltf` with its buffer files, or `.glb`: every
+    /// triangle primitive of its scene, placed by its nodes); `path` is relative to the scene
+    /// file (the built-in scene resolves it among the embedded assets).
     Mesh {
-        /// Path of the OBJ file (required, not empty).
+        /// Path of the OBJ or glTF file (required, not empty).
         path: String,
     },
     /// A square in the xz plane, centred at the origin, facing +y, `size` units wide,

@@ -1,0 +1,229 @@
+//! glTF 2.0 meshes (issue 48): a `.glb`, or a `.gltf` with its buffers in files beside it. Every
+//! triangle primitive of the file's scene (the default one, else the first), placed by its
+//! nodes' transforms, becomes part of one mesh, in node order, as the OBJ loader makes one mesh
+//! of an OBJ's groups.
+
+use super::MeshError;
+use super::obj::{LoadOptions, Loaded};
+use glam::{Mat4, Vec3};
+use std::path::Path;
+
+/// What is wrong with a glTF file ([`MeshError::Gltf`]).
+#[derive(Debug, thiserror::Error)]
+pub enum GltfProblem {
+    /// The gltf crate could not parse or validate it.
+    #[error("not a valid glTF 2.0 file: {0}")]
+    Parse(#[from] ::gltf::Error),
+    /// A buffer given as a `data:` URI (not read: give it as a `.bin` file or use `.glb`).
+    #[error("buffer {buffer} is a data: URI; save the file as .glb or with a .bin file")]
+    DataUri {
+        /// The buffer's index.
+        buffer: usize,
+    },
+    /// A buffer's file could not be read.
+    #[error("buffer {buffer}: cannot read {}: {source}", path.display())]
+    BufferFile {
+        /// The buffer's index.
+        buffer: usize,
+        /// The file it names.
+        path: std::path::PathBuf,
+        /// Why reading failed.
+        source: std::io::Error,
+    },
+    /// A buffer names the binary chunk, and the file has none.
+    #[error("buffer {buffer} is the binary chunk, and the file has none")]
+    NoBinaryChunk {
+        /// The buffer's index.
+        buffer: usize,
+    },
+    /// A buffer holds fewer bytes than its `byteLength`.
+    #[error("buffer {buffer} holds {found} bytes, less than its byteLength {declared}")]
+    ShortBuffer {
+        /// The buffer's index.
+        buffer: usize,
+        /// Bytes there.
+        found: usize,
+        /// Its `byteLength`.
+        declared: usize,
+    },
+    /// A primitive draws points, lines or strips instead of triangles.
+    #[error("mesh {mesh} primitive {primitive} (node {node}) draws {mode:?}; only triangles are read")]
+    NotTriangles {
+        /// The node that places the mesh.
+        node: usize,
+        /// The mesh.
+        mesh: usize,
+        /// The primitive, within the mesh.
+        primitive: usize,
+        /// Its mode.
+        mode: ::gltf::mesh::Mode,
+    },
+    /// A primitive has no POSITION accessor, or one that cannot be read.
+    #[error("mesh {mesh} primitive {primitive} (node {node}): no readable POSITION accessor")]
+    NoPositions {
+        /// The node that places the mesh.
+        node: usize,
+        /// The mesh.
+        mesh: usize,
+        /// The primitive, within the mesh.
+        primitive: usize,
+    },
+    /// An index is past the primitive's vertices, or the indices are not whole triangles.
+    #[error("mesh {mesh} primitive {primitive} (node {node}): accessor {accessor} {why}")]
+    BadIndices {
+        /// The node that places the mesh.
+        node: usize,
+        /// The mesh.
+        mesh: usize,
+        /// The primitive, within the mesh.
+        primitive: usize,
+        /// The indices' accessor.
+        accessor: usize,
+        /// What is wrong.
+        why: String,
+    },
+    /// The file has no scene, or its scene places no mesh.
+    #[error("no scene places a mesh")]
+    NoMesh,
+}
+
+/// Read the glTF at `path` ([`super::Mesh::load`] for a `.gltf` or `.glb`).
+pub(super) fn load(path: &Path, options: &LoadOptions) -> Result<Loaded, MeshError> {
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_path_buf(), source })?;
+    parse(&bytes, &path.display().to_string(), path.parent(), options)
+}
+
+/// Parse a glTF already in memory; `source_name` names it in errors, and `base` is where its
+/// buffer files are (`None`: only a `.glb`'s own binary chunk can be read).
+pub(super) fn parse(
+    bytes: &[u8],
+    source_name: &str,
+    base: Option<&Path>,
+    options: &LoadOptions,
+) -> Result<Loaded, MeshError> {
+    options.validate()?;
+    let fail = |problem| MeshError::Gltf { source_name: source_name.to_string(), problem: Box::new(problem) };
+    let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| fail(GltfProblem::Parse(e)))?;
+    let buffers = buffers(&file, base).map_err(fail)?;
+    let scene = file.default_scene().or_else(|| file.scenes().next()).ok_or_else(|| fail(GltfProblem::NoMesh))?;
+    let mut out = Loaded { positions: Vec::new(), triangles: Vec::new(), flip_winding: false };
+    for node in scene.nodes() {
+        place(&node, Mat4::IDENTITY, &buffers, &mut out).map_err(fail)?;
+    }
+    if out.triangles.is_empty() {
+        return Err(fail(GltfProblem::NoMesh));
+    }
+    if options.scale != 1.0 || options.transform != Mat4::IDENTITY {
+        for p in &mut out.positions {
+            *p = options.transform.transform_point3(*p * options.scale);
+        }
+    }
+    out.flip_winding = options.mirrors();
+    Ok(out)
+}
+
+/// Every buffer's bytes: the binary chunk, or a file relative to `base`.
+fn buffers(file: &::gltf::Gltf, base: Option<&Path>) -> Result<Vec<Vec<u8>>, GltfProblem> {
+    file.buffers()
+        .map(|b| {
+            let buffer = b.index();
+            let data = match b.source() {
+                ::gltf::buffer::Source::Bin => file.blob.clone().ok_or(GltfProblem::NoBinaryChunk { buffer })?,
+                ::gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                    return Err(GltfProblem::DataUri { buffer });
+                }
+                ::gltf::buffer::Source::Uri(uri) => {
+                    let path = base.unwrap_or(Path::new(".")).join(uri);
+                    std::fs::read(&path).map_err(|source| GltfProblem::BufferFile { buffer, path, source })?
+                }
+            };
+            if data.len() < b.length() {
+                return Err(GltfProblem::ShortBuffer { buffer, found: data.len(), declared: b.length() });
+            }
+            Ok(data)
+        })
+        .collect()
+}
+
+/// Append `node`'s mesh and its children's, placed by `parent` times the node's own transform.
+/// A mirroring transform has its triangles' winding swapped, so that they keep facing out.
+fn place(node: &::gltf::Node, parent: Mat4, buffers: &[Vec<u8>], out: &mut Loaded) -> Result<(), GltfProblem> {
+    let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+    if let Some(mesh) = node.mesh() {
+        for primitive in mesh.primitives() {
+            let at = (node.index(), mesh.index(), primitive.index());
+            append(&primitive, at, world, buffers, out)?;
+        }
+    }
+    for child in node.children() {
+        place(&child, world, buffers, out)?;
+    }
+    Ok(())
+}
+
+/// Append one triangle primitive, its positions placed by `world`.
+fn append(
+    primitive: &::gltf::Primitive,
+    (node, mesh, index): (usize, usize, usize),
+    world: Mat4,
+    buffers: &[Vec<u8>],
+    out: &mut Loaded,
+) -> Result<(), GltfProblem> {
+    if primitive.mode() != ::gltf::mesh::Mode::Triangles {
+        return Err(GltfProblem::NotTriangles { node, mesh, primitive: index, mode: primitive.mode() });
+    }
+    let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let positions: Vec<Vec3> = reader
+        .read_positions()
+        .ok_or(GltfProblem::NoPositions { node, mesh, primitive: index })?
+        .map(|p| world.transform_point3(Vec3::from(p)))
+        .collect();
+    let count = positions.len();
+    let indices: Vec<u32> = match reader.read_indices() {
+        Some(i) => i.into_u32().collect(),
+        None => (0..count as u32).collect(),
+    };
+    let bad = |why: String| GltfProblem::BadIndices {
+        node,
+        mesh,
+        primitive: index,
+        accessor: primitive.indices().map_or(usize::MAX, |a| a.index()),
+        why,
+    };
+    if !indices.len().is_multiple_of(3) {
+        return Err(bad(format!("holds {} indices, not whole triangles", indices.len())));
+    }
+    if let Some(&i) = indices.iter().find(|&&i| i as usize >= count) {
+        return Err(bad(format!("refers to vertex {i}, but the primitive has {count}")));
+    }
+    let base = out.positions.len() as u32;
+    let mirrored = world.determinant() < 0.0;
+    out.triangles.extend(indices.chunks_exact(3).map(|t| {
+        let [a, b, c] = [t[0] + base, t[1] + base, t[2] + base];
+        if mirrored { [a, c, b] } else { [a, b, c] }
+    }));
+    out.positions.extend(positions);
+    Ok(())
+}
+
+/// A binary glTF (`.glb`) holding `json` and the binary chunk `bin`, each padded to 4 bytes as
+/// the container asks (JSON with spaces, binary with zeros).
+pub fn glb_bytes(json: &[u8], bin: &[u8]) -> Vec<u8> {
+    let pad = |n: usize| n.div_ceil(4) * 4;
+    let (json_len, bin_len) = (pad(json.len()), pad(bin.len()));
+    let total = 12 + 8 + json_len + if bin.is_empty() { 0 } else { 8 + bin_len };
+    let mut out = Vec::with_capacity(total);
+    for word in [0x4654_6C67u32, 2, total as u32, json_len as u32, 0x4E4F_534A] {
+        out.extend(word.to_le_bytes());
+    }
+    out.extend(json);
+    out.resize(20 + json_len, b' ');
+    if !bin.is_empty() {
+        for word in [bin_len as u32, 0x004E_4942] {
+            out.extend(word.to_le_bytes());
+        }
+        out.extend(bin);
+        out.resize(total, 0);
+    }
+    out
+}
