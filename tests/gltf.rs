@@ -154,3 +154,48 @@ fn a_gltf_with_a_missing_buffer_file_stops_the_render_naming_it() {
     assert!(png.is_file());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A scene's object can take one named node of a glTF file (with its children), placed as the
+/// file's scene places it; a name that no node has is refused listing the names there are, and
+/// `node` on an OBJ mesh is refused naming the key.
+#[test]
+fn an_object_takes_one_named_node_of_a_gltf_placed_as_its_scene_places_it() {
+    let dir = temp_dir("gltf-node");
+    let (bin, views) = triangle_bin();
+    let json = format!(
+        r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0, 1]}}],
+        "nodes": [{{"name": "Left", "translation": [-5, 0, 0], "mesh": 0}},
+                  {{"name": "Group", "translation": [5, 0, 0], "children": [2]}},
+                  {{"name": "Right", "translation": [0, 3, 0], "mesh": 0}}],
+        "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1}}]}}], {views}}}"#
+    );
+    let file = dir.join("two.glb");
+    std::fs::write(&file, glb_bytes(json.as_bytes(), &bin)).unwrap();
+    let min = |m: &Mesh| m.positions().iter().fold(Vec3::INFINITY, |a, p| a.min(*p));
+    let right = Mesh::load_gltf_node(&file, "Right", &LoadOptions::default()).unwrap();
+    assert_eq!((right.positions().len(), min(&right)), (3, Vec3::new(5.0, 3.0, 0.0)));
+    let left = Mesh::load_gltf_node(&file, "Left", &LoadOptions::default()).unwrap();
+    assert_eq!(min(&left), Vec3::new(-5.0, 0.0, 0.0));
+    let whole = Mesh::load(&file, &LoadOptions::default()).unwrap();
+    assert_eq!(whole.positions().len(), 6);
+    let (message, p) = problem(Mesh::load_gltf_node(&file, "Middle", &LoadOptions::default()));
+    assert!(matches!(&p, GltfProblem::NoSuchNode { names, .. } if names == &["Left", "Group", "Right"]), "{p:?}");
+    assert!(message.contains("two.glb") && message.contains("\"Middle\""), "{message}");
+
+    let scene = |path: &str| {
+        format!(
+            "[camera]\neye = [0.0, 0.0, 30.0]\ntarget = [0.0, 0.0, 0.0]\nfov_y = 40.0\nresolution = [32, 32]\n\
+             [[object]]\nshape = {{ type = \"mesh\", path = \"{path}\", node = \"Right\" }}\n\
+             material = {{ type = \"translucent\", preset = \"marble\", mm_per_unit = 10.0 }}\n\
+             [[light]]\ntype = \"directional\"\ndirection = [0.0, 0.0, 1.0]\nirradiance = [1.0, 1.0, 1.0]\n"
+        )
+    };
+    let prepared = |text: &str| {
+        let scene = translucent::scene::Scene::parse(text, "node.toml", Some(dir.clone()))?;
+        translucent::scene::build::PreparedScene::new(&scene, &Default::default()).map(|p| p.objects[0].mesh.positions().len())
+    };
+    assert_eq!(prepared(&scene("two.glb")).unwrap(), 3);
+    let refused = prepared(&scene("../bunny.obj")).unwrap_err().to_string();
+    assert!(refused.contains("shape.node") && refused.contains("not a .gltf or .glb"), "{refused}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -29,7 +29,7 @@ intensity = [1.0, 1.0, 1.0]
 fn builtin_scene_is_the_marble_bunny() {
     let scene = Scene::builtin();
     let s = &scene.file;
-    assert!(matches!(&s.objects[0].shape, Shape::Mesh { path } if path == "../bunny-37k.obj"));
+    assert!(matches!(&s.objects[0].shape, Shape::Mesh { path, .. } if path == "../bunny-37k.obj"));
     assert!(matches!(&s.objects[0].material, MaterialSpec::Translucent { preset: Some(p), .. } if p == "marble"));
     assert!(matches!(s.objects[1].material, MaterialSpec::Opaque { .. }));
     assert!(s.lights.iter().any(|l| matches!(l, Light::Environment { .. })));
@@ -46,7 +46,7 @@ fn the_built_in_scene_file_loads_from_disk_as_the_binary_embeds_it() {
     // path must resolve from its own folder as well as among the embedded assets.
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/default.toml");
     let scene = Scene::load(&path).unwrap();
-    let Shape::Mesh { path: mesh } = &scene.file.objects[0].shape else { panic!("the first object is the bunny") };
+    let Shape::Mesh { path: mesh, .. } = &scene.file.objects[0].shape else { panic!("the first object is the bunny") };
     match scene.resolve(mesh).unwrap() {
         translucent::scene::AssetSource::File(file) => assert!(file.is_file(), "{} is missing", file.display()),
         translucent::scene::AssetSource::Embedded(_) => panic!("a scene read from disk resolves from disk"),

@@ -82,23 +82,34 @@ pub enum GltfProblem {
         /// What is wrong.
         why: String,
     },
+    /// No node of the scene has the name a scene's `shape.node` gives.
+    #[error("no node of its scene is named {name:?} (the file's named nodes: {names:?})")]
+    NoSuchNode {
+        /// The name asked for.
+        name: String,
+        /// Every named node of the file.
+        names: Vec<String>,
+    },
     /// The file has no scene, or its scene places no mesh.
     #[error("no scene places a mesh")]
     NoMesh,
 }
 
-/// Read the glTF at `path` ([`super::Mesh::load`] for a `.gltf` or `.glb`).
-pub(super) fn load(path: &Path, options: &LoadOptions) -> Result<Loaded, MeshError> {
+/// Read the glTF at `path` ([`super::Mesh::load`] for a `.gltf` or `.glb`): the whole scene, or
+/// the node named `node` and its children.
+pub(super) fn load(path: &Path, node: Option<&str>, options: &LoadOptions) -> Result<Loaded, MeshError> {
     let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_path_buf(), source })?;
-    parse(&bytes, &path.display().to_string(), path.parent(), options)
+    parse(&bytes, &path.display().to_string(), path.parent(), node, options)
 }
 
 /// Parse a glTF already in memory; `source_name` names it in errors, and `base` is where its
-/// buffer files are (`None`: only a `.glb`'s own binary chunk can be read).
+/// buffer files are (`None`: only a `.glb`'s own binary chunk can be read). With `node`, only
+/// that node of the scene and its children.
 pub(super) fn parse(
     bytes: &[u8],
     source_name: &str,
     base: Option<&Path>,
+    node: Option<&str>,
     options: &LoadOptions,
 ) -> Result<Loaded, MeshError> {
     options.validate()?;
@@ -107,8 +118,15 @@ pub(super) fn parse(
     let buffers = buffers(&file, base).map_err(fail)?;
     let scene = file.default_scene().or_else(|| file.scenes().next()).ok_or_else(|| fail(GltfProblem::NoMesh))?;
     let mut out = Loaded { positions: Vec::new(), triangles: Vec::new(), flip_winding: false };
-    for node in scene.nodes() {
-        place(&node, Mat4::IDENTITY, &buffers, &mut out).map_err(fail)?;
+    let roots: Vec<(::gltf::Node, Mat4)> = match node {
+        None => scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect(),
+        Some(name) => vec![find(scene.nodes(), name, Mat4::IDENTITY).ok_or_else(|| {
+            let names = file.nodes().filter_map(|n| n.name().map(str::to_string)).collect();
+            fail(GltfProblem::NoSuchNode { name: name.to_string(), names })
+        })?],
+    };
+    for (root, parent) in roots {
+        place(&root, parent, &buffers, &mut out).map_err(fail)?;
     }
     if out.triangles.is_empty() {
         return Err(fail(GltfProblem::NoMesh));
@@ -143,6 +161,25 @@ fn buffers(file: &::gltf::Gltf, base: Option<&Path>) -> Result<Vec<Vec<u8>>, Glt
             Ok(data)
         })
         .collect()
+}
+
+/// The first node named `name` among `nodes` and their descendants (depth first), with the
+/// transform of its parents.
+fn find<'a>(
+    nodes: impl Iterator<Item = ::gltf::Node<'a>>,
+    name: &str,
+    parent: Mat4,
+) -> Option<(::gltf::Node<'a>, Mat4)> {
+    for node in nodes {
+        if node.name() == Some(name) {
+            return Some((node, parent));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if let Some(found) = find(node.children(), name, world) {
+            return Some(found);
+        }
+    }
+    None
 }
 
 /// Append `node`'s mesh and its children's, placed by `parent` times the node's own transform.

@@ -217,7 +217,7 @@ impl Mesh {
     /// recomputed from the geometry.
     pub fn load(path: impl AsRef<std::path::Path>, options: &LoadOptions) -> Result<Mesh, MeshError> {
         let path = path.as_ref();
-        let loaded = if is_gltf(path) { gltf::load(path, options)? } else { obj::load(path, options)? };
+        let loaded = if is_gltf(path) { gltf::load(path, None, options)? } else { obj::load(path, options)? };
         Mesh::build(path.display().to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
     }
 
@@ -228,6 +228,19 @@ impl Mesh {
         Mesh::build(source_name.to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
     }
 
+    /// Read the mesh of the node named `node` of a glTF 2.0 file, with its children's, placed
+    /// as the file's scene places it (an error listing the names there are when no node of the
+    /// scene has it).
+    pub fn load_gltf_node(
+        path: impl AsRef<std::path::Path>,
+        node: &str,
+        options: &LoadOptions,
+    ) -> Result<Mesh, MeshError> {
+        let path = path.as_ref();
+        let loaded = gltf::load(path, Some(node), options)?;
+        Mesh::build(path.display().to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
+    }
+
     /// Parse a glTF 2.0 file in memory (a `.glb`, or a `.gltf` whose buffers are files in
     /// `base`), with the same validation as [`Mesh::load`]; `source_name` names it in errors.
     pub fn from_gltf_slice(
@@ -236,7 +249,7 @@ impl Mesh {
         base: Option<&std::path::Path>,
         options: &LoadOptions,
     ) -> Result<Mesh, MeshError> {
-        let loaded = gltf::parse(bytes, source_name, base, options)?;
+        let loaded = gltf::parse(bytes, source_name, base, None, options)?;
         Mesh::build(source_name.to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
     }
 

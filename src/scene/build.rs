@@ -490,15 +490,18 @@ fn light_is_finite(l: &PreparedLight) -> bool {
 
 fn load_shape(scene: &Scene, shape: &Shape) -> Result<(String, Mesh), SceneError> {
     match shape {
-        Shape::Mesh { path } => {
+        Shape::Mesh { path, node } => {
             let mesh = match scene.resolve(path)? {
-                AssetSource::File(p) => Mesh::load(&p, &LoadOptions::default())?,
+                AssetSource::File(p) => match node {
+                    Some(node) => Mesh::load_gltf_node(&p, node, &LoadOptions::default())?,
+                    None => Mesh::load(&p, &LoadOptions::default())?,
+                },
                 AssetSource::Embedded(bytes) => {
                     let text = std::str::from_utf8(bytes).map_err(SceneError::EmbeddedMeshNotUtf8)?;
                     Mesh::from_obj_text(text, path, &LoadOptions::default())?
                 }
             };
-            Ok((path.clone(), mesh))
+            Ok((node.as_ref().map_or_else(|| path.clone(), |n| format!("{path}#{n}")), mesh))
         }
         Shape::Plane { size, divisions } => Ok(("plane".into(), plane(*size, *divisions)?)),
         Shape::Sphere { radius, divisions } => Ok(("sphere".into(), sphere(*radius, *divisions)?)),

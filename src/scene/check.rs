@@ -116,6 +116,9 @@ pub enum BadValue {
     /// A mesh path of nothing but white space.
     #[error("is empty")]
     EmptyPath,
+    /// A `node` given for a mesh that is not a glTF file.
+    #[error("names a glTF node, and the mesh is not a .gltf or .glb file")]
+    NodeOutsideGltf,
     /// A built-in shape's size or radius zero, negative or not finite.
     #[error("size/radius {0} must be positive")]
     SizeNotPositive(f32),
@@ -274,7 +277,10 @@ fn check_camera(c: &Camera) -> Check {
 /// divisions.
 fn check_shape(key: &impl Fn(&str) -> String, shape: &Shape) -> Check {
     match shape {
-        Shape::Mesh { path } if path.trim().is_empty() => refuse(key("shape.path"), BadValue::EmptyPath),
+        Shape::Mesh { path, .. } if path.trim().is_empty() => refuse(key("shape.path"), BadValue::EmptyPath),
+        Shape::Mesh { path, node: Some(_) } if !crate::mesh::is_gltf(std::path::Path::new(path)) => {
+            refuse(key("shape.node"), BadValue::NodeOutsideGltf)
+        }
         Shape::Plane { size, divisions } | Shape::Sphere { radius: size, divisions } => {
             if !(size.is_finite() && *size > 0.0) {
                 return refuse(key("shape"), BadValue::SizeNotPositive(*size));

@@ -92,6 +92,12 @@ pub enum Shape {
     Mesh {
         /// Path of the OBJ or glTF file (required, not empty).
         path: String,
+        /// glTF only: the name of the node whose mesh (and its children's) this object is,
+        /// placed as the file's scene places it (default: every node of the scene, as one
+        /// mesh). Several objects can each take one node of the same file, each with its own
+        /// material.
+        #[serde(default)]
+        node: Option<String>,
     },
     /// A square in the xz plane, centred at the origin, facing +y, `size` units wide,
     /// split into `divisions`^2 quads.
