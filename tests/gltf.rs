@@ -112,6 +112,33 @@ fn a_bad_glb_is_refused_naming_the_file_and_what_in_it_is_wrong() {
     // A binary chunk shorter than its buffer.
     let (_, p) = problem(parse(&with(r#"{"attributes": {"POSITION": 0}}"#), &bin[..40]));
     assert!(matches!(p, GltfProblem::ShortBuffer { .. } | GltfProblem::Parse(_)), "{p:?}");
+    // POSITION naming an accessor that is not there (the gltf crate's validation panicked on it;
+    // fuzz/corpus/gltf/regression-position-accessor-missing.glb).
+    let (message, p) = problem(parse(&with(r#"{"attributes": {"POSITION": 5}}"#), &bin));
+    assert!(matches!(p, GltfProblem::NoSuchAccessor { accessor: 5, count: 2, .. }), "{p:?}");
+    assert!(message.contains("POSITION is accessor 5, and the file has 2 accessors"), "{message}");
+    // A GLB header whose length is under 12 (the gltf crate subtracted unchecked).
+    let mut short = glb_bytes(with(r#"{"attributes": {"POSITION": 0}}"#).as_bytes(), &bin);
+    short[8..12].copy_from_slice(&0u32.to_le_bytes());
+    let (_, p) = problem(Mesh::from_gltf_slice(&short, "short.glb", None, &LoadOptions::default()));
+    assert!(matches!(p, GltfProblem::GlbLength { declared: 0 }), "{p:?}");
+    // POSITION as two floats, not three (the reader asserted on it in debug builds).
+    let (_, p) = problem(parse(&with(r#"{"attributes": {"POSITION": 1}}"#), &bin));
+    assert!(matches!(p, GltfProblem::Accessor { accessor: 1, role: "POSITION", .. } | GltfProblem::Parse(_)), "{p:?}");
+    // An accessor of no element (the reader subtracted one from its count unchecked).
+    let empty = with(r#"{"attributes": {"POSITION": 0}, "indices": 1}"#).replace(r#""count": 3, "type": "SCALAR""#, r#""count": 0, "type": "SCALAR""#);
+    let (message, p) = problem(parse(&empty, &bin));
+    assert!(matches!(p, GltfProblem::Accessor { accessor: 1, role: "indices", .. }), "{p:?}");
+    assert!(message.contains("holds 0 elements"), "{message}");
+    for regression in [
+        "regression-position-vec2.glb",
+        "regression-glb-length-zero.glb",
+        "regression-accessor-count-zero.glb",
+        "regression-position-accessor-missing.glb",
+    ] {
+        let fuzzed = std::fs::read(repo_path(&format!("fuzz/corpus/gltf/{regression}"))).unwrap();
+        assert!(Mesh::from_gltf_slice(&fuzzed, regression, None, &LoadOptions::default()).is_err(), "{regression}");
+    }
     // A buffer as a data: URI.
     let data = r#"{"asset": {"version": "2.0"}, "buffers": [{"byteLength": 4, "uri": "data:application/octet-stream;base64,AAAAAA=="}]}"#;
     let (_, p) = problem(parse(data, &[]));

@@ -5,6 +5,7 @@
 
 use super::MeshError;
 use super::obj::{LoadOptions, Loaded};
+use ::gltf::accessor::{DataType, Dimensions};
 use glam::{Mat4, Vec3};
 use std::path::Path;
 
@@ -82,6 +83,34 @@ pub enum GltfProblem {
         /// What is wrong.
         why: String,
     },
+    /// An accessor of a type or layout that is not read.
+    #[error("accessor {accessor} ({role}) {why}")]
+    Accessor {
+        /// The accessor.
+        accessor: usize,
+        /// What the primitive uses it for.
+        role: &'static str,
+        /// What is wrong.
+        why: String,
+    },
+    /// A GLB header whose total length is less than the header itself.
+    #[error("the GLB header gives a length of {declared} bytes, less than its own 12")]
+    GlbLength {
+        /// The length it gives.
+        declared: u32,
+    },
+    /// A primitive's POSITION names an accessor that is not there.
+    #[error("mesh {mesh} primitive {primitive}: POSITION is accessor {accessor}, and the file has {count} accessors")]
+    NoSuchAccessor {
+        /// The mesh.
+        mesh: usize,
+        /// The primitive, within the mesh.
+        primitive: usize,
+        /// The accessor it names.
+        accessor: usize,
+        /// How many accessors there are.
+        count: usize,
+    },
     /// No node of the scene has the name a scene's `shape.node` gives.
     #[error("no node of its scene is named {name:?} (the file's named nodes: {names:?})")]
     NoSuchNode {
@@ -114,6 +143,7 @@ pub(super) fn parse(
 ) -> Result<Loaded, MeshError> {
     options.validate()?;
     let fail = |problem| MeshError::Gltf { source_name: source_name.to_string(), problem: Box::new(problem) };
+    prevalidate(bytes).map_err(fail)?;
     let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| fail(GltfProblem::Parse(e)))?;
     let buffers = buffers(&file, base).map_err(fail)?;
     let scene = file.default_scene().or_else(|| file.scenes().next()).ok_or_else(|| fail(GltfProblem::NoMesh))?;
@@ -138,6 +168,36 @@ pub(super) fn parse(
     }
     out.flip_winding = options.mirrors();
     Ok(out)
+}
+
+/// Refuse what the gltf crate (1.4.1) would panic on rather than report, both found by
+/// `fuzz/fuzz_targets/gltf.rs`: a GLB header whose length is under the header's own 12 bytes
+/// (`Glb::from_slice` subtracts 12 from it unchecked), and a primitive whose POSITION names an
+/// accessor that does not exist (gltf-json's validation looks it up before checking it is
+/// there). What does not parse is left for the gltf crate to report.
+fn prevalidate(bytes: &[u8]) -> Result<(), GltfProblem> {
+    use ::gltf::json::{mesh::Semantic, validation::Checked};
+    if let Some(length) = bytes.strip_prefix(b"glTF").and_then(|b| b.get(4..8)) {
+        let declared = u32::from_le_bytes(length.try_into().expect("4 bytes"));
+        if declared < 12 {
+            return Err(GltfProblem::GlbLength { declared });
+        }
+    }
+    let json = match ::gltf::Glb::from_slice(bytes) {
+        Ok(glb) => glb.json,
+        Err(_) if bytes.starts_with(b"glTF") => return Ok(()),
+        Err(_) => std::borrow::Cow::Borrowed(bytes),
+    };
+    let Ok(root) = serde_json::from_slice::<::gltf::json::Root>(&json) else { return Ok(()) };
+    for (mesh, m) in root.meshes.iter().enumerate() {
+        for (primitive, p) in m.primitives.iter().enumerate() {
+            let position = p.attributes.get(&Checked::Valid(Semantic::Positions));
+            if let Some(accessor) = position.map(|a| a.value()).filter(|&a| a >= root.accessors.len()) {
+                return Err(GltfProblem::NoSuchAccessor { mesh, primitive, accessor, count: root.accessors.len() });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Every buffer's bytes: the binary chunk, or a file relative to `base`.
@@ -198,6 +258,47 @@ fn place(node: &::gltf::Node, parent: Mat4, buffers: &[Vec<u8>], out: &mut Loade
     Ok(())
 }
 
+/// Refuse an accessor the gltf crate's reader would misread (in release builds) or assert on
+/// (in debug builds, found by the fuzzer): another type than `dimensions` of one of `types`, a
+/// stride shorter than an element, no element or more than its view holds, or sparse storage or
+/// no buffer view (not read here).
+fn readable(
+    accessor: &::gltf::Accessor,
+    role: &'static str,
+    types: &[DataType],
+    dimensions: Dimensions,
+) -> Result<(), GltfProblem> {
+    let bad = |why: String| GltfProblem::Accessor { accessor: accessor.index(), role, why };
+    if !types.contains(&accessor.data_type()) || accessor.dimensions() != dimensions || accessor.normalized() {
+        return Err(bad(format!(
+            "is {:?} of {:?}{}, not {dimensions:?} of {types:?}",
+            accessor.dimensions(),
+            accessor.data_type(),
+            if accessor.normalized() { " (normalized)" } else { "" }
+        )));
+    }
+    if accessor.sparse().is_some() {
+        return Err(bad("is sparse, which is not read".into()));
+    }
+    let Some(view) = accessor.view() else { return Err(bad("has no buffer view".into())) };
+    let stride = view.stride().unwrap_or(accessor.size());
+    if stride < accessor.size() {
+        return Err(bad(format!("has a byteStride of {stride}, less than its {}-byte elements", accessor.size())));
+    }
+    // Its last element must end inside its view: the reader computes that end unchecked.
+    let end = accessor
+        .count()
+        .checked_sub(1)
+        .and_then(|last| stride.checked_mul(last)?.checked_add(accessor.offset())?.checked_add(accessor.size()));
+    match end {
+        None => Err(bad(format!("holds {} elements", accessor.count()))),
+        Some(end) if end > view.length() => {
+            Err(bad(format!("ends at byte {end} of its buffer view, which holds {}", view.length())))
+        }
+        Some(_) => Ok(()),
+    }
+}
+
 /// Append one triangle primitive, its positions placed by `world`.
 fn append(
     primitive: &::gltf::Primitive,
@@ -208,6 +309,12 @@ fn append(
 ) -> Result<(), GltfProblem> {
     if primitive.mode() != ::gltf::mesh::Mode::Triangles {
         return Err(GltfProblem::NotTriangles { node, mesh, primitive: index, mode: primitive.mode() });
+    }
+    let position = primitive.get(&::gltf::Semantic::Positions);
+    let position = position.ok_or(GltfProblem::NoPositions { node, mesh, primitive: index })?;
+    readable(&position, "POSITION", &[DataType::F32], Dimensions::Vec3)?;
+    if let Some(indices) = primitive.indices() {
+        readable(&indices, "indices", &[DataType::U8, DataType::U16, DataType::U32], Dimensions::Scalar)?;
     }
     let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
     let positions: Vec<Vec3> = reader
