@@ -139,6 +139,18 @@ fn a_bad_glb_is_refused_naming_the_file_and_what_in_it_is_wrong() {
         let fuzzed = std::fs::read(repo_path(&format!("fuzz/corpus/gltf/{regression}"))).unwrap();
         assert!(Mesh::from_gltf_slice(&fuzzed, regression, None, &LoadOptions::default()).is_err(), "{regression}");
     }
+    // Nodes that are not trees: a cycle (it recursed without end), and two parents.
+    let graph = |nodes: &str| {
+        format!(
+            r#"{{"asset": {{"version": "2.0"}}, "scenes": [{{"nodes": [0]}}], "nodes": {nodes},
+            "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1}}]}}], {views}}}"#
+        )
+    };
+    let (message, p) = problem(parse(&graph(r#"[{"mesh": 0}, {"children": [2]}, {"children": [1]}]"#), &bin));
+    assert!(matches!(p, GltfProblem::NotATree { why: "is its own ancestor", .. }), "{p:?}");
+    assert!(message.contains("glTF nodes must form trees"), "{message}");
+    let (_, p) = problem(parse(&graph(r#"[{"children": [1, 2]}, {"children": [2]}, {"mesh": 0}]"#), &bin));
+    assert!(matches!(p, GltfProblem::NotATree { node: 2, why: "has two parents" }), "{p:?}");
     // A buffer as a data: URI.
     let data = r#"{"asset": {"version": "2.0"}, "buffers": [{"byteLength": 4, "uri": "data:application/octet-stream;base64,AAAAAA=="}]}"#;
     let (_, p) = problem(parse(data, &[]));

@@ -93,6 +93,14 @@ pub enum GltfProblem {
         /// What is wrong.
         why: String,
     },
+    /// Nodes that do not form trees.
+    #[error("node {node} {why}; glTF nodes must form trees")]
+    NotATree {
+        /// The node.
+        node: usize,
+        /// How it breaks the trees.
+        why: &'static str,
+    },
     /// A GLB header whose total length is less than the header itself.
     #[error("the GLB header gives a length of {declared} bytes, less than its own 12")]
     GlbLength {
@@ -147,6 +155,7 @@ pub(super) fn parse(
     let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| fail(GltfProblem::Parse(e)))?;
     let buffers = buffers(&file, base).map_err(fail)?;
     let scene = file.default_scene().or_else(|| file.scenes().next()).ok_or_else(|| fail(GltfProblem::NoMesh))?;
+    trees(&file, &scene).map_err(fail)?;
     let mut out = Loaded { positions: Vec::new(), triangles: Vec::new(), flip_winding: false };
     let roots: Vec<(::gltf::Node, Mat4)> = match node {
         None => scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect(),
@@ -221,6 +230,41 @@ fn buffers(file: &::gltf::Gltf, base: Option<&Path>) -> Result<Vec<Vec<u8>>, Glt
             Ok(data)
         })
         .collect()
+}
+
+/// Check that the nodes form trees, as glTF requires and the walks below assume: no node with
+/// two parents, none its own ancestor, and the scene's roots with no parent (the gltf crate
+/// does not check, and a cycle would recurse without end).
+fn trees(file: &::gltf::Gltf, scene: &::gltf::Scene) -> Result<(), GltfProblem> {
+    let mut parent: Vec<Option<usize>> = vec![None; file.nodes().len()];
+    for node in file.nodes() {
+        for child in node.children() {
+            if parent[child.index()].replace(node.index()).is_some() {
+                return Err(GltfProblem::NotATree { node: child.index(), why: "has two parents" });
+            }
+        }
+    }
+    if let Some(root) = scene.nodes().find(|n| parent[n.index()].is_some()) {
+        return Err(GltfProblem::NotATree { node: root.index(), why: "is a root of the scene and a child" });
+    }
+    // Walk up from each node; 1 marks the walk in progress, 2 nodes known to reach a root.
+    let mut state = vec![0u8; parent.len()];
+    for start in 0..parent.len() {
+        let mut at = Some(start);
+        while let Some(n) = at.filter(|&n| state[n] != 2) {
+            if state[n] == 1 {
+                return Err(GltfProblem::NotATree { node: n, why: "is its own ancestor" });
+            }
+            state[n] = 1;
+            at = parent[n];
+        }
+        let mut at = Some(start);
+        while let Some(n) = at.filter(|&n| state[n] == 1) {
+            state[n] = 2;
+            at = parent[n];
+        }
+    }
+    Ok(())
 }
 
 /// The first node named `name` among `nodes` and their descendants (depth first), with the
