@@ -132,9 +132,8 @@ impl<'a> Caster<'a> {
         (Source::new(corners, depth, grid, mesh.triangle_areas()[t]), shadows)
     }
 
-    /// The source [`Caster::source_and_shadows`] made, made again for its pieces (without the
-    /// second moments, which its summary keeps): from its `shadows` without a ray, else ray
-    /// cast again. The same bits.
+    /// The source [`Caster::source_and_shadows`] made, made again for its pieces: from its
+    /// `shadows` without a ray, else ray cast again. The same bits.
     pub(super) fn source_again(
         &self,
         mesh: &Mesh,
@@ -152,7 +151,7 @@ impl<'a> Caster<'a> {
             None => known,
         };
         let (grid, _) = self.grid(&corners, normals, depth, at);
-        Source::pieces_only(corners, depth, grid, mesh.triangle_areas()[t])
+        Source::new(corners, depth, grid, mesh.triangle_areas()[t])
     }
 
     /// `E_t` at the grid points of a triangle's grid at `depth` (at [`grid_index`]), and the

@@ -11,15 +11,6 @@ pub(super) struct Source {
     /// `E_t` at grid point `(i, j)` (`u = i/n`, `v = j/n`, `n = 2^depth`), at [`grid_index`].
     pub(super) grid: Vec<DVec3>,
     pub(super) area: f64,
-    /// Flux `integral E_t dA` per channel and its `E_t`-weighted centroid.
-    pub(super) flux: [f64; 3],
-    pub(super) centroid: [DVec3; 3],
-    /// Second moment `integral (y - c)(y - c)^T E_t dA` about each channel's centroid `c`:
-    /// xx, yy, zz, xy, xz, yz.
-    pub(super) quadrupole: [[f64; 6]; 3],
-    /// Bounding sphere of the triangle (centre of its corners).
-    pub(super) centre: DVec3,
-    pub(super) radius: f64,
     /// Exact moments of every piece coarser than a grid cell by more than [`PYRAMID_SKIP`]
     /// splits, in the order `quadrature::Quadrature::piece` splits (node `k`'s children are
     /// `4k + 1 ..= 4k + 4`, the root is the whole triangle), so a piece spanning many cells can
@@ -38,11 +29,13 @@ pub(super) struct Summary {
     /// Its grid's depth and point count.
     pub(super) depth: u32,
     pub(super) points: usize,
-    /// As [`Source::flux`], [`Source::centroid`], [`Source::quadrupole`], [`Source::centre`]
-    /// and [`Source::radius`].
+    /// Flux `integral E_t dA` per channel and its `E_t`-weighted centroid.
     pub(super) flux: [f64; 3],
     pub(super) centroid: [DVec3; 3],
+    /// Second moment `integral (y - c)(y - c)^T E_t dA` about each channel's centroid `c`:
+    /// xx, yy, zz, xy, xz, yz.
     pub(super) quadrupole: [[f64; 6]; 3],
+    /// Bounding sphere of the triangle (centre of its corners).
     pub(super) centre: DVec3,
     pub(super) radius: f64,
 }
@@ -146,17 +139,22 @@ impl Source {
         sum
     }
 
-    /// This source as a whole, for triangle `triangle`.
+    /// This source as a whole, for triangle `triangle`: its flux and centroid from the
+    /// pyramid's root, its second moments from the grid, its bounding sphere from its corners.
     pub(super) fn summary(&self, triangle: usize) -> Summary {
+        let centre = (self.corners[0] + self.corners[1] + self.corners[2]) / 3.0;
+        let radius = self.corners.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
+        let whole = self.moments(WHOLE, 0, 0);
+        let centroid = whole.centroid(centre);
         Summary {
             triangle,
             depth: self.depth,
             points: self.grid.len(),
-            flux: self.flux,
-            centroid: self.centroid,
-            quadrupole: self.quadrupole,
-            centre: self.centre,
-            radius: self.radius,
+            flux: whole.flux,
+            centroid,
+            quadrupole: self.second_moments(&centroid),
+            centre,
+            radius,
         }
     }
 
@@ -211,40 +209,17 @@ pub(super) fn linear_moments(y: &[DVec3; 3], e: &[DVec3; 3], area: f64) -> ([f64
 }
 
 impl Source {
-    /// A triangle's source from its `E_t` grid at `depth`: its moment pyramid, flux, centroid
-    /// and second moments, and its bounding sphere.
+    /// A triangle's source from its `E_t` grid at `depth`, with its moment pyramid (what
+    /// [`Source::moments`] and [`Source::irradiance`] need; [`Source::summary`] the rest).
     pub(super) fn new(corners: [DVec3; 3], depth: u32, grid: Vec<DVec3>, area: f64) -> Source {
-        let mut s = Source::pieces_only(corners, depth, grid, area);
-        s.quadrupole = s.second_moments();
-        s
-    }
-
-    /// [`Source::new`] without the second moments: what [`Source::moments`] and
-    /// [`Source::irradiance`] need of a triangle integrated piece by piece.
-    pub(super) fn pieces_only(corners: [DVec3; 3], depth: u32, grid: Vec<DVec3>, area: f64) -> Source {
-        let centre = (corners[0] + corners[1] + corners[2]) / 3.0;
-        let radius = corners.iter().map(|p| p.distance(centre)).fold(0.0, f64::max);
-        let mut s = Source {
-            corners,
-            depth,
-            grid,
-            area,
-            flux: [0.0; 3],
-            centroid: [DVec3::ZERO; 3],
-            quadrupole: [[0.0; 6]; 3],
-            centre,
-            radius,
-            pyramid: vec![Moments::default(); pyramid_nodes(depth)],
-        };
-        let whole = s.build_pyramid(WHOLE, 0, 0);
-        s.centroid = whole.centroid(centre);
-        s.flux = whole.flux;
+        let mut s = Source { corners, depth, grid, area, pyramid: vec![Moments::default(); pyramid_nodes(depth)] };
+        s.build_pyramid(WHOLE, 0, 0);
         s
     }
 
     /// `integral (y - c)(y - c)^T E_t dA` about each channel's centroid, cell by cell: Radon's
     /// rule is exact for the cubic `(y - c)^2 E_t`.
-    fn second_moments(&self) -> [[f64; 6]; 3] {
+    fn second_moments(&self, centroid: &[DVec3; 3]) -> [[f64; 6]; 3] {
         let n = 1usize << self.depth;
         let cell_area = self.area / (n * n) as f64;
         let mut q = [[0.0; 6]; 3];
@@ -255,7 +230,7 @@ impl Source {
                 let p = y[0] * b[0] + y[1] * b[1] + y[2] * b[2];
                 let ep = e[0] * b[0] + e[1] * b[1] + e[2] * b[2];
                 for ch in 0..3 {
-                    let r = p - self.centroid[ch];
+                    let r = p - centroid[ch];
                     let we = w * cell_area * ep[ch];
                     let terms = [r.x * r.x, r.y * r.y, r.z * r.z, r.x * r.y, r.x * r.z, r.y * r.z];
                     for (qk, t) in q[ch].iter_mut().zip(terms) {
