@@ -67,3 +67,29 @@ pub fn remove_on_interrupt(outputs: &[&std::path::PathBuf]) -> anyhow::Result<()
     });
     Ok(())
 }
+
+/// Attaches a transport kernel to every object whose material asks for one
+/// (`material.model = "transport"`), read from the cache folder `dir` (default: the truth's)
+/// or walked there with a progress bar.
+pub fn attach_kernels(
+    prepared: &mut translucent::scene::build::PreparedScene,
+    dir: Option<&std::path::Path>,
+) -> anyhow::Result<()> {
+    use translucent::reference::{rte_mesh::KernelSettings, transport_cache, truth};
+    if !prepared.objects.iter().any(|o| o.wants_transport()) {
+        return Ok(());
+    }
+    let dir = dir.map_or_else(truth::default_cache_dir, std::path::Path::to_path_buf);
+    let bar = indicatif::ProgressBar::new(0).with_style(
+        indicatif::ProgressStyle::with_template("transport kernel of {msg}: {bar:30} {pos}/{len} patches, {elapsed}")
+            .expect("a valid template"),
+    );
+    let names: Vec<String> = prepared.objects.iter().map(|o| o.name.clone()).collect();
+    let result = transport_cache::attach(&mut prepared.objects, &KernelSettings::default(), &dir, &|i, done, of| {
+        bar.set_message(names[i].clone());
+        bar.set_length(of as u64);
+        bar.set_position(done as u64);
+    });
+    bar.finish_and_clear();
+    Ok(result?)
+}

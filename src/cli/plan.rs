@@ -44,7 +44,8 @@ pub fn run(args: &Args) -> Result<()> {
         max_error: args.max_error,
         ..Overrides::default()
     };
-    let prepared = PreparedScene::new(&scene, &overrides)?;
+    let mut prepared = PreparedScene::new(&scene, &overrides)?;
+    super::attach_kernels(&mut prepared, None)?;
     let objects = prepared.objects.len();
     let mut planner = Planner::new(objects, Change::Everything);
     let needs = plan::needs(&prepared, false, planner.baked_levels());

@@ -222,7 +222,8 @@ fn prepare(args: &Args) -> Result<PreparedScene> {
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
     let prepared = PreparedScene::new(&scene, &overrides);
     spinner.finish_and_clear();
-    let prepared = prepared?;
+    let mut prepared = prepared?;
+    super::attach_kernels(&mut prepared, None)?;
     if args.export_exitance.is_some() && prepared.scene.file.render.gather == GatherMode::Pixel {
         bail!(
             "--export-exitance needs exitance at the vertices, and the pixel gather computes it only at \

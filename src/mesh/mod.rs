@@ -16,6 +16,7 @@ mod enclosure;
 mod lod;
 mod gltf;
 mod obj;
+pub mod patches;
 pub mod shapes;
 mod topology;
 

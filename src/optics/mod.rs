@@ -27,6 +27,7 @@
 pub mod beam_single;
 pub mod beam_table;
 pub mod dipole;
+pub mod transport;
 pub mod directional_dipole;
 pub mod fresnel;
 pub mod gpu;

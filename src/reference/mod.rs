@@ -11,6 +11,7 @@ pub(crate) mod json_null;
 pub mod rte;
 pub mod rte_cache;
 pub mod rte_mesh;
+pub mod transport_cache;
 pub mod single;
 pub mod texture;
 pub mod tree;

@@ -11,6 +11,7 @@ use super::gather_sparse::GatherSparsePass;
 use super::gather_texture::GatherTexturePass;
 use super::gather_tree::GatherTreePass;
 use super::graph::Use;
+use super::transport::{GatherThenTransport, TransportPass};
 use super::pass::{FrameInputs, PassContext, Rebuild, RegisteredPass, RenderPass};
 use crate::scene::GatherMode;
 use ash::vk;
@@ -33,8 +34,13 @@ impl RegisteredPass for GatherChoice {
             _ => Box::new(GatherPass::new(gpu, resources)?),
         };
         // Channels of single scattering between points overwrite the dipole's after it.
-        Ok(Some(GatherChoice(match BeamGatherPass::new(gpu, resources)? {
+        let gather: Box<dyn RenderPass> = match BeamGatherPass::new(gpu, resources)? {
             Some(beams) => Box::new(GatherThenBeams { gather, beams }),
+            None => gather,
+        };
+        // Then the transport kernels scale the exitance of the objects that have one.
+        Ok(Some(GatherChoice(match TransportPass::new(gpu, resources)? {
+            Some(transport) => Box::new(GatherThenTransport { gather, transport }),
             None => gather,
         })))
     }

@@ -38,6 +38,8 @@ pub struct GpuScene {
     pub beams: Vec<Option<super::beam_tables::ObjectBeams>>,
     /// The nodes' stand-ins' first entry in `beam_sources`: `tree_order`'s length.
     pub beam_standins: u32,
+    /// Per object, in scene order: where its transport kernel lies, if it has one.
+    pub transport: Vec<Option<super::transport_tables::ObjectTransport>>,
     /// Triangles in `bvh_triangles`: 0 when nothing casts a shadow.
     pub caster_triangles: u32,
     /// How far a shadow ray starts off the surface, along the normal, and the least distance
@@ -187,6 +189,8 @@ struct PackedObjects {
     /// Per object, its sample hierarchy where a channel takes single scattering between
     /// points (`beam_gather::pack_tables` reads it rather than building it again).
     beam_trees: Vec<Option<crate::sampling::SampleTree>>,
+    /// Per object, its first vertex and first sample.
+    firsts: Vec<[u32; 2]>,
 }
 
 impl PackedObjects {
@@ -194,6 +198,7 @@ impl PackedObjects {
         let mut packed = PackedObjects { beam_trees: vec![None; scene.objects.len()], ..Default::default() };
         for (i, o) in scene.objects.iter().enumerate() {
             let first = [packed.vertices.len() as u32, packed.samples.len() as u32];
+            packed.firsts.push(first);
             packed.object(o);
             if matches!(o.material, crate::scene::build::ResolvedMaterial::Translucent { .. }) {
                 packed.receiver(scene, i, o, first);
@@ -410,6 +415,7 @@ impl GpuScene {
         let beam_node_count = if any_beams { p.tree_nodes.len() } else { 1 };
         // The samples' entries, then the nodes' stand-ins.
         let beam_source_count = if any_beams { p.tree_order.len() + p.tree_nodes.len() } else { 1 };
+        let t = super::transport_tables::pack(scene, &p.firsts);
         let zeros = vec![[0f32; 4]; p.vertices.len()];
         let sized = |name, item: usize, count: usize| storage(gpu, name, (item * count) as u64, none);
         // Made in the order they always were, vertices then indices first.
@@ -447,10 +453,16 @@ impl GpuScene {
                 beam_sources: sized("beam sources", std::mem::size_of::<BeamSourceRecord>(), beam_source_count)?,
                 beam_norms: upload(gpu, "beam receivers", &receivers, none)?,
                 beam_items: upload(gpu, "beam walk items", &items, none)?,
+                transport_patches: upload(gpu, "transport patches", &t.patches, none)?,
+                transport_items: upload(gpu, "transport items", &t.items, none)?,
+                transport_matrix: upload(gpu, "transport matrix", &t.matrix, none)?,
+                transport_sums: sized("transport sums", 48, t.patches.len().max(1))?,
+                transport_neighbours: upload(gpu, "transport neighbours", &t.neighbours, none)?,
             },
             indices,
             beams,
             beam_standins: p.tree_order.len() as u32,
+            transport: t.objects,
             caster_triangles: p.bvh_triangles.len() as u32,
             ray_offset: scene.ray_offset() as f32,
             textures: p.textures,

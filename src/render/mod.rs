@@ -45,4 +45,6 @@ pub mod splat;
 pub mod target;
 pub mod targets;
 pub mod tonemap;
+pub mod transport;
+pub mod transport_tables;
 pub mod vertex_light;

@@ -135,6 +135,16 @@ declare_resources! {
         BeamNorms: beam_norms = "BeamNorms",
         /// Per receiver of the whole mesh, the items of its walk (`SceneBuffers::beam_items`).
         BeamItems: beam_items = "BeamItems",
+        /// The transport kernels' patches (`SceneBuffers::transport_patches`).
+        TransportPatches: transport_patches = "TransportPatches",
+        /// Per patch, its vertices and samples (`SceneBuffers::transport_items`).
+        TransportItems: transport_items = "TransportItems",
+        /// The kernels' `W` (`SceneBuffers::transport_matrix`).
+        TransportMatrix: transport_matrix = "TransportMatrix",
+        /// Per patch, this frame's flux and exitances (`SceneBuffers::transport_sums`).
+        TransportSums: transport_sums = "TransportSums",
+        /// Per vertex of a kernel's object, its patch neighbours (`SceneBuffers::transport_neighbours`).
+        TransportNeighbours: transport_neighbours = "TransportNeighbours",
     }
     other {
         /// Exitance at the samples, the sparse gather's stage 0 (owned by `GatherSparsePass`).

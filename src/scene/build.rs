@@ -57,7 +57,11 @@ pub struct PreparedScene {
 /// shadow under what stands on it. Translucent objects carry gathered exitance, which varies
 /// over the width of the diffusion profile, and every level keeps its vertices' values exactly.
 fn lod_allowed(material: &ResolvedMaterial, environment_lit: bool) -> bool {
-    matches!(material, ResolvedMaterial::Translucent { .. }) || !environment_lit
+    match material {
+        // The transport kernel's patches are the whole mesh's vertices.
+        ResolvedMaterial::Translucent { model, .. } => *model != super::ScatteringModel::Transport,
+        ResolvedMaterial::Opaque { .. } => !environment_lit,
+    }
 }
 
 /// Overrides from the command line, applied on top of the scene file.
@@ -335,6 +339,7 @@ fn placed_object(
         density: None,
         levels,
         atlas: None,
+        transport: None,
     }
 }
 

@@ -475,12 +475,17 @@ pub enum ScatteringModel {
     Auto,
     /// Single scattering between points in every channel
     Single,
+    /// The dipole scaled per patch of the surface to the radiative transfer through this
+    /// object's own mesh, by a transport kernel walked once per mesh and medium
+    /// (`optics::transport`); the dipole until the kernel is attached
+    Transport,
 }
 
 named_choices!(ScatteringModel, "scattering model", {
     Dipole => "dipole",
     Auto => "auto",
     Single => "single",
+    Transport => "transport",
 });
 
 impl ScatteringModel {
@@ -488,7 +493,7 @@ impl ScatteringModel {
     /// `alpha'` is each channel's reduced albedo.
     pub fn single_channels(self, alpha_prime: [f64; 3]) -> [bool; 3] {
         match self {
-            ScatteringModel::Dipole => [false; 3],
+            ScatteringModel::Dipole | ScatteringModel::Transport => [false; 3],
             ScatteringModel::Single => [true; 3],
             ScatteringModel::Auto => alpha_prime.map(|a| a < crate::optics::beam_single::ALBEDO_BELOW),
         }

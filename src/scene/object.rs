@@ -58,6 +58,9 @@ pub struct PreparedObject {
     /// The texture gather's atlas of its mesh, whose texels are then its samples (translucent
     /// objects of a scene with `render.gather = "texture"` only).
     pub atlas: Option<std::sync::Arc<crate::mesh::atlas::Atlas>>,
+    /// Its transport kernel where `material.model = "transport"` and the caller attached one
+    /// (`reference::transport_cache`); until then the object takes the dipole.
+    pub transport: Option<std::sync::Arc<crate::optics::transport::TransportKernel>>,
 }
 
 impl PreparedObject {
@@ -70,6 +73,11 @@ impl PreparedObject {
             }
             ResolvedMaterial::Opaque { .. } => [false; 3],
         }
+    }
+
+    /// Whether its material asks for the transport kernel (`material.model = "transport"`).
+    pub fn wants_transport(&self) -> bool {
+        matches!(&self.material, ResolvedMaterial::Translucent { model: super::ScatteringModel::Transport, .. })
     }
 
     /// The hierarchy over its samples for the hierarchical gather (built on each call; the

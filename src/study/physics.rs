@@ -114,7 +114,7 @@ impl Physics {
         let model = vertex_error_f64(&exitance, &truth.exitance);
         let noise = noise(&exitance, &stderr);
         let walks = reference.objects.iter().flatten().map(|o| o.photons).max().unwrap_or(1);
-        let models = alternative_models(base, &truth.exitance, models, (options, walks))?;
+        let models = alternative_models(base, &truth.exitance, models, (options, walks), dir)?;
         let alternatives =
             models.iter().skip(1).map(|(name, m)| (name.clone(), vertex_error_f64(&exitance, m))).collect();
         let cosines = light_cosines(base);
@@ -162,11 +162,14 @@ pub enum Model {
     /// As [`Model::Transport`], the light attenuated with depth as the refracted beam is: the
     /// limit of kernels precomputed at a few entry cosines (`rte_mesh::ModelEntry::Slanted`).
     TransportSlanted,
+    /// The dipole scaled per patch by a transport kernel between patches walked without the
+    /// lights (`rte_mesh::kernel`), in three blends.
+    Kernel,
 }
 
 impl Model {
     /// Every model, in the report's order.
-    pub const ALL: [Model; 9] = [
+    pub const ALL: [Model; 10] = [
         Model::Between,
         Model::PerChannel,
         Model::DipoleSingle,
@@ -176,6 +179,7 @@ impl Model {
         Model::DirectionalAlpha,
         Model::Transport,
         Model::TransportSlanted,
+        Model::Kernel,
     ];
 
     /// Its name on the command line.
@@ -190,6 +194,7 @@ impl Model {
             Model::DirectionalAlpha => "directional-alpha",
             Model::Transport => "transport",
             Model::TransportSlanted => "transport-slanted",
+            Model::Kernel => "kernel",
         }
     }
 
@@ -206,6 +211,7 @@ impl Model {
             Model::DirectionalAlpha => "directional dipole, Grosjean's D, source alpha'".into(),
             Model::Transport => "transport in the mesh, light entering along the normal".into(),
             Model::TransportSlanted => "transport in the mesh, along the normal at the refracted depth".into(),
+            Model::Kernel => "transport kernel (dipole scaled per patch)".into(),
         }
     }
 }
@@ -228,6 +234,7 @@ fn alternative_models(
     truth: &[Exitance],
     models: &[Model],
     reference: (&MeshOptions, u64),
+    dir: &Path,
 ) -> Result<Vec<(String, Vec<Exitance>)>, StudyError> {
     use crate::optics::directional_dipole::{Diffusion, Strength};
     use crate::reference::directional;
@@ -251,6 +258,7 @@ fn alternative_models(
             Model::DirectionalAlpha => variant(Diffusion::Grosjean, Strength::ReducedAlbedo),
             Model::Transport => transport(base, reference, ModelEntry::Normal)?,
             Model::TransportSlanted => transport(base, reference, ModelEntry::Slanted)?,
+            Model::Kernel => crate::reference::transport_cache::model_exitance(base, truth, dir)?,
         };
         out.push((m.label(), exitance));
     }

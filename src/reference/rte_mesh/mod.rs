@@ -45,6 +45,7 @@
 mod adjoint;
 mod beam;
 mod geometry;
+mod kernel;
 mod sources;
 mod tally;
 mod walk;
@@ -286,6 +287,48 @@ fn exitance_by(
             }))
         })
         .collect()
+}
+
+/// How finely and how long a transport kernel is walked (`optics::transport`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct KernelSettings {
+    /// The most patches of the surface: fewer where the mesh has under
+    /// [`VERTICES_PER_PATCH`] vertices per patch.
+    pub patches: usize,
+    /// Walks per patch and channel.
+    pub walks: u64,
+    /// The seed of the random streams.
+    pub seed: u64,
+}
+
+impl Default for KernelSettings {
+    /// At most 384 patches of 1,500 walks: see docs/PHYSICS.md, "The transport kernel".
+    fn default() -> KernelSettings {
+        KernelSettings { patches: 384, walks: 1500, seed: 1 }
+    }
+}
+
+impl KernelSettings {
+    /// The patches of a mesh of `vertices` vertices: [`KernelSettings::patches`], fewer where
+    /// that would leave under [`VERTICES_PER_PATCH`] vertices per patch.
+    pub fn patches_for(&self, vertices: usize) -> usize {
+        self.patches.min(vertices / VERTICES_PER_PATCH).max(1)
+    }
+}
+
+/// The fewest vertices per patch: a patch's dipole exitance is averaged over its vertices.
+pub const VERTICES_PER_PATCH: usize = 8;
+
+/// Object `o`'s transport kernel, walked (`kernel::transport_kernel`); `progress` hears the
+/// patches done and their count. An opaque object or an open mesh is refused.
+pub fn object_kernel(
+    o: &PreparedObject,
+    settings: &KernelSettings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<crate::optics::transport::TransportKernel, RteError> {
+    let media = media_of(o)?.ok_or_else(|| RteError::NotTranslucent { name: o.name.clone() })?;
+    let patches = crate::mesh::patches::Patches::new(&o.mesh, settings.patches_for(o.mesh.positions().len()));
+    Ok(kernel::transport_kernel(&o.mesh, &media, patches, (settings.walks, settings.seed), progress))
 }
 
 /// The media the walks see in object `o`'s three channels (`Medium::reduced`), `None` for an

@@ -1,7 +1,6 @@
 //! The tally: what leaves through each vertex's cell, per photon and channel, summed into the
 //! exitance and its standard error.
 
-use crate::mesh::Mesh;
 use crate::reference::truth::LIT_FLOOR;
 
 /// Per vertex and channel, the sums of the photons' scores and of their squares; per channel,
@@ -59,16 +58,7 @@ pub fn relative_stderr(exitance: &[[f64; 3]], stderr: &[[f64; 3]]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Each vertex's barycentric dual cell area: a third of each of its triangles.
-pub(super) fn cell_areas(mesh: &Mesh) -> Vec<f64> {
-    let mut cells = vec![0.0; mesh.positions().len()];
-    for (t, tri) in mesh.triangles().iter().enumerate() {
-        for &v in tri {
-            cells[v as usize] += mesh.triangle_areas()[t] / 3.0;
-        }
-    }
-    cells
-}
+pub(super) use crate::mesh::patches::cell_areas;
 
 /// Weight that left through the cell of `vertex` in `channel` (scene units: flux).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -62,18 +62,18 @@ impl ObjectWalk<'_> {
 
 /// Where one channel's walk starts: at `p` on `triangle`, inwards along `d`, with `weight`
 /// (scene units).
-struct Start {
-    p: DVec3,
-    d: DVec3,
-    triangle: usize,
-    channel: usize,
-    weight: f64,
+pub(super) struct Start {
+    pub(super) p: DVec3,
+    pub(super) d: DVec3,
+    pub(super) triangle: usize,
+    pub(super) channel: usize,
+    pub(super) weight: f64,
 }
 
 /// One channel's walk from `start`: its exits are pushed to `exits`; true if it met the surface
 /// from outside (and was dropped there). With `split`, expected-value splitting at the boundary
 /// (see the module's documentation), else the analog choice between reflecting and leaving.
-fn walk(
+pub(super) fn walk(
     geometry: &Geometry,
     medium: &Medium,
     start: &Start,

@@ -1,0 +1,121 @@
+//! Transport-kernel pass (`glsl/transport.comp`): for each gathered object with
+//! `material.model = "transport"` and a kernel attached (`optics::transport`,
+//! `PreparedObject::transport`), the dipole's exitance at its vertices scaled per patch of its
+//! surface to the radiative transfer through its own mesh. It runs in the gather's slot after the
+//! dipole gather (and the between-points pass): stage 0 sums each patch's transmitted flux and
+//! dipole exitance, stage 1 applies the kernel, stage 2 scales each vertex.
+//!
+//! Bindings: `BINDINGS`, in binding order. Push: `TransportPush`.
+
+use super::graph::{Resource, Resources, Use, compute_uses, read, write};
+use super::pass::{FrameInputs, RenderPass};
+use super::transport_tables::ObjectTransport;
+use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuResult};
+use ash::vk;
+use std::sync::Arc;
+
+/// `TransportPush` in glsl/transport.comp.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct TransportPush {
+    /// x: the stage; y: the object's first patch; z: its patch count; w: 0.
+    pub stage: [u32; 4],
+    /// x: its first vertex; y: its vertex count; z: its first neighbour entry; w: 0.
+    pub vertices: [u32; 4],
+}
+
+/// glsl/transport.comp's bindings, in binding order.
+const BINDINGS: [Resource; 7] = [
+    Resource::Splat,
+    Resource::Exitance,
+    Resource::TransportPatches,
+    Resource::TransportItems,
+    Resource::TransportMatrix,
+    Resource::TransportSums,
+    Resource::TransportNeighbours,
+];
+
+/// The three stages of glsl/transport.comp, one dispatch per object each.
+pub struct TransportPass {
+    pipeline: ComputePipeline,
+    set: DescriptorSet,
+}
+
+impl TransportPass {
+    /// The pipeline and one descriptor set over `BINDINGS`; `None` when no object of the scene
+    /// has a kernel attached.
+    pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<Option<TransportPass>> {
+        if resources.scene.transport.iter().all(Option::is_none) {
+            return Ok(None);
+        }
+        let pipeline = ComputePipeline::new(gpu, "transport.comp")?;
+        let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
+        Ok(Some(TransportPass { pipeline, set }))
+    }
+
+    /// The gathered objects with a kernel this frame.
+    fn planned<'a>(frame: &'a FrameInputs) -> impl Iterator<Item = ObjectTransport> + 'a {
+        frame.scene.transport.iter().enumerate().filter_map(|(i, t)| t.filter(|_| frame.plan.gathers(i)))
+    }
+
+    /// Whether this frame gathers an object with a kernel.
+    fn any(frame: &FrameInputs) -> bool {
+        Self::planned(frame).next().is_some()
+    }
+}
+
+impl RenderPass for TransportPass {
+    fn uses(&self, _: &FrameInputs) -> Vec<Use> {
+        let mut uses = compute_uses(&BINDINGS, &[Resource::TransportSums]);
+        // The exitance is read by stage 0 and written by stage 2; the sums by both stages.
+        for u in &mut uses {
+            if matches!(u.resource, Resource::Exitance | Resource::TransportSums) {
+                *u = Use::write(u.resource, Access::ComputeReadWrite);
+            }
+        }
+        uses
+    }
+
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        let push = |stage, t: &ObjectTransport| TransportPush {
+            stage: [stage, t.patches[0], t.patches[1], 0],
+            vertices: [t.vertices[0], t.vertices[1], t.first_neighbour, 0],
+        };
+        for t in Self::planned(frame) {
+            // One workgroup of 64 per patch.
+            self.pipeline.dispatch(cmd, &self.set, &push(0, &t), [64 * t.patches[1], 1, 1]);
+        }
+        frame.before(cmd, &[write(Resource::TransportSums, Access::ComputeReadWrite)]);
+        for t in Self::planned(frame) {
+            self.pipeline.dispatch(cmd, &self.set, &push(1, &t), [t.patches[1], 1, 1]);
+        }
+        frame.before(cmd, &[read(Resource::TransportSums, Access::ComputeRead)]);
+        for t in Self::planned(frame) {
+            self.pipeline.dispatch(cmd, &self.set, &push(2, &t), [t.vertices[1], 1, 1]);
+        }
+    }
+}
+
+/// The gather's slot with the transport pass after it: the gather (and the between-points
+/// pass) writes the dipole's exitance, then this pass scales it (a barrier between them, from
+/// their declarations).
+pub struct GatherThenTransport {
+    /// The gather `render.gather` names, with the between-points pass where it runs.
+    pub gather: Box<dyn RenderPass>,
+    /// The transport pass.
+    pub transport: TransportPass,
+}
+
+impl RenderPass for GatherThenTransport {
+    fn uses(&self, frame: &FrameInputs) -> Vec<Use> {
+        self.gather.uses(frame)
+    }
+
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        self.gather.record(cmd, frame);
+        if TransportPass::any(frame) {
+            frame.before(cmd, &self.transport.uses(frame));
+            self.transport.record(cmd, frame);
+        }
+    }
+}

@@ -1,0 +1,162 @@
+//! The transport kernel (`material.model = "transport"`, `optics::transport`): its walks against
+//! the half-space's closed answer and energy, the GPU pass (`glsl/transport.comp`) against its
+//! f64 twin, and its cache refusing what it cannot trust.
+
+mod common;
+
+use translucent::reference::rte::{Budget, Medium, half_space_reflectance};
+use translucent::reference::rte_mesh::{KernelSettings, object_kernel};
+use translucent::reference::transport_cache;
+use translucent::render::plan::Change;
+use translucent::render::renderer::Renderer;
+use translucent::scene::Scene;
+use translucent::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
+
+/// A sphere of `radius` mm (1 unit = 1 mm) of `material` (TOML fields) with `model`, under
+/// one directional light.
+fn sphere(radius: f64, divisions: u32, material: &str, model: &str) -> PreparedScene {
+    let text = format!(
+        r#"
+[camera]
+eye = [0.0, {eye_y}, {eye_z}]
+target = [0.0, 0.0, 0.0]
+resolution = [32, 32]
+
+[[object]]
+shape = {{ type = "sphere", radius = {radius}, divisions = {divisions} }}
+material = {{ type = "translucent", {material}, mm_per_unit = 1.0, model = "{model}" }}
+casts_shadow = false
+
+[[light]]
+type = "directional"
+direction = [0.8, 0.5, 0.3]
+irradiance = [1.0, 1.0, 1.0]
+
+[sampling]
+count = 1500
+"#,
+        eye_y = 1.2 * radius,
+        eye_z = 4.5 * radius,
+    );
+    PreparedScene::new(&Scene::parse(&text, "test.toml", None).unwrap(), &Overrides::default()).unwrap()
+}
+
+fn quiet(_: usize, _: usize) {}
+
+#[test]
+fn a_kernel_on_a_sphere_far_wider_than_its_diffusion_length_reflects_what_the_half_space_does() {
+    // sigma_s' 10/mm, sigma_a 0.5 to 2/mm (diffusion lengths 0.13 to 0.25 mm) at eta 1 in a
+    // 100 mm sphere: locally a half-space, so the flux out per unit flux in (a column's sum) is
+    // Chandrasekhar's plane albedo at normal incidence (`rte::half_space_reflectance`, checked
+    // against the H-function in tests/rte.rs) within 1% (measured: 0.08, 0.09, 0.32%; at eta 1.3
+    // on a 10 mm sphere the curvature adds 1.2 to 2.8%, on a 40 mm one 0.04 to 1.5%).
+    let scene = sphere(100.0, 24, "sigma_a = [1.0, 2.0, 0.5], sigma_s_prime = [10.0, 10.0, 10.0], eta = 1.0", "transport");
+    let o = &scene.objects[0];
+    let settings = KernelSettings { patches: 16, walks: 8000, seed: 3 };
+    let kernel = object_kernel(o, &settings, &quiet).unwrap();
+    let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else { unreachable!() };
+    let k = kernel.patches.len();
+    for (c, dipole) in dipoles.iter().enumerate() {
+        let medium = Medium::reduced(dipole);
+        let exact = half_space_reflectance(&medium, 1.0, &Budget::photons(400_000), 5, &|_| {}).unwrap();
+        let columns: Vec<f64> = (0..k).map(|j| (0..k).map(|i| kernel.flux[c][i * k + j]).sum()).collect();
+        let mean = columns.iter().sum::<f64>() / k as f64;
+        let relative = (mean - exact.mean) / exact.mean;
+        assert!(relative.abs() < 0.01, "channel {c}: kernel {mean:.4} against the half-space's {:.4}", exact.mean);
+        // Energy: no patch sends out more than came in.
+        assert!(columns.iter().all(|&s| s > 0.0 && s <= 1.0), "channel {c}: {columns:?}");
+    }
+}
+
+#[test]
+fn a_kernel_brightens_a_marble_sphere_the_dipole_leaves_too_dark_and_keeps_energy() {
+    // The 2 cm marble sphere: the light the half-space loses deep below comes back out, so
+    // each patch sends out more than the dipole's R_d,total, and never more than came in.
+    let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
+    let o = &scene.objects[0];
+    let kernel = object_kernel(o, &KernelSettings { patches: 24, walks: 400, seed: 1 }, &quiet).unwrap();
+    let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else { unreachable!() };
+    let k = kernel.patches.len();
+    for (c, dipole) in dipoles.iter().enumerate() {
+        let total: f64 = kernel.flux[c].iter().sum::<f64>() / k as f64;
+        let dipole = dipole.r_d_total();
+        assert!(total > 1.05 * dipole && total <= 1.0, "channel {c}: kernel {total:.3}, dipole {dipole:.3}");
+    }
+}
+
+/// The splat's transmitted irradiance and area per sample.
+type Splat = Vec<([f32; 3], f32)>;
+
+/// Per vertex of object 0, its exitance after one full frame, and the splat's irradiance and
+/// area per sample.
+fn frame(prepared: PreparedScene) -> (Vec<[f32; 3]>, Splat) {
+    common::with_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, prepared).unwrap();
+        let plan = renderer.plan(Change::Everything);
+        renderer.frame(&plan).unwrap();
+        (renderer.exitance(0).unwrap(), renderer.splat_irradiance().unwrap())
+    })
+}
+
+#[test]
+fn the_gpu_transport_pass_matches_its_f64_twin() {
+    let mut scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
+    let kernel = object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 300, seed: 2 }, &quiet).unwrap();
+    let dipole_scene = scene.clone();
+    scene.objects[0].transport = Some(std::sync::Arc::new(kernel.clone()));
+    let (scaled, splat) = frame(scene.clone());
+    // Without a kernel the object takes the dipole: the same splat and gather, unscaled.
+    let (dipole, _) = frame(dipole_scene);
+    let o = &scene.objects[0];
+    let p = &kernel.patches;
+    let points = o.samples.iter().zip(&splat).map(|(s, (e, _))| {
+        let j = p.nearest(&p.features(s.position.as_dvec3(), s.normal.as_dvec3()));
+        (j, s.area, e.map(f64::from))
+    });
+    let phi = kernel.patch_flux(points);
+    let dipole64: Vec<[f64; 3]> = dipole.iter().map(|m| m.map(f64::from)).collect();
+    let near = kernel.vertex_neighbours(o.mesh.positions(), o.mesh.vertex_normals());
+    let twin = kernel.exitance(&phi, &dipole64, &near);
+    let brightest = twin.iter().flatten().fold(0.0f64, |a, &b| a.max(b));
+    let mut worst = 0.0f64;
+    let mut changed = 0.0f64;
+    for ((g, t), d) in scaled.iter().zip(&twin).zip(&dipole64) {
+        for c in 0..3 {
+            assert!(g[c].is_finite() && g[c] >= 0.0);
+            worst = worst.max((f64::from(g[c]) - t[c]).abs() / brightest);
+            changed = changed.max((t[c] - d[c]).abs() / brightest);
+        }
+    }
+    assert!(worst < 1e-4, "GPU against its f64 twin: {worst:.2e} of the brightest vertex");
+    assert!(changed > 0.05, "the kernel must change the picture: {changed:.3}");
+}
+
+#[test]
+fn a_damaged_or_foreign_kernel_cache_file_is_walked_anew_never_used() {
+    let dir = common::temp_dir("transport-cache");
+    let scene = sphere(10.0, 8, "preset = \"marble\"", "transport");
+    let o = &scene.objects[0];
+    let settings = KernelSettings { patches: 8, walks: 50, seed: 4 };
+    let (first, cached) = transport_cache::cached(o, &settings, &dir, &quiet).unwrap();
+    assert!(!cached);
+    let (again, cached) = transport_cache::cached(o, &settings, &dir, &quiet).unwrap();
+    assert!(cached);
+    assert_eq!(first, again);
+    let path = dir.join(format!("kernel-{}.json", transport_cache::content_key(o, &settings)));
+    // One value edited: the checksum no longer matches, so the file is walked anew.
+    let text = std::fs::read_to_string(&path).unwrap();
+    let edited = text.replacen("\"walks\":50", "\"walks\":51", 1);
+    assert_ne!(edited, text);
+    std::fs::write(&path, edited).unwrap();
+    let (walked, cached) = transport_cache::cached(o, &settings, &dir, &quiet).unwrap();
+    assert!(!cached, "an edited file must not be used");
+    assert_eq!(walked, first);
+    // Another setting is another key: never this file.
+    let other = KernelSettings { walks: 60, ..settings };
+    assert_ne!(transport_cache::content_key(o, &other), transport_cache::content_key(o, &settings));
+    // A folder that cannot be written in fails at once, naming it.
+    let file = dir.join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let err = transport_cache::cached(o, &other, &file, &quiet).unwrap_err();
+    assert!(err.to_string().contains("a-file"), "{err}");
+}
