@@ -2,7 +2,7 @@
 //! seed paper's FPS-against-sample-count comparison (its Figure 7), on whatever device the
 //! loader offers (TRANSLUCENT_DEVICE to choose). Prints figures; asserts nothing.
 //!
-//!     cargo bench --bench render [-- frames|savings|levels|terms|hierarchy|growth|models|planner|gathers]
+//!     cargo bench --bench render [-- frames|savings|levels|terms|hierarchy|growth|models|transport|planner|gathers]
 //!
 //! Two timings per pass: GPU timestamp queries inside one submission, and the wall time of the
 //! pass submitted alone (submission to fence). On lavapipe a timestamp used to be taken only at
@@ -614,6 +614,9 @@ fn main() {
     }
     if wanted("models") {
         models::models(&gpu);
+    }
+    if wanted("transport") {
+        models::transport(&gpu);
     }
     if wanted("planner") {
         planner(&gpu);

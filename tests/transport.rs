@@ -4,13 +4,16 @@
 
 mod common;
 
+use translucent::optics::transport::TransportKernel;
 use translucent::reference::rte::{Budget, Medium, half_space_reflectance};
 use translucent::reference::rte_mesh::{KernelSettings, object_kernel};
 use translucent::reference::transport_cache;
 use translucent::render::plan::Change;
 use translucent::render::renderer::Renderer;
-use translucent::scene::Scene;
-use translucent::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
+use translucent::render::edit::SceneEdit;
+use translucent::scene::build::{KernelDropped, Overrides, PreparedScene, ResolvedMaterial};
+use translucent::scene::needs::KernelState;
+use translucent::scene::{Scene, Transform};
 
 /// A sphere of `radius` mm (1 unit = 1 mm) of `material` (TOML fields) with `model`, under
 /// one directional light.
@@ -98,28 +101,26 @@ fn frame(prepared: PreparedScene) -> (Vec<[f32; 3]>, Splat) {
     })
 }
 
-#[test]
-fn the_gpu_transport_pass_matches_its_f64_twin() {
-    let mut scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
-    let kernel = object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 300, seed: 2 }, &quiet).unwrap();
-    let dipole_scene = scene.clone();
+/// The worst difference of the GPU's scaled exitance from the f64 twin, and the largest change
+/// the kernel makes to the dipole, both as a share of the brightest vertex, for `scene` with
+/// `kernel` attached to object 0.
+fn against_twin(mut scene: PreparedScene, kernel: &TransportKernel) -> (f64, f64) {
+    let dipole_scene = PreparedScene { objects: scene.objects.iter().cloned().map(|mut o| { o.transport = None; o }).collect(), ..scene.clone() };
     scene.objects[0].transport = Some(std::sync::Arc::new(kernel.clone()));
     let (scaled, splat) = frame(scene.clone());
     // Without a kernel the object takes the dipole: the same splat and gather, unscaled.
     let (dipole, _) = frame(dipole_scene);
     let o = &scene.objects[0];
-    let p = &kernel.patches;
+    let placed = kernel.placed(&o.mesh);
     let points = o.samples.iter().zip(&splat).map(|(s, (e, _))| {
-        let j = p.nearest(&p.features(s.position.as_dvec3(), s.normal.as_dvec3()));
-        (j, s.area, e.map(f64::from))
+        (TransportKernel::sample_patch(&placed, s.position, s.normal), s.area, e.map(f64::from))
     });
     let phi = kernel.patch_flux(points);
     let dipole64: Vec<[f64; 3]> = dipole.iter().map(|m| m.map(f64::from)).collect();
-    let near = kernel.vertex_neighbours(o.mesh.positions(), o.mesh.vertex_normals());
+    let near = TransportKernel::vertex_neighbours(&placed, &o.mesh);
     let twin = kernel.exitance(&phi, &dipole64, &near);
     let brightest = twin.iter().flatten().fold(0.0f64, |a, &b| a.max(b));
-    let mut worst = 0.0f64;
-    let mut changed = 0.0f64;
+    let (mut worst, mut changed) = (0.0f64, 0.0f64);
     for ((g, t), d) in scaled.iter().zip(&twin).zip(&dipole64) {
         for c in 0..3 {
             assert!(g[c].is_finite() && g[c] >= 0.0);
@@ -127,8 +128,53 @@ fn the_gpu_transport_pass_matches_its_f64_twin() {
             changed = changed.max((t[c] - d[c]).abs() / brightest);
         }
     }
+    (worst, changed)
+}
+
+#[test]
+fn the_gpu_transport_pass_matches_its_f64_twin_before_and_after_a_rigid_move() {
+    let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
+    let kernel = object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 300, seed: 2 }, &quiet).unwrap();
+    let (worst, changed) = against_twin(scene.clone(), &kernel);
     assert!(worst < 1e-4, "GPU against its f64 twin: {worst:.2e} of the brightest vertex");
     assert!(changed > 0.05, "the kernel must change the picture: {changed:.3}");
+    // Turned and moved: the same kernel, its patches following the vertices.
+    let mut moved = scene.clone();
+    moved.objects[0].transport = Some(std::sync::Arc::new(kernel.clone()));
+    let rigid = Transform { rotate: Some([30.0, 60.0, 0.0]), translate: Some([3.0, -2.0, 1.0]), ..Transform::default() };
+    moved.set_transform(0, rigid).unwrap();
+    assert_eq!(moved.objects[0].transport.as_deref(), Some(&kernel), "a rigid move keeps the kernel");
+    let (worst, changed) = against_twin(moved, &kernel);
+    assert!(worst < 1e-4 && changed > 0.05, "after the move: {worst:.2e}, {changed:.3}");
+}
+
+#[test]
+fn a_scale_or_a_material_edit_drops_the_kernel_with_its_reason_and_the_dipole_takes_over() {
+    let mut scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
+    let kernel = object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 100, seed: 2 }, &quiet).unwrap();
+    scene.objects[0].transport = Some(std::sync::Arc::new(kernel));
+    let mut scaled = scene.clone();
+    scaled.set_transform(0, Transform { scale: Some(1.5), ..Transform::default() }).unwrap();
+    assert!(scaled.objects[0].transport.is_none());
+    assert_eq!(scaled.objects[0].kernel_dropped, Some(KernelDropped::Scaled));
+    let dipole_scene = PreparedScene { objects: scene.objects.iter().cloned().map(|mut o| { o.transport = None; o }).collect(), ..scene.clone() };
+    let (dipole, _) = frame(dipole_scene);
+    let ResolvedMaterial::Translucent { material, .. } = scene.objects[0].material.clone() else { unreachable!() };
+    common::with_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, scene).unwrap();
+        let plan = renderer.plan(Change::Everything);
+        assert!(matches!(plan.objects[0].transport, Some(KernelState::Scales { .. })), "{plan}");
+        renderer.frame(&plan).unwrap();
+        assert_ne!(renderer.exitance(0).unwrap(), dipole);
+        renderer.edit(SceneEdit::Material { object: 0, material }).unwrap();
+        let plan = renderer.plan(Change::Material(0));
+        let text = plan.to_string();
+        assert_eq!(plan.objects[0].transport, Some(KernelState::Dropped { why: KernelDropped::MaterialEdited }));
+        assert!(text.contains("transport kernel dropped: its material was edited"), "{text}");
+        renderer.frame(&plan).unwrap();
+        // The same coefficients, the kernel gone: the dipole's exitance exactly.
+        assert_eq!(renderer.exitance(0).unwrap(), dipole);
+    });
 }
 
 #[test]

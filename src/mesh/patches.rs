@@ -81,6 +81,22 @@ impl Patches {
         patches
     }
 
+    /// These patches on `mesh`, a rigid move of the mesh they were made on (same vertices and
+    /// triangles): each centre the area-weighted mean of its vertices' features there, as the
+    /// last k-means step left it on the first mesh.
+    pub fn placed_on(&self, mesh: &Mesh) -> Patches {
+        let mut sum = vec![([0.0; 6], 0.0); self.len()];
+        for (v, (p, n)) in mesh.positions().iter().zip(mesh.vertex_normals()).enumerate() {
+            let (s, w) = &mut sum[self.of_vertex[v] as usize];
+            let f = self.features(p.as_dvec3(), n.as_dvec3());
+            (0..6).for_each(|d| s[d] += self.cells[v] * f[d]);
+            *w += self.cells[v];
+        }
+        let centres =
+            sum.iter().zip(&self.centres).map(|((s, w), old)| if *w > 0.0 { s.map(|x| x / w) } else { *old }).collect();
+        Patches { centres, ..self.clone() }
+    }
+
     /// How many patches.
     pub fn len(&self) -> usize {
         self.centres.len()

@@ -20,6 +20,7 @@
 //! blending the patches' ratios) keeps a dark patch's large ratio from brightening its lit
 //! neighbours. The f32 twin is `glsl/transport.comp`.
 
+use crate::mesh::Mesh;
 use crate::mesh::patches::Patches;
 
 /// The kernel of one object (see the module's documentation).
@@ -93,14 +94,26 @@ impl TransportKernel {
         dipole.iter().zip(near).map(|(&m, near)| Self::scaled(m, near, &f, &d)).collect()
     }
 
-    /// Each vertex's patch neighbours, from `positions` and `normals`.
-    pub fn vertex_neighbours(&self, positions: &[glam::Vec3], normals: &[glam::Vec3]) -> Vec<Vec<(u32, f64)>> {
+    /// Its patches on `mesh`, the object as it stands now (`Patches::placed_on`): a rigid move
+    /// keeps the kernel, and the patches' centres follow the vertices.
+    pub fn placed(&self, mesh: &Mesh) -> Patches {
+        self.patches.placed_on(mesh)
+    }
+
+    /// Each vertex's patch neighbours on `mesh` (`placed` its patches there).
+    pub fn vertex_neighbours(placed: &Patches, mesh: &Mesh) -> Vec<Vec<(u32, f64)>> {
         use rayon::prelude::*;
-        positions
+        mesh.positions()
             .par_iter()
-            .zip(normals)
-            .map(|(p, n)| self.patches.neighbours(&self.patches.features(p.as_dvec3(), n.as_dvec3())))
+            .zip(mesh.vertex_normals())
+            .map(|(p, n)| placed.neighbours(&placed.features(p.as_dvec3(), n.as_dvec3())))
             .collect()
+    }
+
+    /// The patch of a sample at `position` with `normal` (`placed` the patches on the mesh as
+    /// it stands): the nearest centre.
+    pub fn sample_patch(placed: &Patches, position: glam::Vec3, normal: glam::Vec3) -> u32 {
+        placed.nearest(&placed.features(position.as_dvec3(), normal.as_dvec3()))
     }
 
     /// Bytes of device memory the kernel takes (`W` as f32 RGBA per pair of patches).

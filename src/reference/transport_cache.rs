@@ -174,7 +174,7 @@ pub fn model_exitance(
         let phi = k.patch_flux(points);
         let whole = gathered.as_ref().map_or(truth.as_slice(), |g| g[index].as_slice());
         let (f, d) = (k.transport_exitance(&phi), k.dipole_exitance(whole));
-        let near = k.vertex_neighbours(positions, normals);
+        let near = TransportKernel::vertex_neighbours(&k.placed(&o.mesh), &o.mesh);
         out.push(
             truth
                 .iter()

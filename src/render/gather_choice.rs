@@ -38,8 +38,10 @@ impl RegisteredPass for GatherChoice {
             Some(beams) => Box::new(GatherThenBeams { gather, beams }),
             None => gather,
         };
-        // Then the transport kernels scale the exitance of the objects that have one.
-        Ok(Some(GatherChoice(match TransportPass::new(gpu, resources)? {
+        // Then the transport kernels scale the per-vertex exitance of the objects that have
+        // one (the texture gather's lives in its atlas: there the dipole alone).
+        let per_vertex = settings.gather != GatherMode::Texture;
+        Ok(Some(GatherChoice(match TransportPass::new(gpu, resources)?.filter(|_| per_vertex) {
             Some(transport) => Box::new(GatherThenTransport { gather, transport }),
             None => gather,
         })))

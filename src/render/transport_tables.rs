@@ -2,6 +2,7 @@
 //! patch its lists and area, the kernels' matrices, and per vertex its patch neighbours, packed
 //! once at upload for every object that has a kernel attached.
 
+use crate::optics::transport::TransportKernel;
 use crate::scene::build::{PreparedObject, PreparedScene};
 
 /// One patch as glsl/transport.comp reads it (`TransportPatchRecord`).
@@ -56,17 +57,17 @@ impl PackedTransport {
     fn object(
         &mut self,
         o: &PreparedObject,
-        kernel: &crate::optics::transport::TransportKernel,
+        kernel: &TransportKernel,
         [first_vertex, first_sample]: [u32; 2],
     ) -> ObjectTransport {
-        let p = &kernel.patches;
+        let p = &kernel.placed(&o.mesh);
         let (first_patch, k) = (self.patches.len() as u32, p.len());
         let (mut vertices, mut samples) = (vec![Vec::new(); k], vec![Vec::new(); k]);
         for (v, &i) in p.of_vertex.iter().enumerate() {
             vertices[i as usize].push([first_vertex + v as u32, (p.cells[v] as f32).to_bits()]);
         }
         for (s, sample) in o.samples.iter().enumerate() {
-            let i = p.nearest(&p.features(sample.position.as_dvec3(), sample.normal.as_dvec3()));
+            let i = TransportKernel::sample_patch(p, sample.position, sample.normal);
             samples[i as usize].push([first_sample + s as u32, (sample.area as f32).to_bits()]);
         }
         let first_row = self.matrix.len() as u32;
@@ -81,7 +82,7 @@ impl PackedTransport {
         }
         self.matrix.extend((0..k * k).map(|ij| [0, 1, 2].map(|c| kernel.flux[c][ij] as f32)).map(|[r, g, b]| [r, g, b, 0.0]));
         let first_neighbour = self.neighbours.len() as u32;
-        for near in kernel.vertex_neighbours(o.mesh.positions(), o.mesh.vertex_normals()) {
+        for near in TransportKernel::vertex_neighbours(p, &o.mesh) {
             let mut pairs = [[0u32; 2]; crate::mesh::patches::NEIGHBOURS];
             for (slot, &(i, w)) in pairs.iter_mut().zip(&near) {
                 *slot = [first_patch + i, (w as f32).to_bits()];

@@ -12,7 +12,7 @@ use glam::{EulerRot, Mat4, Quat, Vec3};
 use std::sync::Arc;
 
 /// The prepared object and its material (`scene::object`).
-pub use super::object::{PreparedObject, ResolvedMaterial};
+pub use super::object::{KernelDropped, PreparedObject, ResolvedMaterial};
 /// The warnings preparing a scene gives per object (`scene::warnings`).
 pub use super::warnings::{near_plane_warning, precision_warning};
 /// The built-in shapes, built by the mesh floor (`mesh::shapes`).
@@ -206,6 +206,7 @@ impl PreparedScene {
         let (mesh, frame) = place_mesh(&scene, object, &old.name, loaded)?;
         let placed = (old.name.clone(), mesh, frame);
         objects[object] = placed_object(&scene, object, placed, old.material.clone(), environment_lit);
+        keep_kernel(old, &mut objects[object]);
         sample_objects(&scene, &mut objects, Some(object))?;
         self.scene = scene;
         self.objects = objects;
@@ -340,6 +341,22 @@ fn placed_object(
         levels,
         atlas: None,
         transport: None,
+        kernel_dropped: None,
+    }
+}
+
+/// Carries `old`'s transport kernel over to `moved`, the same object placed anew: a rigid move
+/// (its area unchanged within 1e-6) keeps it, the patches following the vertices
+/// (`TransportKernel::placed`); a scale drops it (`KernelDropped::Scaled`).
+fn keep_kernel(old: &PreparedObject, moved: &mut PreparedObject) {
+    moved.kernel_dropped = old.kernel_dropped;
+    if old.transport.is_some() {
+        let (a, b) = (old.mesh.total_area(), moved.mesh.total_area());
+        if (a - b).abs() <= 1e-6 * a {
+            moved.transport.clone_from(&old.transport);
+        } else {
+            moved.kernel_dropped = Some(super::object::KernelDropped::Scaled);
+        }
     }
 }
 

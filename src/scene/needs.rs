@@ -41,6 +41,8 @@ pub struct ObjectFacts {
     /// Per channel, its reduced albedo `alpha'` where `material.model` gives it single
     /// scattering between points (`ScatteringModel::single_channels`); `None` for the dipole.
     pub single: [Option<f64>; 3],
+    /// Where `material.model = "transport"`: whether its kernel is attached.
+    pub transport: Option<KernelState>,
     /// Centre of its bounding sphere.
     pub center: [f32; 3],
     /// Radius of its bounding sphere.
@@ -56,6 +58,44 @@ pub struct ObjectFacts {
     /// How its sample count was chosen and the per-vertex error predicted for it
     /// (`scene::accuracy`); `None` for an opaque object.
     pub density: Option<super::accuracy::Density>,
+}
+
+/// Where an object's material asks for the transport kernel (`optics::transport`), what it
+/// gets.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(tag = "state", rename_all = "snake_case")]
+pub enum KernelState {
+    /// Its kernel is attached: glsl/transport.comp scales the dipole's exitance after the
+    /// gather.
+    Scales {
+        /// Patches of its surface.
+        patches: usize,
+        /// Walks per patch and channel.
+        walks: u64,
+    },
+    /// None is attached (not yet walked, or the caller attached none): the dipole alone.
+    NotAttached,
+    /// Its kernel was dropped: the dipole alone until one is attached again.
+    Dropped {
+        /// Why.
+        why: super::build::KernelDropped,
+    },
+}
+
+impl std::fmt::Display for KernelState {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            KernelState::Scales { patches, walks } => write!(
+                f,
+                "transport kernel ({patches} patches, {walks} walks each) scales the dipole's exitance after the \
+                 gather to the transport through this mesh (material.model = \"transport\")"
+            ),
+            KernelState::NotAttached => {
+                write!(f, "material.model = \"transport\" but no kernel is attached: the dipole alone")
+            }
+            KernelState::Dropped { why } => write!(f, "transport kernel dropped: {why}; the dipole alone until one is attached")
+        }
+    }
 }
 
 /// One level of detail as the planner weighs it (`mesh::LodLevel`). Lengths in scene units.
@@ -109,8 +149,14 @@ impl ObjectFacts {
             super::build::ResolvedMaterial::Opaque { .. } => [0.0; 3],
         };
         let chosen = object.single_channels();
+        let transport = object.wants_transport().then(|| match (&object.transport, object.kernel_dropped) {
+            (Some(k), _) => KernelState::Scales { patches: k.patches.len(), walks: k.walks },
+            (None, Some(why)) => KernelState::Dropped { why },
+            (None, None) => KernelState::NotAttached,
+        });
         ObjectFacts {
             single: [0, 1, 2].map(|c| chosen[c].then_some(alpha[c])),
+            transport,
             name: object.name.clone(),
             center: center.to_array(),
             radius,

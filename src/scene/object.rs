@@ -61,6 +61,28 @@ pub struct PreparedObject {
     /// Its transport kernel where `material.model = "transport"` and the caller attached one
     /// (`reference::transport_cache`); until then the object takes the dipole.
     pub transport: Option<std::sync::Arc<crate::optics::transport::TransportKernel>>,
+    /// Why a kernel it had was dropped (it takes the dipole until one is attached again).
+    pub kernel_dropped: Option<KernelDropped>,
+}
+
+/// Why an object's transport kernel no longer holds, so that it was dropped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum KernelDropped {
+    /// Its material changed (`SceneEdit::Material`): the kernel is the old medium's.
+    MaterialEdited,
+    /// It was moved by more than a rotation and translation (`SceneEdit::Transform`): a scale
+    /// changes its size against the medium's free paths.
+    Scaled,
+}
+
+impl std::fmt::Display for KernelDropped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            KernelDropped::MaterialEdited => "its material was edited, and the kernel is the old medium's",
+            KernelDropped::Scaled => "it was scaled, and the kernel is for its old size",
+        })
+    }
 }
 
 impl PreparedObject {

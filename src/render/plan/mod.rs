@@ -181,6 +181,8 @@ pub struct ObjectPlan {
     /// Per channel, its reduced albedo where `material.model` gives it single scattering
     /// between points (glsl/beam_gather.comp overwrites the dipole's exitance there).
     pub single: [Option<f64>; 3],
+    /// Where `material.model = "transport"`: whether its kernel scales the dipole.
+    pub transport: Option<crate::scene::needs::KernelState>,
     /// Index in the scene.
     pub object: usize,
     /// Mesh path or shape.
@@ -334,6 +336,9 @@ impl fmt::Display for Plan {
                     Transport::Gather => "gather",
                 };
                 writeln!(f, "    {c} {t} {}", ch.why)?;
+            }
+            if let Some(t) = o.transport {
+                writeln!(f, "    {t}")?;
             }
             for (c, alpha) in ["R", "G", "B"].iter().zip(o.single) {
                 let Some(alpha) = alpha else { continue };

@@ -110,6 +110,7 @@ impl Frame<'_> {
         ObjectPlan {
             object: i,
             single: facts.single,
+            transport: facts.transport,
             name: facts.name.clone(),
             in_view,
             pixel_footprint: footprint,

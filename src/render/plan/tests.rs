@@ -7,6 +7,7 @@ fn object(radius: f32, spacing: f64, profile: f64) -> ObjectFacts {
     ObjectFacts {
         name: "sphere".into(),
         single: [None; 3],
+        transport: None,
         center: [0.0, 0.0, 0.0],
         radius,
         sample_spacing: spacing,

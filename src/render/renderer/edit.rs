@@ -96,6 +96,11 @@ impl Renderer {
         // The one copy: the prepared object's. A later move (`SceneEdit::Transform`) keeps it,
         // and `scene().scene.file` stays the file as it was read.
         *m = material;
+        // The kernel is the old medium's: the object takes the dipole until one is attached.
+        if o.transport.take().is_some() {
+            o.kernel_dropped = Some(crate::scene::build::KernelDropped::MaterialEdited);
+            self.gpu_scene.transport[object] = None;
+        }
         self.gpu_scene.set_material(&self.scene, object);
         self.needs = Self::needs_of(&self.scene, self.target, &self.planner);
         self.planner.mark(Change::Material(object));
