@@ -55,7 +55,7 @@ fn a_kernel_on_a_sphere_far_wider_than_its_diffusion_length_reflects_what_the_ha
     // on a 10 mm sphere the curvature adds 1.2 to 2.8%, on a 40 mm one 0.04 to 1.5%).
     let scene = sphere(100.0, 24, "sigma_a = [1.0, 2.0, 0.5], sigma_s_prime = [10.0, 10.0, 10.0], eta = 1.0", "transport");
     let o = &scene.objects[0];
-    let settings = KernelSettings { patches: 16, walks: 8000, seed: 3 };
+    let settings = KernelSettings { patches: 16, walks: 16 * 8000, seed: 3 };
     let kernel = object_kernel(o, &settings, &quiet).unwrap();
     let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else { unreachable!() };
     let k = kernel.patches.len();
@@ -77,7 +77,7 @@ fn a_kernel_brightens_a_marble_sphere_the_dipole_leaves_too_dark_and_keeps_energ
     // each patch sends out more than the dipole's R_d,total, and never more than came in.
     let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
     let o = &scene.objects[0];
-    let kernel = object_kernel(o, &KernelSettings { patches: 24, walks: 400, seed: 1 }, &quiet).unwrap();
+    let kernel = object_kernel(o, &KernelSettings { patches: 24, walks: 16 * 400, seed: 1 }, &quiet).unwrap();
     let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else { unreachable!() };
     let k = kernel.patches.len();
     for (c, dipole) in dipoles.iter().enumerate() {
@@ -113,7 +113,7 @@ fn against_twin(mut scene: PreparedScene, kernel: &TransportKernel) -> (f64, f64
     let o = &scene.objects[0];
     let placed = kernel.placed(&o.mesh);
     let points = o.samples.iter().zip(&splat).map(|(s, (e, _))| {
-        (TransportKernel::sample_patch(&placed, s.position, s.normal), s.area, e.map(f64::from))
+        (kernel.sample_patch(&o.mesh, s.triangle, s.barycentric), s.area, e.map(f64::from))
     });
     let phi = kernel.patch_flux(points);
     let dipole64: Vec<[f64; 3]> = dipole.iter().map(|m| m.map(f64::from)).collect();
@@ -134,7 +134,7 @@ fn against_twin(mut scene: PreparedScene, kernel: &TransportKernel) -> (f64, f64
 #[test]
 fn the_gpu_transport_pass_matches_its_f64_twin_before_and_after_a_rigid_move() {
     let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
-    let kernel = object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 300, seed: 2 }, &quiet).unwrap();
+    let kernel = object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 16 * 300, seed: 2 }, &quiet).unwrap();
     let (worst, changed) = against_twin(scene.clone(), &kernel);
     assert!(worst < 1e-4, "GPU against its f64 twin: {worst:.2e} of the brightest vertex");
     assert!(changed > 0.05, "the kernel must change the picture: {changed:.3}");
@@ -151,7 +151,7 @@ fn the_gpu_transport_pass_matches_its_f64_twin_before_and_after_a_rigid_move() {
 #[test]
 fn a_scale_or_a_material_edit_drops_the_kernel_with_its_reason_and_the_dipole_takes_over() {
     let mut scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
-    let kernel = object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 100, seed: 2 }, &quiet).unwrap();
+    let kernel = object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 16 * 100, seed: 2 }, &quiet).unwrap();
     scene.objects[0].transport = Some(std::sync::Arc::new(kernel));
     let mut scaled = scene.clone();
     scaled.set_transform(0, Transform { scale: Some(1.5), ..Transform::default() }).unwrap();
@@ -182,7 +182,7 @@ fn a_damaged_or_foreign_kernel_cache_file_is_walked_anew_never_used() {
     let dir = common::temp_dir("transport-cache");
     let scene = sphere(10.0, 8, "preset = \"marble\"", "transport");
     let o = &scene.objects[0];
-    let settings = KernelSettings { patches: 8, walks: 50, seed: 4 };
+    let settings = KernelSettings { patches: 8, walks: 7 * 50, seed: 4 };
     let (first, cached) = transport_cache::cached(o, &settings, &dir, &quiet).unwrap();
     assert!(!cached);
     let (again, cached) = transport_cache::cached(o, &settings, &dir, &quiet).unwrap();
@@ -191,14 +191,15 @@ fn a_damaged_or_foreign_kernel_cache_file_is_walked_anew_never_used() {
     let path = dir.join(format!("kernel-{}.json", transport_cache::content_key(o, &settings)));
     // One value edited: the checksum no longer matches, so the file is walked anew.
     let text = std::fs::read_to_string(&path).unwrap();
-    let edited = text.replacen("\"walks\":50", "\"walks\":51", 1);
-    assert_ne!(edited, text);
+    let walks = format!("\"walks\":{}", first.walks);
+    let edited = text.replacen(&walks, &format!("\"walks\":{}", first.walks + 1), 1);
+    assert!(edited != text, "the file holds {walks}");
     std::fs::write(&path, edited).unwrap();
     let (walked, cached) = transport_cache::cached(o, &settings, &dir, &quiet).unwrap();
     assert!(!cached, "an edited file must not be used");
     assert_eq!(walked, first);
     // Another setting is another key: never this file.
-    let other = KernelSettings { walks: 60, ..settings };
+    let other = KernelSettings { walks: 7 * 60, ..settings };
     assert_ne!(transport_cache::content_key(o, &other), transport_cache::content_key(o, &settings));
     // A folder that cannot be written in fails at once, naming it.
     let file = dir.join("a-file");

@@ -91,5 +91,6 @@ pub fn attach_kernels(
         bar.set_position(done as u64);
     });
     bar.finish_and_clear();
-    Ok(result?)
+    use anyhow::Context as _;
+    result.context("material.model = \"transport\": walking the transport kernel inside the mesh")
 }

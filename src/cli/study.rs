@@ -375,7 +375,8 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     if let Some(p) = &study.physics {
         let pct = |v: [f64; 3]| v.map(|e| format!("{:.2}%", 100.0 * e)).join(", ");
         out!(
-            "model error (dipole against the radiative transfer, r, g, b): {}; reference noise {}",
+            "model error ({} against the radiative transfer, r, g, b): {}; reference noise {}",
+            p.model_name,
             pct(p.model.rel_rms),
             pct(p.noise)
         );

@@ -11,6 +11,8 @@ use rayon::prelude::*;
 const LLOYD: usize = 6;
 /// Patches a point's value is blended from ([`Patches::neighbours`]).
 pub const NEIGHBOURS: usize = 8;
+/// The width of the blend between patches, in patch radii.
+pub const BLEND: f64 = 1.0;
 
 /// A point's features: its position, then its unit normal times the patches' radius.
 pub type Features = [f64; 6];
@@ -126,7 +128,9 @@ impl Patches {
     }
 
     /// The [`NEIGHBOURS`] patches nearest to `x` (fewer if there are fewer), each with its
-    /// blending weight `exp(-d^2 / radius^2)` (`d` the distance in features, floored above 0).
+    /// blending weight `exp(-d^2 / (BLEND radius)^2)` (`d` the distance in features, floored
+    /// above 0; a blend 1.5 radii wide read 0.3 to 1.1 points worse on the bunny's ears, and
+    /// on the marble sphere 0.3 to 0.4 better in red and green, 0.9 worse in blue).
     pub fn neighbours(&self, x: &Features) -> Vec<(u32, f64)> {
         let mut near: Vec<(f64, usize)> =
             self.centres.iter().enumerate().map(|(i, c)| (distance2(c, x), i)).collect();
@@ -134,7 +138,7 @@ impl Patches {
         near.select_nth_unstable_by(n - 1, |a, b| a.0.total_cmp(&b.0));
         near.truncate(n);
         near.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let h2 = self.radius * self.radius;
+        let h2 = BLEND * BLEND * self.radius * self.radius;
         near.into_iter().map(|(d2, i)| (i as u32, (-d2 / h2).exp().max(1e-30))).collect()
     }
 }

@@ -110,10 +110,13 @@ impl TransportKernel {
             .collect()
     }
 
-    /// The patch of a sample at `position` with `normal` (`placed` the patches on the mesh as
-    /// it stands): the nearest centre.
-    pub fn sample_patch(placed: &Patches, position: glam::Vec3, normal: glam::Vec3) -> u32 {
-        placed.nearest(&placed.features(position.as_dvec3(), normal.as_dvec3()))
+    /// The patch of a sample on `triangle` of `mesh` at `barycentric`: that of the corner
+    /// whose dual cell holds it (the largest coordinate), so that the samples split the
+    /// transmitted flux between patches as the vertices' cells split the surface.
+    pub fn sample_patch(&self, mesh: &Mesh, triangle: u32, barycentric: [f32; 3]) -> u32 {
+        let b = barycentric;
+        let corner = if b[0] >= b[1] && b[0] >= b[2] { 0 } else if b[1] >= b[2] { 1 } else { 2 };
+        self.patches.of_vertex[mesh.triangles()[triangle as usize][corner] as usize]
     }
 
     /// Bytes of device memory the kernel takes (`W` as f32 RGBA per pair of patches).

@@ -67,7 +67,7 @@ impl PackedTransport {
             vertices[i as usize].push([first_vertex + v as u32, (p.cells[v] as f32).to_bits()]);
         }
         for (s, sample) in o.samples.iter().enumerate() {
-            let i = TransportKernel::sample_patch(p, sample.position, sample.normal);
+            let i = kernel.sample_patch(&o.mesh, sample.triangle, sample.barycentric);
             samples[i as usize].push([first_sample + s as u32, (sample.area as f32).to_bits()]);
         }
         let first_row = self.matrix.len() as u32;

@@ -417,8 +417,16 @@ pub fn run(
     if !base.has_translucent() {
         return Err(StudyError::NothingTranslucent);
     }
-    let (truth, truth_cached) =
+    let (mut truth, truth_cached) =
         truth::cached(&base, &config.truth, truth_dir, &|l, d, n| progress(Event::Truth(l, d, n)))?;
+    // A material with model = "transport": its kernel scales the renderer's exitance, so the
+    // truth is the dipole's exact integral scaled by it in f64.
+    let mut base = base;
+    if base.objects.iter().any(|o| o.wants_transport()) {
+        use crate::reference::{rte_mesh::KernelSettings, transport_cache};
+        transport_cache::attach(&mut base.objects, &KernelSettings::default(), truth_dir, &|_, _, _| {})?;
+        truth.exitance = transport_cache::model_exitance(&base, &truth.exitance, truth_dir)?;
+    }
     if truth_cached {
         progress(Event::TruthCached);
     }

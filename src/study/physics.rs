@@ -55,6 +55,10 @@ pub struct Physics {
     pub lost: [u64; 3],
     /// Whether it came from the cache.
     pub cached: bool,
+    /// The scene's own model, which the truth is the exact integral of: "dipole", or "dipole
+    /// scaled by its transport kernel" where a material says `model = "transport"` (the study
+    /// then scales the truth by the kernel in f64, `transport_cache::model_exitance`).
+    pub model_name: &'static str,
     /// The budget and seed it was walked with.
     pub options: MeshOptions,
     /// Other models against the same reference, per channel: the dipole with the
@@ -119,7 +123,10 @@ impl Physics {
             models.iter().skip(1).map(|(name, m)| (name.clone(), vertex_error_f64(&exitance, m))).collect();
         let cosines = light_cosines(base);
         let bands = models.iter().map(|(name, m)| (name.clone(), band_errors(&exitance, m, &cosines))).collect();
+        let model_name =
+            if base.objects.iter().any(|o| o.wants_transport()) { "dipole scaled by its transport kernel" } else { "dipole" };
         Ok(Physics {
+            model_name,
             exitance,
             stderr,
             model,
@@ -466,7 +473,7 @@ fn alternatives_table(out: &mut String, p: &Physics) {
     );
     let _ = writeln!(out, "| model | r | g | b |");
     let _ = writeln!(out, "|---|---:|---:|---:|");
-    let models = std::iter::once(("dipole", &p.model)).chain(p.alternatives.iter().map(|(n, e)| (n.as_str(), e)));
+    let models = std::iter::once((p.model_name, &p.model)).chain(p.alternatives.iter().map(|(n, e)| (n.as_str(), e)));
     for (name, e) in models {
         let cell = |c: usize| format!("{} % ({:+.1} %)", percent(e.rel_rms[c]), 100.0 * e.bias[c]);
         let _ = writeln!(out, "| {name} | {} | {} | {} |", cell(0), cell(1), cell(2));
@@ -521,6 +528,7 @@ fn reference_paragraph(out: &mut String, p: &Physics) {
             "RMS over lit receivers of the relative standard error",
         ),
     };
+    let model = p.model_name;
     let budget = [
         Some(format!("at most {} {unit}", b.max_photons)),
         b.relative_stderr.map(|s| format!("to {s} precision")),
@@ -536,8 +544,8 @@ fn reference_paragraph(out: &mut String, p: &Physics) {
          Reference: the radiative transfer equation by Monte Carlo inside each translucent mesh, {walk} \
          (Fresnel transmittance in and out, isotropic scattering with `sigma_s = sigma_s'`; budget {budget} per object, seed {}): {} {unit}, {:.1} s when walked{}; \
          precision reached ({precision}, worst channel) {}, walks lost \
-         {:?}. Model error: the dipole's exact integral against it; discretisation error: the renderer \
-         against the dipole's exact integral (the study's `rel_rms`); total error: the renderer against it. \
+         {:?}. Model error: the {model}'s exact integral against it; discretisation error: the renderer \
+         against that integral (the study's `rel_rms`); total error: the renderer against it. \
          Relative RMS over the vertices lit in the reference. The reference noise is the RMS of its relative \
          standard error per vertex, which every error against it contains in quadrature: an error \
          not well above it is noise.\n",

@@ -295,16 +295,16 @@ pub struct KernelSettings {
     /// The most patches of the surface: fewer where the mesh has under
     /// [`VERTICES_PER_PATCH`] vertices per patch.
     pub patches: usize,
-    /// Walks per patch and channel.
+    /// Walks per channel over all patches, shared evenly (at least one per patch).
     pub walks: u64,
     /// The seed of the random streams.
     pub seed: u64,
 }
 
 impl Default for KernelSettings {
-    /// At most 384 patches of 1,500 walks: see docs/PHYSICS.md, "The transport kernel".
+    /// At most 384 patches, 600,000 walks: see docs/PHYSICS.md, "The transport kernel".
     fn default() -> KernelSettings {
-        KernelSettings { patches: 384, walks: 1500, seed: 1 }
+        KernelSettings { patches: 384, walks: 600_000, seed: 1 }
     }
 }
 
@@ -327,8 +327,10 @@ pub fn object_kernel(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<crate::optics::transport::TransportKernel, RteError> {
     let media = media_of(o)?.ok_or_else(|| RteError::NotTranslucent { name: o.name.clone() })?;
-    let patches = crate::mesh::patches::Patches::new(&o.mesh, settings.patches_for(o.mesh.positions().len()));
-    Ok(kernel::transport_kernel(&o.mesh, &media, patches, (settings.walks, settings.seed), progress))
+    let count = settings.patches_for(o.mesh.positions().len());
+    let patches = crate::mesh::patches::Patches::new(&o.mesh, count);
+    let per_patch = (settings.walks / count as u64).max(1);
+    Ok(kernel::transport_kernel(&o.mesh, &media, patches, (per_patch, settings.seed), progress))
 }
 
 /// The media the walks see in object `o`'s three channels (`Medium::reduced`), `None` for an
