@@ -11,6 +11,7 @@ use translucent::reference::transport_cache;
 use translucent::render::plan::Change;
 use translucent::render::renderer::Renderer;
 use translucent::render::edit::SceneEdit;
+use translucent::render::transport_tables::level_cells;
 use translucent::scene::build::{KernelDropped, Overrides, PreparedScene, ResolvedMaterial};
 use translucent::scene::needs::KernelState;
 use translucent::scene::{Scene, Transform};
@@ -90,26 +91,42 @@ fn a_kernel_brightens_a_marble_sphere_the_dipole_leaves_too_dark_and_keeps_energ
 /// The splat's transmitted irradiance and area per sample.
 type Splat = Vec<([f32; 3], f32)>;
 
-/// Per vertex of object 0, its exitance after one full frame, and the splat's irradiance and
+/// Object 0's exitance at every vertex after one full frame gathered at level of detail `level`
+/// (0 off the level's vertices, which the frame leaves alone), and the splat's irradiance and
 /// area per sample.
-fn frame(prepared: PreparedScene) -> (Vec<[f32; 3]>, Splat) {
+fn frame_at(prepared: PreparedScene, level: usize) -> (Vec<[f32; 3]>, Splat) {
+    let count = prepared.objects[0].mesh.positions().len();
     common::with_gpu(|gpu| {
         let mut renderer = Renderer::new(gpu, prepared).unwrap();
-        let plan = renderer.plan(Change::Everything);
+        let mut plan = renderer.plan(Change::Everything);
+        plan.objects.iter_mut().for_each(|o| o.level = level);
         renderer.frame(&plan).unwrap();
-        (renderer.exitance(0).unwrap(), renderer.splat_irradiance().unwrap())
+        let at = renderer.exitance_at_level(0).unwrap();
+        assert_eq!(at.level, level);
+        let mut all = vec![[0.0f32; 3]; count];
+        at.vertices.iter().zip(&at.values).for_each(|(&v, m)| all[v as usize] = *m);
+        (all, renderer.splat_irradiance().unwrap())
     })
+}
+
+/// Object 0's exitance after one full frame at level 0, and the splat.
+fn frame(prepared: PreparedScene) -> (Vec<[f32; 3]>, Splat) {
+    frame_at(prepared, 0)
 }
 
 /// The worst difference of the GPU's scaled exitance from the f64 twin, and the largest change
 /// the kernel makes to the dipole, both as a share of the brightest vertex, for `scene` with
-/// `kernel` attached to object 0.
-fn against_twin(mut scene: PreparedScene, kernel: &TransportKernel) -> (f64, f64) {
-    let dipole_scene = PreparedScene { objects: scene.objects.iter().cloned().map(|mut o| { o.transport = None; o }).collect(), ..scene.clone() };
+/// `kernel` attached to object 0, gathered at level of detail `level`.
+fn against_twin(mut scene: PreparedScene, kernel: &TransportKernel, level: usize) -> (f64, f64) {
+    let without = |mut o: translucent::scene::build::PreparedObject| {
+        o.transport = None;
+        o
+    };
+    let dipole_scene = PreparedScene { objects: scene.objects.iter().cloned().map(without).collect(), ..scene.clone() };
     scene.objects[0].transport = Some(std::sync::Arc::new(kernel.clone()));
-    let (scaled, splat) = frame(scene.clone());
+    let (scaled, splat) = frame_at(scene.clone(), level);
     // Without a kernel the object takes the dipole: the same splat and gather, unscaled.
-    let (dipole, _) = frame(dipole_scene);
+    let (dipole, _) = frame_at(dipole_scene, level);
     let o = &scene.objects[0];
     let placed = kernel.placed(&o.mesh);
     let points = o.samples.iter().zip(&splat).map(|(s, (e, _))| {
@@ -118,7 +135,8 @@ fn against_twin(mut scene: PreparedScene, kernel: &TransportKernel) -> (f64, f64
     let phi = kernel.patch_flux(points);
     let dipole64: Vec<[f64; 3]> = dipole.iter().map(|m| m.map(f64::from)).collect();
     let near = TransportKernel::vertex_neighbours(&placed, &o.mesh);
-    let twin = kernel.exitance(&phi, &dipole64, &near);
+    let cells = level_cells(o, &o.levels[level].triangles);
+    let twin = kernel.exitance(&phi, (&dipole64, &cells), &near);
     let brightest = twin.iter().flatten().fold(0.0f64, |a, &b| a.max(b));
     let (mut worst, mut changed) = (0.0f64, 0.0f64);
     for ((g, t), d) in scaled.iter().zip(&twin).zip(&dipole64) {
@@ -132,19 +150,22 @@ fn against_twin(mut scene: PreparedScene, kernel: &TransportKernel) -> (f64, f64
 }
 
 #[test]
-fn the_gpu_transport_pass_matches_its_f64_twin_before_and_after_a_rigid_move() {
-    let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
-    let kernel = object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 16 * 300, seed: 2 }, &quiet).unwrap();
-    let (worst, changed) = against_twin(scene.clone(), &kernel);
-    assert!(worst < 1e-4, "GPU against its f64 twin: {worst:.2e} of the brightest vertex");
-    assert!(changed > 0.05, "the kernel must change the picture: {changed:.3}");
+fn the_gpu_transport_pass_matches_its_f64_twin_at_each_level_and_after_a_rigid_move() {
+    let scene = sphere(10.0, 24, "preset = \"marble\"", "transport");
+    assert!(scene.objects[0].levels.len() > 1, "the test needs a coarser level of detail");
+    let kernel = object_kernel(&scene.objects[0], &KernelSettings { patches: 48, walks: 48 * 300, seed: 2 }, &quiet).unwrap();
+    for level in [0, scene.objects[0].levels.len() - 1] {
+        let (worst, changed) = against_twin(scene.clone(), &kernel, level);
+        assert!(worst < 1e-4, "level {level}: GPU against its f64 twin, {worst:.2e} of the brightest vertex");
+        assert!(changed > 0.05, "level {level}: the kernel must change the picture, {changed:.3}");
+    }
     // Turned and moved: the same kernel, its patches following the vertices.
     let mut moved = scene.clone();
     moved.objects[0].transport = Some(std::sync::Arc::new(kernel.clone()));
     let rigid = Transform { rotate: Some([30.0, 60.0, 0.0]), translate: Some([3.0, -2.0, 1.0]), ..Transform::default() };
     moved.set_transform(0, rigid).unwrap();
     assert_eq!(moved.objects[0].transport.as_deref(), Some(&kernel), "a rigid move keeps the kernel");
-    let (worst, changed) = against_twin(moved, &kernel);
+    let (worst, changed) = against_twin(moved, &kernel, 0);
     assert!(worst < 1e-4 && changed > 0.05, "after the move: {worst:.2e}, {changed:.3}");
 }
 
@@ -162,12 +183,14 @@ fn a_scale_or_a_material_edit_drops_the_kernel_with_its_reason_and_the_dipole_ta
     let ResolvedMaterial::Translucent { material, .. } = scene.objects[0].material.clone() else { unreachable!() };
     common::with_gpu(|gpu| {
         let mut renderer = Renderer::new(gpu, scene).unwrap();
-        let plan = renderer.plan(Change::Everything);
+        let mut plan = renderer.plan(Change::Everything);
+        plan.objects.iter_mut().for_each(|o| o.level = 0);
         assert!(matches!(plan.objects[0].transport, Some(KernelState::Scales { .. })), "{plan}");
         renderer.frame(&plan).unwrap();
         assert_ne!(renderer.exitance(0).unwrap(), dipole);
         renderer.edit(SceneEdit::Material { object: 0, material }).unwrap();
-        let plan = renderer.plan(Change::Material(0));
+        let mut plan = renderer.plan(Change::Material(0));
+        plan.objects.iter_mut().for_each(|o| o.level = 0);
         let text = plan.to_string();
         assert_eq!(plan.objects[0].transport, Some(KernelState::Dropped { why: KernelDropped::MaterialEdited }));
         assert!(text.contains("transport kernel dropped: its material was edited"), "{text}");

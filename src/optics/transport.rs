@@ -62,13 +62,17 @@ impl TransportKernel {
     }
 
     /// `D_I`: per patch, the dipole's exitance `dipole` (per vertex) averaged over it by the
-    /// vertices' cells.
-    pub fn dipole_exitance(&self, dipole: &[[f64; 3]]) -> PerPatch {
-        let mut d = vec![[0.0; 3]; self.patches.len()];
+    /// vertices' `cells` (the mesh's dual cells, or a level of detail's: zero off the level);
+    /// 0 where none of its vertices has a cell.
+    pub fn dipole_exitance(&self, dipole: &[[f64; 3]], cells: &[f64]) -> PerPatch {
+        let (mut d, mut area) = (vec![[0.0; 3]; self.patches.len()], vec![0.0; self.patches.len()]);
         for (v, &i) in self.patches.of_vertex.iter().enumerate() {
-            (0..3).for_each(|c| d[i as usize][c] += self.patches.cells[v] * dipole[v][c]);
+            if cells[v] > 0.0 {
+                (0..3).for_each(|c| d[i as usize][c] += cells[v] * dipole[v][c]);
+                area[i as usize] += cells[v];
+            }
         }
-        d.iter_mut().zip(&self.patches.area).for_each(|(d, a)| d.iter_mut().for_each(|x| *x /= a));
+        d.iter_mut().zip(&area).for_each(|(d, &a)| d.iter_mut().for_each(|x| *x = if a > 0.0 { *x / a } else { 0.0 }));
         d
     }
 
@@ -86,12 +90,14 @@ impl TransportKernel {
         })
     }
 
-    /// The model's exitance at every vertex from the dipole's `dipole` at every vertex and the
+    /// The model's exitance at every vertex from the dipole's `dipole` at the vertices whose
+    /// `cells` are positive (the whole mesh's dual cells, or a level of detail's) and the
     /// fluxes `phi` (the f64 twin of `glsl/transport.comp`), each vertex blended from `near`
-    /// (per vertex, its `Patches::neighbours`).
-    pub fn exitance(&self, phi: &[[f64; 3]], dipole: &[[f64; 3]], near: &[Vec<(u32, f64)>]) -> Vec<[f64; 3]> {
-        let (f, d) = (self.transport_exitance(phi), self.dipole_exitance(dipole));
-        dipole.iter().zip(near).map(|(&m, near)| Self::scaled(m, near, &f, &d)).collect()
+    /// (per vertex, its `Patches::neighbours`); the others as they are.
+    pub fn exitance(&self, phi: &[[f64; 3]], (dipole, cells): (&[[f64; 3]], &[f64]), near: &[Vec<(u32, f64)>]) -> Vec<[f64; 3]> {
+        let (f, d) = (self.transport_exitance(phi), self.dipole_exitance(dipole, cells));
+        let scale = |((&m, near), &c): ((&[f64; 3], &Vec<(u32, f64)>), &f64)| if c > 0.0 { Self::scaled(m, near, &f, &d) } else { m };
+        dipole.iter().zip(near).zip(cells).map(scale).collect()
     }
 
     /// Its patches on `mesh`, the object as it stands now (`Patches::placed_on`): a rigid move

@@ -173,7 +173,7 @@ pub fn model_exitance(
         });
         let phi = k.patch_flux(points);
         let whole = gathered.as_ref().map_or(truth.as_slice(), |g| g[index].as_slice());
-        let (f, d) = (k.transport_exitance(&phi), k.dipole_exitance(whole));
+        let (f, d) = (k.transport_exitance(&phi), k.dipole_exitance(whole, &k.patches.cells));
         let near = TransportKernel::vertex_neighbours(&k.placed(&o.mesh), &o.mesh);
         out.push(
             truth

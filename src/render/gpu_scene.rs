@@ -39,7 +39,7 @@ pub struct GpuScene {
     /// The nodes' stand-ins' first entry in `beam_sources`: `tree_order`'s length.
     pub beam_standins: u32,
     /// Per object, in scene order: where its transport kernel lies, if it has one.
-    pub transport: Vec<Option<super::transport_tables::ObjectTransport>>,
+    pub transport: Vec<Option<Vec<super::transport_tables::LevelTransport>>>,
     /// Triangles in `bvh_triangles`: 0 when nothing casts a shadow.
     pub caster_triangles: u32,
     /// How far a shadow ray starts off the surface, along the normal, and the least distance
@@ -415,7 +415,7 @@ impl GpuScene {
         let beam_node_count = if any_beams { p.tree_nodes.len() } else { 1 };
         // The samples' entries, then the nodes' stand-ins.
         let beam_source_count = if any_beams { p.tree_order.len() + p.tree_nodes.len() } else { 1 };
-        let t = super::transport_tables::pack(scene, &p.firsts);
+        let t = super::transport_tables::pack(scene, &p.firsts, &l.levels);
         let zeros = vec![[0f32; 4]; p.vertices.len()];
         let sized = |name, item: usize, count: usize| storage(gpu, name, (item * count) as u64, none);
         // Made in the order they always were, vertices then indices first.

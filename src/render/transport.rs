@@ -9,7 +9,7 @@
 
 use super::graph::{Resource, Resources, Use, compute_uses, read, write};
 use super::pass::{FrameInputs, RenderPass};
-use super::transport_tables::ObjectTransport;
+use super::transport_tables::LevelTransport;
 use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use ash::vk;
 use std::sync::Arc;
@@ -20,12 +20,13 @@ use std::sync::Arc;
 pub struct TransportPush {
     /// x: the stage; y: the object's first patch; z: its patch count; w: 0.
     pub stage: [u32; 4],
-    /// x: its first vertex; y: its vertex count; z: its first neighbour entry; w: 0.
+    /// x: the object's first vertex; y: the level's vertex count; z: the object's first
+    /// neighbour entry; w: the level's first entry in `level_vertices`.
     pub vertices: [u32; 4],
 }
 
 /// glsl/transport.comp's bindings, in binding order.
-const BINDINGS: [Resource; 7] = [
+const BINDINGS: [Resource; 8] = [
     Resource::Splat,
     Resource::Exitance,
     Resource::TransportPatches,
@@ -33,6 +34,7 @@ const BINDINGS: [Resource; 7] = [
     Resource::TransportMatrix,
     Resource::TransportSums,
     Resource::TransportNeighbours,
+    Resource::LevelVertices,
 ];
 
 /// The three stages of glsl/transport.comp, one dispatch per object each.
@@ -53,9 +55,12 @@ impl TransportPass {
         Ok(Some(TransportPass { pipeline, set }))
     }
 
-    /// The gathered objects with a kernel this frame.
-    fn planned<'a>(frame: &'a FrameInputs) -> impl Iterator<Item = ObjectTransport> + 'a {
-        frame.scene.transport.iter().enumerate().filter_map(|(i, t)| t.filter(|_| frame.plan.gathers(i)))
+    /// The gathered objects with a kernel this frame, at the level each is gathered at.
+    fn planned<'a>(frame: &'a FrameInputs) -> impl Iterator<Item = LevelTransport> + 'a {
+        frame.scene.transport.iter().enumerate().filter_map(|(i, t)| {
+            let levels = t.as_ref().filter(|_| frame.plan.gathers(i))?;
+            levels.get(frame.plan.level(i).min(levels.len() - 1)).copied()
+        })
     }
 
     /// Whether this frame gathers an object with a kernel.
@@ -77,9 +82,9 @@ impl RenderPass for TransportPass {
     }
 
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        let push = |stage, t: &ObjectTransport| TransportPush {
+        let push = |stage, t: &LevelTransport| TransportPush {
             stage: [stage, t.patches[0], t.patches[1], 0],
-            vertices: [t.vertices[0], t.vertices[1], t.first_neighbour, 0],
+            vertices: [t.vertices[0], t.vertices[1], t.first_neighbour, t.first_entry],
         };
         for t in Self::planned(frame) {
             // One workgroup of 64 per patch.

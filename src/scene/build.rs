@@ -57,11 +57,7 @@ pub struct PreparedScene {
 /// shadow under what stands on it. Translucent objects carry gathered exitance, which varies
 /// over the width of the diffusion profile, and every level keeps its vertices' values exactly.
 fn lod_allowed(material: &ResolvedMaterial, environment_lit: bool) -> bool {
-    match material {
-        // The transport kernel's patches are the whole mesh's vertices.
-        ResolvedMaterial::Translucent { model, .. } => *model != super::ScatteringModel::Transport,
-        ResolvedMaterial::Opaque { .. } => !environment_lit,
-    }
+    matches!(material, ResolvedMaterial::Translucent { .. }) || !environment_lit
 }
 
 /// Overrides from the command line, applied on top of the scene file.
