@@ -8,9 +8,9 @@ use translucent::optics::transport::TransportKernel;
 use translucent::reference::rte::{Budget, Medium, half_space_reflectance};
 use translucent::reference::rte_mesh::{KernelSettings, object_kernel};
 use translucent::reference::transport_cache;
+use translucent::render::edit::SceneEdit;
 use translucent::render::plan::Change;
 use translucent::render::renderer::Renderer;
-use translucent::render::edit::SceneEdit;
 use translucent::render::transport_tables::level_cells;
 use translucent::scene::build::{KernelDropped, Overrides, PreparedScene, ResolvedMaterial};
 use translucent::scene::needs::KernelState;
@@ -54,7 +54,8 @@ fn a_kernel_on_a_sphere_far_wider_than_its_diffusion_length_reflects_what_the_ha
     // Chandrasekhar's plane albedo at normal incidence (`rte::half_space_reflectance`, checked
     // against the H-function in tests/rte.rs) within 1% (measured: 0.08, 0.09, 0.32%; at eta 1.3
     // on a 10 mm sphere the curvature adds 1.2 to 2.8%, on a 40 mm one 0.04 to 1.5%).
-    let scene = sphere(100.0, 24, "sigma_a = [1.0, 2.0, 0.5], sigma_s_prime = [10.0, 10.0, 10.0], eta = 1.0", "transport");
+    let scene =
+        sphere(100.0, 24, "sigma_a = [1.0, 2.0, 0.5], sigma_s_prime = [10.0, 10.0, 10.0], eta = 1.0", "transport");
     let o = &scene.objects[0];
     let settings = KernelSettings { patches: 16, walks: 16 * 8000, seed: 3 };
     let kernel = object_kernel(o, &settings, &quiet).unwrap();
@@ -129,9 +130,11 @@ fn against_twin(mut scene: PreparedScene, kernel: &TransportKernel, level: usize
     let (dipole, _) = frame_at(dipole_scene, level);
     let o = &scene.objects[0];
     let placed = kernel.placed(&o.mesh);
-    let points = o.samples.iter().zip(&splat).map(|(s, (e, _))| {
-        (kernel.sample_patch(&o.mesh, s.triangle, s.barycentric), s.area, e.map(f64::from))
-    });
+    let points = o
+        .samples
+        .iter()
+        .zip(&splat)
+        .map(|(s, (e, _))| (kernel.sample_patch(&o.mesh, s.triangle, s.barycentric), s.area, e.map(f64::from)));
     let phi = kernel.patch_flux(points);
     let dipole64: Vec<[f64; 3]> = dipole.iter().map(|m| m.map(f64::from)).collect();
     let near = TransportKernel::vertex_neighbours(&placed, &o.mesh);
@@ -153,7 +156,8 @@ fn against_twin(mut scene: PreparedScene, kernel: &TransportKernel, level: usize
 fn the_gpu_transport_pass_matches_its_f64_twin_at_each_level_and_after_a_rigid_move() {
     let scene = sphere(10.0, 24, "preset = \"marble\"", "transport");
     assert!(scene.objects[0].levels.len() > 1, "the test needs a coarser level of detail");
-    let kernel = object_kernel(&scene.objects[0], &KernelSettings { patches: 48, walks: 48 * 300, seed: 2 }, &quiet).unwrap();
+    let kernel =
+        object_kernel(&scene.objects[0], &KernelSettings { patches: 48, walks: 48 * 300, seed: 2 }, &quiet).unwrap();
     for level in [0, scene.objects[0].levels.len() - 1] {
         let (worst, changed) = against_twin(scene.clone(), &kernel, level);
         assert!(worst < 1e-4, "level {level}: GPU against its f64 twin, {worst:.2e} of the brightest vertex");
@@ -162,7 +166,8 @@ fn the_gpu_transport_pass_matches_its_f64_twin_at_each_level_and_after_a_rigid_m
     // Turned and moved: the same kernel, its patches following the vertices.
     let mut moved = scene.clone();
     moved.objects[0].transport = Some(std::sync::Arc::new(kernel.clone()));
-    let rigid = Transform { rotate: Some([30.0, 60.0, 0.0]), translate: Some([3.0, -2.0, 1.0]), ..Transform::default() };
+    let rigid =
+        Transform { rotate: Some([30.0, 60.0, 0.0]), translate: Some([3.0, -2.0, 1.0]), ..Transform::default() };
     moved.set_transform(0, rigid).unwrap();
     assert_eq!(moved.objects[0].transport.as_deref(), Some(&kernel), "a rigid move keeps the kernel");
     let (worst, changed) = against_twin(moved, &kernel, 0);
@@ -172,13 +177,25 @@ fn the_gpu_transport_pass_matches_its_f64_twin_at_each_level_and_after_a_rigid_m
 #[test]
 fn a_scale_or_a_material_edit_drops_the_kernel_with_its_reason_and_the_dipole_takes_over() {
     let mut scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
-    let kernel = object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 16 * 100, seed: 2 }, &quiet).unwrap();
+    let kernel =
+        object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 16 * 100, seed: 2 }, &quiet).unwrap();
     scene.objects[0].transport = Some(std::sync::Arc::new(kernel));
     let mut scaled = scene.clone();
     scaled.set_transform(0, Transform { scale: Some(1.5), ..Transform::default() }).unwrap();
     assert!(scaled.objects[0].transport.is_none());
     assert_eq!(scaled.objects[0].kernel_dropped, Some(KernelDropped::Scaled));
-    let dipole_scene = PreparedScene { objects: scene.objects.iter().cloned().map(|mut o| { o.transport = None; o }).collect(), ..scene.clone() };
+    let dipole_scene = PreparedScene {
+        objects: scene
+            .objects
+            .iter()
+            .cloned()
+            .map(|mut o| {
+                o.transport = None;
+                o
+            })
+            .collect(),
+        ..scene.clone()
+    };
     let (dipole, _) = frame(dipole_scene);
     let ResolvedMaterial::Translucent { material, .. } = scene.objects[0].material.clone() else { unreachable!() };
     common::with_gpu(|gpu| {

@@ -132,8 +132,7 @@ impl Patches {
     /// above 0; a blend 1.5 radii wide read 0.3 to 1.1 points worse on the bunny's ears, and
     /// on the marble sphere 0.3 to 0.4 better in red and green, 0.9 worse in blue).
     pub fn neighbours(&self, x: &Features) -> Vec<(u32, f64)> {
-        let mut near: Vec<(f64, usize)> =
-            self.centres.iter().enumerate().map(|(i, c)| (distance2(c, x), i)).collect();
+        let mut near: Vec<(f64, usize)> = self.centres.iter().enumerate().map(|(i, c)| (distance2(c, x), i)).collect();
         let n = NEIGHBOURS.min(near.len());
         near.select_nth_unstable_by(n - 1, |a, b| a.0.total_cmp(&b.0));
         near.truncate(n);

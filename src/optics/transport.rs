@@ -94,10 +94,16 @@ impl TransportKernel {
     /// `cells` are positive (the whole mesh's dual cells, or a level of detail's) and the
     /// fluxes `phi` (the f64 twin of `glsl/transport.comp`), each vertex blended from `near`
     /// (per vertex, its `Patches::neighbours`); the others as they are.
-    pub fn exitance(&self, phi: &[[f64; 3]], (dipole, cells): (&[[f64; 3]], &[f64]), near: &[Vec<(u32, f64)>]) -> Vec<[f64; 3]> {
+    pub fn exitance(
+        &self,
+        phi: &[[f64; 3]],
+        (dipole, cells): (&[[f64; 3]], &[f64]),
+        near: &[Vec<(u32, f64)>],
+    ) -> Vec<[f64; 3]> {
         let (f, d) = (self.transport_exitance(phi), self.dipole_exitance(dipole, cells));
-        let scale = |((&m, near), &c): ((&[f64; 3], &Vec<(u32, f64)>), &f64)| if c > 0.0 { Self::scaled(m, near, &f, &d) } else { m };
-        dipole.iter().zip(near).zip(cells).map(scale).collect()
+        (0..dipole.len())
+            .map(|v| if cells[v] > 0.0 { Self::scaled(dipole[v], &near[v], &f, &d) } else { dipole[v] })
+            .collect()
     }
 
     /// Its patches on `mesh`, the object as it stands now (`Patches::placed_on`): a rigid move
@@ -121,7 +127,13 @@ impl TransportKernel {
     /// transmitted flux between patches as the vertices' cells split the surface.
     pub fn sample_patch(&self, mesh: &Mesh, triangle: u32, barycentric: [f32; 3]) -> u32 {
         let b = barycentric;
-        let corner = if b[0] >= b[1] && b[0] >= b[2] { 0 } else if b[1] >= b[2] { 1 } else { 2 };
+        let corner = if b[0] >= b[1] && b[0] >= b[2] {
+            0
+        } else if b[1] >= b[2] {
+            1
+        } else {
+            2
+        };
         self.patches.of_vertex[mesh.triangles()[triangle as usize][corner] as usize]
     }
 

@@ -73,7 +73,8 @@ impl PackedTransport {
             samples[i as usize].push([first_sample + s as u32, (sample.area as f32).to_bits()]);
         }
         let first_row = self.matrix.len() as u32;
-        self.matrix.extend((0..k * k).map(|ij| [0, 1, 2].map(|c| kernel.flux[c][ij] as f32)).map(|[r, g, b]| [r, g, b, 0.0]));
+        self.matrix
+            .extend((0..k * k).map(|ij| [0, 1, 2].map(|c| kernel.flux[c][ij] as f32)).map(|[r, g, b]| [r, g, b, 0.0]));
         let first_neighbour = self.neighbours.len() as u32;
         for near in TransportKernel::vertex_neighbours(&placed, &o.mesh) {
             let mut pairs = [[0u32; 2]; crate::mesh::patches::NEIGHBOURS];

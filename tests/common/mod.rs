@@ -214,5 +214,11 @@ fn set_splat_irradiance(renderer: &mut Renderer, irradiance: &[[f32; 3]]) {
             records.push(SplatRecord::new(irradiance[records.len()], s.area as f32, near, beam));
         }
     }
-    renderer.scene_data_mut().buffers_mut().get_mut(translucent::render::graph::Resource::Splat).unwrap().write(0, &records).unwrap();
+    renderer
+        .scene_data_mut()
+        .buffers_mut()
+        .get_mut(translucent::render::graph::Resource::Splat)
+        .unwrap()
+        .write(0, &records)
+        .unwrap();
 }
