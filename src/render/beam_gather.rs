@@ -15,7 +15,7 @@
 //! Bindings: `BINDINGS`, in binding order. Push: `BeamGatherPush`.
 
 use super::graph::{Resource, Resources, Use, compute_uses, read, write};
-use super::pass::{FrameInputs, RenderPass};
+use super::pass::{AfterGather, FrameInputs, RenderPass};
 pub use super::beam_tables::{ObjectBeams, PackedBeams, ReceiverWalk, WalkItem, object_tables, pack_tables, receiver_walks, walk};
 use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use ash::vk;
@@ -83,8 +83,11 @@ impl BeamGatherPass {
         Ok(Some(BeamGatherPass { pipeline, set }))
     }
 
+}
+
+impl AfterGather for BeamGatherPass {
     /// Whether this frame gathers an object with a between-points channel.
-    fn any(frame: &FrameInputs) -> bool {
+    fn runs(frame: &FrameInputs) -> bool {
         frame.scene.beams.iter().enumerate().any(|(i, b)| b.is_some() && frame.plan.gathers(i))
     }
 }
@@ -163,29 +166,6 @@ impl BeamGatherPass {
             critical: [b.mu_c, b.opening, b.window, 0.0],
             normal_total: [r0, r1, r2, b.reach],
             stage: [1, 0, 0, frame.scene.beam_standins],
-        }
-    }
-}
-
-/// The gather's slot with the between-points pass after it: the dipole gather writes every
-/// channel, then this pass overwrites its own (a barrier between them, from their declarations).
-pub struct GatherThenBeams {
-    /// The dipole gather `render.gather` names.
-    pub gather: Box<dyn RenderPass>,
-    /// The between-points pass.
-    pub beams: BeamGatherPass,
-}
-
-impl RenderPass for GatherThenBeams {
-    fn uses(&self, frame: &FrameInputs) -> Vec<Use> {
-        self.gather.uses(frame)
-    }
-
-    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        self.gather.record(cmd, frame);
-        if BeamGatherPass::any(frame) {
-            frame.before(cmd, &self.beams.uses(frame));
-            self.beams.record(cmd, frame);
         }
     }
 }

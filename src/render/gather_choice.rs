@@ -3,7 +3,7 @@
 //! by the between-points single scattering where an object takes it. Each of those is a pass of
 //! its own module and GLSL; this one only chooses among them.
 
-use super::beam_gather::{BeamGatherPass, GatherThenBeams};
+use super::beam_gather::BeamGatherPass;
 use super::error::RenderError;
 use super::gather::GatherPass;
 use super::gather_pixel::GatherPixelPass;
@@ -11,8 +11,8 @@ use super::gather_sparse::GatherSparsePass;
 use super::gather_texture::GatherTexturePass;
 use super::gather_tree::GatherTreePass;
 use super::graph::Use;
-use super::transport::{GatherThenTransport, TransportPass};
-use super::pass::{FrameInputs, PassContext, Rebuild, RegisteredPass, RenderPass};
+use super::transport::TransportPass;
+use super::pass::{FrameInputs, GatherThen, PassContext, Rebuild, RegisteredPass, RenderPass};
 use crate::scene::GatherMode;
 use ash::vk;
 
@@ -35,14 +35,14 @@ impl RegisteredPass for GatherChoice {
         };
         // Channels of single scattering between points overwrite the dipole's after it.
         let gather: Box<dyn RenderPass> = match BeamGatherPass::new(gpu, resources)? {
-            Some(beams) => Box::new(GatherThenBeams { gather, beams }),
+            Some(beams) => Box::new(GatherThen { gather, then: beams }),
             None => gather,
         };
         // Then the transport kernels scale the per-vertex exitance of the objects that have
         // one (the texture gather's lives in its atlas: there the dipole alone).
         let per_vertex = settings.gather != GatherMode::Texture;
         Ok(Some(GatherChoice(match TransportPass::new(gpu, resources)?.filter(|_| per_vertex) {
-            Some(transport) => Box::new(GatherThenTransport { gather, transport }),
+            Some(transport) => Box::new(GatherThen { gather, then: transport }),
             None => gather,
         })))
     }

@@ -67,6 +67,36 @@ pub trait RenderPass: Send {
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs);
 }
 
+/// A pass that runs in the gather's slot after the gather, on the frames that call for it (the
+/// between-points single scattering, the transport kernel).
+pub trait AfterGather: RenderPass {
+    /// Whether this frame's plan has work for it.
+    fn runs(frame: &FrameInputs) -> bool;
+}
+
+/// The gather's slot: the gather, then `then` where this frame calls for it, a barrier between
+/// them from their declarations. Its uses are the gather's; `then` declares its own when it runs.
+pub struct GatherThen<P> {
+    /// What runs first: the gather `render.gather` names (itself perhaps a `GatherThen`).
+    pub gather: Box<dyn RenderPass>,
+    /// What runs after it.
+    pub then: P,
+}
+
+impl<P: AfterGather> RenderPass for GatherThen<P> {
+    fn uses(&self, frame: &FrameInputs) -> Vec<Use> {
+        self.gather.uses(frame)
+    }
+
+    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
+        self.gather.record(cmd, frame);
+        if P::runs(frame) {
+            frame.before(cmd, &self.then.uses(frame));
+            self.then.record(cmd, frame);
+        }
+    }
+}
+
 /// What a registered pass is built from: the device, the frame's shared resources, the scene
 /// and what the planner knows of it, and the host's choices.
 pub struct PassContext<'a> {

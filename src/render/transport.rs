@@ -2,13 +2,13 @@
 //! `material.model = "transport"` and a kernel attached (`optics::transport`,
 //! `PreparedObject::transport`), the dipole's exitance at its vertices scaled per patch of its
 //! surface to the radiative transfer through its own mesh. It runs in the gather's slot after the
-//! dipole gather (and the between-points pass): stage 0 sums each patch's transmitted flux and
-//! dipole exitance, stage 1 applies the kernel, stage 2 scales each vertex.
+//! dipole gather and the between-points pass (`pass::GatherThen`): stage 0 sums each patch's
+//! transmitted flux and dipole exitance, stage 1 applies the kernel, stage 2 scales each vertex.
 //!
 //! Bindings: `BINDINGS`, in binding order. Push: `TransportPush`.
 
 use super::graph::{Resource, Resources, Use, compute_uses, read, write};
-use super::pass::{FrameInputs, RenderPass};
+use super::pass::{AfterGather, FrameInputs, RenderPass};
 use super::transport_tables::LevelTransport;
 use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use ash::vk;
@@ -63,8 +63,11 @@ impl TransportPass {
         })
     }
 
+}
+
+impl AfterGather for TransportPass {
     /// Whether this frame gathers an object with a kernel.
-    fn any(frame: &FrameInputs) -> bool {
+    fn runs(frame: &FrameInputs) -> bool {
         Self::planned(frame).next().is_some()
     }
 }
@@ -97,30 +100,6 @@ impl RenderPass for TransportPass {
         frame.before(cmd, &[read(Resource::TransportSums, Access::ComputeRead)]);
         for t in Self::planned(frame) {
             self.pipeline.dispatch(cmd, &self.set, &push(2, &t), [t.vertices[1], 1, 1]);
-        }
-    }
-}
-
-/// The gather's slot with the transport pass after it: the gather (and the between-points
-/// pass) writes the dipole's exitance, then this pass scales it (a barrier between them, from
-/// their declarations).
-pub struct GatherThenTransport {
-    /// The gather `render.gather` names, with the between-points pass where it runs.
-    pub gather: Box<dyn RenderPass>,
-    /// The transport pass.
-    pub transport: TransportPass,
-}
-
-impl RenderPass for GatherThenTransport {
-    fn uses(&self, frame: &FrameInputs) -> Vec<Use> {
-        self.gather.uses(frame)
-    }
-
-    fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        self.gather.record(cmd, frame);
-        if TransportPass::any(frame) {
-            frame.before(cmd, &self.transport.uses(frame));
-            self.transport.record(cmd, frame);
         }
     }
 }
