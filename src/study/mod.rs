@@ -425,7 +425,12 @@ pub fn run(
     if base.objects.iter().any(|o| o.wants_transport()) {
         use crate::reference::{rte_mesh::KernelSettings, transport_cache};
         transport_cache::attach(&mut base.objects, &KernelSettings::default(), truth_dir, &|_, _, _| {})?;
-        truth.exitance = transport_cache::model_exitance(&base, &truth.exitance, truth_dir)?;
+        let scaled = transport_cache::model_exitance(&base, &truth.exitance, truth_dir)?;
+        for ((t, s), o) in truth.exitance.iter_mut().zip(scaled).zip(&base.objects) {
+            if o.wants_transport() {
+                *t = s;
+            }
+        }
     }
     if truth_cached {
         progress(Event::TruthCached);
