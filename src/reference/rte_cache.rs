@@ -14,7 +14,7 @@
 
 use super::rte::{Progress, RteError};
 use super::rte_mesh::{self, MeshOptions, ObjectExitance, Walk};
-use super::truth::{Fnv, FolderProblem, folder_problem};
+use super::truth::{Fnv, FolderProblem, folder_problem, read_cached, write_replacing};
 use crate::scene::build::{PreparedScene, ResolvedMaterial};
 use std::path::{Path, PathBuf};
 
@@ -150,14 +150,9 @@ pub fn cached(
 ) -> Result<(RteReference, bool), RteCacheError> {
     let key = content_key(scene, options);
     let path = dir.join(format!("rte-{key}.json"));
-    if let Ok(bytes) = std::fs::read(&path) {
-        match serde_json::from_slice::<RteReference>(&bytes) {
-            Ok(r) => match r.unusable_for(scene, &key) {
-                None => return Ok((r, true)),
-                Some(why) => log::warn!("radiative-transfer cache {}: {why}; walking it anew", path.display()),
-            },
-            Err(e) => log::warn!("radiative-transfer cache {}: unreadable ({e}); walking it anew", path.display()),
-        }
+    let usable = |r: &RteReference| r.unusable_for(scene, &key);
+    if let Some(r) = read_cached(&path, ("radiative-transfer cache", "walking it anew"), usable) {
+        return Ok((r, true));
     }
     if let Some(why) = folder_problem(dir) {
         return Err(RteCacheError::Folder { path: dir.to_path_buf(), why });
@@ -166,10 +161,6 @@ pub fn cached(
     let mut reference = RteReference { version: VERSION, key: key.clone(), objects, checksum: String::new() };
     reference.checksum = reference.digest();
     let json = serde_json::to_vec(&reference).map_err(|error| RteCacheError::Json { path: path.clone(), error })?;
-    // Write then rename, so a run cut short never leaves half a reference behind.
-    let tmp = dir.join(format!(".rte-{key}.json.tmp"));
-    let io = |error| RteCacheError::Io { path: path.clone(), error };
-    std::fs::write(&tmp, json).map_err(io)?;
-    std::fs::rename(&tmp, &path).map_err(io)?;
+    write_replacing(&path, &json).map_err(|error| RteCacheError::Io { path: path.clone(), error })?;
     Ok((reference, false))
 }

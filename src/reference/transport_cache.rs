@@ -10,7 +10,7 @@
 
 use super::rte_cache::RteCacheError;
 use super::rte_mesh::{KernelSettings, object_kernel};
-use super::truth::{Fnv, folder_problem};
+use super::truth::{Fnv, folder_problem, read_cached, write_replacing};
 use crate::optics::transport::TransportKernel;
 use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
 use std::path::Path;
@@ -101,14 +101,9 @@ pub fn cached(
 ) -> Result<(TransportKernel, bool), RteCacheError> {
     let key = content_key(o, settings);
     let path = dir.join(format!("kernel-{key}.json"));
-    if let Ok(bytes) = std::fs::read(&path) {
-        match serde_json::from_slice::<CachedKernel>(&bytes) {
-            Ok(c) => match c.unusable_for(o, &key) {
-                None => return Ok((c.kernel, true)),
-                Some(why) => log::warn!("transport kernel cache {}: {why}; walking it anew", path.display()),
-            },
-            Err(e) => log::warn!("transport kernel cache {}: unreadable ({e}); walking it anew", path.display()),
-        }
+    let usable = |c: &CachedKernel| c.unusable_for(o, &key);
+    if let Some(c) = read_cached(&path, ("transport kernel cache", "walking it anew"), usable) {
+        return Ok((c.kernel, true));
     }
     if let Some(why) = folder_problem(dir) {
         return Err(RteCacheError::Folder { path: dir.to_path_buf(), why });
@@ -117,11 +112,7 @@ pub fn cached(
     let mut cached = CachedKernel { version: VERSION, key: key.clone(), kernel, checksum: String::new() };
     cached.checksum = cached.digest();
     let json = serde_json::to_vec(&cached).map_err(|error| RteCacheError::Json { path: path.clone(), error })?;
-    // Write then rename, so a run cut short never leaves half a kernel behind.
-    let tmp = dir.join(format!(".kernel-{key}.json.tmp"));
-    let io = |error| RteCacheError::Io { path: path.clone(), error };
-    std::fs::write(&tmp, json).map_err(io)?;
-    std::fs::rename(&tmp, &path).map_err(io)?;
+    write_replacing(&path, &json).map_err(|error| RteCacheError::Io { path: path.clone(), error })?;
     Ok((cached.kernel, false))
 }
 

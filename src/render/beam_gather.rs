@@ -14,7 +14,7 @@
 //!
 //! Bindings: `BINDINGS`, in binding order. Push: `BeamGatherPush`.
 
-use super::graph::{Resource, Resources, Use, compute_uses, read, write};
+use super::graph::{Resource, Resources, Use, compute_uses_read_write, read, write};
 use super::pass::{AfterGather, FrameInputs, RenderPass};
 pub use super::beam_tables::{ObjectBeams, PackedBeams, ReceiverWalk, WalkItem, object_tables, pack_tables, receiver_walks, walk};
 use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuResult};
@@ -82,7 +82,6 @@ impl BeamGatherPass {
         let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
         Ok(Some(BeamGatherPass { pipeline, set }))
     }
-
 }
 
 impl AfterGather for BeamGatherPass {
@@ -94,15 +93,9 @@ impl AfterGather for BeamGatherPass {
 
 impl RenderPass for BeamGatherPass {
     fn uses(&self, _: &FrameInputs) -> Vec<Use> {
-        let mut uses = compute_uses(&BINDINGS, &[]);
         // It keeps the dipole's channels: the exitance is read and written; stage 1 reads the
         // nodes stage 0 wrote.
-        for u in &mut uses {
-            if matches!(u.resource, Resource::Exitance | Resource::BeamNodes | Resource::BeamSources) {
-                *u = Use::write(u.resource, Access::ComputeReadWrite);
-            }
-        }
-        uses
+        compute_uses_read_write(&BINDINGS, &[Resource::Exitance, Resource::BeamNodes, Resource::BeamSources])
     }
 
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {

@@ -14,7 +14,7 @@ use super::gpu_scene::GpuScene;
 use super::targets::FrameTargets;
 use crate::gpu::{Binding, Buffer, GpuError, GpuResult, Named};
 
-pub use super::resource::{HOST_READ, Resource, SCENE_BUFFERS, Use, compute_uses, overwrite, read, write};
+pub use super::resource::{HOST_READ, Resource, SCENE_BUFFERS, Use, compute_uses, compute_uses_read_write, overwrite, read, write};
 
 /// The registry of the frame's shared resources: the scene's buffers and the frame targets.
 /// Passes bind from it by name, so no binding list restates which buffer is which.

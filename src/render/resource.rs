@@ -204,6 +204,17 @@ pub const fn overwrite(resource: Resource, access: Access) -> Use {
     Use::overwrite(resource, access)
 }
 
+/// [`compute_uses`] of a pass that reads what it writes: each of `read_write` both read and
+/// written (`Access::ComputeReadWrite`), every other binding read. For a pass that keeps part
+/// of a buffer, or whose later dispatches read what its earlier ones wrote.
+pub fn compute_uses_read_write(bindings: &[Resource], read_write: &[Resource]) -> Vec<Use> {
+    let mut uses = compute_uses(bindings, &[]);
+    for u in uses.iter_mut().filter(|u| read_write.contains(&u.resource)) {
+        *u = write(u.resource, Access::ComputeReadWrite);
+    }
+    uses
+}
+
 /// The declaration of a compute pass that touches exactly the resources it binds: each of
 /// `writes` written, every other binding read (an image sampled, a buffer as storage). One line
 /// per pass: `compute_uses(&BINDINGS, &[Resource::Splat])`.

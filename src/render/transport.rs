@@ -7,7 +7,7 @@
 //!
 //! Bindings: `BINDINGS`, in binding order. Push: `TransportPush`.
 
-use super::graph::{Resource, Resources, Use, compute_uses, read, write};
+use super::graph::{Resource, Resources, Use, compute_uses_read_write, read, write};
 use super::pass::{AfterGather, FrameInputs, RenderPass};
 use super::transport_tables::LevelTransport;
 use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuResult};
@@ -62,7 +62,6 @@ impl TransportPass {
             levels.get(frame.plan.level(i).min(levels.len() - 1)).copied()
         })
     }
-
 }
 
 impl AfterGather for TransportPass {
@@ -74,14 +73,8 @@ impl AfterGather for TransportPass {
 
 impl RenderPass for TransportPass {
     fn uses(&self, _: &FrameInputs) -> Vec<Use> {
-        let mut uses = compute_uses(&BINDINGS, &[Resource::TransportSums]);
-        // The exitance is read by stage 0 and written by stage 2; the sums by both stages.
-        for u in &mut uses {
-            if matches!(u.resource, Resource::Exitance | Resource::TransportSums) {
-                *u = Use::write(u.resource, Access::ComputeReadWrite);
-            }
-        }
-        uses
+        // The exitance is read by stage 0 and written by stage 2; the sums by all three.
+        compute_uses_read_write(&BINDINGS, &[Resource::Exitance, Resource::TransportSums])
     }
 
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {

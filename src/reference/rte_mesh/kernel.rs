@@ -72,7 +72,13 @@ fn column(
     if corners.is_empty() || walks == 0 {
         return out;
     }
-    let cdf: Vec<f64> = corners.iter().scan(0.0, |s, &(_, _, a)| Some(std::mem::replace(s, *s + a) + a)).collect();
+    let cdf: Vec<f64> = corners
+        .iter()
+        .scan(0.0, |sum, &(_, _, a)| {
+            *sum += a;
+            Some(*sum)
+        })
+        .collect();
     let total = cdf[cdf.len() - 1];
     let mut exits: Vec<Exit> = Vec::new();
     for _ in 0..walks {

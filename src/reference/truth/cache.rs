@@ -60,26 +60,15 @@ pub fn cached(
 ) -> Result<(Truth, bool), TruthError> {
     let key = content_key(scene, options);
     let path = dir.join(format!("truth-{key}.json"));
-    if let Ok(bytes) = std::fs::read(&path) {
-        // An unreadable, foreign, edited or damaged file is recomputed and replaced, never
-        // trusted.
-        match serde_json::from_slice::<Truth>(&bytes) {
-            Ok(truth) => match truth.unusable_for(scene, options, &key) {
-                None => return Ok((truth, true)),
-                Some(why) => log::warn!("truth cache {}: {why}; computing it anew", path.display()),
-            },
-            Err(e) => log::warn!("truth cache {}: unreadable ({e}); computing it anew", path.display()),
-        }
+    let usable = |t: &Truth| t.unusable_for(scene, options, &key);
+    if let Some(truth) = read_cached(&path, ("truth cache", "computing it anew"), usable) {
+        return Ok((truth, true));
     }
     // A folder the truth cannot be written to is found before the truth is computed.
     writable_folder(dir)?;
     let truth = compute(scene, options, progress)?;
-    let io = |error| TruthError::Io { path: path.clone(), error };
     let json = serde_json::to_vec(&truth).map_err(|error| TruthError::Json { path: path.clone(), error })?;
-    // Write then rename, so a run cut short never leaves half a truth behind.
-    let tmp = dir.join(format!(".truth-{key}.json.tmp"));
-    std::fs::write(&tmp, json).map_err(io)?;
-    std::fs::rename(&tmp, &path).map_err(io)?;
+    write_replacing(&path, &json).map_err(|error| TruthError::Io { path: path.clone(), error })?;
     Ok((truth, false))
 }
 
@@ -90,6 +79,34 @@ fn writable_folder(dir: &Path) -> Result<(), TruthError> {
         None => Ok(()),
         Some(why) => Err(TruthError::Folder { path: dir.to_path_buf(), why }),
     }
+}
+
+/// The value cached at `path`, if the file is there, parses, and `unusable` finds nothing
+/// wrong with it. An unreadable, foreign, edited or damaged file is never trusted: a warning
+/// names `cache` (which cache), the file and why, and that it is `instead` (done anew).
+pub(crate) fn read_cached<T: serde::de::DeserializeOwned>(
+    path: &Path,
+    (cache, instead): (&str, &str),
+    unusable: impl FnOnce(&T) -> Option<String>,
+) -> Option<T> {
+    let bytes = std::fs::read(path).ok()?;
+    match serde_json::from_slice::<T>(&bytes) {
+        Ok(value) => match unusable(&value) {
+            None => return Some(value),
+            Some(why) => log::warn!("{cache} {}: {why}; {instead}", path.display()),
+        },
+        Err(e) => log::warn!("{cache} {}: unreadable ({e}); {instead}", path.display()),
+    }
+    None
+}
+
+/// `bytes` written to `path` through a hidden temporary beside it (`.NAME.tmp`), renamed into
+/// place, so a run cut short never leaves half a file behind.
+pub(crate) fn write_replacing(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let name = path.file_name().map_or_else(Default::default, |n| n.to_string_lossy().into_owned());
+    let tmp = path.with_file_name(format!(".{name}.tmp"));
+    std::fs::write(&tmp, bytes)?;
+    std::fs::rename(&tmp, path)
 }
 
 /// What keeps `dir` (made if missing) from being a folder a file can be written in, if

@@ -70,7 +70,7 @@ mod store;
 /// The vertices the truth is computed at (`scene::accuracy`, where occlusion picks them too).
 pub use crate::scene::accuracy::receiver_subset;
 pub use cache::FolderProblem;
-pub(crate) use cache::{Fnv, folder_problem};
+pub(crate) use cache::{Fnv, folder_problem, read_cached, write_replacing};
 pub use cache::{cached, content_key, default_cache_dir};
 pub use memory::{
     DEFAULT_MEMORY_CAP, LevelMemory, MemoryLimitKind, available_memory, default_memory_limit, human_bytes,
