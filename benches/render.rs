@@ -2,7 +2,8 @@
 //! seed paper's FPS-against-sample-count comparison (its Figure 7), on whatever device the
 //! loader offers (TRANSLUCENT_DEVICE to choose). Prints figures; asserts nothing.
 //!
-//!     cargo bench --bench render [-- frames|savings|levels|terms|hierarchy|growth|models|transport|planner|gathers]
+//!     cargo bench --bench render [-- frames|savings|levels|terms|hierarchy|growth|models|transport|receivers|
+//!                                    planner|gathers]
 //!
 //! Two timings per pass: GPU timestamp queries inside one submission, and the wall time of the
 //! pass submitted alone (submission to fence). On lavapipe a timestamp used to be taken only at
@@ -14,6 +15,8 @@
 mod growth;
 #[path = "render/models.rs"]
 mod models;
+#[path = "render/receivers.rs"]
+mod receivers;
 #[path = "render/roofline.rs"]
 mod roofline;
 
@@ -617,6 +620,9 @@ fn main() {
     }
     if wanted("transport") {
         models::transport(&gpu);
+    }
+    if wanted("receivers") {
+        receivers::receivers(&gpu);
     }
     if wanted("planner") {
         planner(&gpu);

@@ -49,6 +49,7 @@ struct GatherSparsePush {
     uint receiver_count;    // receivers at the level of detail gathered (stage 1's threads)
     uint first_listed;      // unused here (the hierarchical gather's stage 0 lists its nodes)
     uint listed_count;
+    uint only_picked;       // unused here (the hierarchical gather's pick of receivers)
 };
 layout(push_constant) uniform GatherSparsePushBlock { GatherSparsePush push; };
 

@@ -28,7 +28,8 @@
 // order (uint[]), 6 = node power (NodePowerRecord[], written by stage 0, read by stage 1),
 // 7 = receiver order (uint[]), 8 = receiver records (ReceiverGroupRecord[], one per receiver), 9 = group items
 // (uint[]), 10 = exitance (vec4 per vertex, written by stage 1), 11 = boundary distances (vec2
-// per vertex, mesh::Mesh::boundary_distances). Push: GatherTreePush.
+// per vertex, mesh::Mesh::boundary_distances), 12 = receiver state (uvec2 per vertex, picked by
+// glsl/receiver_view.comp where push.only_picked). Push: GatherTreePush.
 #include "dipole.glsl"
 #include "scene.glsl"
 #include "gather.glsl"
@@ -47,6 +48,7 @@ layout(std430, set = 0, binding = 8) readonly buffer ReceiverGroups { ReceiverGr
 layout(std430, set = 0, binding = 9) readonly buffer GroupItems { uint group_items[]; };
 layout(std430, set = 0, binding = 10) writeonly buffer Exitance { vec4 exitance[]; };
 layout(std430, set = 0, binding = 11) readonly buffer VertexBoundary { vec2 vertex_boundary[]; };
+layout(std430, set = 0, binding = 12) readonly buffer ReceiverState { uvec2 receiver_state[]; };
 struct GatherTreePush {
     uint object;            // the receiving object's index
     uint stage;             // 0: aggregate the nodes; 1: gather at the vertices
@@ -57,6 +59,7 @@ struct GatherTreePush {
     uint receiver_count;    // receivers at the level of detail gathered (stage 1's threads)
     uint first_listed;      // stage 0: this dispatch's nodes, tree_order[first_listed + k]
     uint listed_count;      // stage 0: their count (one height of the hierarchy)
+    uint only_picked;       // stage 1: only the receivers glsl/receiver_view.comp picked
 };
 layout(push_constant) uniform GatherTreePushBlock { GatherTreePush push; };
 
@@ -123,6 +126,8 @@ void main() {
     // No barrier below, so invocations past the last receiver may leave at once.
     if (k >= push.receiver_count) return;
     uint v = receiver_order[push.first_receiver + k];
+    // The rest hold exitance gathered under this generation of the splat, or wait their turn.
+    if (push.only_picked != 0u && receiver_state[v].y == 0u) return;
     vec3 x = vertex_position(vertices[v]);
     uvec4 list = receiver_groups[push.first_group + k].items;
     DipoleChannel ch[3] = gather_channels(o);

@@ -186,6 +186,11 @@ fn every_gather_and_frame_change_is_clean_under_synchronisation_validation() {
             renderer.frame_isolated(&light).unwrap();
             renderer.hdr_image().unwrap();
             renderer.frame(&camera_plan).unwrap();
+            // A readback mid-sweep gathers what the sweep left (the hierarchical gather).
+            let light = renderer.plan(Change::Light(1));
+            renderer.frame(&light).unwrap();
+            renderer.exitance_at_level(0).unwrap();
+            renderer.frame(&renderer.plan(Change::Camera)).unwrap();
         });
         assert!(messages.is_empty(), "{gather} gather, synchronisation validation:\n{}", messages.join("\n"));
     }

@@ -60,12 +60,13 @@ pub fn run(args: &Args) -> Result<()> {
             GatherMode::Vertex | GatherMode::Hierarchical | GatherMode::Texture
         ),
     );
-    let frames: Vec<(Change, plan::Plan)> = Change::all(prepared.scene.file.lights.len(), objects)
+    let mut frames: Vec<(Change, plan::Plan)> = Change::all(prepared.scene.file.lights.len(), objects)
         .into_iter()
         .map(|change| {
             (change, if change == Change::Everything { first.clone() } else { planner.plan_for(&needs, &view, change) })
         })
         .collect();
+    count_seen(&prepared, &view, &mut frames);
     if args.json {
         let json = serde_json::json!({
             "scene": prepared.scene.name,
@@ -82,4 +83,25 @@ pub fn run(args: &Args) -> Result<()> {
         out!("{}", p.to_string().trim_end());
     }
     Ok(())
+}
+
+/// Each gathered object's receivers an eye may see, counted on the host as the GPU picks them
+/// (`receiver_view::seen_receivers`), in every plan that gathers visible-first; counted once per
+/// level.
+fn count_seen(prepared: &PreparedScene, view: &plan::View, frames: &mut [(Change, plan::Plan)]) {
+    use translucent::render::plan::ReceiverScope;
+    use translucent::render::receiver_view::seen_receivers;
+    use translucent::render::target::DepthConvention;
+    let mut counted = std::collections::HashMap::new();
+    for o in frames.iter_mut().flat_map(|(_, p)| p.objects.iter_mut()) {
+        if !o.gather || !matches!(o.receivers, ReceiverScope::VisibleFirst { .. }) {
+            continue;
+        }
+        let object = &prepared.objects[o.object];
+        let seen = *counted.entry((o.object, o.level)).or_insert_with(|| {
+            let of = object.levels.get(o.level).map_or(0, |l| l.vertices.len());
+            [seen_receivers(object, o.level, view, DepthConvention::Standard).len(), of]
+        });
+        o.receivers_seen = Some(seen);
+    }
 }

@@ -11,7 +11,7 @@ use translucent::render::plan::{Change, Pass};
 use translucent::render::renderer::Renderer;
 use translucent::sampling::Method;
 use translucent::scene::build::{Overrides, PreparedScene};
-use translucent::scene::{GatherMode, Light, Scene, SplatVisibility, TransportMode, lights};
+use translucent::scene::{GatherMode, Light, ReceiverPolicy, Scene, SplatVisibility, TransportMode, lights};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -80,6 +80,11 @@ pub struct Args {
     /// render.splat_visibility)
     #[arg(long, value_parser = super::one_of::<SplatVisibility>(&SplatVisibility::ALL.map(SplatVisibility::name)))]
     pub splat_visibility: Option<SplatVisibility>,
+    /// Which receivers the hierarchical gather recomputes after a change: those the eye may see
+    /// first and the rest over the next frames, or every one each time (overrides
+    /// render.receivers)
+    #[arg(long, value_parser = super::one_of::<ReceiverPolicy>(&ReceiverPolicy::ALL.map(ReceiverPolicy::name)))]
+    pub receivers: Option<ReceiverPolicy>,
     /// Write each translucent vertex's world position and the RGB radiant exitance drawn there
     /// to a PLY: gathered channels as gathered, local ones as R_d,total E_t at the vertex
     /// (implies --full-detail: every vertex gathered)
@@ -124,6 +129,7 @@ impl Default for Args {
             explain: false,
             transport: None,
             splat_visibility: None,
+            receivers: None,
             export_exitance: None,
             full_detail: false,
         }
@@ -215,6 +221,7 @@ fn prepare(args: &Args) -> Result<PreparedScene> {
         resolution: args.resolution,
         transport: args.transport,
         splat_visibility: args.splat_visibility,
+        receivers: args.receivers,
         // Exported exitance is every vertex's.
         level_of_detail: (args.full_detail || args.export_exitance.is_some()).then_some(false),
     };

@@ -13,6 +13,7 @@ mod boundary;
 pub mod bvh;
 mod curvature;
 mod enclosure;
+pub mod facing;
 mod lod;
 mod gltf;
 mod obj;

@@ -29,7 +29,7 @@ impl RegisteredPass for GatherChoice {
         let gather: Box<dyn RenderPass> = match settings.gather {
             _ if context.needs.pixel_gather => return Ok(Some(GatherChoice(Box::new(GatherPixelPass::new(gpu, resources)?)))),
             GatherMode::Sparse => Box::new(GatherSparsePass::new(gpu, resources)?),
-            GatherMode::Hierarchical => Box::new(GatherTreePass::new(gpu, resources)?),
+            GatherMode::Hierarchical => Box::new(GatherTreePass::new(gpu, resources, context.options.depth)?),
             GatherMode::Texture => Box::new(GatherTexturePass::new(gpu, resources, settings.texture_samples)?),
             _ => Box::new(GatherPass::new(gpu, resources)?),
         };

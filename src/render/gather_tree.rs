@@ -14,6 +14,8 @@
 use super::graph::{Resource, Resources, Use, compute_uses};
 use super::group_gather::{GroupGather, Stage0};
 use super::pass::{FrameInputs, RenderPass};
+use super::receiver_view::ReceiverView;
+use super::target::DepthTest;
 use crate::gpu::{ComputePipeline, Gpu, GpuResult};
 use ash::vk;
 use std::sync::Arc;
@@ -23,7 +25,7 @@ use std::sync::Arc;
 pub use super::group_gather::GroupGatherPush as GatherTreePush;
 
 /// glsl/gather_tree.comp's bindings, in binding order.
-const BINDINGS: [Resource; 12] = [
+const BINDINGS: [Resource; 13] = [
     Resource::Vertices,
     Resource::Samples,
     Resource::Splat,
@@ -36,6 +38,7 @@ const BINDINGS: [Resource; 12] = [
     Resource::GroupItems,
     Resource::Exitance,
     Resource::VertexBoundary,
+    Resource::ReceiverState,
 ];
 
 /// The hierarchical gather: two dispatches of glsl/gather_tree.comp per translucent object the
@@ -47,16 +50,26 @@ pub struct GatherTreePass {
 impl GatherTreePass {
     /// The pipeline and one descriptor set over `BINDINGS` (whose group items `GpuScene::new`
     /// built for the scene's `render.gather_epsilon`).
-    pub fn new(gpu: &Arc<Gpu>, resources: &Resources) -> GpuResult<GatherTreePass> {
+    /// `depth` is the shading pass's depth test, which decides whether it culls hidden faces
+    /// (and so whether the pick of receivers tests their facing).
+    pub fn new(gpu: &Arc<Gpu>, resources: &Resources, depth: DepthTest) -> GpuResult<GatherTreePass> {
         let pipeline = ComputePipeline::new(gpu, "gather_tree.comp")?;
         let set = pipeline.descriptor_set(&resources.bind_all(&BINDINGS)?)?;
-        Ok(GatherTreePass { stages: GroupGather::new(pipeline, set, Resource::NodePower, Stage0::ByHeight) })
+        let mut stages = GroupGather::new(pipeline, set, Resource::NodePower, Stage0::ByHeight);
+        stages.view = Some(ReceiverView::new(gpu, resources, depth)?);
+        Ok(GatherTreePass { stages })
     }
 }
 
 impl RenderPass for GatherTreePass {
     fn uses(&self, _: &FrameInputs) -> Vec<Use> {
-        compute_uses(&BINDINGS, &[Resource::NodePower, Resource::Exitance])
+        // What the pick binds too is declared once, as the pick uses it: it reads and writes
+        // the receiver state before stage 1 reads it.
+        let view = ReceiverView::uses();
+        let mut uses = compute_uses(&BINDINGS, &[Resource::NodePower, Resource::Exitance]);
+        uses.retain(|u| !view.iter().any(|v| v.resource == u.resource));
+        uses.extend(view);
+        uses
     }
 
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {

@@ -122,6 +122,7 @@ fn pack_levels(scene: &PreparedScene) -> PackedLevels {
                 vertex_count: level_vertices.len() as u32 - first_entry,
                 enclosure: enclosure(o.mesh.positions(), &level.triangles),
                 bounds: level.bounds(o.mesh.positions()),
+                reach: crate::mesh::facing::longest_edge(o.mesh.positions(), &level.triangles),
             });
         }
         levels.push(ranges);
@@ -170,6 +171,8 @@ struct PackedObjects {
     objects: Vec<ObjectRecord>,
     samples: Vec<SampleRecord>,
     vertex_boundary: Vec<[f32; 2]>,
+    /// Per vertex, its facing cone (`mesh::facing`).
+    receiver_cones: Vec<[f32; 4]>,
     receivers: Vec<Receiver>,
     coarser_receivers: Vec<Vec<Receiver>>,
     node_heights: Vec<Vec<[u32; 2]>>,
@@ -235,6 +238,8 @@ impl PackedObjects {
         }
         let faces = o.mesh.face_normals();
         self.samples.extend(o.samples.iter().map(|s| SampleRecord::new(s, faces[s.triangle as usize])));
+        let levels = o.levels.iter().map(|l| (&l.triangles[..], enclosure(positions, &l.triangles)));
+        self.receiver_cones.extend(crate::mesh::facing::vertex_cones(positions, levels));
         let ranges = [first_vertex, positions.len() as u32, first_sample, o.samples.len() as u32];
         self.objects.push(ObjectRecord::new(o, ranges));
         self.atlas(o);
@@ -458,6 +463,9 @@ impl GpuScene {
                 transport_matrix: upload(gpu, "transport matrix", &t.matrix, none)?,
                 transport_sums: sized("transport sums", 48, t.patches.len().max(1))?,
                 transport_neighbours: upload(gpu, "transport neighbours", &t.neighbours, none)?,
+                receiver_cones: upload(gpu, "receiver cones", &p.receiver_cones, none)?,
+                // Generation 0, which no gather marks: every receiver stale.
+                receiver_state: upload(gpu, "receiver state", &vec![[0u32; 2]; p.vertices.len()], none)?,
             },
             indices,
             beams,

@@ -9,6 +9,8 @@
 use super::gpu_scene::Receiver;
 use super::graph::{Resource, read, write};
 use super::pass::FrameInputs;
+use super::plan::ReceiverScope;
+use super::receiver_view::ReceiverView;
 use crate::gpu::{Access, ComputePipeline, DescriptorSet};
 use ash::vk;
 
@@ -36,6 +38,9 @@ pub struct GroupGatherPush {
     pub first_listed: u32,
     /// Their count: the dispatch's threads.
     pub listed_count: u32,
+    /// Stage 1 of the hierarchical gather: 1 to gather only the receivers
+    /// `receiver_view` picked; 0 otherwise.
+    pub only_picked: u32,
 }
 
 impl GroupGatherPush {
@@ -51,6 +56,7 @@ impl GroupGatherPush {
             receiver_count: receiver.vertex_count,
             first_listed: 0,
             listed_count: 0,
+            only_picked: 0,
         }
     }
 }
@@ -73,6 +79,9 @@ pub(super) struct GroupGather {
     pub handoff: Resource,
     /// What stage 0 runs over: the sparse gather's samples, or the hierarchy by height.
     pub stage0: Stage0,
+    /// The hierarchical gather's pick of receivers before stage 1, for the objects the plan
+    /// gathers visible-first; `None`: every receiver.
+    pub view: Option<ReceiverView>,
 }
 
 impl GroupGather {
@@ -85,22 +94,33 @@ impl GroupGather {
             "{}: local size is not RECEIVER_GROUP_SIZE",
             pipeline.name()
         );
-        GroupGather { pipeline, set, handoff, stage0 }
+        GroupGather { pipeline, set, handoff, stage0, view: None }
     }
 
-    /// Stage 0 over the plan's receivers, the hand-off barrier, stage 1 over the same receivers
-    /// at the level of detail the plan draws each at (`GpuScene::receiver_at`: the whole mesh
-    /// where the scene built no coarser receivers).
+    /// The pick of receivers (`view`), stage 0 over the plan's receivers whose splat is new to
+    /// the gather, the hand-off barrier, stage 1 over the same receivers at the level of detail
+    /// the plan draws each at (`GpuScene::receiver_at`: the whole mesh where the scene built no
+    /// coarser receivers), the picked ones alone where the plan says so. The pick goes first:
+    /// every dispatch of the gather's pipeline binds the receiver state it writes.
     pub fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         let planned =
             || frame.scene.receivers.iter().enumerate().filter(|(_, r)| frame.plan.gathers(r.object as usize));
-        for (j, r) in planned() {
+        let at = |j: usize, r: &Receiver| frame.scene.receiver_at(j, frame.plan.level(r.object as usize));
+        if let Some(view) = &self.view {
+            for (j, r) in planned() {
+                view.record(cmd, frame, at(j, r), frame.plan.receivers(r.object as usize));
+            }
+            frame.before(cmd, &[read(Resource::ReceiverState, Access::ComputeRead)]);
+        }
+        for (j, r) in planned().filter(|(_, r)| frame.plan.receivers(r.object as usize).fresh()) {
             self.record_stage0(cmd, frame, j, r);
         }
         frame.before(cmd, &[read(self.handoff, Access::ComputeRead)]);
         for (j, r) in planned() {
-            let at = frame.scene.receiver_at(j, frame.plan.level(r.object as usize));
-            self.pipeline.dispatch(cmd, &self.set, &GroupGatherPush::new(at, 1), [at.vertex_count, 1, 1]);
+            let scope = frame.plan.receivers(r.object as usize);
+            let picked = self.view.is_some() && matches!(scope, ReceiverScope::VisibleFirst { .. });
+            let push = GroupGatherPush { only_picked: u32::from(picked), ..GroupGatherPush::new(at(j, r), 1) };
+            self.pipeline.dispatch(cmd, &self.set, &push, [at(j, r).vertex_count, 1, 1]);
         }
     }
 

@@ -34,6 +34,7 @@ pub mod plan;
 #[cfg(test)]
 mod probe;
 pub mod ranges;
+pub mod receiver_view;
 pub mod records;
 pub mod registry;
 pub mod renderer;

@@ -20,6 +20,9 @@ pub struct LevelRange {
     pub enclosure: Enclosure,
     /// Its vertices' bounding box, scene units: (min, max).
     pub bounds: (Vec3, Vec3),
+    /// Its longest edge (`mesh::facing::longest_edge`): a vertex of a triangle that meets the
+    /// view frustum lies at most this far outside it.
+    pub reach: f32,
 }
 
 /// A draw of one object: index range and vertex offset in the shared buffers.

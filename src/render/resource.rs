@@ -145,6 +145,11 @@ declare_resources! {
         TransportSums: transport_sums = "TransportSums",
         /// Per vertex of a kernel's object, its patch neighbours (`SceneBuffers::transport_neighbours`).
         TransportNeighbours: transport_neighbours = "TransportNeighbours",
+        /// Per vertex, its facing cone (`mesh::facing::vertex_cones`; `SceneBuffers::receiver_cones`).
+        ReceiverCones: receiver_cones = "ReceiverCones",
+        /// Per vertex, the splat generation its exitance was gathered under and whether this
+        /// frame gathers it (`glsl/receiver_view.comp`; `SceneBuffers::receiver_state`).
+        ReceiverState: receiver_state = "ReceiverState",
     }
     other {
         /// Exitance at the samples, the sparse gather's stage 0 (owned by `GatherSparsePass`).

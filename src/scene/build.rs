@@ -78,6 +78,8 @@ pub struct Overrides {
     pub transport: Option<crate::scene::TransportMode>,
     /// `--splat-visibility`: replaces `render.splat_visibility`.
     pub splat_visibility: Option<crate::scene::SplatVisibility>,
+    /// `--receivers`: replaces `render.receivers`.
+    pub receivers: Option<crate::scene::ReceiverPolicy>,
     /// `--full-detail` (false): replaces `render.level_of_detail`.
     pub level_of_detail: Option<bool>,
     /// `--max-error`: replaces `render.max_error` ([`crate::scene::MIN_MAX_ERROR`] to
@@ -272,6 +274,9 @@ fn apply_overrides(scene: &mut Scene, overrides: &Overrides) -> Result<(), Scene
     }
     if let Some(v) = overrides.splat_visibility {
         scene.file.render.splat_visibility = v;
+    }
+    if let Some(r) = overrides.receivers {
+        scene.file.render.receivers = r;
     }
     let render = &mut scene.file.render;
     render.texture_samples = overrides.texture_samples.unwrap_or(render.texture_samples);

@@ -371,7 +371,30 @@ pub struct RenderSettings {
     /// How the splat finds whether a light reaches a sample (default `"hybrid"`).
     #[serde(default)]
     pub splat_visibility: SplatVisibility,
+    /// Which receivers the hierarchical gather recomputes after a change (default
+    /// `"visible_first"`).
+    #[serde(default)]
+    pub receivers: ReceiverPolicy,
 }
+
+/// Which receivers the hierarchical gather recomputes after the lights or a material change:
+/// `render.receivers`, `--receivers`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ReceiverPolicy {
+    /// Those on a face the eye may see at once, the rest over the next
+    /// `render::plan::SWEEP_FRAMES` frames without a change; a receiver coming into view
+    /// stale is gathered the frame it does. Every image equals `every`'s
+    #[default]
+    VisibleFirst,
+    /// Every receiver of the level drawn, each time
+    Every,
+}
+
+named_choices!(ReceiverPolicy, "receivers", {
+    VisibleFirst => "visible_first",
+    Every => "every",
+});
 
 /// How the splat finds whether a light reaches a sample: `render.splat_visibility`,
 /// `--splat-visibility`.
@@ -538,6 +561,7 @@ impl Default for RenderSettings {
             texture_samples: DEFAULT_TEXTURE_SAMPLES,
             texture_resolution: DEFAULT_TEXTURE_RESOLUTION,
             splat_visibility: SplatVisibility::default(),
+            receivers: ReceiverPolicy::default(),
         }
     }
 }

@@ -24,6 +24,10 @@ pub struct SceneNeeds {
     pub transport: super::TransportMode,
     /// `render.splat_visibility`: how the splat finds whether a light reaches a sample.
     pub splat_visibility: super::SplatVisibility,
+    /// `render.gather`: only the hierarchical gather recomputes some receivers and keeps the rest.
+    pub gather: super::GatherMode,
+    /// `render.receivers`: which receivers the hierarchical gather recomputes after a change.
+    pub receivers: super::ReceiverPolicy,
     /// Per object, in scene order: what the planner weighs for it.
     pub objects: Vec<ObjectFacts>,
     /// Scene units a shadow-map texel spans (`PreparedScene::shadow_texel`).
@@ -195,6 +199,8 @@ impl PreparedScene {
             host_target: false,
             transport: self.scene.file.render.transport,
             splat_visibility: self.scene.file.render.splat_visibility,
+            gather: self.scene.file.render.gather,
+            receivers: self.scene.file.render.receivers,
             objects: self.objects.iter().map(ObjectFacts::of).collect(),
             shadow_texel: self.shadow_texel(),
             caster_center: self.caster_bounds.0.to_array(),

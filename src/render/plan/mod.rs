@@ -31,6 +31,7 @@ mod objects;
 mod passes;
 mod planner;
 mod reason;
+pub mod receivers;
 #[cfg(test)]
 mod tests;
 
@@ -38,6 +39,7 @@ pub use crate::scene::needs::SceneNeeds;
 use glam::{Mat4, Vec3, Vec4};
 pub use objects::{choose, choose_level};
 pub use planner::{BakedLevels, Planner, needs};
+pub use receivers::{EveryReason, ReceiverScope, SWEEP_FRAMES, Sweep};
 pub use reason::{ChannelFigures, ChannelReason, LevelReason, ObjectReason, PassReason, ShadowFilter, SkipReason};
 use std::fmt;
 
@@ -203,6 +205,13 @@ pub struct ObjectPlan {
     pub environment_kept: bool,
     /// Its exitance is gathered this frame.
     pub gather: bool,
+    /// Which of its receivers, when it is gathered.
+    pub receivers: ReceiverScope,
+    /// Of the receivers at its level, how many an eye may see and how many there are, where
+    /// the caller counted them on the host (`receiver_view::seen_receivers`; `translucent plan`
+    /// does); `None` otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub receivers_seen: Option<[usize; 2]>,
     /// Why it is (or is not) splatted and gathered (`splat` and `gather` follow from it).
     pub why: ObjectReason,
     /// Whether its gathered exitance still needs recomputing after this frame (lights or its
@@ -276,6 +285,12 @@ impl Plan {
         self.objects.get(object).map_or(SplatLights::All, |o| o.splat_lights)
     }
 
+    /// Which of object `object`'s receivers the gather recomputes (every one in a plan made by
+    /// hand).
+    pub fn receivers(&self, object: usize) -> ReceiverScope {
+        self.objects.get(object).map_or(ReceiverScope::Every { why: EveryReason::Asked }, |o| o.receivers)
+    }
+
     /// Whether object `object` is gathered (when the gather runs).
     pub fn gathers(&self, object: usize) -> bool {
         self.objects.get(object).is_none_or(|o| o.gather)
@@ -327,6 +342,16 @@ impl fmt::Display for Plan {
                 writeln!(f, "    splat: key lights only, the environment's part kept from an earlier frame")?;
             }
             writeln!(f, "    level {}: {}", o.level, o.level_why)?;
+            if o.gather {
+                write!(f, "    gathers {}", o.receivers)?;
+                match (o.receivers, o.receivers_seen) {
+                    (ReceiverScope::VisibleFirst { sweep: Some(s), .. }, Some([_, of])) => {
+                        writeln!(f, ": {} of the level's {of} receivers in the chunk", s.range(of as u32)[1])?
+                    }
+                    (_, Some([seen, of])) => writeln!(f, ": {seen} of the level's {of} may be seen")?,
+                    (_, None) => writeln!(f)?,
+                }
+            }
             if let Some(d) = &o.density {
                 writeln!(f, "    {d}")?;
             }

@@ -6,6 +6,7 @@ use super::{
     Change, ChannelFigures, ChannelPlan, ChannelReason, LOCAL_PIXELS, LOCAL_SPACING, LOD_EDGE_PIXELS, LOD_ERROR_PIXELS,
     LevelReason, ObjectPlan, ObjectReason, SplatLights, Transport,
 };
+use super::receivers::{ReceiverScope, SWEEP_FRAMES, Sweep};
 use crate::scene::TransportMode;
 use crate::scene::needs::{LevelFacts, ObjectFacts};
 use glam::Vec3;
@@ -88,6 +89,19 @@ pub(super) struct ObjectHistory {
     pub gathered: Option<usize>,
     /// The environment's part of its samples' irradiance, kept on the GPU, is current.
     pub environment_kept: bool,
+    /// Its splat generation: the last one its visible-first gathers marked receivers with.
+    pub generation: u32,
+    /// The sweep its last visible-first gather left, if it has not finished.
+    pub sweep: Option<SweepState>,
+}
+
+/// A sweep still to run over an object's receivers (`receivers::Sweep`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SweepState {
+    /// The next chunk.
+    pub next: u32,
+    /// The level of detail whose receivers it sweeps: drawn at another, it starts again there.
+    pub level: usize,
 }
 
 impl Frame<'_> {
@@ -102,8 +116,17 @@ impl Frame<'_> {
         let (level, level_why) = self.level(facts, in_view);
         let stale_now = history.stale || self.lights_stale || change == Change::Material(i);
         let finer = history.gathered.is_some_and(|g| level < g);
-        let why = self.work(i, &channels, in_view, stale_now, finer.then_some(level));
+        // A sweep left unfinished goes on at the level drawn, from its first chunk at a new one.
+        let sweep = history.sweep.map(|s| Sweep { chunk: if s.level == level { s.next } else { 0 }, of: SWEEP_FRAMES });
+        let why = self.work(i, &channels, in_view, stale_now, finer.then_some(level), sweep);
         let (splat, gather) = why.splat_and_gather();
+        let (policy, mode) = (self.needs.receivers, self.needs.gather);
+        let receivers = match why {
+            ObjectReason::Sweeping { chunk, of } => {
+                ReceiverScope::of(facts, policy, mode, history.generation, false, Some(Sweep { chunk, of }))
+            }
+            _ => ReceiverScope::of(facts, policy, mode, history.generation.wrapping_add(1).max(1), true, None),
+        };
         let kept = history.environment_kept && !self.environment_stale && change != Change::Material(i);
         let splat_lights =
             if splat && kept && self.needs.environment.is_some() { SplatLights::KeyLights } else { SplatLights::All };
@@ -120,6 +143,8 @@ impl Frame<'_> {
             splat_lights,
             environment_kept: kept,
             gather,
+            receivers,
+            receivers_seen: None,
             why,
             level,
             level_why,
@@ -141,7 +166,7 @@ impl Frame<'_> {
 
     /// Whether object `i`, with `channels`, is splatted and gathered, and why: `stale_now`, its
     /// exitance is out of date; `finer`, the level it is drawn at when that is finer than the
-    /// last gathered.
+    /// last gathered; `sweep`, the chunk its last gather left for this frame.
     fn work(
         &self,
         i: usize,
@@ -149,6 +174,7 @@ impl Frame<'_> {
         in_view: bool,
         stale_now: bool,
         finer: Option<usize>,
+        sweep: Option<Sweep>,
     ) -> ObjectReason {
         if channels.is_empty() {
             ObjectReason::Opaque
@@ -167,6 +193,8 @@ impl Frame<'_> {
             ObjectReason::PixelGather
         } else if let Some(level) = finer {
             ObjectReason::FinerLevel { level }
+        } else if let Some(Sweep { chunk, of }) = sweep {
+            ObjectReason::Sweeping { chunk, of }
         } else {
             ObjectReason::Unchanged
         }

@@ -2,7 +2,8 @@
 //! whether baked levels of detail are current), the plan a frame gets from it, and the history a
 //! recorded frame leaves. Also `needs`, the one place a renderer's `SceneNeeds` are computed.
 
-use super::objects::ObjectHistory;
+use super::objects::{ObjectHistory, SweepState};
+use super::receivers::ReceiverScope;
 use super::frame::Frame;
 use super::passes::shadow_filter;
 use super::{Change, Pass, Plan, SceneNeeds, View};
@@ -55,6 +56,12 @@ pub struct Planner {
     environment_kept: Vec<bool>,
     /// Whether levels baked from the sky light are current.
     baked: BakedLevels,
+    /// Per object: its splat generation, the mark of the receivers its visible-first gathers
+    /// computed (`ReceiverScope::VisibleFirst`); 0 before any.
+    generation: Vec<u32>,
+    /// Per object: the sweep over the receivers no eye ray reached that its last visible-first
+    /// gather left, until it finishes.
+    sweep: Vec<Option<SweepState>>,
 }
 
 impl Planner {
@@ -68,6 +75,8 @@ impl Planner {
             gathered: vec![usize::MAX; objects],
             environment_kept: vec![false; objects],
             baked: BakedLevels::Current,
+            generation: vec![0; objects],
+            sweep: vec![None; objects],
         }
     }
 
@@ -114,6 +123,8 @@ impl Planner {
                     stale: self.stale.get(i).copied().unwrap_or(true),
                     gathered: self.gathered.get(i).copied(),
                     environment_kept: self.environment_kept.get(i).copied().unwrap_or(false),
+                    generation: self.generation.get(i).copied().unwrap_or(0),
+                    sweep: self.sweep.get(i).copied().flatten(),
                 };
                 frame.object(i, facts, history)
             })
@@ -154,8 +165,32 @@ impl Planner {
             self.environment_kept[o.object] = (o.splat && plan.runs(Pass::Splat)) || o.environment_kept;
             if o.gather && plan.runs(Pass::Gather) {
                 self.gathered[o.object] = if gather_by_level { o.level } else { 0 };
+                self.swept(o.object, o.receivers, o.level);
             }
         }
+    }
+
+    /// Object `object` was gathered over `receivers` at `level`: a fresh visible-first gather
+    /// marks its generation and leaves a sweep from the first chunk, a chunk moves the sweep on
+    /// (or ends it), and a gather of every receiver ends it.
+    fn swept(&mut self, object: usize, receivers: ReceiverScope, level: usize) {
+        self.sweep[object] = match receivers {
+            ReceiverScope::VisibleFirst { generation, fresh: true, .. } => {
+                self.generation[object] = generation;
+                Some(SweepState { next: 0, level })
+            }
+            ReceiverScope::VisibleFirst { sweep: Some(s), .. } => {
+                (s.chunk + 1 < s.of).then_some(SweepState { next: s.chunk + 1, level })
+            }
+            ReceiverScope::VisibleFirst { sweep: None, .. } => self.sweep[object],
+            ReceiverScope::Every { .. } => None,
+        };
+    }
+
+    /// Object `object`'s splat generation and whether a sweep over its receivers is still to
+    /// run (`Renderer::exitance` finishes it before reading).
+    pub fn sweep_pending(&self, object: usize) -> Option<u32> {
+        self.sweep.get(object).copied().flatten().map(|_| self.generation[object])
     }
 
     /// The levels of detail were baked from the sky light as the last vertex-light pass left it.
@@ -178,6 +213,7 @@ impl Planner {
     /// (`Renderer::set_exitance`): the whole mesh holds it, as after a gather at level 0.
     pub fn exitance_written(&mut self, object: usize) {
         self.gathered[object] = 0;
+        self.sweep[object] = None;
     }
 
     /// A history with the given stale flags and gathered levels, nothing pending.
@@ -189,6 +225,8 @@ impl Planner {
             gathered: gathered.to_vec(),
             environment_kept: vec![false; stale.len()],
             baked: BakedLevels::Current,
+            generation: vec![0; stale.len()],
+            sweep: vec![None; stale.len()],
         }
     }
 }

@@ -152,6 +152,15 @@ pub enum ObjectReason {
         /// The level drawn this frame.
         level: usize,
     },
+    /// Unchanged since its last gather, which left receivers no eye ray reached for later:
+    /// this frame's chunk of them gathered (`receivers::SWEEP_FRAMES`), sample irradiance and
+    /// the hierarchy's power reused.
+    Sweeping {
+        /// This frame's chunk, from 0.
+        chunk: u32,
+        /// Chunks in the sweep.
+        of: u32,
+    },
     /// Lights and material unchanged: the exitance is reused.
     Unchanged,
 }
@@ -163,7 +172,7 @@ impl ObjectReason {
         match self {
             Opaque | AllLocal | OutOfView | Unchanged => (false, false),
             MaterialChanged | GeometryChanged | LightsChanged | InViewAgain => (true, true),
-            PixelGather | FinerLevel { .. } => (false, true),
+            PixelGather | FinerLevel { .. } | Sweeping { .. } => (false, true),
         }
     }
 }
@@ -316,6 +325,12 @@ impl fmt::Display for ObjectReason {
             ObjectReason::FinerLevel { level } => write!(
                 f,
                 "level {level} is finer than the last gathered: its vertices gathered, sample irradiance reused"
+            ),
+            ObjectReason::Sweeping { chunk, of } => write!(
+                f,
+                "unchanged since its last gather: chunk {} of {of} of the receivers it left for later gathered, \
+                 with any stale receiver that came into view",
+                chunk + 1
             ),
             ObjectReason::Unchanged => {
                 write!(f, "lights and material unchanged: exitance is view-independent, reused")

@@ -48,6 +48,8 @@ fn needs(shadow_layers: u32, translucent_objects: usize) -> SceneNeeds {
         host_target: false,
         transport: TransportMode::Auto,
         splat_visibility: crate::scene::SplatVisibility::Hybrid,
+        gather: crate::scene::GatherMode::Vertex,
+        receivers: crate::scene::ReceiverPolicy::VisibleFirst,
         objects: (0..translucent_objects).map(|_| object(1.0, 0.1, 0.3)).collect(),
         shadow_texel: 0.01,
         caster_center: [0.0; 3],
@@ -330,4 +332,79 @@ fn withdrawn_baked_levels_leave_the_needs_one_level() {
 
 fn needs_of(scene: &crate::scene::build::PreparedScene, baked: BakedLevels) -> SceneNeeds {
     super::needs(scene, false, baked)
+}
+
+/// A hierarchically gathered scene of one translucent object with three levels, seen from
+/// `view()`, under `policy`.
+fn hierarchical(policy: crate::scene::ReceiverPolicy) -> SceneNeeds {
+    let mut needs = needs(0, 1);
+    needs.gather = crate::scene::GatherMode::Hierarchical;
+    needs.receivers = policy;
+    needs.objects[0].levels = levels();
+    needs
+}
+
+/// Plan and record one frame after `change`.
+fn step(planner: &mut Planner, needs: &SceneNeeds, view: &View, change: Change) -> ObjectPlan {
+    planner.mark(change);
+    let p = planner.plan(needs, view);
+    planner.recorded(&p, true);
+    p.objects[0].clone()
+}
+
+#[test]
+fn after_a_change_the_unseen_receivers_are_swept_over_the_next_frames_then_nothing_runs() {
+    let needs = hierarchical(crate::scene::ReceiverPolicy::VisibleFirst);
+    let mut planner = Planner::new(1, Change::Everything);
+    let first = step(&mut planner, &needs, &view(), Change::Everything);
+    assert_eq!(first.receivers, ReceiverScope::VisibleFirst { generation: 1, fresh: true, sweep: None });
+    let lit = step(&mut planner, &needs, &view(), Change::Lights);
+    assert_eq!(lit.receivers, ReceiverScope::VisibleFirst { generation: 2, fresh: true, sweep: None });
+    for chunk in 0..SWEEP_FRAMES {
+        let o = step(&mut planner, &needs, &view(), Change::Camera);
+        assert_eq!(o.why, ObjectReason::Sweeping { chunk, of: SWEEP_FRAMES });
+        assert!(o.gather && !o.splat);
+        let sweep = Some(Sweep { chunk, of: SWEEP_FRAMES });
+        assert_eq!(o.receivers, ReceiverScope::VisibleFirst { generation: 2, fresh: false, sweep });
+        assert_eq!(planner.sweep_pending(0), (chunk + 1 < SWEEP_FRAMES).then_some(2));
+    }
+    let settled = step(&mut planner, &needs, &view(), Change::Camera);
+    assert_eq!(settled.why, ObjectReason::Unchanged);
+    assert!(!settled.gather);
+}
+
+#[test]
+fn a_sweep_starts_again_at_a_new_level_and_a_change_makes_a_new_generation() {
+    let needs = hierarchical(crate::scene::ReceiverPolicy::VisibleFirst);
+    let mut planner = Planner::new(1, Change::Everything);
+    step(&mut planner, &needs, &view(), Change::Everything);
+    step(&mut planner, &needs, &view(), Change::Camera);
+    step(&mut planner, &needs, &view(), Change::Camera);
+    // Twice as far: a coarser level, whose receivers the sweep starts over.
+    let far = View { eye: Vec3::new(0.0, 0.0, 10.0), ..view() };
+    let far = View {
+        view_proj: far.projection * glam::camera::rh::view::look_at_mat4(far.eye, Vec3::ZERO, Vec3::Y),
+        ..far
+    };
+    let o = step(&mut planner, &needs, &far, Change::Camera);
+    assert!(o.level > 0);
+    assert_eq!(o.why, ObjectReason::Sweeping { chunk: 0, of: SWEEP_FRAMES });
+    // A light moving mid-sweep: a fresh gather under the next generation.
+    let lit = step(&mut planner, &needs, &far, Change::Light(0));
+    assert_eq!(lit.receivers, ReceiverScope::VisibleFirst { generation: 2, fresh: true, sweep: None });
+}
+
+#[test]
+fn every_receiver_is_gathered_where_the_scene_asks_or_another_gather_or_pass_needs_it() {
+    let mut planner = Planner::new(1, Change::Everything);
+    let asked = hierarchical(crate::scene::ReceiverPolicy::Every);
+    let every = step(&mut planner, &asked, &view(), Change::Everything);
+    assert_eq!(every.receivers, ReceiverScope::Every { why: EveryReason::Asked });
+    assert_eq!(step(&mut planner, &asked, &view(), Change::Camera).why, ObjectReason::Unchanged);
+    let flat = step(&mut Planner::new(1, Change::Everything), &needs(0, 1), &view(), Change::Everything);
+    assert_eq!(flat.receivers, ReceiverScope::Every { why: EveryReason::GatherMode });
+    let mut single = hierarchical(crate::scene::ReceiverPolicy::VisibleFirst);
+    single.objects[0].single = [Some(0.1), None, None];
+    let o = step(&mut Planner::new(1, Change::Everything), &single, &view(), Change::Everything);
+    assert_eq!(o.receivers, ReceiverScope::Every { why: EveryReason::AfterGather });
 }

@@ -9,7 +9,7 @@ use crate::render::frame::{LevelExitance, NonFinite};
 use crate::render::graph::{Resource, Resources, read};
 use crate::render::local_exitance::LocalExitancePass;
 use crate::render::pass::RenderPass;
-use crate::render::plan::{Change, Pass};
+use crate::render::plan::{Change, Pass, ReceiverScope, Sweep};
 use ash::vk;
 
 impl Renderer {
@@ -86,12 +86,38 @@ impl Renderer {
         Ok(LevelExitance { level, vertices, values })
     }
 
-    /// Object `object`'s exitance buffer as it stands, every vertex.
+    /// Object `object`'s exitance buffer as it stands, every vertex, after the receivers a
+    /// visible-first gather left for later are gathered (`finish_sweep`).
     fn exitance_all(&self, object: usize) -> Result<Vec<[f32; 3]>, RenderError> {
+        self.finish_sweep(object)?;
         let all: Vec<[f32; 4]> = self.gpu_scene.buffers.exitance.read()?;
         let first = self.gpu_scene.object_range(object).first_vertex as usize;
         let count = self.scene.objects[object].mesh.positions().len();
         Ok(all[first..first + count].iter().map(|e| [e[0], e[1], e[2]]).collect())
+    }
+
+    /// Gather, in a submission of its own, the receivers of object `object` that its last
+    /// visible-first gather left for later frames (`plan::receivers`), at the level it gathered
+    /// at: the whole level in one chunk, under the same splat generation, so that what is read
+    /// back is what a gather of every receiver gives. The planner's sweep goes on, finding
+    /// nothing left. Nothing when no sweep is pending.
+    fn finish_sweep(&self, object: usize) -> Result<(), RenderError> {
+        let Some(generation) = self.planner.sweep_pending(object) else { return Ok(()) };
+        let Some(gather) = self.passes.get(Pass::Gather) else { return Ok(()) };
+        let mut plan = self.planner.plan_for(&self.needs, &self.view(), Change::Camera);
+        for o in &mut plan.objects {
+            o.gather = o.object == object;
+            o.level = self.planner.gathered_level(o.object).unwrap_or(0);
+            o.receivers = ReceiverScope::VisibleFirst { generation, fresh: false, sweep: Some(Sweep::ALL) };
+        }
+        self.gpu.one_shot("finish sweep", |cmd| {
+            let frame = self.inputs(&plan, None, None);
+            frame.before(cmd, &gather.uses(&frame));
+            gather.record(cmd, &frame);
+            let r = Resource::Exitance;
+            frame.before(cmd, &[read(r, Access::HostRead), read(r, Access::TransferRead)]);
+        })?;
+        Ok(())
     }
 
     /// Replace object `object`'s per-vertex exitance (RGB per vertex, its vertex order) before

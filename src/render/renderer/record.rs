@@ -8,7 +8,7 @@ use crate::render::error::RenderError;
 use crate::render::frame::{FrameTimings, RecordedFrame};
 use crate::render::graph::{HOST_READ, Resource, read, write};
 use crate::render::pass::FrameInputs;
-use crate::render::plan::{Change, Pass, Plan};
+use crate::render::plan::{Change, EveryReason, Pass, Plan, ReceiverScope};
 use crate::render::target::{HostSync, HostTarget, TargetDesc};
 use crate::scene::GatherMode;
 use ash::vk;
@@ -96,6 +96,10 @@ impl Renderer {
         self.follow_extent(extent);
         let mut plan = self.planner.plan(&self.needs, &self.view());
         plan.passes.retain(|(p, _)| !matches!(p, Pass::Shade | Pass::Tonemap));
+        // The host reads every vertex, seen or not.
+        for o in plan.objects.iter_mut().filter(|o| o.gather) {
+            o.receivers = ReceiverScope::Every { why: EveryReason::HostReadsExitance };
+        }
         self.host_frames = true;
         let frame = self.record_checked(cmd, &plan, None);
         let uses: Vec<_> = [Resource::Exitance, Resource::EnvironmentIrradiance]

@@ -1,0 +1,112 @@
+//! The hierarchical gather's visible-first receivers (`render::plan::receivers`): after a
+//! change it recomputes the receivers an eye may see and sweeps the rest over the next frames,
+//! and every image, and every readback, equals a gather of every receiver.
+
+mod common;
+
+use common::{builtin, with_gpu};
+use glam::Vec3;
+use std::sync::Arc;
+use translucent::gpu::Gpu;
+use translucent::render::edit::SceneEdit;
+use translucent::render::plan::{Change, ReceiverScope, SWEEP_FRAMES, View};
+use translucent::render::receiver_view::seen_receivers;
+use translucent::render::renderer::Renderer;
+use translucent::render::target::DepthConvention;
+use translucent::scene::build::Overrides;
+use translucent::scene::{GatherMode, ReceiverPolicy, lights};
+
+/// The built-in scene gathered hierarchically at 400 samples, its receivers under `policy`.
+fn renderer(gpu: &Arc<Gpu>, policy: ReceiverPolicy) -> Renderer {
+    let overrides =
+        Overrides { gather: Some(GatherMode::Hierarchical), receivers: Some(policy), ..Overrides::default() };
+    Renderer::new(gpu, builtin(&overrides)).expect("renderer")
+}
+
+/// Render the frame the pending change calls for; the image and the bunny's receiver scope.
+fn frame(renderer: &mut Renderer) -> (Vec<u8>, ReceiverScope) {
+    let plan = renderer.plan(renderer.pending_change().unwrap_or(Change::Camera));
+    renderer.frame(&plan).expect("frame");
+    (renderer.image().expect("image").0, plan.objects[0].receivers)
+}
+
+/// How many of the bunny's vertices the last frame's pick marked, out of how many.
+fn picked(renderer: &Renderer) -> (usize, usize) {
+    let state: Vec<[u32; 2]> = renderer.scene_data().buffers().receiver_state().read().expect("state");
+    let count = renderer.scene().objects[0].mesh.positions().len();
+    (state[..count].iter().filter(|s| s[1] == 1).count(), count)
+}
+
+#[test]
+fn every_image_of_a_light_drag_and_an_orbit_equals_a_gather_of_every_receiver() {
+    with_gpu(|gpu| {
+        let mut visible = renderer(gpu, ReceiverPolicy::VisibleFirst);
+        let mut every = renderer(gpu, ReceiverPolicy::Every);
+        let (image, scope) = frame(&mut visible);
+        assert!(matches!(scope, ReceiverScope::VisibleFirst { fresh: true, sweep: None, .. }), "{scope:?}");
+        let (first, count) = picked(&visible);
+        assert!(first > 0 && first < count * 3 / 4, "the first frame picked {first} of {count} vertices");
+        assert_eq!(image, frame(&mut every).0, "first frame");
+        // Two light moves, then an orbit long enough to finish the sweep and go past it.
+        for step in 0..(2 + SWEEP_FRAMES as usize + 3) {
+            for r in [&mut visible, &mut every] {
+                let edit = if step < 2 {
+                    let light = &r.scene().scene.file.lights[0];
+                    SceneEdit::Light { index: 0, light: lights::orbit(light, Vec3::ZERO, 20.0).unwrap() }
+                } else {
+                    SceneEdit::Camera(r.camera().orbited(Vec3::ZERO, 25.0))
+                };
+                r.edit(edit).unwrap();
+            }
+            let (a, scope) = frame(&mut visible);
+            assert_eq!(a, frame(&mut every).0, "frame {step} ({scope:?})");
+        }
+        // The sweep has finished: every vertex of the level holds the last generation's
+        // exitance, and a camera frame gathers nothing.
+        let plan = visible.plan(Change::Camera);
+        assert!(!plan.objects[0].gather, "{plan}");
+    });
+}
+
+#[test]
+fn exitance_read_back_mid_sweep_equals_a_gather_of_every_receiver() {
+    with_gpu(|gpu| {
+        let read = |policy| {
+            let mut r = renderer(gpu, policy);
+            let mut plan = r.plan(Change::Everything);
+            // Every vertex: the readback refuses a coarser level.
+            plan.objects.iter_mut().for_each(|o| o.level = 0);
+            r.frame(&plan).expect("frame");
+            let before = picked(&r).0;
+            (r.exitance(0).expect("exitance"), before)
+        };
+        let (visible, first) = read(ReceiverPolicy::VisibleFirst);
+        let (every, _) = read(ReceiverPolicy::Every);
+        assert!(first < visible.len(), "the first frame picked all {first} vertices: nothing left to finish");
+        assert_eq!(visible, every);
+    });
+}
+
+#[test]
+fn the_gpu_picks_the_receivers_its_host_twin_sees_on_a_frame_of_change() {
+    with_gpu(|gpu| {
+        let mut r = renderer(gpu, ReceiverPolicy::VisibleFirst);
+        for _ in 0..2 {
+            let plan = r.plan(r.pending_change().unwrap_or(Change::Camera));
+            r.frame(&plan).expect("frame");
+            let state: Vec<[u32; 2]> = r.scene_data().buffers().receiver_state().read().expect("state");
+            let gpu_picked: Vec<u32> = (0..r.scene().objects[0].mesh.positions().len() as u32)
+                .filter(|&v| state[v as usize][1] == 1)
+                .collect();
+            let view = View::of_camera(&r.camera(), r.scene().scene.file.camera.resolution[1]);
+            let host = seen_receivers(&r.scene().objects[0], plan.objects[0].level, &view, DepthConvention::Standard);
+            assert!(!host.is_empty() && host.len() < r.scene().objects[0].levels[plan.objects[0].level].vertices.len());
+            assert_eq!(gpu_picked, host);
+            // From the other side of the bunny, after a light move: a fresh pick.
+            r.edit(SceneEdit::Camera(r.camera().orbited(Vec3::ZERO, 150.0))).unwrap();
+            let light = &r.scene().scene.file.lights[0];
+            let moved = lights::orbit(light, Vec3::ZERO, 10.0).unwrap();
+            r.edit(SceneEdit::Light { index: 0, light: moved }).unwrap();
+        }
+    });
+}
