@@ -122,12 +122,13 @@ void main() {
         if (k < push.listed_count) aggregate(tree_order[push.first_listed + k]);
         return;
     }
-    ObjectRecord o = objects[push.object];
     // No barrier below, so invocations past the last receiver may leave at once.
     if (k >= push.receiver_count) return;
     uint v = receiver_order[push.first_receiver + k];
-    // The rest hold exitance gathered under this generation of the splat, or wait their turn.
+    // The rest hold exitance gathered under this generation of the splat, or wait their turn;
+    // they leave before the object's record is loaded.
     if (push.only_picked != 0u && receiver_state[v].y == 0u) return;
+    ObjectRecord o = objects[push.object];
     vec3 x = vertex_position(vertices[v]);
     uvec4 list = receiver_groups[push.first_group + k].items;
     DipoleChannel ch[3] = gather_channels(o);

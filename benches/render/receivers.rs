@@ -10,7 +10,7 @@ use glam::{Mat4, Vec3};
 use std::sync::Arc;
 use translucent::SceneEdit;
 use translucent::gpu::{Gpu, median};
-use translucent::render::plan::{Change, Pass};
+use translucent::render::plan::{Change, Pass, SWEEP_FRAMES};
 use translucent::render::renderer::Renderer;
 use translucent::scene::ReceiverPolicy;
 use translucent::scene::build::Overrides;
@@ -77,6 +77,15 @@ pub fn receivers(gpu: &Arc<Gpu>) {
         m[1][1] / m[0][1],
         100.0 * picked_share(&rows[1], level)
     );
+
+    // The camera frames after the light stops: the sweep's chunks, then nothing to gather.
+    let (sweep, _) = side_by_side(&mut rows, Change::Camera, SWEEP_FRAMES as usize - WARM_UP, None);
+    let (after, _) = side_by_side(&mut rows, Change::Camera, FRAMES, None);
+    println!("\nCamera frames after the light stops (frame by timestamps; gather ms in brackets):");
+    println!("  {:<16} {:>22} {:>22}", "receivers", "the sweep's frames", "after it");
+    for (name, (s, a)) in ["every", "visible_first"].iter().zip(sweep.iter().zip(&after)) {
+        println!("  {name:<16} {:>13.2} ({:>5.2}) {:>15.2} ({:>4.2})", s[1], s[0], a[1], a[0]);
+    }
 
     // Both rows step, so that their lights stay where the other's are.
     let (one, _) = side_by_side(&mut rows, Change::Light(0), FRAMES, None);

@@ -125,7 +125,9 @@ impl Frame<'_> {
             ObjectReason::Sweeping { chunk, of } => {
                 ReceiverScope::of(facts, policy, mode, history.generation, false, Some(Sweep { chunk, of }))
             }
-            _ => ReceiverScope::of(facts, policy, mode, history.generation.wrapping_add(1).max(1), true, None),
+            // A gather that aggregates the splat makes a new generation; no gather, none.
+            _ if gather => ReceiverScope::of(facts, policy, mode, history.generation.wrapping_add(1).max(1), true, None),
+            _ => ReceiverScope::of(facts, policy, mode, history.generation, false, None),
         };
         let kept = history.environment_kept && !self.environment_stale && change != Change::Material(i);
         let splat_lights =
