@@ -9,8 +9,9 @@
 // Three stages (push `stage.x`), each one dispatch per object, a barrier between them:
 //   0: one workgroup per patch: Phi and D, summed over its items in shared memory;
 //   1: one invocation per patch: F, its row of W against every patch's Phi;
-//   2: one invocation per vertex: the scale, where the blended D is positive and the ratio
-//      finite (else the dipole's value stays).
+//   2: one invocation per vertex: the scale, in the channels push.stage.w names (the others
+//      take single scattering between points, which the pass before wrote), where the blended
+//      D is positive and the ratio finite (else the dipole's value stays).
 // Bindings: 0 = splat (SplatRecord[], read), 1 = exitance (vec4 per vertex, read by stage 0,
 // written by stage 2), 2 = patches (TransportPatchRecord[]), 3 = items (uvec2: index, area
 // bits), 4 = the kernels' W (vec4 per pair, rgb), 5 = sums (three vec4 per patch: Phi, D, F;
@@ -36,7 +37,8 @@ layout(std430, set = 0, binding = 6) readonly buffer TransportNeighbours { uvec4
 layout(std430, set = 0, binding = 7) readonly buffer LevelVertices { uint level_vertices[]; };
 
 struct TransportPush {
-    uvec4 stage;    // x: the stage; y: the object's first patch; z: its patches; w: 0
+    uvec4 stage;    // x: the stage; y: the object's first patch; z: its patches; w: the
+                    // channels it scales (bit c)
     uvec4 vertices; // x: its first vertex; y: the level's vertices; z: the object's first
                     // neighbour entry; w: the level's first entry in level_vertices
 };
@@ -105,7 +107,8 @@ void scale_vertex(uint i) {
     vec4 m = exitance[v];
     for (int c = 0; c < 3; ++c) {
         float ratio = f[c] / d[c];
-        if (d[c] > 0.0 && !isinf(ratio) && !isnan(ratio)) m[c] *= ratio;
+        bool scaled = (push.stage.w & (1u << uint(c))) != 0u;
+        if (scaled && d[c] > 0.0 && !isinf(ratio) && !isnan(ratio)) m[c] *= ratio;
     }
     exitance[v] = m;
 }

@@ -175,6 +175,24 @@ fn the_gpu_transport_pass_matches_its_f64_twin_at_each_level_and_after_a_rigid_m
 }
 
 #[test]
+fn in_ketchup_the_kernel_scales_red_and_leaves_green_and_blue_to_single_scattering_between_points() {
+    let scene = sphere(10.0, 24, "preset = \"ketchup\"", "transport");
+    assert_eq!(scene.objects[0].single_channels(), [false, true, true], "ketchup's reduced albedos");
+    let settings = KernelSettings { patches: 48, walks: 48 * 300, seed: 2 };
+    let kernel = object_kernel(&scene.objects[0], &settings, &quiet).unwrap();
+    let mut with = scene.clone();
+    with.objects[0].transport = Some(std::sync::Arc::new(kernel));
+    // Without a kernel attached: the dipole in red, single scattering between points in green
+    // and blue, as model = "auto" draws them.
+    let (unscaled, _) = frame(scene);
+    let (scaled, _) = frame(with);
+    assert!(scaled.iter().zip(&unscaled).all(|(s, u)| s[1] == u[1] && s[2] == u[2]), "green and blue were scaled");
+    let brightest = unscaled.iter().map(|m| m[0]).fold(0.0f32, f32::max);
+    let changed = scaled.iter().zip(&unscaled).map(|(s, u)| (s[0] - u[0]).abs()).fold(0.0f32, f32::max);
+    assert!(changed > 0.05 * brightest, "red must be scaled: {changed} of {brightest}");
+}
+
+#[test]
 fn a_scale_or_a_material_edit_drops_the_kernel_with_its_reason_and_the_dipole_takes_over() {
     let mut scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
     let kernel =

@@ -18,7 +18,8 @@ use std::sync::Arc;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct TransportPush {
-    /// x: the stage; y: the object's first patch; z: its patch count; w: 0.
+    /// x: the stage; y: the object's first patch; z: its patch count; w: the channels it
+    /// scales (`LevelTransport::channels`).
     pub stage: [u32; 4],
     /// x: the object's first vertex; y: the level's vertex count; z: the object's first
     /// neighbour entry; w: the level's first entry in `level_vertices`.
@@ -79,7 +80,7 @@ impl RenderPass for TransportPass {
 
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
         let push = |stage, t: &LevelTransport| TransportPush {
-            stage: [stage, t.patches[0], t.patches[1], 0],
+            stage: [stage, t.patches[0], t.patches[1], t.channels],
             vertices: [t.vertices[0], t.vertices[1], t.first_neighbour, t.first_entry],
         };
         for t in Self::planned(frame) {

@@ -28,6 +28,9 @@ pub struct LevelTransport {
     pub first_neighbour: u32,
     /// The level's first entry in `level_vertices`.
     pub first_entry: u32,
+    /// Bit `c` set where the kernel scales channel `c`: those that take no single scattering
+    /// between points (`PreparedObject::single_channels`), which the between-points pass wrote.
+    pub channels: u32,
 }
 
 /// Every kernel packed (`pack`).
@@ -67,6 +70,8 @@ impl PackedTransport {
     ) -> Vec<LevelTransport> {
         let placed = kernel.placed(&o.mesh);
         let k = placed.len();
+        let single = o.single_channels();
+        let channels = (0..3).filter(|&c| !single[c]).map(|c| 1u32 << c).sum();
         let mut samples = vec![Vec::new(); k];
         for (s, sample) in o.samples.iter().enumerate() {
             let i = kernel.sample_patch(&o.mesh, sample.triangle, sample.barycentric);
@@ -109,6 +114,7 @@ impl PackedTransport {
                     vertices: [first_vertex, range.vertex_count],
                     first_neighbour,
                     first_entry: range.first_entry,
+                    channels,
                 }
             })
             .collect()

@@ -498,9 +498,10 @@ pub enum ScatteringModel {
     Auto,
     /// Single scattering between points in every channel
     Single,
-    /// The dipole scaled per patch of the surface to the radiative transfer through this
-    /// object's own mesh, by a transport kernel walked once per mesh and medium
-    /// (`optics::transport`); the dipole until the kernel is attached
+    /// Per channel: single scattering between points where the reduced albedo is under 0.3, as
+    /// `auto`; elsewhere the dipole scaled per patch of the surface to the radiative transfer
+    /// through this object's own mesh, by a transport kernel walked once per mesh and medium
+    /// (`optics::transport`; the dipole until the kernel is attached)
     Transport,
 }
 
@@ -516,9 +517,11 @@ impl ScatteringModel {
     /// `alpha'` is each channel's reduced albedo.
     pub fn single_channels(self, alpha_prime: [f64; 3]) -> [bool; 3] {
         match self {
-            ScatteringModel::Dipole | ScatteringModel::Transport => [false; 3],
+            ScatteringModel::Dipole => [false; 3],
             ScatteringModel::Single => [true; 3],
-            ScatteringModel::Auto => alpha_prime.map(|a| a < crate::optics::beam_single::ALBEDO_BELOW),
+            ScatteringModel::Auto | ScatteringModel::Transport => {
+                alpha_prime.map(|a| a < crate::optics::beam_single::ALBEDO_BELOW)
+            }
         }
     }
 }

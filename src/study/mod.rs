@@ -420,12 +420,15 @@ pub fn run(
     let (mut truth, truth_cached) =
         truth::cached(&base, &config.truth, truth_dir, &|l, d, n| progress(Event::Truth(l, d, n)))?;
     // A material with model = "transport": its kernel scales the renderer's exitance, so the
-    // truth is the dipole's exact integral scaled by it in f64.
+    // truth is the dipole's exact integral scaled by it in f64 (single scattering between
+    // points in its channels of low albedo).
     let mut base = base;
     if base.objects.iter().any(|o| o.wants_transport()) {
         use crate::reference::{rte_mesh::KernelSettings, transport_cache};
         transport_cache::attach(&mut base.objects, &KernelSettings::default(), truth_dir, &|_, _, _| {})?;
         let scaled = transport_cache::model_exitance(&base, &truth.exitance, truth_dir)?;
+        // Its channels of single scattering between points, as the renderer draws them.
+        let scaled = physics::with_single_between_points(&base, scaled);
         for ((t, s), o) in truth.exitance.iter_mut().zip(scaled).zip(&base.objects) {
             if o.wants_transport() {
                 *t = s;

@@ -169,8 +169,9 @@ pub enum Model {
     /// As [`Model::Transport`], the light attenuated with depth as the refracted beam is: the
     /// limit of kernels precomputed at a few entry cosines (`rte_mesh::ModelEntry::Slanted`).
     TransportSlanted,
-    /// The dipole scaled per patch by a transport kernel between patches walked without the
-    /// lights (`rte_mesh::kernel`), in three blends.
+    /// What `material.model = "transport"` renders: per channel, single scattering between
+    /// points under `beam_single::ALBEDO_BELOW`, else the dipole scaled per patch by a
+    /// transport kernel between patches walked without the lights (`rte_mesh::kernel`).
     Kernel,
 }
 
@@ -218,7 +219,9 @@ impl Model {
             Model::DirectionalAlpha => "directional dipole, Grosjean's D, source alpha'".into(),
             Model::Transport => "transport in the mesh, light entering along the normal".into(),
             Model::TransportSlanted => "transport in the mesh, along the normal at the refracted depth".into(),
-            Model::Kernel => "transport kernel (dipole scaled per patch)".into(),
+            Model::Kernel => format!(
+                "transport kernel (dipole scaled per patch; between points under albedo {ALBEDO_BELOW})"
+            ),
         }
     }
 }
@@ -265,7 +268,10 @@ fn alternative_models(
             Model::DirectionalAlpha => variant(Diffusion::Grosjean, Strength::ReducedAlbedo),
             Model::Transport => transport(base, reference, ModelEntry::Normal)?,
             Model::TransportSlanted => transport(base, reference, ModelEntry::Slanted)?,
-            Model::Kernel => crate::reference::transport_cache::model_exitance(base, truth, dir)?,
+            Model::Kernel => {
+                let scaled = crate::reference::transport_cache::model_exitance(base, truth, dir)?;
+                with_single_between_points(base, scaled)
+            }
         };
         out.push((m.label(), exitance));
     }
@@ -297,6 +303,23 @@ fn transport(
             o.as_ref().map_or_else(|| vec![[0.0; 3]; count], |o| o.per_vertex(count).0)
         })
         .collect())
+}
+
+/// `exitance` with single scattering between points in the channels whose reduced albedo is
+/// under `optics::beam_single::ALBEDO_BELOW`, as `material.model = "transport"` renders them
+/// (the between-points reference computed only where a channel takes it).
+pub fn with_single_between_points(base: &PreparedScene, exitance: Vec<Exitance>) -> Vec<Exitance> {
+    use crate::optics::beam_single::ALBEDO_BELOW;
+    use crate::scene::build::ResolvedMaterial;
+    let any = base.objects.iter().any(|o| match &o.material {
+        ResolvedMaterial::Translucent { dipoles, .. } => dipoles.iter().any(|d| d.alpha_prime < ALBEDO_BELOW),
+        ResolvedMaterial::Opaque { .. } => false,
+    });
+    if !any {
+        return exitance;
+    }
+    let beam = crate::reference::single::between_points(base, crate::reference::directional::FINENESS);
+    per_channel_choice(base, &exitance, &beam)
 }
 
 /// Per object, vertex and channel: `single` where the channel's reduced albedo is under
