@@ -110,3 +110,29 @@ fn the_gpu_picks_the_receivers_its_host_twin_sees_on_a_frame_of_change() {
         }
     });
 }
+
+#[test]
+fn a_plan_recorded_again_after_later_frames_still_gathers_what_its_splat_changed() {
+    with_gpu(|gpu| {
+        let mut rows = [renderer(gpu, ReceiverPolicy::VisibleFirst), renderer(gpu, ReceiverPolicy::Every)];
+        let move_light = |r: &mut Renderer| {
+            let light = &r.scene().scene.file.lights[0];
+            let moved = lights::orbit(light, Vec3::ZERO, 30.0).unwrap();
+            r.edit(SceneEdit::Light { index: 0, light: moved }).unwrap();
+        };
+        for r in rows.iter_mut() {
+            frame(r);
+        }
+        // Made now, recorded after another light frame has marked the receivers it saw.
+        let old = rows[0].plan(Change::Light(0));
+        for r in rows.iter_mut() {
+            move_light(r);
+            frame(r);
+            move_light(r);
+        }
+        rows[0].frame(&old).unwrap();
+        let fresh = rows[1].plan(Change::Light(0));
+        rows[1].frame(&fresh).unwrap();
+        assert_eq!(rows[0].image().unwrap().0, rows[1].image().unwrap().0);
+    });
+}

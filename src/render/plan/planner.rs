@@ -187,6 +187,21 @@ impl Planner {
         };
     }
 
+    /// `plan` with the splat generations its visible-first gathers mark receivers with taken
+    /// from this history, not from when the plan was made: a fresh gather gets the next
+    /// generation, a sweep's chunk the current one. So a plan recorded again after later
+    /// frames (a caller's own) still recomputes what its splat changed.
+    pub fn stamped(&self, plan: &Plan) -> Plan {
+        let mut plan = plan.clone();
+        for o in &mut plan.objects {
+            let current = self.generation.get(o.object).copied().unwrap_or(0);
+            if let ReceiverScope::VisibleFirst { generation, fresh, .. } = &mut o.receivers {
+                *generation = if *fresh { current.wrapping_add(1).max(1) } else { current };
+            }
+        }
+        plan
+    }
+
     /// Object `object`'s splat generation and whether a sweep over its receivers is still to
     /// run (`Renderer::exitance` finishes it before reading).
     pub fn sweep_pending(&self, object: usize) -> Option<u32> {

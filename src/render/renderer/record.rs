@@ -150,6 +150,7 @@ impl Renderer {
 
     /// `record_plan` after its checks: `target` suits this renderer, or `plan` does not shade.
     fn record_checked(&mut self, cmd: vk::CommandBuffer, plan: &Plan, target: Option<&HostTarget>) -> RecordedFrame {
+        let plan = &self.planner.stamped(plan);
         let mark_slot = self.marks.slot(self.generation + 1);
         self.undo = Some(Undo {
             hazards: self.hazards.get_mut().clone(),
