@@ -31,8 +31,7 @@ struct ReceiverViewPush {
     uint receiver_count;  // its receivers
     uint generation;      // the object's splat generation
     uint flags;           // VIEW_TEST | FACING_TEST
-    uint sweep_first;     // this frame's chunk of the sweep, in receiver order
-    uint sweep_count;
+    uint sweep[2];        // this frame's chunk of the sweep, in receiver order: first, count
     float reach;          // the level's longest edge
     uint pad;
 };
@@ -66,7 +65,7 @@ void main() {
     if (k >= push.receiver_count) return;
     uint v = receiver_order[push.first_receiver + k];
     uvec2 state = receiver_state[v];
-    bool swept = k - push.sweep_first < push.sweep_count;
+    bool swept = k - push.sweep[0] < push.sweep[1];
     bool seen = false;
     if ((push.flags & VIEW_TEST) != 0u) {
         vec3 x = vertex_position(vertices[v]);

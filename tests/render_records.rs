@@ -11,6 +11,7 @@ use translucent::render::gather_sparse::GatherSparsePush;
 use translucent::render::gather_texture::GatherTexturePush;
 use translucent::render::gather_tree::GatherTreePush;
 use translucent::render::local_exitance::LocalExitancePush;
+use translucent::render::receiver_view::ReceiverViewPush;
 use translucent::render::records::{
     BeamNodeRecord, BeamReceiverRecord, BeamSourceRecord, LightGpu, NodePowerRecord, ObjectRecord, SampleRecord,
     SplatRecord, TreeNodeRecord, Vertex,
@@ -182,7 +183,7 @@ type PushCase = (&'static str, &'static str, &'static str, usize, &'static [&'st
 /// Every pass's push block, as `push_blocks_match_glsl_and_spirv` checks them.
 /// `GatherTexturePush`'s fields, in order.
 /// The two-stage gathers' push block (`GroupGatherPush`), the same in both shaders.
-const GROUP_GATHER_PUSH_FIELDS: [&str; 9] = [
+const GROUP_GATHER_PUSH_FIELDS: [&str; 10] = [
     "object",
     "stage",
     "first_node",
@@ -192,6 +193,7 @@ const GROUP_GATHER_PUSH_FIELDS: [&str; 9] = [
     "receiver_count",
     "first_listed",
     "listed_count",
+    "only_picked",
 ];
 
 const TEXTURE_PUSH_FIELDS: [&str; 12] = [
@@ -304,9 +306,20 @@ fn push_cases() -> [PushCase; 12] {
     ]
 }
 
+/// The push blocks of the steps inside a pass (the hierarchical gather's pick of receivers).
+fn step_push_cases() -> [PushCase; 1] {
+    [(
+        "receiver_view.comp",
+        include_str!("../glsl/receiver_view.comp"),
+        "ReceiverViewPush",
+        size_of::<ReceiverViewPush>(),
+        &["view_proj", "eye", "first_receiver", "receiver_count", "generation", "flags", "sweep", "reach", "pad"],
+    )]
+}
+
 #[test]
 fn push_blocks_match_glsl_and_spirv() {
-    for (shader, source, name, rust_size, rust_fields) in push_cases() {
+    for (shader, source, name, rust_size, rust_fields) in push_cases().into_iter().chain(step_push_cases()) {
         let (fields, size) = glsl_layout(source, name);
         assert_eq!(size, rust_size, "{name}: GLSL and Rust sizes differ");
         let names: Vec<&str> = fields.iter().map(|(n, _)| n.as_str()).collect();

@@ -2,10 +2,10 @@
 //! whether baked levels of detail are current), the plan a frame gets from it, and the history a
 //! recorded frame leaves. Also `needs`, the one place a renderer's `SceneNeeds` are computed.
 
-use super::objects::{ObjectHistory, SweepState};
-use super::receivers::ReceiverScope;
 use super::frame::Frame;
+use super::objects::{ObjectHistory, SweepState};
 use super::passes::shadow_filter;
+use super::receivers::ReceiverScope;
 use super::{Change, Pass, Plan, SceneNeeds, View};
 use crate::scene::build::PreparedScene;
 
