@@ -219,9 +219,9 @@ impl Model {
             Model::DirectionalAlpha => "directional dipole, Grosjean's D, source alpha'".into(),
             Model::Transport => "transport in the mesh, light entering along the normal".into(),
             Model::TransportSlanted => "transport in the mesh, along the normal at the refracted depth".into(),
-            Model::Kernel => format!(
-                "transport kernel (dipole scaled per patch; between points under albedo {ALBEDO_BELOW})"
-            ),
+            Model::Kernel => {
+                format!("transport kernel (dipole scaled per patch; between points under albedo {ALBEDO_BELOW})")
+            }
         }
     }
 }
@@ -309,13 +309,7 @@ fn transport(
 /// under `optics::beam_single::ALBEDO_BELOW`, as `material.model = "transport"` renders them
 /// (the between-points reference computed only where a channel takes it).
 pub fn with_single_between_points(base: &PreparedScene, exitance: Vec<Exitance>) -> Vec<Exitance> {
-    use crate::optics::beam_single::ALBEDO_BELOW;
-    use crate::scene::build::ResolvedMaterial;
-    let any = base.objects.iter().any(|o| match &o.material {
-        ResolvedMaterial::Translucent { dipoles, .. } => dipoles.iter().any(|d| d.alpha_prime < ALBEDO_BELOW),
-        ResolvedMaterial::Opaque { .. } => false,
-    });
-    if !any {
+    if !base.objects.iter().any(|o| low_albedo(&o.material).contains(&true)) {
         return exitance;
     }
     let beam = crate::reference::single::between_points(base, crate::reference::directional::FINENESS);
@@ -325,19 +319,23 @@ pub fn with_single_between_points(base: &PreparedScene, exitance: Vec<Exitance>)
 /// Per object, vertex and channel: `single` where the channel's reduced albedo is under
 /// `optics::beam_single::ALBEDO_BELOW`, else the dipole's `truth`.
 fn per_channel_choice(base: &PreparedScene, truth: &[Exitance], single: &[Exitance]) -> Vec<Exitance> {
-    use crate::optics::beam_single::ALBEDO_BELOW;
+    let rows = base.objects.iter().zip(truth.iter().zip(single));
+    rows.map(|(o, (t, s))| {
+        let once = low_albedo(&o.material);
+        t.iter().zip(s).map(|(t, s)| [0, 1, 2].map(|c| if once[c] { s[c] } else { t[c] })).collect()
+    })
+    .collect()
+}
+
+/// Per channel, whether its reduced albedo is under `optics::beam_single::ALBEDO_BELOW`.
+fn low_albedo(material: &crate::scene::build::ResolvedMaterial) -> [bool; 3] {
     use crate::scene::build::ResolvedMaterial;
-    base.objects
-        .iter()
-        .zip(truth.iter().zip(single))
-        .map(|(o, (t, s))| {
-            let once = match &o.material {
-                ResolvedMaterial::Translucent { dipoles, .. } => dipoles.map(|d| d.alpha_prime < ALBEDO_BELOW),
-                ResolvedMaterial::Opaque { .. } => [false; 3],
-            };
-            t.iter().zip(s).map(|(t, s)| [0, 1, 2].map(|c| if once[c] { s[c] } else { t[c] })).collect()
-        })
-        .collect()
+    match material {
+        ResolvedMaterial::Translucent { dipoles, .. } => {
+            dipoles.map(|d| d.alpha_prime < crate::optics::beam_single::ALBEDO_BELOW)
+        }
+        ResolvedMaterial::Opaque { .. } => [false; 3],
+    }
 }
 
 /// Per object and vertex, the cosine between the vertex normal and the direction to the first
