@@ -1,8 +1,8 @@
 //! Which of an object's receivers the gather recomputes this frame. Exitance at a receiver is a
 //! sum over the samples, so a receiver gathered under this generation of the object's splat
 //! holds its final value: after a change, the hierarchical gather recomputes the receivers on
-//! a face the eye may see (`mesh::facing`, and the view frustum widened by the object's longest
-//! edge) at once, and the rest in `SWEEP_FRAMES` chunks over the frames that follow without a
+//! a face the eye may see (`mesh::facing`, and the view frustum widened by the drawn level's
+//! longest edge) at once, and the rest in `SWEEP_FRAMES` chunks over the frames that follow without a
 //! change. A receiver that comes into view before its chunk is gathered the frame it does, so
 //! every image equals a full gather's; the chunks only bound how long the unseen ones wait.
 
