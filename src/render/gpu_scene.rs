@@ -135,6 +135,16 @@ fn pack_levels(scene: &PreparedScene) -> PackedLevels {
     PackedLevels { indices, levels, casters, level_vertices }
 }
 
+/// Per vertex of every object, in scene order, its facing cone (`mesh::facing::vertex_cones`)
+/// over the triangles of each of its levels, with the enclosures `pack_levels` found.
+fn receiver_cones(scene: &PreparedScene, levels: &[Vec<LevelRange>]) -> Vec<[f32; 4]> {
+    let cones = scene.objects.iter().zip(levels).flat_map(|(o, ranges)| {
+        let triangles = o.levels.iter().zip(ranges).map(|(l, r)| (&l.triangles[..], r.enclosure));
+        crate::mesh::facing::vertex_cones(o.mesh.positions(), triangles)
+    });
+    cones.collect()
+}
+
 fn storage(gpu: &Arc<Gpu>, name: &str, bytes: u64, extra: vk::BufferUsageFlags) -> GpuResult<Buffer> {
     Buffer::new(gpu, &BufferDesc::gpu_only(name, bytes.max(16), vk::BufferUsageFlags::STORAGE_BUFFER | extra))
 }
@@ -171,8 +181,6 @@ struct PackedObjects {
     objects: Vec<ObjectRecord>,
     samples: Vec<SampleRecord>,
     vertex_boundary: Vec<[f32; 2]>,
-    /// Per vertex, its facing cone (`mesh::facing`).
-    receiver_cones: Vec<[f32; 4]>,
     receivers: Vec<Receiver>,
     coarser_receivers: Vec<Vec<Receiver>>,
     node_heights: Vec<Vec<[u32; 2]>>,
@@ -238,8 +246,6 @@ impl PackedObjects {
         }
         let faces = o.mesh.face_normals();
         self.samples.extend(o.samples.iter().map(|s| SampleRecord::new(s, faces[s.triangle as usize])));
-        let levels = o.levels.iter().map(|l| (&l.triangles[..], enclosure(positions, &l.triangles)));
-        self.receiver_cones.extend(crate::mesh::facing::vertex_cones(positions, levels));
         let ranges = [first_vertex, positions.len() as u32, first_sample, o.samples.len() as u32];
         self.objects.push(ObjectRecord::new(o, ranges));
         self.atlas(o);
@@ -463,7 +469,7 @@ impl GpuScene {
                 transport_matrix: upload(gpu, "transport matrix", &t.matrix, none)?,
                 transport_sums: sized("transport sums", 48, t.patches.len().max(1))?,
                 transport_neighbours: upload(gpu, "transport neighbours", &t.neighbours, none)?,
-                receiver_cones: upload(gpu, "receiver cones", &p.receiver_cones, none)?,
+                receiver_cones: upload(gpu, "receiver cones", &receiver_cones(scene, &l.levels), none)?,
                 // Generation 0, which no gather marks: every receiver stale.
                 receiver_state: upload(gpu, "receiver state", &vec![[0u32; 2]; p.vertices.len()], none)?,
             },

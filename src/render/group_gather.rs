@@ -119,8 +119,9 @@ impl GroupGather {
         for (j, r) in planned() {
             let scope = frame.plan.receivers(r.object as usize);
             let picked = self.view.is_some() && matches!(scope, ReceiverScope::VisibleFirst { .. });
-            let push = GroupGatherPush { only_picked: u32::from(picked), ..GroupGatherPush::new(at(j, r), 1) };
-            self.pipeline.dispatch(cmd, &self.set, &push, [at(j, r).vertex_count, 1, 1]);
+            let at = at(j, r);
+            let push = GroupGatherPush { only_picked: u32::from(picked), ..GroupGatherPush::new(at, 1) };
+            self.pipeline.dispatch(cmd, &self.set, &push, [at.vertex_count, 1, 1]);
         }
     }
 

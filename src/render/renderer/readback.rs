@@ -9,7 +9,7 @@ use crate::render::frame::{LevelExitance, NonFinite};
 use crate::render::graph::{Resource, Resources, read};
 use crate::render::local_exitance::LocalExitancePass;
 use crate::render::pass::RenderPass;
-use crate::render::plan::{Change, Pass, ReceiverScope, Sweep};
+use crate::render::plan::{Change, Pass, Plan, ReceiverScope, Sweep};
 use ash::vk;
 
 impl Renderer {
@@ -54,13 +54,7 @@ impl Renderer {
         let resources = Resources { scene: &self.gpu_scene, targets: &self.targets };
         let pass = LocalExitancePass::new(&self.gpu, &resources, object)?;
         let plan = self.planner.plan_for(&self.needs, &self.view(), Change::Camera);
-        self.gpu.one_shot("local exitance", |cmd| {
-            let frame = self.inputs(&plan, None, None);
-            frame.before(cmd, &pass.uses(&frame));
-            pass.record(cmd, &frame);
-            let r = Resource::LocalExitance;
-            frame.before(cmd, &[read(r, Access::HostRead), read(r, Access::TransferRead)]);
-        })?;
+        self.record_alone("local exitance", &pass, &plan, Resource::LocalExitance)?;
         let local: Vec<[f32; 4]> = self.gpu_scene.buffers.local_exitance.read()?;
         let first = self.gpu_scene.object_range(object).first_vertex as usize;
         for (e, l) in exitance.iter_mut().zip(&local[first..]) {
@@ -107,15 +101,21 @@ impl Renderer {
         let mut plan = self.planner.plan_for(&self.needs, &self.view(), Change::Camera);
         for o in &mut plan.objects {
             o.gather = o.object == object;
-            o.level = self.planner.gathered_level(o.object).unwrap_or(0);
-            o.receivers = ReceiverScope::VisibleFirst { generation, fresh: false, sweep: Some(Sweep::ALL) };
         }
-        self.gpu.one_shot("finish sweep", |cmd| {
-            let frame = self.inputs(&plan, None, None);
-            frame.before(cmd, &gather.uses(&frame));
-            gather.record(cmd, &frame);
-            let r = Resource::Exitance;
-            frame.before(cmd, &[read(r, Access::HostRead), read(r, Access::TransferRead)]);
+        let o = &mut plan.objects[object];
+        o.level = self.planner.gathered_level(object).unwrap_or(0);
+        o.receivers = ReceiverScope::VisibleFirst { generation, fresh: false, sweep: Some(Sweep::ALL) };
+        self.record_alone("finish sweep", gather, &plan, Resource::Exitance)
+    }
+
+    /// Record `pass` alone for `plan` in a submission of its own, wait, and leave its output `out`
+    /// readable by the host (directly or by a copy).
+    fn record_alone(&self, name: &str, pass: &dyn RenderPass, plan: &Plan, out: Resource) -> Result<(), RenderError> {
+        self.gpu.one_shot(name, |cmd| {
+            let frame = self.inputs(plan, None, None);
+            frame.before(cmd, &pass.uses(&frame));
+            pass.record(cmd, &frame);
+            frame.before(cmd, &[read(out, Access::HostRead), read(out, Access::TransferRead)]);
         })?;
         Ok(())
     }
