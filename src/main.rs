@@ -31,6 +31,10 @@ enum Command {
     /// exact dipole integral (CSV, Markdown, a plot)
     #[cfg(feature = "study")]
     Study(Box<cli::study::Args>),
+    /// Show a scene in a window, live: orbit, pan and zoom with the mouse, drag lights with
+    /// Ctrl, switch the model, gather and error target with keys (m, g, e)
+    #[cfg(feature = "viewer")]
+    View(cli::view::Args),
 }
 
 fn main() -> ExitCode {
@@ -45,6 +49,8 @@ fn main() -> ExitCode {
         Some(Command::Plan(args)) => cli::plan::run(&args),
         #[cfg(feature = "study")]
         Some(Command::Study(args)) => cli::study::run(&cli.gpu, &args),
+        #[cfg(feature = "viewer")]
+        Some(Command::View(args)) => cli::view::run(&cli.gpu, &args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -16,6 +16,8 @@ pub mod render;
 pub mod sample;
 #[cfg(feature = "study")]
 pub mod study;
+#[cfg(feature = "viewer")]
+pub mod view;
 
 use translucent::gpu::GpuOptions;
 

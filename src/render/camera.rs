@@ -18,7 +18,13 @@ pub struct CameraView {
 impl CameraView {
     /// The scene file's camera, its near and far planes fitted around the scene.
     pub fn of_scene(scene: &PreparedScene) -> CameraView {
-        let camera = &scene.scene.file.camera;
+        CameraView::of_camera(&scene.scene.file.camera, scene)
+    }
+
+    /// `camera` (a scene file's `[camera]`: eye, target, up, field of view, and its resolution
+    /// for the aspect ratio) in `scene`, its near and far planes fitted around the scene: how a
+    /// host that moves the camera itself (the viewer) gives it to `SceneEdit::Camera`.
+    pub fn of_camera(camera: &crate::scene::Camera, scene: &PreparedScene) -> CameraView {
         CameraView {
             view: camera.view(),
             projection: camera.projection(scene.bounds.0, scene.bounds.1),

@@ -12,7 +12,7 @@ use crate::gpu::{Access, Binding, Buffer, BufferDesc, ComputePipeline, Descripto
 use ash::vk;
 use std::sync::Arc;
 
-/// Where the tone curve's input is capped (`TONE_SATURATION` in glsl/tonemap.comp): the curve
+/// Where the tone curve's input is capped (`TONE_SATURATION` in glsl/common/tonemap.glsl): the curve
 /// is 1 from 7.25 on, and the cap keeps its squares finite in f32.
 pub const TONE_SATURATION: f64 = 64.0;
 

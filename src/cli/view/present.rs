@@ -1,0 +1,164 @@
+//! The viewer's present pass: one triangle over the window that tone-maps the HDR image
+//! translucent drew into the swapchain image, with the tone-map pass's curve
+//! (glsl/examples/viewer_present.frag, glsl/common/tonemap.glsl).
+
+use super::host::Host;
+use anyhow::Result;
+use ash::vk;
+
+/// The pipeline, its one descriptor set (the HDR image) and the sampler that set holds.
+pub struct Present {
+    device: ash::Device,
+    set_layout: vk::DescriptorSetLayout,
+    pool: vk::DescriptorPool,
+    set: vk::DescriptorSet,
+    sampler: vk::Sampler,
+    layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+    format: vk::Format,
+}
+
+impl Present {
+    /// The pass for swapchain images of `format`.
+    pub fn new(host: &Host, format: vk::Format) -> Result<Present> {
+        let device = &host.device;
+        let binding = [vk::DescriptorSetLayoutBinding::default()
+            .binding(0)
+            .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+            .descriptor_count(1)
+            .stage_flags(vk::ShaderStageFlags::FRAGMENT)];
+        let sizes = [vk::DescriptorPoolSize { ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER, descriptor_count: 1 }];
+        let push = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::FRAGMENT, offset: 0, size: 4 }];
+        // SAFETY: valid create infos; everything is destroyed in `drop`.
+        unsafe {
+            let set_layout = device
+                .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&binding), None)?;
+            let pool = device
+                .create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None)?;
+            let layouts = [set_layout];
+            let allocate = vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts);
+            let set = device.allocate_descriptor_sets(&allocate)?[0];
+            let sampler = device.create_sampler(&vk::SamplerCreateInfo::default(), None)?;
+            let layout = device.create_pipeline_layout(
+                &vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts).push_constant_ranges(&push),
+                None,
+            )?;
+            let mut present = Present { device: device.clone(), set_layout, pool, set, sampler, layout, pipeline: vk::Pipeline::null(), format };
+            present.pipeline = pipeline(device, layout, format)?;
+            Ok(present)
+        }
+    }
+
+    /// The swapchain image format this pass draws.
+    pub fn format(&self) -> vk::Format {
+        self.format
+    }
+
+    /// Point the pass at `hdr` (in SHADER_READ_ONLY_OPTIMAL when drawn). Only while no frame
+    /// that reads the set is in flight.
+    pub fn bind(&self, hdr: vk::ImageView) {
+        let image = [vk::DescriptorImageInfo {
+            sampler: self.sampler,
+            image_view: hdr,
+            image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        }];
+        let write = [vk::WriteDescriptorSet::default()
+            .dst_set(self.set)
+            .dst_binding(0)
+            .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
+            .image_info(&image)];
+        // SAFETY: the set is not in use (the caller waits for the device first).
+        unsafe { self.device.update_descriptor_sets(&write, &[]) };
+    }
+
+    /// Draw into `target` (in COLOR_ATTACHMENT_OPTIMAL) of `extent`, at `exposure`.
+    pub fn record(&self, cmd: vk::CommandBuffer, target: vk::ImageView, extent: vk::Extent2D, exposure: f32) {
+        let colors = [vk::RenderingAttachmentInfo::default()
+            .image_view(target)
+            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .load_op(vk::AttachmentLoadOp::DONT_CARE)
+            .store_op(vk::AttachmentStoreOp::STORE)];
+        let rendering = vk::RenderingInfo::default().render_area(extent.into()).layer_count(1).color_attachments(&colors);
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: extent.width as f32,
+            height: extent.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        let device = &self.device;
+        // SAFETY: `cmd` is recording outside any rendering; the set points at a live image.
+        unsafe {
+            device.cmd_begin_rendering(cmd, &rendering);
+            device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.layout, 0, &[self.set], &[]);
+            device.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::FRAGMENT, 0, &exposure.to_ne_bytes());
+            device.cmd_set_viewport(cmd, 0, &[viewport]);
+            device.cmd_set_scissor(cmd, 0, &[extent.into()]);
+            // translucent leaves the cull mode as its last draw set it (docs/GPU.md).
+            device.cmd_set_cull_mode(cmd, vk::CullModeFlags::NONE);
+            device.cmd_draw(cmd, 3, 1, 0, 0);
+            device.cmd_end_rendering(cmd);
+        }
+    }
+}
+
+impl Drop for Present {
+    fn drop(&mut self) {
+        // SAFETY: the viewer waits for the device to be idle before dropping the pass.
+        unsafe {
+            self.device.destroy_pipeline(self.pipeline, None);
+            self.device.destroy_pipeline_layout(self.layout, None);
+            self.device.destroy_sampler(self.sampler, None);
+            self.device.destroy_descriptor_pool(self.pool, None);
+            self.device.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}
+
+/// The graphics pipeline: no vertex input, no depth, dynamic viewport, scissor and cull mode.
+fn pipeline(device: &ash::Device, layout: vk::PipelineLayout, format: vk::Format) -> Result<vk::Pipeline> {
+    let module = |name: &str| -> Result<vk::ShaderModule> {
+        let words = translucent::gpu::shaders::spirv(name)?;
+        // SAFETY: SPIR-V compiled by glslang in build.rs; destroyed below.
+        Ok(unsafe { device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None) }?)
+    };
+    let (vert, frag) = (module("examples/viewer_present.vert")?, module("examples/viewer_present.frag")?);
+    let stages = [
+        vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vert).name(c"main"),
+        vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(frag).name(c"main"),
+    ];
+    let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
+    let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+    let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+    let raster = vk::PipelineRasterizationStateCreateInfo::default().polygon_mode(vk::PolygonMode::FILL).line_width(1.0);
+    let multisample =
+        vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let blend_attachments =
+        [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
+    let blend = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend_attachments);
+    let dynamic_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR, vk::DynamicState::CULL_MODE];
+    let dynamic = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic_states);
+    let formats = [format];
+    let mut rendering = vk::PipelineRenderingCreateInfo::default().color_attachment_formats(&formats);
+    let info = [vk::GraphicsPipelineCreateInfo::default()
+        .stages(&stages)
+        .vertex_input_state(&vertex_input)
+        .input_assembly_state(&assembly)
+        .viewport_state(&viewport)
+        .rasterization_state(&raster)
+        .multisample_state(&multisample)
+        .color_blend_state(&blend)
+        .dynamic_state(&dynamic)
+        .layout(layout)
+        .push_next(&mut rendering)];
+    // SAFETY: valid create infos; the modules are destroyed once the pipeline exists.
+    let pipeline = unsafe {
+        let made = device.create_graphics_pipelines(vk::PipelineCache::null(), &info, None);
+        device.destroy_shader_module(vert, None);
+        device.destroy_shader_module(frag, None);
+        made.map_err(|(_, e)| e)?[0]
+    };
+    Ok(pipeline)
+}
