@@ -87,7 +87,8 @@ pub fn light_anchor(light: &Light, centre: Vec3, radius: f32) -> Option<Vec3> {
 }
 
 /// The light whose anchor lands nearest `cursor` (pixels) in a `size` window seen through
-/// `view_proj`, if one lands within 64 pixels.
+/// `view_proj`, among those in front of the camera (no marker is drawn yet, so the nearest one
+/// is taken however far).
 pub fn pick_light(lights: &[Light], centre: Vec3, radius: f32, view_proj: Mat4, cursor: [f32; 2], size: [f32; 2]) -> Option<usize> {
     let on_screen = |p: Vec3| {
         let clip = view_proj * p.extend(1.0);
@@ -98,7 +99,6 @@ pub fn pick_light(lights: &[Light], centre: Vec3, radius: f32, view_proj: Mat4, 
         .enumerate()
         .filter_map(|(i, l)| light_anchor(l, centre, radius).and_then(on_screen).map(|p| (i, p)))
         .map(|(i, p)| (i, (p[0] - cursor[0]).hypot(p[1] - cursor[1])))
-        .filter(|&(_, d)| d < 64.0)
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(i, _)| i)
 }
@@ -188,7 +188,8 @@ mod tests {
         let lights = [light, turned];
         let view_proj = Mat4::orthographic_rh(-4.0, 4.0, -4.0, 4.0, -10.0, 10.0);
         assert_eq!(pick_light(&lights, Vec3::ZERO, 1.0, view_proj, [384.0, 256.0], [512.0, 512.0]), Some(0));
-        assert_eq!(pick_light(&lights, Vec3::ZERO, 1.0, view_proj, [0.0, 0.0], [512.0, 512.0]), None);
+        assert_eq!(pick_light(&lights, Vec3::ZERO, 1.0, view_proj, [250.0, 250.0], [512.0, 512.0]), Some(1));
+        assert_eq!(pick_light(&lights[..0], Vec3::ZERO, 1.0, view_proj, [250.0, 250.0], [512.0, 512.0]), None);
     }
 
     #[test]
