@@ -75,16 +75,16 @@ impl App {
     /// The window, the Vulkan on it and the renderer, at the scene's resolution.
     fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
         let [w, h] = self.scene.file.camera.resolution;
-        let attributes = Window::default_attributes()
-            .with_title("translucent")
-            .with_inner_size(PhysicalSize::new(w, h));
+        let attributes =
+            Window::default_attributes().with_title("translucent").with_inner_size(PhysicalSize::new(w, h));
         let window = event_loop.create_window(attributes).context("opening a window (is DISPLAY set?)")?;
         let validation = self.gpu_args.options().validation;
         let host = Host::new(&window, self.gpu_args.device.as_deref(), validation)?;
         let prepared = PreparedScene::new(&self.scene, &self.overrides)?;
         let radius = prepared.bounds.1;
         let size = window.inner_size();
-        let viewer = Viewer::new(host, prepared, vk::Extent2D { width: size.width, height: size.height }, self.args.vsync)?;
+        let viewer =
+            Viewer::new(host, prepared, vk::Extent2D { width: size.width, height: size.height }, self.args.vsync)?;
         let mut camera = self.scene.file.camera.clone();
         let extent = viewer.extent();
         camera.resolution = [extent.width, extent.height];

@@ -49,8 +49,7 @@ impl Orbit {
         let offset = self.eye() - self.target();
         let up = self.up();
         let pitch_now = (offset.normalize().dot(up)).clamp(-1.0, 1.0).asin().to_degrees();
-        let pitch =
-            (pitch_now + dy * DEGREES_PER_PIXEL).clamp(-MAX_PITCH_DEGREES, MAX_PITCH_DEGREES) - pitch_now;
+        let pitch = (pitch_now + dy * DEGREES_PER_PIXEL).clamp(-MAX_PITCH_DEGREES, MAX_PITCH_DEGREES) - pitch_now;
         let (right, _) = self.image_axes();
         let turn = Quat::from_axis_angle(up, (-dx * DEGREES_PER_PIXEL).to_radians())
             * Quat::from_axis_angle(right, (-pitch).to_radians());
@@ -89,7 +88,14 @@ pub fn light_anchor(light: &Light, centre: Vec3, radius: f32) -> Option<Vec3> {
 /// The light whose anchor lands nearest `cursor` (pixels) in a `size` window seen through
 /// `view_proj`, among those in front of the camera (no marker is drawn yet, so the nearest one
 /// is taken however far).
-pub fn pick_light(lights: &[Light], centre: Vec3, radius: f32, view_proj: Mat4, cursor: [f32; 2], size: [f32; 2]) -> Option<usize> {
+pub fn pick_light(
+    lights: &[Light],
+    centre: Vec3,
+    radius: f32,
+    view_proj: Mat4,
+    cursor: [f32; 2],
+    size: [f32; 2],
+) -> Option<usize> {
     let on_screen = |p: Vec3| {
         let clip = view_proj * p.extend(1.0);
         (clip.w > 0.0).then(|| [(clip.x / clip.w * 0.5 + 0.5) * size[0], (clip.y / clip.w * 0.5 + 0.5) * size[1]])
@@ -186,7 +192,7 @@ mod tests {
         assert!((Vec3::from(position).length() - 2.0).abs() < 1e-5);
         assert!(position[2].abs() > 1.99, "{position:?}");
         let lights = [light, turned];
-        let view_proj = Mat4::orthographic_rh(-4.0, 4.0, -4.0, 4.0, -10.0, 10.0);
+        let view_proj = Mat4::from_scale(Vec3::new(0.25, 0.25, 0.1)); // x and y in -4..4 across the window
         assert_eq!(pick_light(&lights, Vec3::ZERO, 1.0, view_proj, [384.0, 256.0], [512.0, 512.0]), Some(0));
         assert_eq!(pick_light(&lights, Vec3::ZERO, 1.0, view_proj, [250.0, 250.0], [512.0, 512.0]), Some(1));
         assert_eq!(pick_light(&lights[..0], Vec3::ZERO, 1.0, view_proj, [250.0, 250.0], [512.0, 512.0]), None);

@@ -72,8 +72,9 @@ impl Host {
         let instance = unsafe { entry.create_instance(&info, None) }.context("vkCreateInstance")?;
         let debug = if validation { Some(messenger(&entry, &instance)?) } else { None };
         // SAFETY: the window outlives the surface (the viewer drops the host before the window).
-        let surface = unsafe { ash_window::create_surface(&entry, &instance, display, window.window_handle()?.as_raw(), None) }
-            .context("creating the window's Vulkan surface")?;
+        let surface =
+            unsafe { ash_window::create_surface(&entry, &instance, display, window.window_handle()?.as_raw(), None) }
+                .context("creating the window's Vulkan surface")?;
         let surface_loader = ash::khr::surface::Instance::new(&entry, &instance);
         let (physical, family, name) = pick_device(&instance, &surface_loader, surface, wanted)?;
         let device = create_device(&instance, physical, family)?;

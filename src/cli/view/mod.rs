@@ -89,7 +89,8 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let mut app = app::App::new(args.clone(), gpu_args.clone(), scene, overrides);
     event_loop.run_app(&mut app)?;
     let outcome = app.outcome.take();
-    let (frames, median) = app.viewer.as_ref().map_or((0, None), |v| (v.frame_ms.len() as u64 + 1, median(&v.frame_ms)));
+    let (frames, median) =
+        app.viewer.as_ref().map_or((0, None), |v| (v.frame_ms.len() as u64 + 1, median(&v.frame_ms)));
     drop(app); // the viewer's Vulkan before the validation count
     let outcome = outcome.unwrap_or_else(|| bail!("the window closed before it was drawn"))?;
     let messages = host::validation_messages();

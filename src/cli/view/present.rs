@@ -33,8 +33,10 @@ impl Present {
         unsafe {
             let set_layout = device
                 .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&binding), None)?;
-            let pool = device
-                .create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None)?;
+            let pool = device.create_descriptor_pool(
+                &vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes),
+                None,
+            )?;
             let layouts = [set_layout];
             let allocate = vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts);
             let set = device.allocate_descriptor_sets(&allocate)?[0];
@@ -43,7 +45,16 @@ impl Present {
                 &vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts).push_constant_ranges(&push),
                 None,
             )?;
-            let mut present = Present { device: device.clone(), set_layout, pool, set, sampler, layout, pipeline: vk::Pipeline::null(), format };
+            let mut present = Present {
+                device: device.clone(),
+                set_layout,
+                pool,
+                set,
+                sampler,
+                layout,
+                pipeline: vk::Pipeline::null(),
+                format,
+            };
             present.pipeline = pipeline(device, layout, format)?;
             Ok(present)
         }
@@ -78,7 +89,8 @@ impl Present {
             .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
             .load_op(vk::AttachmentLoadOp::DONT_CARE)
             .store_op(vk::AttachmentStoreOp::STORE)];
-        let rendering = vk::RenderingInfo::default().render_area(extent.into()).layer_count(1).color_attachments(&colors);
+        let rendering =
+            vk::RenderingInfo::default().render_area(extent.into()).layer_count(1).color_attachments(&colors);
         let viewport = vk::Viewport {
             x: 0.0,
             y: 0.0,
@@ -132,7 +144,8 @@ fn pipeline(device: &ash::Device, layout: vk::PipelineLayout, format: vk::Format
     let vertex_input = vk::PipelineVertexInputStateCreateInfo::default();
     let assembly = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
     let viewport = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
-    let raster = vk::PipelineRasterizationStateCreateInfo::default().polygon_mode(vk::PolygonMode::FILL).line_width(1.0);
+    let raster =
+        vk::PipelineRasterizationStateCreateInfo::default().polygon_mode(vk::PolygonMode::FILL).line_width(1.0);
     let multisample =
         vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
     let blend_attachments =

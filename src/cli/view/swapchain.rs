@@ -57,9 +57,14 @@ impl Swapchain {
         } else {
             caps.current_extent
         };
-        let count = if caps.max_image_count == 0 { caps.min_image_count + 1 } else { (caps.min_image_count + 1).min(caps.max_image_count) };
+        let count = if caps.max_image_count == 0 {
+            caps.min_image_count + 1
+        } else {
+            (caps.min_image_count + 1).min(caps.max_image_count)
+        };
         // The screenshot copies from the image it presents.
-        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | (caps.supported_usage_flags & vk::ImageUsageFlags::TRANSFER_SRC);
+        let usage =
+            vk::ImageUsageFlags::COLOR_ATTACHMENT | (caps.supported_usage_flags & vk::ImageUsageFlags::TRANSFER_SRC);
         let info = vk::SwapchainCreateInfoKHR::default()
             .surface(surface)
             .min_image_count(count)
@@ -92,7 +97,10 @@ impl Swapchain {
         unsafe {
             swapchain.images = swapchain.loader.get_swapchain_images(handle)?;
             for &image in &swapchain.images {
-                swapchain.views.push(host.device.create_image_view(&view_info(image, format.format, vk::ImageAspectFlags::COLOR), None)?);
+                swapchain.views.push(
+                    host.device
+                        .create_image_view(&view_info(image, format.format, vk::ImageAspectFlags::COLOR), None)?,
+                );
                 swapchain.drawn.push(host.device.create_semaphore(&vk::SemaphoreCreateInfo::default(), None)?);
             }
         }
@@ -103,7 +111,6 @@ impl Swapchain {
     pub fn view(&self, index: u32) -> vk::ImageView {
         self.views[index as usize]
     }
-
 }
 
 impl Drop for Swapchain {
@@ -120,7 +127,11 @@ impl Drop for Swapchain {
 }
 
 /// A 2D view of mip 0, layer 0.
-pub fn view_info(image: vk::Image, format: vk::Format, aspect: vk::ImageAspectFlags) -> vk::ImageViewCreateInfo<'static> {
+pub fn view_info(
+    image: vk::Image,
+    format: vk::Format,
+    aspect: vk::ImageAspectFlags,
+) -> vk::ImageViewCreateInfo<'static> {
     vk::ImageViewCreateInfo::default()
         .image(image)
         .view_type(vk::ImageViewType::TYPE_2D)
@@ -185,7 +196,8 @@ impl Surfaces {
         let old = old.map_or(vk::SwapchainKHR::null(), |s| s.swapchain.handle);
         let swapchain = Swapchain::new(host, size, vsync, old)?;
         let extent = swapchain.extent;
-        let hdr = Image::new(host, HDR_FORMAT, extent, vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED)?;
+        let hdr =
+            Image::new(host, HDR_FORMAT, extent, vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED)?;
         let depth = Image::new(host, DEPTH_FORMAT, extent, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?;
         Ok(Surfaces { hdr, depth, swapchain })
     }

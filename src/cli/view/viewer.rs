@@ -142,7 +142,8 @@ impl Viewer {
         }
         let swapchain = &self.surfaces.swapchain;
         // SAFETY: the semaphore's last signal was waited on by this slot's last submission.
-        let acquire = unsafe { swapchain.loader.acquire_next_image(swapchain.handle, u64::MAX, acquired, vk::Fence::null()) };
+        let acquire =
+            unsafe { swapchain.loader.acquire_next_image(swapchain.handle, u64::MAX, acquired, vk::Fence::null()) };
         let index = match acquire {
             Ok((index, suboptimal)) => {
                 self.stale |= suboptimal;
@@ -174,7 +175,10 @@ impl Viewer {
         }
         // SAFETY: waits for the submission that copied the image.
         unsafe { device.wait_for_fences(&[fence], true, u64::MAX) }?;
-        Ok(self.shot.as_ref().map(|b| to_rgba(b.bytes(), self.surfaces.swapchain.extent, self.surfaces.swapchain.format)))
+        Ok(self
+            .shot
+            .as_ref()
+            .map(|b| to_rgba(b.bytes(), self.surfaces.swapchain.extent, self.surfaces.swapchain.format)))
     }
 
     /// Everything one frame records into `cmd`: translucent into the HDR image, the tone map
@@ -189,7 +193,14 @@ impl Viewer {
         image_barrier(&device, cmd, hdr, (L::UNDEFINED, L::COLOR_ATTACHMENT_OPTIMAL), SAMPLED, COLOR_WRITE);
         image_barrier(&device, cmd, depth, (L::UNDEFINED, L::DEPTH_ATTACHMENT_OPTIMAL), DEPTH, DEPTH);
         let recorded = self.renderer.record_frame(cmd, Some(&self.target()))?;
-        image_barrier(&device, cmd, hdr, (L::COLOR_ATTACHMENT_OPTIMAL, L::SHADER_READ_ONLY_OPTIMAL), COLOR_WRITE, SAMPLED);
+        image_barrier(
+            &device,
+            cmd,
+            hdr,
+            (L::COLOR_ATTACHMENT_OPTIMAL, L::SHADER_READ_ONLY_OPTIMAL),
+            COLOR_WRITE,
+            SAMPLED,
+        );
         image_barrier(&device, cmd, image, (L::UNDEFINED, L::COLOR_ATTACHMENT_OPTIMAL), COLOR_WRITE, COLOR_WRITE);
         let exposure = self.renderer.scene().scene.file.render.exposure;
         self.present.record(cmd, self.surfaces.swapchain.view(index), extent, exposure);
@@ -230,11 +241,20 @@ impl Viewer {
         let buffer = self.shot.as_ref().map(|b| b.buffer).unwrap_or_default();
         let device = &self.host.device;
         use vk::ImageLayout as L;
-        image_barrier(device, cmd, image, (L::COLOR_ATTACHMENT_OPTIMAL, L::TRANSFER_SRC_OPTIMAL), COLOR_WRITE, COPY_READ);
+        image_barrier(
+            device,
+            cmd,
+            image,
+            (L::COLOR_ATTACHMENT_OPTIMAL, L::TRANSFER_SRC_OPTIMAL),
+            COLOR_WRITE,
+            COPY_READ,
+        );
         let layers = vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::COLOR).layer_count(1);
-        let region = [vk::BufferImageCopy::default()
-            .image_subresource(layers)
-            .image_extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })];
+        let region = [vk::BufferImageCopy::default().image_subresource(layers).image_extent(vk::Extent3D {
+            width: extent.width,
+            height: extent.height,
+            depth: 1,
+        })];
         let host_read = [vk::MemoryBarrier2::default()
             .src_stage_mask(vk::PipelineStageFlags2::COPY)
             .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
@@ -256,12 +276,16 @@ impl Viewer {
         let waits = [vk::SemaphoreSubmitInfo::default()
             .semaphore(acquired)
             .stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)];
-        let signals = [vk::SemaphoreSubmitInfo::default().semaphore(drawn).stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
+        let signals =
+            [vk::SemaphoreSubmitInfo::default().semaphore(drawn).stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(cmd)];
-        let submit =
-            [vk::SubmitInfo2::default().wait_semaphore_infos(&waits).command_buffer_infos(&cmds).signal_semaphore_infos(&signals)];
+        let submit = [vk::SubmitInfo2::default()
+            .wait_semaphore_infos(&waits)
+            .command_buffer_infos(&cmds)
+            .signal_semaphore_infos(&signals)];
         let (swapchains, indices, wait) = ([swapchain.handle], [index], [drawn]);
-        let present = vk::PresentInfoKHR::default().wait_semaphores(&wait).swapchains(&swapchains).image_indices(&indices);
+        let present =
+            vk::PresentInfoKHR::default().wait_semaphores(&wait).swapchains(&swapchains).image_indices(&indices);
         // SAFETY: `cmd` has ended; the semaphores and fence are this frame's.
         unsafe {
             self.host.device.queue_submit2(self.host.queue, &submit, fence).context("vkQueueSubmit2")?;
