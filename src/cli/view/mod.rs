@@ -169,12 +169,10 @@ fn title(viewer: &viewer::Viewer) -> String {
         }
         None => "nothing changed".into(),
     };
+    let (device, top, gather) = (viewer.device_name(), top.join(", "), render.gather.name());
+    let (target, predicted) = (render.max_error * 100.0, predicted * 100.0);
     format!(
-        "translucent on {} · {fps} frames/s · GPU {gpu:.1} ms ({}) · {why} · gather {} · max error {}%, predicted {:.2}%",
-        viewer.device_name(),
-        top.join(", "),
-        render.gather.name(),
-        render.max_error * 100.0,
-        predicted * 100.0
+        "translucent on {device} · {fps} frames/s · GPU {gpu:.1} ms ({top}) · {why} · gather {gather} · \
+         max error {target}%, predicted {predicted:.2}%"
     )
 }
