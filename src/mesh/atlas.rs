@@ -125,12 +125,90 @@ struct Chart {
 }
 
 impl Chart {
+    /// Point `p` in the chart's plane coordinates (scene units).
+    fn project(&self, p: DVec3) -> DVec2 {
+        let d = p - self.origin;
+        DVec2::new(d.dot(self.axes[0]), d.dot(self.axes[1]))
+    }
+
     /// Atlas coordinates (texels) of point `p` at `scale` texels per unit.
     fn uv(&self, p: DVec3, scale: f64) -> DVec2 {
-        let d = p - self.origin;
-        let q = DVec2::new(d.dot(self.axes[0]), d.dot(self.axes[1]));
-        self.offset + (q - self.bounds.0) * scale
+        self.offset + (self.project(p) - self.bounds.0) * scale
     }
+
+    /// The chart's bounding box in its plane coordinates.
+    fn measure(&mut self, mesh: &Mesh) {
+        let mut bounds = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for &t in &self.triangles {
+            for p in mesh.corners(t) {
+                let q = self.project(p);
+                bounds = (bounds.0.min(q), bounds.1.max(q));
+            }
+        }
+        self.bounds = bounds;
+    }
+
+    /// Turn the chart's axes in its plane to the rectangle of least area around it: one of its
+    /// sides lies along an edge of the convex hull of its corners (Freeman and Shapira 1975).
+    fn fit_rectangle(&mut self, mesh: &Mesh) {
+        let points: Vec<DVec2> =
+            self.triangles.iter().flat_map(|&t| mesh.corners(t)).map(|p| self.project(p)).collect();
+        let hull = convex_hull(points.clone());
+        let mut best = (f64::INFINITY, DVec2::X);
+        for (i, &a) in hull.iter().enumerate() {
+            let Some(edge) = (hull[(i + 1) % hull.len()] - a).try_normalize() else { continue };
+            let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+            for &p in &hull {
+                let q = DVec2::new(p.dot(edge), edge.perp_dot(p));
+                (lo, hi) = (lo.min(q), hi.max(q));
+            }
+            let area = (hi - lo).x * (hi - lo).y;
+            if area < best.0 {
+                best = (area, edge);
+            }
+        }
+        let (u, v) = (self.axes[0], self.axes[1]);
+        let d = best.1;
+        self.axes = [u * d.x + v * d.y, v * d.x - u * d.y];
+        // Keep the plane's orientation: the second axis is the normal crossed with the first.
+        if self.axes[0].cross(self.axes[1]).dot(u.cross(v)) < 0.0 {
+            self.axes[1] = -self.axes[1];
+        }
+        self.measure(mesh);
+    }
+
+    /// Lay the chart on its side: a quarter turn in its plane.
+    fn turn(&mut self) {
+        let [u, v] = self.axes;
+        self.axes = [v, -u];
+        let (lo, hi) = self.bounds;
+        self.bounds = (DVec2::new(lo.y, -hi.x), DVec2::new(hi.y, -lo.x));
+    }
+}
+
+/// The convex hull of `points`, counter-clockwise (Andrew's monotone chain).
+fn convex_hull(mut points: Vec<DVec2>) -> Vec<DVec2> {
+    points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    points.dedup();
+    if points.len() < 3 {
+        return points;
+    }
+    let mut hull: Vec<DVec2> = Vec::with_capacity(2 * points.len());
+    for pass in [false, true] {
+        let start = hull.len();
+        let ordered: Box<dyn Iterator<Item = &DVec2>> =
+            if pass { Box::new(points.iter().rev()) } else { Box::new(points.iter()) };
+        for &p in ordered {
+            while hull.len() >= start + 2
+                && (hull[hull.len() - 1] - hull[hull.len() - 2]).perp_dot(p - hull[hull.len() - 2]) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    hull
 }
 
 impl Atlas {
@@ -140,7 +218,7 @@ impl Atlas {
             return Err(AtlasError::Resolution(resolution));
         }
         let mut charts = grow_charts(mesh);
-        let scale = pack(&mut charts, mesh.total_area(), resolution)?;
+        let scale = pack(mesh, &mut charts, mesh.total_area(), resolution)?;
         let (texels, index) = bake(mesh, &charts, scale, resolution);
         let mut vertex_texel = vec![None; mesh.positions().len()];
         for chart in &charts {
@@ -197,61 +275,145 @@ fn grow_charts(mesh: &Mesh) -> Vec<Chart> {
         }
         let axes = axis.any_orthonormal_pair();
         let origin = mesh.corners(seed)[0];
-        let project = |p: DVec3| DVec2::new((p - origin).dot(axes.0), (p - origin).dot(axes.1));
-        let mut bounds = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-        for &t in &triangles {
-            for p in mesh.corners(t) {
-                bounds = (bounds.0.min(project(p)), bounds.1.max(project(p)));
-            }
-        }
-        charts.push(Chart { triangles, origin, axes: [axes.0, axes.1], bounds, offset: DVec2::ZERO });
+        let bounds = (DVec2::ZERO, DVec2::ZERO);
+        let mut chart = Chart { triangles, origin, axes: [axes.0, axes.1], bounds, offset: DVec2::ZERO };
+        chart.measure(mesh);
+        charts.push(chart);
     }
     charts
 }
 
-/// Place the charts on shelves at the largest scale (texels per unit) of the sequence starting
-/// where they would cover 60% of the atlas and shrinking by 10% a step that fits; each chart's
-/// `offset` is set. An error when even the smallest scale does not fit.
-fn pack(charts: &mut [Chart], area: f64, resolution: u32) -> Result<f64, AtlasError> {
+/// The charts packed at the largest scale (texels per unit) at which they fit, found by
+/// bisection to 0.1%: each chart turned to the rectangle of least area around it
+/// ([`Chart::fit_rectangle`]), then laid by [`skyline`] at that scale; each chart's `offset`
+/// (and, for those laid on their side, its axes) is set. An error when even a scale at which
+/// every chart is a few texels does not fit.
+fn pack(mesh: &Mesh, charts: &mut [Chart], area: f64, resolution: u32) -> Result<f64, AtlasError> {
     let side = f64::from(resolution);
-    let mut scale = (0.6 * side * side / area.max(f64::MIN_POSITIVE)).sqrt();
-    let mut order: Vec<usize> = (0..charts.len()).collect();
-    let extent = |c: &Chart| c.bounds.1 - c.bounds.0;
-    order.sort_by(|&a, &b| extent(&charts[b]).y.total_cmp(&extent(&charts[a]).y));
-    for _ in 0..400 {
-        if let Some(offsets) = shelves(charts, &order, scale, side) {
-            for (c, o) in charts.iter_mut().zip(offsets) {
-                c.offset = o;
-            }
-            return Ok(scale);
-        }
-        scale *= 0.9;
+    for chart in charts.iter_mut() {
+        chart.fit_rectangle(mesh);
     }
-    Err(AtlasError::TooManyCharts { charts: charts.len(), resolution })
+    let full = (side * side / area.max(f64::MIN_POSITIVE)).sqrt();
+    let (mut lo, mut hi) = (full * 0.5, full);
+    let mut best = None;
+    for _ in 0..40 {
+        if let Some(layout) = skyline(mesh, charts, lo, resolution) {
+            best = Some((lo, layout));
+            break;
+        }
+        (hi, lo) = (lo, lo * 0.7);
+    }
+    let Some((mut scale, mut layout)) = best else {
+        return Err(AtlasError::TooManyCharts { charts: charts.len(), resolution });
+    };
+    while hi / lo > 1.001 {
+        let mid = (lo * hi).sqrt();
+        match skyline(mesh, charts, mid, resolution) {
+            Some(found) => (lo, scale, layout) = (mid, mid, found),
+            None => hi = mid,
+        }
+    }
+    for (chart, (offset, turned)) in charts.iter_mut().zip(layout) {
+        if turned {
+            chart.turn();
+        }
+        chart.offset = offset;
+    }
+    Ok(scale)
 }
 
-/// Shelf packing of `charts` in `order` at `scale`: each chart's offset (its bounding box's
-/// minimum, one texel inside its padded cell), or `None` when they overflow `side`.
-fn shelves(charts: &[Chart], order: &[usize], scale: f64, side: f64) -> Option<Vec<DVec2>> {
-    let mut offsets = vec![DVec2::ZERO; charts.len()];
-    let (mut x, mut y, mut shelf) = (0.0, 0.0, 0.0f64);
-    for &i in order {
-        let e = (charts[i].bounds.1 - charts[i].bounds.0) * scale;
-        let (w, h) = ((e.x + 1.0).ceil() + 2.0, (e.y + 1.0).ceil() + 2.0);
-        if w > side {
-            return None;
+/// The columns a chart covers at some scale, each with the lowest and highest row a triangle's
+/// box reaches, relative to the chart's own corner: the shape [`skyline`] lays.
+struct Profile {
+    /// Per column, (lowest row, highest row); `None` where no triangle reaches.
+    columns: Vec<Option<(i64, i64)>>,
+}
+
+impl Profile {
+    /// The texel cells the chart's triangles' boxes touch at `scale`: two charts whose cells
+    /// differ share no texel centre, so they need no gap (the texture gather's local window
+    /// takes the texels around a receiver by their own positions, whichever chart they are
+    /// of). With `turned`, the chart laid on its side.
+    fn of(mesh: &Mesh, chart: &Chart, scale: f64, turned: bool) -> Profile {
+        let extent = (chart.bounds.1 - chart.bounds.0) * scale;
+        let width = if turned { extent.y } else { extent.x }.floor() as usize + 1;
+        let mut columns = vec![None; width];
+        for &t in &chart.triangles {
+            let uv = mesh.corners(t).map(|p| {
+                let q = (chart.project(p) - chart.bounds.0) * scale;
+                if turned { DVec2::new(q.y, extent.x - q.x) } else { q }
+            });
+            let lo = uv[0].min(uv[1]).min(uv[2]);
+            let hi = uv[0].max(uv[1]).max(uv[2]);
+            let (x0, x1) = (lo.x.floor() as i64, (hi.x.floor() as i64).min(width as i64 - 1));
+            let (y0, y1) = (lo.y.floor() as i64, hi.y.floor() as i64 + 1);
+            for column in &mut columns[x0.max(0) as usize..=x1.max(0) as usize] {
+                *column = Some(column.map_or((y0, y1), |(a, b): (i64, i64)| (a.min(y0), b.max(y1))));
+            }
         }
-        if x + w > side {
-            (x, y, shelf) = (0.0, y + shelf, 0.0);
-        }
-        if y + h > side {
-            return None;
-        }
-        offsets[i] = DVec2::new(x + 1.0, y + 1.0);
-        x += w;
-        shelf = shelf.max(h);
+        Profile { columns }
     }
-    Some(offsets)
+
+    /// Where the profile rests on `sky` (each column's first free row) with its first column
+    /// at `x`: the row its corner goes to, the highest row it then reaches, and the texels it
+    /// leaves empty beneath it.
+    fn rest(&self, sky: &[i64], x: usize) -> (i64, i64, i64) {
+        let mut y = 0;
+        for (c, column) in self.columns.iter().enumerate() {
+            if let Some((bottom, _)) = column {
+                y = y.max(sky[x + c] - bottom);
+            }
+        }
+        let (mut top, mut holes) = (y, 0);
+        for (c, column) in self.columns.iter().enumerate() {
+            if let Some((bottom, high)) = column {
+                top = top.max(y + high);
+                holes += y + bottom - sky[x + c];
+            }
+        }
+        (y, top, holes)
+    }
+}
+
+/// Tetris-like packing at `scale`: each chart, largest first, in whichever of its two
+/// orientations and at whichever column leaves the lowest top, dropped until it rests on what is
+/// already there (each column's first free row; holes under overhangs stay empty). Per chart
+/// its offset (texels, its box's corner) and whether it lies on its side, or `None` when the
+/// charts overflow the atlas.
+fn skyline(mesh: &Mesh, charts: &[Chart], scale: f64, resolution: u32) -> Option<Vec<(DVec2, bool)>> {
+    let side = resolution as usize;
+    let mut sky = vec![0i64; side];
+    let mut order: Vec<usize> = (0..charts.len()).collect();
+    let size = |c: &Chart| (c.bounds.1 - c.bounds.0).max_element();
+    order.sort_by(|&a, &b| size(&charts[b]).total_cmp(&size(&charts[a])));
+    let mut layout = vec![(DVec2::ZERO, false); charts.len()];
+    for i in order {
+        let profiles = [false, true].map(|turned| Profile::of(mesh, &charts[i], scale, turned));
+        let mut best: Option<(i64, usize, i64, usize, i64)> = None;
+        for (p, profile) in profiles.iter().enumerate() {
+            let width = profile.columns.len();
+            for x in 0..=side.saturating_sub(width) {
+                let (y, top, holes) = profile.rest(&sky, x);
+                // The texels this placement spends: those it leaves empty beneath it, and the
+                // rows it adds above the lowest it could reach.
+                let cost = holes + top * width as i64;
+                if width <= side && best.is_none_or(|b| cost < b.0) {
+                    best = Some((cost, x, y, p, top));
+                }
+            }
+        }
+        let (_, x, y, p, top) = best?;
+        if top > side as i64 {
+            return None;
+        }
+        for (c, column) in profiles[p].columns.iter().enumerate() {
+            if let Some((_, high)) = column {
+                sky[x + c] = sky[x + c].max(y + high);
+            }
+        }
+        layout[i] = (DVec2::new(x as f64, y as f64), p == 1);
+    }
+    Some(layout)
 }
 
 /// The texels every chart triangle covers (see the module's doc), in Morton order, and the
