@@ -18,7 +18,7 @@ pub const DEFAULT_FOV_Y: f32 = 35.0;
 pub(super) fn first(
     document: &::gltf::Document,
     nodes: &[(::gltf::Node, Mat4)],
-) -> Result<Option<(Camera, GltfPart)>, GltfSceneProblem> {
+) -> Result<Option<(Camera, GltfPart)>, Box<GltfSceneProblem>> {
     let Some((node, world, camera)) = nodes.iter().find_map(|(n, w)| Some((n, w, n.camera()?))) else {
         return Ok(None);
     };
@@ -28,7 +28,7 @@ pub(super) fn first(
     let json = &document.as_json().cameras[camera.index()];
     let perspective = match (json.type_, &json.perspective) {
         (::gltf::json::validation::Checked::Valid(::gltf::json::camera::Type::Perspective), Some(p)) => p,
-        _ => return Err(GltfSceneProblem::Orthographic { camera: part }),
+        _ => return Err(Box::new(GltfSceneProblem::Orthographic { camera: part })),
     };
     let eye = world.transform_point3(Vec3::ZERO);
     let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();

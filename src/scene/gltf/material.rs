@@ -32,10 +32,13 @@ impl Materials {
 
 /// Every material of `document` mapped, `overrides` applied by name; an override naming no
 /// material of the file is refused.
-pub(super) fn materials(document: &::gltf::Gltf, overrides: &GltfOverrides) -> Result<Materials, GltfSceneProblem> {
+pub(super) fn materials(
+    document: &::gltf::Gltf,
+    overrides: &GltfOverrides,
+) -> Result<Materials, Box<GltfSceneProblem>> {
     let names: Vec<String> = document.materials().filter_map(|m| m.name().map(str::to_string)).collect();
     if let Some(name) = overrides.material.keys().find(|n| !names.contains(n)) {
-        return Err(GltfSceneProblem::NoSuchMaterial { name: name.clone(), names });
+        return Err(Box::new(GltfSceneProblem::NoSuchMaterial { name: name.clone(), names }));
     }
     let by_index = document
         .materials()
@@ -47,19 +50,19 @@ pub(super) fn materials(document: &::gltf::Gltf, overrides: &GltfOverrides) -> R
             };
             Ok((spec, part))
         })
-        .collect::<Result<_, GltfSceneProblem>>()?;
+        .collect::<Result<_, Box<GltfSceneProblem>>>()?;
     let part = GltfPart::Material { index: None, name: None };
     let default = (MaterialSpec::Opaque { albedo: [1.0; 3], roughness: 1.0 }, part);
     Ok(Materials { by_index, default })
 }
 
 /// One material mapped: translucent where it has a volume or diffuse transmission, else opaque.
-fn spec(material: &::gltf::Material, part: &GltfPart) -> Result<MaterialSpec, GltfSceneProblem> {
+fn spec(material: &::gltf::Material, part: &GltfPart) -> Result<MaterialSpec, Box<GltfSceneProblem>> {
     let volume = material.volume().filter(|v| v.thickness_factor() > 0.0);
     let diffuse_transmission = material.extension_value(DIFFUSE_TRANSMISSION).is_some();
     match (volume, diffuse_transmission) {
         (Some(volume), _) => medium(material, &volume, part),
-        (None, true) => Err(GltfSceneProblem::NoVolume { material: part.clone() }),
+        (None, true) => Err(Box::new(GltfSceneProblem::NoVolume { material: part.clone() })),
         (None, false) => Ok(opaque(material)),
     }
 }
@@ -77,7 +80,7 @@ fn medium(
     material: &::gltf::Material,
     volume: &::gltf::material::Volume,
     part: &GltfPart,
-) -> Result<MaterialSpec, GltfSceneProblem> {
+) -> Result<MaterialSpec, Box<GltfSceneProblem>> {
     let eta = f64::from(material.ior().unwrap_or(DEFAULT_IOR));
     let pbr = material.pbr_metallic_roughness();
     let base = pbr.base_color_factor();
@@ -87,14 +90,14 @@ fn medium(
     for c in 0..3 {
         let per_unit = -f64::from(color[c]).ln() / f64::from(distance);
         if !(per_unit.is_finite() && per_unit > 0.0) {
-            return Err(GltfSceneProblem::NoExtinction {
+            return Err(Box::new(GltfSceneProblem::NoExtinction {
                 material: part.clone(),
                 channel: c,
                 color: color[c],
                 distance,
-            });
+            }));
         }
-        let medium = |source| GltfSceneProblem::Medium { material: part.clone(), source };
+        let medium = |source| Box::new(GltfSceneProblem::Medium { material: part.clone(), source });
         let alpha = crate::optics::albedo::reduced_albedo(f64::from(base[c]), eta).map_err(medium)?;
         let sigma_t = per_unit / MM_PER_GLTF_UNIT;
         sigma_s_prime[c] = alpha * sigma_t;

@@ -46,7 +46,7 @@ pub(super) fn scene_file(
     (base, file_name): (&Path, &str),
     overrides: &GltfOverrides,
 ) -> Result<SceneFile, SceneError> {
-    let fail = |problem| SceneError::Gltf { file: name.to_string(), problem: Box::new(problem) };
+    let fail = |problem| SceneError::Gltf { file: name.to_string(), problem };
     let (document, scene) = crate::mesh::gltf_document(bytes, name)?;
     let scene = document.scenes().nth(scene).expect("gltf_document's scene");
     let nodes = walk(&scene);
@@ -64,7 +64,7 @@ pub(super) fn scene_file(
     let file =
         SceneFile { camera, objects, lights, sampling: overrides.sampling.clone(), render: overrides.render.clone() };
     let origins = Origins { camera: camera_origin, objects: object_origins, lights: light_origins };
-    crate::scene::check::check(&file).map_err(|e| fail(refused(e, &origins)))?;
+    crate::scene::check::check(&file).map_err(|e| fail(Box::new(refused(e, &origins))))?;
     Ok(file)
 }
 
