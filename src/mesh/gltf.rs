@@ -161,13 +161,27 @@ pub(super) fn load(path: &Path, select: Select, options: &LoadOptions) -> Result
 /// default one, else the first); `source_name` names it in errors. For the scene reader
 /// (`scene::Scene::from_gltf`), which reads cameras, lights and materials from it.
 pub fn gltf_document(bytes: &[u8], source_name: &str) -> Result<(::gltf::Gltf, usize), MeshError> {
-    let fail = |problem| MeshError::Gltf { source_name: source_name.to_string(), problem: Box::new(problem) };
-    prevalidate(bytes).map_err(fail)?;
-    let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| fail(GltfProblem::Parse(e)))?;
-    let scene = file.default_scene().or_else(|| file.scenes().next()).ok_or_else(|| fail(GltfProblem::NoMesh))?;
-    trees(&file, &scene).map_err(fail)?;
-    let index = scene.index();
-    Ok((file, index))
+    let file = document(bytes).map_err(|p| gltf_error(source_name, p))?;
+    let scene = scene_of(&file).map_err(|p| gltf_error(source_name, p))?;
+    Ok((file, scene))
+}
+
+fn gltf_error(source_name: &str, problem: GltfProblem) -> MeshError {
+    MeshError::Gltf { source_name: source_name.to_string(), problem: Box::new(problem) }
+}
+
+/// The file parsed and validated by the gltf crate, what it would panic on refused first.
+fn document(bytes: &[u8]) -> Result<::gltf::Gltf, GltfProblem> {
+    prevalidate(bytes)?;
+    Ok(::gltf::Gltf::from_slice(bytes)?)
+}
+
+/// The index of the scene read (the default one, else the first), its nodes checked to form
+/// trees.
+fn scene_of(file: &::gltf::Gltf) -> Result<usize, GltfProblem> {
+    let scene = file.default_scene().or_else(|| file.scenes().next()).ok_or(GltfProblem::NoMesh)?;
+    trees(file, &scene)?;
+    Ok(scene.index())
 }
 
 /// The bounding box of every triangle of a glTF file's scene, placed by its nodes (`base`: where
@@ -188,10 +202,11 @@ pub(super) fn parse(
     options: &LoadOptions,
 ) -> Result<Loaded, MeshError> {
     options.validate()?;
-    let fail = |problem| MeshError::Gltf { source_name: source_name.to_string(), problem: Box::new(problem) };
-    let (file, scene) = gltf_document(bytes, source_name)?;
-    let scene = file.scenes().nth(scene).expect("gltf_document's scene");
+    let fail = |problem| gltf_error(source_name, problem);
+    // Buffers before the scene: a file's bad buffer is reported before its missing scene.
+    let file = document(bytes).map_err(fail)?;
     let buffers = buffers(&file, base).map_err(fail)?;
+    let scene = file.scenes().nth(scene_of(&file).map_err(fail)?).expect("scene_of's scene");
     let mut out = Loaded { positions: Vec::new(), triangles: Vec::new(), flip_winding: false };
     let (roots, only): (Vec<(::gltf::Node, Mat4)>, _) = match select {
         Select::Whole => (scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect(), None),
