@@ -226,6 +226,9 @@ impl Scene {
     /// (else its first) with its camera, lights and materials, `overrides` applied
     /// (docs/SCENES.md, "glTF scenes"). Its meshes are read when it is prepared.
     pub fn from_gltf(path: &Path, overrides: &GltfOverrides) -> Result<Scene, SceneError> {
+        if cfg!(not(feature = "gltf")) {
+            return Err(SceneError::Mesh(crate::mesh::MeshError::GltfDisabled { path: path.to_path_buf() }));
+        }
         let bytes = std::fs::read(path).map_err(|source| SceneError::Read { path: path.to_path_buf(), source })?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         let file_name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
