@@ -11,7 +11,7 @@ use translucent::scene::{GatherMode, Scene, TransportMode};
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Scene file (TOML); the built-in marble bunny when omitted
+    /// Scene file (TOML, or a glTF 2.0 .gltf/.glb scene); the built-in marble bunny when omitted
     pub scene: Option<PathBuf>,
     /// Print JSON (the shape docs/PLAN.md documents) instead of text
     #[arg(long)]

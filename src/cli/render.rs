@@ -15,7 +15,7 @@ use translucent::scene::{GatherMode, Light, ReceiverPolicy, Scene, SplatVisibili
 
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Scene file (TOML); the built-in marble bunny when omitted
+    /// Scene file (TOML, or a glTF 2.0 .gltf/.glb scene); the built-in marble bunny when omitted
     pub scene: Option<PathBuf>,
     /// Output PNG (tone-mapped sRGB)
     #[arg(short, long, default_value = "translucent.png")]

@@ -3,8 +3,9 @@
 //! nodes' transforms, becomes part of one mesh, in node order, as the OBJ loader makes one mesh
 //! of an OBJ's groups.
 
-use super::MeshError;
+use super::glb::GltfNodePart;
 use super::obj::{LoadOptions, Loaded};
+use super::{Mesh, MeshError};
 use ::gltf::accessor::{DataType, Dimensions};
 use glam::{Mat4, Vec3};
 use std::path::Path;
@@ -127,45 +128,105 @@ pub enum GltfProblem {
         /// Every named node of the file.
         names: Vec<String>,
     },
+    /// A node a glTF scene's object names (`scene::Scene::from_gltf`) is not in the file's scene.
+    #[error("node {node} is not a node of the file's scene")]
+    NodeNotInScene {
+        /// The node's index.
+        node: usize,
+    },
     /// The file has no scene, or its scene places no mesh.
     #[error("no scene places a mesh")]
     NoMesh,
 }
 
-/// Read the glTF at `path` ([`super::Mesh::load`] for a `.gltf` or `.glb`): the whole scene, or
-/// the node named `node` and its children.
-pub(super) fn load(path: &Path, node: Option<&str>, options: &LoadOptions) -> Result<Loaded, MeshError> {
+/// Which triangles of a glTF file's scene are read.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Select<'a> {
+    /// Every triangle primitive of the scene.
+    Whole,
+    /// The node of this name and its children.
+    Named(&'a str),
+    /// One node's primitives of one material, without its children.
+    Part(GltfNodePart),
+}
+
+/// Read the glTF at `path` ([`super::Mesh::load`] for a `.gltf` or `.glb`): what `select` picks.
+pub(super) fn load(path: &Path, select: Select, options: &LoadOptions) -> Result<Loaded, MeshError> {
     let bytes = std::fs::read(path).map_err(|source| MeshError::Io { path: path.to_path_buf(), source })?;
-    parse(&bytes, &path.display().to_string(), path.parent(), node, options)
+    parse(&bytes, &path.display().to_string(), path.parent(), select, options)
+}
+
+/// A glTF file in memory parsed and validated as the mesh reader reads it (what the gltf crate
+/// would panic on refused first, its nodes checked to form trees), with the scene it reads (the
+/// default one, else the first); `source_name` names it in errors. For the scene reader
+/// (`scene::Scene::from_gltf`), which reads cameras, lights and materials from it.
+pub fn gltf_document(bytes: &[u8], source_name: &str) -> Result<(::gltf::Gltf, usize), MeshError> {
+    let file = document(bytes).map_err(|p| gltf_error(source_name, p))?;
+    let scene = scene_of(&file).map_err(|p| gltf_error(source_name, p))?;
+    Ok((file, scene))
+}
+
+fn gltf_error(source_name: &str, problem: GltfProblem) -> MeshError {
+    MeshError::Gltf { source_name: source_name.to_string(), problem: Box::new(problem) }
+}
+
+/// The file parsed and validated by the gltf crate, what it would panic on refused first.
+fn document(bytes: &[u8]) -> Result<::gltf::Gltf, GltfProblem> {
+    prevalidate(bytes)?;
+    Ok(::gltf::Gltf::from_slice(bytes)?)
+}
+
+/// The index of the scene read (the default one, else the first), its nodes checked to form
+/// trees.
+fn scene_of(file: &::gltf::Gltf) -> Result<usize, GltfProblem> {
+    let scene = file.default_scene().or_else(|| file.scenes().next()).ok_or(GltfProblem::NoMesh)?;
+    trees(file, &scene)?;
+    Ok(scene.index())
+}
+
+/// The bounding box of every triangle of a glTF file's scene, placed by its nodes (`base`: where
+/// its buffer files are), for a default camera that frames it.
+pub fn gltf_bounds(bytes: &[u8], source_name: &str, base: Option<&Path>) -> Result<(Vec3, Vec3), MeshError> {
+    let loaded = parse(bytes, source_name, base, Select::Whole, &LoadOptions::default())?;
+    Ok(loaded.positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(*p), hi.max(*p))))
 }
 
 /// Parse a glTF already in memory; `source_name` names it in errors, and `base` is where its
-/// buffer files are (`None`: only a `.glb`'s own binary chunk can be read). With `node`, only
-/// that node of the scene and its children.
+/// buffer files are (`None`: only a `.glb`'s own binary chunk can be read). `select` says which
+/// triangles of the scene.
 pub(super) fn parse(
     bytes: &[u8],
     source_name: &str,
     base: Option<&Path>,
-    node: Option<&str>,
+    select: Select,
     options: &LoadOptions,
 ) -> Result<Loaded, MeshError> {
     options.validate()?;
-    let fail = |problem| MeshError::Gltf { source_name: source_name.to_string(), problem: Box::new(problem) };
-    prevalidate(bytes).map_err(fail)?;
-    let file = ::gltf::Gltf::from_slice(bytes).map_err(|e| fail(GltfProblem::Parse(e)))?;
+    let fail = |problem| gltf_error(source_name, problem);
+    // Buffers before the scene: a file's bad buffer is reported before its missing scene.
+    let file = document(bytes).map_err(fail)?;
     let buffers = buffers(&file, base).map_err(fail)?;
-    let scene = file.default_scene().or_else(|| file.scenes().next()).ok_or_else(|| fail(GltfProblem::NoMesh))?;
-    trees(&file, &scene).map_err(fail)?;
+    let scene = file.scenes().nth(scene_of(&file).map_err(fail)?).expect("scene_of's scene");
     let mut out = Loaded { positions: Vec::new(), triangles: Vec::new(), flip_winding: false };
-    let roots: Vec<(::gltf::Node, Mat4)> = match node {
-        None => scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect(),
-        Some(name) => vec![find(scene.nodes(), name, Mat4::IDENTITY).ok_or_else(|| {
-            let names = file.nodes().filter_map(|n| n.name().map(str::to_string)).collect();
-            fail(GltfProblem::NoSuchNode { name: name.to_string(), names })
-        })?],
+    let (roots, only): (Vec<(::gltf::Node, Mat4)>, _) = match select {
+        Select::Whole => (scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect(), None),
+        Select::Named(name) => (
+            vec![find(scene.nodes(), &|n| n.name() == Some(name), Mat4::IDENTITY).ok_or_else(|| {
+                let names = file.nodes().filter_map(|n| n.name().map(str::to_string)).collect();
+                fail(GltfProblem::NoSuchNode { name: name.to_string(), names })
+            })?],
+            None,
+        ),
+        Select::Part(part) => (
+            vec![
+                find(scene.nodes(), &|n| n.index() == part.node, Mat4::IDENTITY)
+                    .ok_or_else(|| fail(GltfProblem::NodeNotInScene { node: part.node }))?,
+            ],
+            Some(part.material),
+        ),
     };
     for (root, parent) in roots {
-        place(&root, parent, &buffers, &mut out).map_err(fail)?;
+        place(&root, parent, &buffers, only, &mut out).map_err(fail)?;
     }
     if out.triangles.is_empty() {
         return Err(fail(GltfProblem::NoMesh));
@@ -267,37 +328,50 @@ fn trees(file: &::gltf::Gltf, scene: &::gltf::Scene) -> Result<(), GltfProblem> 
     Ok(())
 }
 
-/// The first node named `name` among `nodes` and their descendants (depth first), with the
+/// The first node `wanted` among `nodes` and their descendants (depth first), with the
 /// transform of its parents.
 fn find<'a>(
     nodes: impl Iterator<Item = ::gltf::Node<'a>>,
-    name: &str,
+    wanted: &dyn Fn(&::gltf::Node) -> bool,
     parent: Mat4,
 ) -> Option<(::gltf::Node<'a>, Mat4)> {
     for node in nodes {
-        if node.name() == Some(name) {
+        if wanted(&node) {
             return Some((node, parent));
         }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
-        if let Some(found) = find(node.children(), name, world) {
+        if let Some(found) = find(node.children(), wanted, world) {
             return Some(found);
         }
     }
     None
 }
 
-/// Append `node`'s mesh and its children's, placed by `parent` times the node's own transform.
-/// A mirroring transform has its triangles' winding swapped, so that they keep facing out.
-fn place(node: &::gltf::Node, parent: Mat4, buffers: &[Vec<u8>], out: &mut Loaded) -> Result<(), GltfProblem> {
+/// Append `node`'s mesh and its children's, placed by `parent` times the node's own transform;
+/// with `only`, the node's primitives of that material alone (`None` inside: the default
+/// material), without its children. A mirroring transform has its triangles' winding swapped,
+/// so that they keep facing out.
+fn place(
+    node: &::gltf::Node,
+    parent: Mat4,
+    buffers: &[Vec<u8>],
+    only: Option<Option<usize>>,
+    out: &mut Loaded,
+) -> Result<(), GltfProblem> {
     let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
     if let Some(mesh) = node.mesh() {
         for primitive in mesh.primitives() {
+            if only.is_some_and(|material| primitive.material().index() != material) {
+                continue;
+            }
             let at = (node.index(), mesh.index(), primitive.index());
             append(&primitive, at, world, buffers, out)?;
         }
     }
-    for child in node.children() {
-        place(&child, world, buffers, out)?;
+    if only.is_none() {
+        for child in node.children() {
+            place(&child, world, buffers, None, out)?;
+        }
     }
     Ok(())
 }
@@ -394,24 +468,37 @@ fn append(
     Ok(())
 }
 
-/// A binary glTF (`.glb`) holding `json` and the binary chunk `bin`, each padded to 4 bytes as
-/// the container asks (JSON with spaces, binary with zeros).
-pub fn glb_bytes(json: &[u8], bin: &[u8]) -> Vec<u8> {
-    let pad = |n: usize| n.div_ceil(4) * 4;
-    let (json_len, bin_len) = (pad(json.len()), pad(bin.len()));
-    let total = 12 + 8 + json_len + if bin.is_empty() { 0 } else { 8 + bin_len };
-    let mut out = Vec::with_capacity(total);
-    for word in [0x4654_6C67u32, 2, total as u32, json_len as u32, 0x4E4F_534A] {
-        out.extend(word.to_le_bytes());
+impl Mesh {
+    /// Read the mesh of the node named `node` of a glTF 2.0 file, with its children's, placed
+    /// as the file's scene places it (an error listing the names there are when no node of the
+    /// scene has it).
+    pub fn load_gltf_node(path: impl AsRef<Path>, node: &str, options: &LoadOptions) -> Result<Mesh, MeshError> {
+        let path = path.as_ref();
+        let loaded = load(path, Select::Named(node), options)?;
+        Mesh::build(path.display().to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
     }
-    out.extend(json);
-    out.resize(20 + json_len, b' ');
-    if !bin.is_empty() {
-        for word in [bin_len as u32, 0x004E_4942] {
-            out.extend(word.to_le_bytes());
-        }
-        out.extend(bin);
-        out.resize(total, 0);
+
+    /// Read one node's triangle primitives of one material from a glTF 2.0 file, placed as the
+    /// file's scene places the node, its children left out: one object of a glTF scene.
+    pub fn load_gltf_part(
+        path: impl AsRef<Path>,
+        part: GltfNodePart,
+        options: &LoadOptions,
+    ) -> Result<Mesh, MeshError> {
+        let path = path.as_ref();
+        let loaded = load(path, Select::Part(part), options)?;
+        Mesh::build(path.display().to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
     }
-    out
+
+    /// Parse a glTF 2.0 file in memory (a `.glb`, or a `.gltf` whose buffers are files in
+    /// `base`), with the same validation as [`Mesh::load`]; `source_name` names it in errors.
+    pub fn from_gltf_slice(
+        bytes: &[u8],
+        source_name: &str,
+        base: Option<&Path>,
+        options: &LoadOptions,
+    ) -> Result<Mesh, MeshError> {
+        let loaded = parse(bytes, source_name, base, Select::Whole, options)?;
+        Mesh::build(source_name.to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
+    }
 }

@@ -14,8 +14,10 @@ pub mod bvh;
 mod curvature;
 mod enclosure;
 pub mod facing;
-mod lod;
+mod glb;
+#[cfg(feature = "gltf")]
 mod gltf;
+mod lod;
 mod obj;
 pub mod patches;
 pub mod shapes;
@@ -27,8 +29,10 @@ use glam::{DVec3, Vec3};
 
 pub use boundary::NO_BOUNDARY;
 pub use enclosure::{Enclosure, enclosure};
+pub use glb::{GltfNodePart, glb_bytes};
+#[cfg(feature = "gltf")]
+pub use gltf::{GltfProblem, gltf_bounds, gltf_document};
 pub use lod::{LodLevel, MIN_LEVEL_TRIANGLES};
-pub use gltf::{GltfProblem, glb_bytes};
 pub use obj::{Element, LoadOptions, ObjProblem};
 
 /// Marks an edge with no single neighbouring triangle (an open boundary or a non-manifold edge).
@@ -127,7 +131,14 @@ pub enum MeshError {
         /// How many triangles were dropped as degenerate.
         degenerate: usize,
     },
+    /// A glTF file, and the crate was built without its `gltf` feature.
+    #[error("{}: glTF files are read only with the crate's `gltf` feature (a default one); build with it", path.display())]
+    GltfDisabled {
+        /// The file.
+        path: PathBuf,
+    },
     /// A glTF file that cannot be read as a mesh.
+    #[cfg(feature = "gltf")]
     #[error("{source_name}: {problem}")]
     Gltf {
         /// The file name, or `<memory>`.
@@ -140,10 +151,23 @@ pub enum MeshError {
     InvalidOptions(LoadOptionsError),
 }
 
+/// The whole scene of the glTF file at `path`; without the `gltf` feature, the error that says so.
+fn load_gltf(path: &std::path::Path, options: &LoadOptions) -> Result<obj::Loaded, MeshError> {
+    #[cfg(feature = "gltf")]
+    return gltf::load(path, gltf::Select::Whole, options);
+    #[cfg(not(feature = "gltf"))]
+    {
+        let _ = options;
+        Err(MeshError::GltfDisabled { path: path.to_path_buf() })
+    }
+}
+
 /// Whether `path` names a glTF file (`.gltf` or `.glb`, any case); every other mesh is read
 /// as OBJ.
 pub fn is_gltf(path: &std::path::Path) -> bool {
-    path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
 }
 
 /// What is wrong with a [`LoadOptions`] ([`MeshError::InvalidOptions`]).
@@ -219,7 +243,7 @@ impl Mesh {
     /// recomputed from the geometry.
     pub fn load(path: impl AsRef<std::path::Path>, options: &LoadOptions) -> Result<Mesh, MeshError> {
         let path = path.as_ref();
-        let loaded = if is_gltf(path) { gltf::load(path, None, options)? } else { obj::load(path, options)? };
+        let loaded = if is_gltf(path) { load_gltf(path, options)? } else { obj::load(path, options)? };
         Mesh::build(path.display().to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
     }
 
@@ -227,31 +251,6 @@ impl Mesh {
     /// validation as [`Mesh::load`]; `source_name` names it in errors.
     pub fn from_obj_text(text: &str, source_name: &str, options: &LoadOptions) -> Result<Mesh, MeshError> {
         let loaded = obj::parse(text, source_name, options)?;
-        Mesh::build(source_name.to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
-    }
-
-    /// Read the mesh of the node named `node` of a glTF 2.0 file, with its children's, placed
-    /// as the file's scene places it (an error listing the names there are when no node of the
-    /// scene has it).
-    pub fn load_gltf_node(
-        path: impl AsRef<std::path::Path>,
-        node: &str,
-        options: &LoadOptions,
-    ) -> Result<Mesh, MeshError> {
-        let path = path.as_ref();
-        let loaded = gltf::load(path, Some(node), options)?;
-        Mesh::build(path.display().to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
-    }
-
-    /// Parse a glTF 2.0 file in memory (a `.glb`, or a `.gltf` whose buffers are files in
-    /// `base`), with the same validation as [`Mesh::load`]; `source_name` names it in errors.
-    pub fn from_gltf_slice(
-        bytes: &[u8],
-        source_name: &str,
-        base: Option<&std::path::Path>,
-        options: &LoadOptions,
-    ) -> Result<Mesh, MeshError> {
-        let loaded = gltf::parse(bytes, source_name, base, None, options)?;
         Mesh::build(source_name.to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
     }
 

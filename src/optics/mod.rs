@@ -5,6 +5,8 @@
 //!
 //! - [`material`]: a [`Material`] (per-channel `sigma_a`, `sigma_s_prime` in 1/mm, `eta`) and the
 //!   derived per-channel [`Dipole`] in scene units (`sigma_tr`, `z_r`, `z_v`, `F_dr`, `A`, ...).
+//! - [`albedo`]: the reduced albedo whose dipole reflects a given diffuse colour (`R_d,total`
+//!   inverted), for materials given by their colour (glTF scenes).
 //! - [`beam_single`]: single scattering between two surface points, the BSSRDF form of
 //!   Jensen et al. 2001 Eq. 3 (the light carried along the refracted beam before it scatters).
 //! - [`dipole`]: the diffuse reflectance profile `R_d(r)` (seed Eq. 8), its total, its exact
@@ -24,10 +26,10 @@
 //!   with.
 //! - [`gpu`]: the std430 records shared with the shaders, mirrored with `#[repr(C)]` + bytemuck.
 
+pub mod albedo;
 pub mod beam_single;
 pub mod beam_table;
 pub mod dipole;
-pub mod transport;
 pub mod directional_dipole;
 pub mod fresnel;
 pub mod gpu;
@@ -36,6 +38,7 @@ pub mod material;
 pub mod presets;
 pub mod quadrature;
 pub mod single_scatter;
+pub mod transport;
 
 pub use dipole::Dipole;
 pub use material::Material;

@@ -513,22 +513,44 @@ fn light_is_finite(l: &PreparedLight) -> bool {
 
 fn load_shape(scene: &Scene, shape: &Shape) -> Result<(String, Mesh), SceneError> {
     match shape {
-        Shape::Mesh { path, node } => {
+        Shape::Mesh { path, node, part } => {
             let mesh = match scene.resolve(path)? {
-                AssetSource::File(p) => match node {
-                    Some(node) => Mesh::load_gltf_node(&p, node, &LoadOptions::default())?,
-                    None => Mesh::load(&p, &LoadOptions::default())?,
-                },
+                AssetSource::File(p) => load_mesh_file(&p, node.as_deref(), *part)?,
                 AssetSource::Embedded(bytes) => {
                     let text = std::str::from_utf8(bytes).map_err(SceneError::EmbeddedMeshNotUtf8)?;
                     Mesh::from_obj_text(text, path, &LoadOptions::default())?
                 }
             };
-            Ok((node.as_ref().map_or_else(|| path.clone(), |n| format!("{path}#{n}")), mesh))
+            let name = match (node, part) {
+                (Some(n), _) => format!("{path}#{n}"),
+                (None, Some(part)) => format!("{path}#node{}", part.node),
+                (None, None) => path.clone(),
+            };
+            Ok((name, mesh))
         }
         Shape::Plane { size, divisions } => Ok(("plane".into(), plane(*size, *divisions)?)),
         Shape::Sphere { radius, divisions } => Ok(("sphere".into(), sphere(*radius, *divisions)?)),
     }
+}
+
+/// A mesh file: an OBJ, or a glTF file's scene, its node named `node` or one node's `part`.
+fn load_mesh_file(
+    path: &std::path::Path,
+    node: Option<&str>,
+    part: Option<crate::mesh::GltfNodePart>,
+) -> Result<Mesh, SceneError> {
+    let options = LoadOptions::default();
+    #[cfg(feature = "gltf")]
+    match (node, part) {
+        (Some(node), _) => return Ok(Mesh::load_gltf_node(path, node, &options)?),
+        (None, Some(part)) => return Ok(Mesh::load_gltf_part(path, part, &options)?),
+        (None, None) => {}
+    }
+    #[cfg(not(feature = "gltf"))]
+    if node.is_some() || part.is_some() {
+        return Err(crate::mesh::MeshError::GltfDisabled { path: path.to_path_buf() }.into());
+    }
+    Ok(Mesh::load(path, &options)?)
 }
 
 /// Apply fit, scale, rotation (degrees, x then y then z) and translation, in that order; also

@@ -278,7 +278,7 @@ fn check_camera(c: &Camera) -> Check {
 fn check_shape(key: &impl Fn(&str) -> String, shape: &Shape) -> Check {
     match shape {
         Shape::Mesh { path, .. } if path.trim().is_empty() => refuse(key("shape.path"), BadValue::EmptyPath),
-        Shape::Mesh { path, node: Some(_) } if !crate::mesh::is_gltf(std::path::Path::new(path)) => {
+        Shape::Mesh { path, node: Some(_), .. } if !crate::mesh::is_gltf(std::path::Path::new(path)) => {
             refuse(key("shape.node"), BadValue::NodeOutsideGltf)
         }
         Shape::Plane { size, divisions } | Shape::Sphere { radius: size, divisions } => {

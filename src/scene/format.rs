@@ -98,6 +98,10 @@ pub enum Shape {
         /// material.
         #[serde(default)]
         node: Option<String>,
+        /// glTF scenes only (no key in a scene file): one node's primitives of one material,
+        /// its children left out; what `Scene::from_gltf` makes each object of.
+        #[serde(skip)]
+        part: Option<crate::mesh::GltfNodePart>,
     },
     /// A square in the xz plane, centred at the origin, facing +y, `size` units wide,
     /// split into `divisions`^2 quads.
@@ -646,9 +650,7 @@ where
 {
     let values = Vec::<T>::deserialize(deserializer)?;
     let len = values.len();
-    values
-        .try_into()
-        .map_err(|_| serde::de::Error::invalid_length(len, &format!("a list of {N} values").as_str()))
+    values.try_into().map_err(|_| serde::de::Error::invalid_length(len, &format!("a list of {N} values").as_str()))
 }
 
 /// `exact_len` for an optional key (absent is `None`).

@@ -6,6 +6,7 @@ pub mod build;
 mod camera;
 mod check;
 pub mod format;
+pub mod gltf;
 pub mod lights;
 pub mod needs;
 mod object;
@@ -13,6 +14,7 @@ mod warnings;
 
 pub use check::{BadValue, Check, CheckError, Number, check_max_error, check_texture};
 pub use format::*;
+pub use gltf::{GltfOverrides, GltfPart, GltfSceneProblem};
 use std::path::{Path, PathBuf};
 
 /// The built-in scene that `translucent render` draws with no arguments.
@@ -95,6 +97,14 @@ pub enum SceneError {
     /// An environment map was refused.
     #[error(transparent)]
     Environment(#[from] lights::EnvironmentError),
+    /// A glTF scene the file's parts cannot make: a camera, light, material or value, named.
+    #[error("{file}: {problem}")]
+    Gltf {
+        /// The glTF file.
+        file: String,
+        /// What is wrong, and where in the file.
+        problem: Box<GltfSceneProblem>,
+    },
     /// `context` names where (e.g. `scene.toml: object[0] (bunny.obj): sampling`).
     #[error("{context}")]
     Context {
@@ -233,8 +243,13 @@ impl Scene {
         Scene::parse(DEFAULT_SCENE, "built-in scene", None).expect("the built-in scene is valid")
     }
 
-    /// Read, parse and check a scene file; its relative paths resolve from its folder.
+    /// Read, parse and check a scene file; its relative paths resolve from its folder. A
+    /// `.gltf` or `.glb` is read as a glTF scene ([`Scene::from_gltf`]) with the overrides
+    /// beside it, if any ([`GltfOverrides::beside`]).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        if crate::mesh::is_gltf(path) {
+            return Scene::from_gltf(path, &GltfOverrides::beside(path)?);
+        }
         let text =
             std::fs::read_to_string(path).map_err(|source| SceneError::Read { path: path.to_path_buf(), source })?;
         let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
