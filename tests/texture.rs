@@ -227,21 +227,3 @@ fn the_twin_agrees_at_the_most_draws_per_receiver() {
         assert!(worst < 1e-3, "worst relative error {worst}");
     });
 }
-
-/// Issue 48: the atlas of the built-in bunny (37.7k vertices) at the default 256x256 uses at
-/// least 60% of its texels (the charts' own shapes packed, not their boxes on shelves; 24% on
-/// shelves), and so do a coarser and a finer one.
-#[test]
-fn the_built_in_bunny_atlas_uses_at_least_60_percent_of_its_texels() {
-    let mesh = common::load_asset("bunny-37k.obj");
-    let share = |resolution: u32| {
-        let atlas = translucent::mesh::atlas::Atlas::new(&mesh, resolution).unwrap();
-        let share = atlas.texels.len() as f64 / f64::from(resolution * resolution);
-        eprintln!("bunny-37k atlas {resolution}: {} charts, {:.1}% of texels used", atlas.charts, share * 100.0);
-        share
-    };
-    for resolution in [128, 256, 512] {
-        let share = share(resolution);
-        assert!(share >= 0.6, "atlas {resolution}: {:.1}% of texels used", share * 100.0);
-    }
-}

@@ -4,8 +4,9 @@
 
 use anyhow::Result;
 use std::path::PathBuf;
-use translucent::render::plan::{self, Change, Planner};
+use translucent::mesh::atlas::{Atlas, AtlasSource};
 use translucent::render::camera::CameraView;
+use translucent::render::plan::{self, Change, Planner};
 use translucent::scene::build::{Overrides, PreparedScene};
 use translucent::scene::{GatherMode, Scene, TransportMode};
 
@@ -73,16 +74,34 @@ pub fn run(args: &Args) -> Result<()> {
             "version": 1,
             "objects": needs.objects,
             "frames": frames.iter().map(|(_, p)| p.to_json()).collect::<Vec<_>>(),
+            "atlases": atlases(&prepared).map(|(object, a)| serde_json::json!({
+                "object": object,
+                "source": match a.source { AtlasSource::OwnUvs => "own_uvs", AtlasSource::Charts(_) => "charts" },
+                "why": match a.source { AtlasSource::OwnUvs => None, AtlasSource::Charts(why) => Some(why.to_string()) },
+                "resolution": a.resolution,
+                "texels": a.texels.len(),
+                "charts": a.charts,
+            })).collect::<Vec<_>>(),
         });
         out!("{}", serde_json::to_string_pretty(&json)?);
         return Ok(());
     }
     out!("{}: {} objects, {} lights", prepared.scene.name, objects, prepared.scene.file.lights.len());
+    for (i, atlas) in atlases(&prepared) {
+        let (side, used) = (atlas.resolution, atlas.texels.len());
+        let share = 100.0 * used as f64 / f64::from(side * side);
+        out!("object {i}: texture atlas {side}x{side} from {}: {used} texels ({share:.1}% used)", atlas.source);
+    }
     for (change, p) in &frames {
         out!("after a change of {change}:");
         out!("{}", p.to_string().trim_end());
     }
     Ok(())
+}
+
+/// The texture gather's atlas of each object that has one, with the object's index.
+fn atlases(prepared: &PreparedScene) -> impl Iterator<Item = (usize, &Atlas)> {
+    prepared.objects.iter().enumerate().filter_map(|(i, o)| o.atlas.as_deref().map(|a| (i, a)))
 }
 
 /// Each gathered object's receivers an eye may see, counted on the host as the GPU picks them

@@ -93,8 +93,103 @@ pub struct Atlas {
     pub vertex_texel: Vec<[u32; 2]>,
     /// How many charts the mesh was cut into.
     pub charts: usize,
-    /// Texels per scene unit (one for all charts).
+    /// Texels per scene unit (one for all charts; the mean over the surface for the mesh's own
+    /// coordinates).
     pub scale: f64,
+    /// Whose layout it is: the mesh's own coordinates, or charts of ours, and why.
+    pub source: AtlasSource,
+}
+
+/// Whose layout an atlas is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AtlasSource {
+    /// The mesh's own texture coordinates (OBJ `vt`, glTF `TEXCOORD_0`), scaled to the atlas.
+    OwnUvs,
+    /// The mesh cut into charts and packed here, because its own coordinates would not do.
+    Charts(ChartsReason),
+}
+
+/// Why an atlas was cut into charts of ours instead of taking the mesh's own coordinates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ChartsReason {
+    /// The mesh has no texture coordinates (or not on every triangle).
+    #[error("the mesh has no texture coordinates")]
+    NoUvs,
+    /// A corner's coordinates lie outside the unit square (tiled or wrapped textures).
+    #[error("triangle {triangle}'s texture coordinates leave the unit square")]
+    OutsideUnitSquare {
+        /// The first such triangle.
+        triangle: usize,
+    },
+    /// Two triangles' coordinates cover the same texel centre (mirrored or repeated parts).
+    #[error("triangles {first} and {second} overlap in texture space")]
+    Overlapping {
+        /// The triangle that covered it first.
+        first: usize,
+        /// The one that covered it again.
+        second: usize,
+    },
+}
+
+impl std::fmt::Display for AtlasSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AtlasSource::OwnUvs => f.write_str("the mesh's own texture coordinates"),
+            AtlasSource::Charts(why) => write!(f, "charts of ours ({why})"),
+        }
+    }
+}
+
+/// The mesh's own coordinates in texels at `resolution`, per triangle corner, or why they will
+/// not do: missing, outside the unit square, or two triangles over one texel centre.
+fn own_uvs(mesh: &Mesh, resolution: u32) -> Result<Vec<[DVec2; 3]>, ChartsReason> {
+    let corners = mesh.corner_uvs().ok_or(ChartsReason::NoUvs)?;
+    let side = f64::from(resolution);
+    let mut uvs = Vec::with_capacity(corners.len());
+    for (triangle, c) in corners.iter().enumerate() {
+        if c.iter().any(|uv| !(0.0..=1.0).contains(&uv.x) || !(0.0..=1.0).contains(&uv.y)) {
+            return Err(ChartsReason::OutsideUnitSquare { triangle });
+        }
+        // Rows run down the atlas as v runs up the image.
+        uvs.push(c.map(|uv| DVec2::new(f64::from(uv.x) * side, (1.0 - f64::from(uv.y)) * side)));
+    }
+    let mut owner = vec![u32::MAX; (resolution * resolution) as usize];
+    for (triangle, uv) in uvs.iter().enumerate() {
+        for [x, y] in inside(uv, resolution) {
+            let slot = &mut owner[(y * resolution + x) as usize];
+            if *slot != u32::MAX {
+                return Err(ChartsReason::Overlapping { first: *slot as usize, second: triangle });
+            }
+            *slot = triangle as u32;
+        }
+    }
+    Ok(uvs)
+}
+
+/// The texel centres strictly inside triangle `uv` (atlas coordinates): a centre on a shared
+/// edge is in neither, so neighbours never count as overlapping.
+fn inside(uv: &[DVec2; 3], resolution: u32) -> Vec<[u32; 2]> {
+    let lo = uv[0].min(uv[1]).min(uv[2]);
+    let hi = uv[0].max(uv[1]).max(uv[2]);
+    let max = f64::from(resolution - 1);
+    let span = |a: f64, b: f64| (a - 0.5).ceil().clamp(0.0, max) as u32..=(b - 0.5).floor().clamp(0.0, max) as u32;
+    let d = (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]);
+    let mut found = Vec::new();
+    if d.abs() < 1e-300 {
+        return found;
+    }
+    const EDGE: f64 = 1e-9;
+    for y in span(lo.y, hi.y) {
+        for x in span(lo.x, hi.x) {
+            let p = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let b1 = (p - uv[0]).perp_dot(uv[2] - uv[0]) / d;
+            let b2 = (uv[1] - uv[0]).perp_dot(p - uv[0]) / d;
+            if b1 > EDGE && b2 > EDGE && 1.0 - b1 - b2 > EDGE {
+                found.push([x, y]);
+            }
+        }
+    }
+    found
 }
 
 /// Why a mesh got no atlas.
@@ -212,14 +307,48 @@ fn convex_hull(mut points: Vec<DVec2>) -> Vec<DVec2> {
 }
 
 impl Atlas {
-    /// Cut `mesh` into charts, pack them into `resolution^2` texels and bake the texels.
+    /// The atlas of `mesh` at `resolution^2` texels: the mesh's own texture coordinates where
+    /// it has them and they fit (`AtlasSource::OwnUvs`), else the mesh cut into charts and
+    /// packed (`AtlasSource::Charts`, with why); then the texels baked.
     pub fn new(mesh: &Mesh, resolution: u32) -> Result<Atlas, AtlasError> {
         if !(MIN_RESOLUTION..=MAX_RESOLUTION).contains(&resolution) {
             return Err(AtlasError::Resolution(resolution));
         }
+        match own_uvs(mesh, resolution) {
+            Ok(uvs) => Ok(Atlas::of_own_uvs(mesh, &uvs, resolution)),
+            Err(why) => Atlas::of_charts(mesh, resolution, why),
+        }
+    }
+
+    /// The atlas of the mesh's own coordinates, scaled to texels (`uvs`, per triangle corner).
+    fn of_own_uvs(mesh: &Mesh, uvs: &[[DVec2; 3]], resolution: u32) -> Atlas {
+        let (texels, index) = bake(mesh, uvs.iter().enumerate().map(|(t, uv)| (t, *uv)), resolution);
+        let mut vertex_texel = vec![None; mesh.positions().len()];
+        for (t, uv) in uvs.iter().enumerate() {
+            for (v, uv) in mesh.triangles()[t].iter().zip(uv) {
+                vertex_texel[*v as usize].get_or_insert_with(|| texel_of(*uv, resolution));
+            }
+        }
+        let texel_area: f64 = uvs.iter().map(|[a, b, c]| 0.5 * (*b - *a).perp_dot(*c - *a).abs()).sum();
+        Atlas {
+            resolution,
+            texels,
+            index,
+            vertex_texel: vertex_texel.into_iter().map(Option::unwrap_or_default).collect(),
+            charts: 0,
+            // One figure for the whole mesh: the mean texels per unit over its surface.
+            scale: (texel_area / mesh.total_area().max(f64::MIN_POSITIVE)).sqrt(),
+            source: AtlasSource::OwnUvs,
+        }
+    }
+
+    /// Cut `mesh` into charts, pack them into `resolution^2` texels and bake the texels.
+    fn of_charts(mesh: &Mesh, resolution: u32, why: ChartsReason) -> Result<Atlas, AtlasError> {
         let mut charts = grow_charts(mesh);
         let scale = pack(mesh, &mut charts, mesh.total_area(), resolution)?;
-        let (texels, index) = bake(mesh, &charts, scale, resolution);
+        let placed =
+            charts.iter().flat_map(|c| c.triangles.iter().map(move |&t| (t, mesh.corners(t).map(|p| c.uv(p, scale)))));
+        let (texels, index) = bake(mesh, placed, resolution);
         let mut vertex_texel = vec![None; mesh.positions().len()];
         for chart in &charts {
             for &t in &chart.triangles {
@@ -233,7 +362,15 @@ impl Atlas {
             }
         }
         let vertex_texel = vertex_texel.into_iter().map(Option::unwrap_or_default).collect();
-        Ok(Atlas { resolution, texels, index, vertex_texel, charts: charts.len(), scale })
+        Ok(Atlas {
+            resolution,
+            texels,
+            index,
+            vertex_texel,
+            charts: charts.len(),
+            scale,
+            source: AtlasSource::Charts(why),
+        })
     }
 
     /// The texel at column `x`, row `y`, if one carries surface there.
@@ -416,31 +553,28 @@ fn skyline(mesh: &Mesh, charts: &[Chart], scale: f64, resolution: u32) -> Option
     Some(layout)
 }
 
-/// The texels every chart triangle covers (see the module's doc), in Morton order, and the
-/// index map.
-fn bake(mesh: &Mesh, charts: &[Chart], scale: f64, resolution: u32) -> (Vec<Texel>, Vec<u32>) {
+/// The texels every triangle covers at its atlas coordinates `placed` (triangle, corners in
+/// texels; see the module's doc), in Morton order, and the index map.
+fn bake(mesh: &Mesh, placed: impl Iterator<Item = (usize, [DVec2; 3])>, resolution: u32) -> (Vec<Texel>, Vec<u32>) {
     let mut index = vec![NO_TEXEL; (resolution * resolution) as usize];
     let mut texels: Vec<Texel> = Vec::new();
-    for chart in charts {
-        for &t in &chart.triangles {
-            let uv = mesh.corners(t).map(|p| chart.uv(p, scale));
-            let covered = cover(&uv, resolution, &mut index, texels.len() as u32);
-            let area = mesh.triangle_areas()[t];
-            if covered.is_empty() {
-                let centroid = (uv[0] + uv[1] + uv[2]) / 3.0;
-                let [x, y] = texel_of(centroid, resolution);
-                let slot = &mut index[(y * resolution + x) as usize];
-                if *slot == NO_TEXEL {
-                    *slot = texels.len() as u32;
-                    texels.push(texel(mesh, t, [1.0 / 3.0; 3], [x, y], 0.0));
-                }
-                texels[*slot as usize].area += area;
-                continue;
+    for (t, uv) in placed {
+        let covered = cover(&uv, resolution, &mut index, texels.len() as u32);
+        let area = mesh.triangle_areas()[t];
+        if covered.is_empty() {
+            let centroid = (uv[0] + uv[1] + uv[2]) / 3.0;
+            let [x, y] = texel_of(centroid, resolution);
+            let slot = &mut index[(y * resolution + x) as usize];
+            if *slot == NO_TEXEL {
+                *slot = texels.len() as u32;
+                texels.push(texel(mesh, t, [1.0 / 3.0; 3], [x, y], 0.0));
             }
-            let share = area / covered.len() as f64;
-            for ([x, y], bary) in covered {
-                texels.push(texel(mesh, t, bary, [x, y], share));
-            }
+            texels[*slot as usize].area += area;
+            continue;
+        }
+        let share = area / covered.len() as f64;
+        for ([x, y], bary) in covered {
+            texels.push(texel(mesh, t, bary, [x, y], share));
         }
     }
     let mut order: Vec<u32> = (0..texels.len() as u32).collect();

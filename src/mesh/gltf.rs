@@ -7,7 +7,7 @@ use super::glb::GltfNodePart;
 use super::obj::{LoadOptions, Loaded};
 use super::{Mesh, MeshError};
 use ::gltf::accessor::{DataType, Dimensions};
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 use std::path::Path;
 
 /// What is wrong with a glTF file ([`MeshError::Gltf`]).
@@ -207,7 +207,7 @@ pub(super) fn parse(
     let file = document(bytes).map_err(fail)?;
     let buffers = buffers(&file, base).map_err(fail)?;
     let scene = file.scenes().nth(scene_of(&file).map_err(fail)?).expect("scene_of's scene");
-    let mut out = Loaded { positions: Vec::new(), triangles: Vec::new(), flip_winding: false };
+    let mut out = Loaded { positions: Vec::new(), triangles: Vec::new(), flip_winding: false, corner_uvs: Some(Vec::new()) };
     let (roots, only): (Vec<(::gltf::Node, Mat4)>, _) = match select {
         Select::Whole => (scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect(), None),
         Select::Named(name) => (
@@ -465,6 +465,16 @@ fn append(
         if mirrored { [a, c, b] } else { [a, b, c] }
     }));
     out.positions.extend(positions);
+    // TEXCOORD_0 per corner, while every primitive so far had it (the atlas's own UVs).
+    let uvs: Option<Vec<Vec2>> =
+        reader.read_tex_coords(0).map(|t| t.into_f32().map(Vec2::from).collect()).filter(|u: &Vec<Vec2>| u.len() == count);
+    match (uvs, out.corner_uvs.as_mut()) {
+        (Some(uvs), Some(corners)) => corners.extend(indices.chunks_exact(3).map(|t| {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| uvs[i as usize]);
+            if mirrored { [a, c, b] } else { [a, b, c] }
+        })),
+        _ => out.corner_uvs = None,
+    }
     Ok(())
 }
 
@@ -475,7 +485,7 @@ impl Mesh {
     pub fn load_gltf_node(path: impl AsRef<Path>, node: &str, options: &LoadOptions) -> Result<Mesh, MeshError> {
         let path = path.as_ref();
         let loaded = load(path, Select::Named(node), options)?;
-        Mesh::build(path.display().to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
+        Mesh::build(path.display().to_string(), loaded)
     }
 
     /// Read one node's triangle primitives of one material from a glTF 2.0 file, placed as the
@@ -487,7 +497,7 @@ impl Mesh {
     ) -> Result<Mesh, MeshError> {
         let path = path.as_ref();
         let loaded = load(path, Select::Part(part), options)?;
-        Mesh::build(path.display().to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
+        Mesh::build(path.display().to_string(), loaded)
     }
 
     /// Parse a glTF 2.0 file in memory (a `.glb`, or a `.gltf` whose buffers are files in
@@ -499,6 +509,6 @@ impl Mesh {
         options: &LoadOptions,
     ) -> Result<Mesh, MeshError> {
         let loaded = parse(bytes, source_name, base, Select::Whole, options)?;
-        Mesh::build(source_name.to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
+        Mesh::build(source_name.to_string(), loaded)
     }
 }

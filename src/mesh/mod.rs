@@ -234,6 +234,7 @@ pub struct Mesh {
     ring: Vec<u32>,
     bounds: (Vec3, Vec3),
     report: MeshReport,
+    corner_uvs: Option<Vec<[glam::Vec2; 3]>>,
 }
 
 impl Mesh {
@@ -244,28 +245,40 @@ impl Mesh {
     pub fn load(path: impl AsRef<std::path::Path>, options: &LoadOptions) -> Result<Mesh, MeshError> {
         let path = path.as_ref();
         let loaded = if is_gltf(path) { load_gltf(path, options)? } else { obj::load(path, options)? };
-        Mesh::build(path.display().to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
+        Mesh::build(path.display().to_string(), loaded)
     }
 
     /// Parse OBJ text in memory (e.g. an asset embedded in the binary), with the same
     /// validation as [`Mesh::load`]; `source_name` names it in errors.
     pub fn from_obj_text(text: &str, source_name: &str, options: &LoadOptions) -> Result<Mesh, MeshError> {
         let loaded = obj::parse(text, source_name, options)?;
-        Mesh::build(source_name.to_string(), loaded.positions, loaded.triangles, loaded.flip_winding)
+        Mesh::build(source_name.to_string(), loaded)
     }
 
     /// Build a mesh from positions and triangles in memory, with the same validation and
     /// clean-up as [`Mesh::load`].
     pub fn from_triangles(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Mesh, MeshError> {
-        Mesh::build("<memory>".to_string(), positions, triangles, false)
+        let loaded = obj::Loaded { positions, triangles, flip_winding: false, corner_uvs: None };
+        Mesh::build("<memory>".to_string(), loaded)
     }
 
-    fn build(
-        source: String,
-        positions: Vec<Vec3>,
-        triangles: Vec<[u32; 3]>,
-        flip_winding: bool,
-    ) -> Result<Mesh, MeshError> {
+    /// This mesh's triangles, corner texture coordinates and clean-up over new `positions` (one
+    /// per vertex, e.g. moved into the scene): how a placed mesh keeps its own UVs.
+    pub fn with_positions(&self, positions: Vec<Vec3>) -> Result<Mesh, MeshError> {
+        let loaded = obj::Loaded {
+            positions,
+            triangles: self.triangles.clone(),
+            flip_winding: false,
+            corner_uvs: self.corner_uvs.clone(),
+        };
+        Mesh::build(self.report.source.clone(), loaded)
+    }
+
+    fn build(source: String, loaded: obj::Loaded) -> Result<Mesh, MeshError> {
+        let obj::Loaded { positions, triangles, flip_winding, mut corner_uvs } = loaded;
+        if corner_uvs.as_ref().is_some_and(|c| c.len() != triangles.len() || c.iter().flatten().any(|uv| !uv.is_finite())) {
+            corner_uvs = None;
+        }
         let mut report = MeshReport {
             source: source.clone(),
             input_vertices: positions.len(),
@@ -298,9 +311,16 @@ impl Mesh {
             for t in &mut triangles {
                 t.swap(1, 2);
             }
+            for c in corner_uvs.iter_mut().flatten() {
+                c.swap(1, 2);
+            }
         }
 
         let before = triangles.len();
+        if let Some(corners) = corner_uvs.as_mut() {
+            let mut kept = triangles.iter().map(|t| !is_degenerate(&positions, t));
+            corners.retain(|_| kept.next().unwrap_or(false));
+        }
         triangles.retain(|t| !is_degenerate(&positions, t));
         report.degenerate_triangles = before - triangles.len();
         if triangles.is_empty() {
@@ -342,7 +362,15 @@ impl Mesh {
             ring: topo.ring,
             bounds: (lo, hi),
             report,
+            corner_uvs,
         })
+    }
+
+    /// Per triangle, the texture coordinates of its three corners, when the file gave every
+    /// triangle some (OBJ `vt`, glTF `TEXCOORD_0`); what the texture gather's atlas uses when
+    /// its charts do not overlap (`atlas::Atlas::new`).
+    pub fn corner_uvs(&self) -> Option<&[[glam::Vec2; 3]]> {
+        self.corner_uvs.as_deref()
     }
 
     /// Vertex positions (one per vertex, after welding and clean-up).

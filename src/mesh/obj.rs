@@ -57,6 +57,8 @@ pub(super) struct Loaded {
     pub positions: Vec<Vec3>,
     pub triangles: Vec<[u32; 3]>,
     pub flip_winding: bool,
+    /// Per triangle, its corners' texture coordinates, when every triangle has them.
+    pub corner_uvs: Option<Vec<[glam::Vec2; 3]>>,
 }
 
 pub(super) fn load(path: &Path, options: &LoadOptions) -> Result<Loaded, MeshError> {
@@ -80,8 +82,19 @@ pub(super) fn parse(text: &str, source_name: &str, options: &LoadOptions) -> Res
 
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
+    // tobj's single index splits a vertex wherever its texture coordinate differs, so each
+    // vertex it gives has one; welding later joins the positions, and the corners keep theirs.
+    let mut corner_uvs = Some(Vec::new());
     for model in &models {
         let base = positions.len() as u32;
+        let uvs = &model.mesh.texcoords;
+        if uvs.len() != model.mesh.positions.len() / 3 * 2 {
+            corner_uvs = None;
+        }
+        if let Some(corners) = corner_uvs.as_mut() {
+            let uv = |i: u32| glam::Vec2::new(uvs[2 * i as usize], uvs[2 * i as usize + 1]);
+            corners.extend(model.mesh.indices.chunks_exact(3).map(|c| [uv(c[0]), uv(c[1]), uv(c[2])]));
+        }
         positions.extend(model.mesh.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
         triangles.extend(model.mesh.indices.chunks_exact(3).map(|c| [c[0] + base, c[1] + base, c[2] + base]));
     }
@@ -93,7 +106,7 @@ pub(super) fn parse(text: &str, source_name: &str, options: &LoadOptions) -> Res
             *p = options.transform.transform_point3(*p * options.scale);
         }
     }
-    Ok(Loaded { positions, triangles, flip_winding: options.mirrors() })
+    Ok(Loaded { positions, triangles, flip_winding: options.mirrors(), corner_uvs })
 }
 
 fn parse_error(source_name: &str, line: usize, problem: ObjProblem, text: &str) -> MeshError {

@@ -580,7 +580,7 @@ fn transform_mesh(mesh: Mesh, t: &super::Transform) -> Result<(Mesh, Option<Arc<
         return Ok((mesh, None));
     }
     let positions = mesh.positions().iter().map(|p| m.transform_point3(*p)).collect();
-    let placed = Mesh::from_triangles(positions, mesh.triangles().to_vec())?;
+    let placed = mesh.with_positions(positions)?;
     Ok((placed, Some(Arc::new(mesh))))
 }
 
