@@ -207,7 +207,8 @@ pub(super) fn parse(
     let file = document(bytes).map_err(fail)?;
     let buffers = buffers(&file, base).map_err(fail)?;
     let scene = file.scenes().nth(scene_of(&file).map_err(fail)?).expect("scene_of's scene");
-    let mut out = Loaded { positions: Vec::new(), triangles: Vec::new(), flip_winding: false, corner_uvs: Some(Vec::new()) };
+    let mut out =
+        Loaded { positions: Vec::new(), triangles: Vec::new(), flip_winding: false, corner_uvs: Some(Vec::new()) };
     let (roots, only): (Vec<(::gltf::Node, Mat4)>, _) = match select {
         Select::Whole => (scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect(), None),
         Select::Named(name) => (
@@ -466,8 +467,10 @@ fn append(
     }));
     out.positions.extend(positions);
     // TEXCOORD_0 per corner, while every primitive so far had it (the atlas's own UVs).
-    let uvs: Option<Vec<Vec2>> =
-        reader.read_tex_coords(0).map(|t| t.into_f32().map(Vec2::from).collect()).filter(|u: &Vec<Vec2>| u.len() == count);
+    let uvs: Option<Vec<Vec2>> = reader
+        .read_tex_coords(0)
+        .map(|t| t.into_f32().map(Vec2::from).collect())
+        .filter(|u: &Vec<Vec2>| u.len() == count);
     match (uvs, out.corner_uvs.as_mut()) {
         (Some(uvs), Some(corners)) => corners.extend(indices.chunks_exact(3).map(|t| {
             let [a, b, c] = [t[0], t[1], t[2]].map(|i| uvs[i as usize]);

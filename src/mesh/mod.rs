@@ -132,7 +132,10 @@ pub enum MeshError {
         degenerate: usize,
     },
     /// A glTF file, and the crate was built without its `gltf` feature.
-    #[error("{}: glTF files are read only with the crate's `gltf` feature (a default one); build with it", path.display())]
+    #[error(
+        "{}: glTF files are read only with the crate's `gltf` feature (a default one); build with it",
+        path.display()
+    )]
     GltfDisabled {
         /// The file.
         path: PathBuf,
@@ -276,7 +279,9 @@ impl Mesh {
 
     fn build(source: String, loaded: obj::Loaded) -> Result<Mesh, MeshError> {
         let obj::Loaded { positions, triangles, flip_winding, mut corner_uvs } = loaded;
-        if corner_uvs.as_ref().is_some_and(|c| c.len() != triangles.len() || c.iter().flatten().any(|uv| !uv.is_finite())) {
+        let unusable =
+            |c: &Vec<[glam::Vec2; 3]>| c.len() != triangles.len() || c.iter().flatten().any(|uv| !uv.is_finite());
+        if corner_uvs.as_ref().is_some_and(unusable) {
             corner_uvs = None;
         }
         let mut report = MeshReport {
@@ -315,14 +320,7 @@ impl Mesh {
                 c.swap(1, 2);
             }
         }
-
-        let before = triangles.len();
-        if let Some(corners) = corner_uvs.as_mut() {
-            let mut kept = triangles.iter().map(|t| !is_degenerate(&positions, t));
-            corners.retain(|_| kept.next().unwrap_or(false));
-        }
-        triangles.retain(|t| !is_degenerate(&positions, t));
-        report.degenerate_triangles = before - triangles.len();
+        report.degenerate_triangles = drop_degenerate(&positions, &mut triangles, corner_uvs.as_mut());
         if triangles.is_empty() {
             return Err(MeshError::NoArea { source_name: source, degenerate: report.degenerate_triangles });
         }
@@ -514,6 +512,21 @@ fn is_degenerate(positions: &[Vec3], t: &[u32; 3]) -> bool {
 
 /// Merge vertices whose positions are bit-identical (after folding -0.0 into 0.0). Returns the
 /// new positions, the re-indexed triangles and how many vertices were merged away.
+/// Drop the triangles of zero area (and their corners' texture coordinates); how many.
+fn drop_degenerate(
+    positions: &[Vec3],
+    triangles: &mut Vec<[u32; 3]>,
+    corner_uvs: Option<&mut Vec<[glam::Vec2; 3]>>,
+) -> usize {
+    let before = triangles.len();
+    if let Some(corners) = corner_uvs {
+        let mut kept = triangles.iter().map(|t| !is_degenerate(positions, t));
+        corners.retain(|_| kept.next().unwrap_or(false));
+    }
+    triangles.retain(|t| !is_degenerate(positions, t));
+    before - triangles.len()
+}
+
 fn weld(positions: Vec<Vec3>, mut triangles: Vec<[u32; 3]>) -> (Vec<Vec3>, Vec<[u32; 3]>, usize) {
     use std::collections::HashMap;
     let mut first: HashMap<[u32; 3], u32> = HashMap::with_capacity(positions.len());
