@@ -400,3 +400,32 @@ fn a_moved_key_light_resplats_only_its_own_part_and_matches_a_full_splat() {
         assert_eq!(plan.objects[1].splat_lights, SplatLights::All, "{plan}");
     });
 }
+
+/// `SceneEdit::Scene` (what the viewer's keys use): a renderer given the same file prepared with
+/// another gather and error target computes everything again and draws exactly what a renderer
+/// made for that preparation draws; its earlier frame's timings stay readable.
+#[test]
+fn a_renderer_given_another_preparation_draws_what_a_renderer_made_for_it_draws() {
+    with_gpu(|gpu| {
+        let scene = Scene::builtin();
+        let first =
+            Overrides { samples: Some(400), gather: Some(translucent::GatherMode::Vertex), ..Overrides::default() };
+        let other = Overrides {
+            max_error: Some(0.03),
+            gather: Some(translucent::GatherMode::Hierarchical),
+            ..Overrides::default()
+        };
+        let mut renderer = Renderer::new(gpu, PreparedScene::new(&scene, &first).unwrap()).unwrap();
+        renderer.frame(&renderer.plan(Change::Everything)).unwrap();
+        let before = renderer.image().unwrap();
+        renderer.edit(SceneEdit::Scene(Box::new(PreparedScene::new(&scene, &other).unwrap()))).unwrap();
+        assert_eq!(renderer.pending_change(), Some(Change::Everything));
+        let counts = frame(gpu, &mut renderer);
+        assert_eq!(counts.get("splat.comp"), 1, "{counts:?}");
+        let edited = renderer.image().unwrap();
+        drop(renderer);
+        let fresh = run_all(gpu, PreparedScene::new(&scene, &other).unwrap()).image().unwrap();
+        assert!(edited == fresh, "the edited renderer's image differs from a fresh one's");
+        assert!(edited != before, "the other settings drew the same image");
+    });
+}

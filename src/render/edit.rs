@@ -42,4 +42,11 @@ pub enum SceneEdit {
         /// Its new transform.
         transform: Transform,
     },
+    /// Draw another prepared scene: the same file prepared with other settings (the gather,
+    /// the error target and so the sample counts, an object's model), or another file. The
+    /// scene's GPU data, frame targets and passes are made anew; the renderer keeps its
+    /// timers, its frame numbers (a frame recorded before can still be timed) and its camera.
+    /// The next frame computes everything (`Change::Everything`). Call with no frame of this
+    /// renderer in flight; on an error nothing changed.
+    Scene(Box<crate::scene::build::PreparedScene>),
 }

@@ -6,7 +6,8 @@
 //!
 //! Mouse: left drag orbits, right or middle drag pans, the wheel zooms, Ctrl + left drag on a
 //! light's marker turns that light about the scene. Keys: `m` model, `g` gather, `e` error
-//! target, `r` resets the camera, `q` or Escape quits.
+//! target (the scene prepared again, given to the renderer as `SceneEdit::Scene`), `r` resets
+//! the camera, `q` or Escape quits.
 
 mod app;
 mod controls;

@@ -94,15 +94,11 @@ impl Viewer {
         self.surfaces.swapchain.extent
     }
 
-    /// A new renderer for `scene` in place of the current one (a setting the renderer takes
-    /// only when made: the gather, the error target, the model).
+    /// Draw `scene` (the scene prepared with another gather, error target or model) through
+    /// `SceneEdit::Scene`, once no frame is in flight.
     pub fn rebuild(&mut self, scene: PreparedScene) -> Result<()> {
         self.idle();
-        for slot in &mut self.slots.slots {
-            slot.recorded = None;
-        }
-        self.renderer = new_renderer(&self.gpu, scene)?;
-        Ok(())
+        Ok(self.renderer.edit(SceneEdit::Scene(Box::new(scene)))?)
     }
 
     /// Wait until the device has finished everything submitted.

@@ -28,7 +28,26 @@ impl Renderer {
             SceneEdit::Light { index, light } => self.set_light(index, light),
             SceneEdit::Material { object, material } => self.set_material(object, material),
             SceneEdit::Transform { object, transform } => self.set_transform(object, transform),
+            SceneEdit::Scene(scene) => self.set_scene(*scene),
         }
+    }
+
+    /// Draw `scene` instead (`SceneEdit::Scene`): a renderer made for it, whose scene data,
+    /// targets, passes, barrier records and planner replace this one's.
+    fn set_scene(&mut self, scene: crate::scene::build::PreparedScene) -> Result<(), RenderError> {
+        self.wait_for_recorded()?;
+        let mut fresh = Renderer::with_options(&self.gpu, scene, self.target, self.options)?;
+        // Swapped field by field: `fresh` then drops with what this renderer drew before.
+        std::mem::swap(&mut self.passes, &mut fresh.passes);
+        std::mem::swap(&mut self.targets, &mut fresh.targets);
+        std::mem::swap(&mut self.gpu_scene, &mut fresh.gpu_scene);
+        std::mem::swap(&mut self.hazards, &mut fresh.hazards);
+        std::mem::swap(&mut self.needs, &mut fresh.needs);
+        std::mem::swap(&mut self.planner, &mut fresh.planner);
+        std::mem::swap(&mut self.scene, &mut fresh.scene);
+        self.background = fresh.background;
+        self.undo = None;
+        Ok(())
     }
 
     /// Move the camera: the next frame re-shades (and, in pixel mode, gathers again); exitance
