@@ -35,8 +35,8 @@ const DEPTH: Scope = (
 /// What the window shows, and what it took. Fields drop in order: translucent before the
 /// viewer's Vulkan objects, the host (device, surface, instance) last.
 pub struct Viewer {
+    /// Holds translucent's `Gpu`: the last reference, dropped with it.
     pub renderer: Renderer,
-    gpu: Arc<Gpu>,
     shot: Option<Readback>,
     slots: Slots,
     present: Present,
@@ -68,7 +68,6 @@ impl Viewer {
         let slots = Slots::new(&host, IN_FLIGHT)?;
         Ok(Viewer {
             renderer,
-            gpu,
             shot: None,
             slots,
             present,
