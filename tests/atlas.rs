@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::load_asset;
+use common::{load_asset, subcommand, temp_dir, text};
 use translucent::mesh::atlas::{Atlas, AtlasSource, ChartsReason};
 use translucent::mesh::{LoadOptions, Mesh, glb_bytes};
 
@@ -101,5 +101,47 @@ fn the_built_in_bunny_atlas_uses_at_least_60_percent_of_its_texels() {
         let share = atlas.texels.len() as f64 / f64::from(resolution * resolution);
         eprintln!("bunny-37k atlas {resolution}: {} charts, {:.1}% of texels used", atlas.charts, share * 100.0);
         assert!(share >= 0.6, "atlas {resolution}: {:.1}% of texels used", share * 100.0);
+    }
+}
+
+/// `plan --json` says which layout each atlas took and why (issue 48: "a typed reason in plan").
+#[test]
+fn plan_says_whether_an_atlas_took_the_meshs_own_uvs_or_charts_and_why() {
+    let dir = temp_dir("atlas-plan");
+    let with = grid_obj(8, |x, z| [0.1 + 0.8 * x, 0.1 + 0.8 * z]);
+    let without: String = with
+        .lines()
+        .filter(|l| !l.starts_with("vt"))
+        .map(|l| {
+            // `f a/a b/b c/c` without texture coordinates: `f a b c`.
+            if l.starts_with('f') {
+                l.split(' ').map(|w| w.split('/').next().unwrap()).collect::<Vec<_>>().join(" ")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    for (name, obj, source, why) in [
+        ("uv", with, "own_uvs", serde_json::Value::Null),
+        ("plain", without, "charts", serde_json::json!("the mesh has no texture coordinates")),
+    ] {
+        std::fs::write(dir.join(format!("{name}.obj")), obj).unwrap();
+        let scene = format!(
+            "[camera]\neye = [0.5, 1.5, 0.5]\ntarget = [0.5, 0.0, 0.5]\nup = [0.0, 0.0, -1.0]\n\n[[object]]\n\
+             shape = {{ type = \"mesh\", path = \"{name}.obj\" }}\n\
+             material = {{ type = \"translucent\", preset = \"marble\", mm_per_unit = 10.0 }}\n\n\
+             [[light]]\ntype = \"directional\"\ndirection = [0.0, 1.0, 0.0]\nirradiance = [1.0, 1.0, 1.0]\n\n\
+             [render]\ngather = \"texture\"\n"
+        );
+        let path = dir.join(format!("{name}.toml"));
+        std::fs::write(&path, scene).unwrap();
+        let out = subcommand("plan", &[path.to_str().unwrap(), "--json"]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let atlas = &json["atlases"][0];
+        assert_eq!(atlas["source"], source, "{name}: {atlas}");
+        assert_eq!(atlas["why"], why, "{name}: {atlas}");
+        assert_eq!(atlas["resolution"], 256);
     }
 }
