@@ -166,9 +166,9 @@ fn own_uvs(mesh: &Mesh, resolution: u32) -> Result<Vec<[DVec2; 3]>, ChartsReason
     Ok(uvs)
 }
 
-/// The texel centres strictly inside triangle `uv` (atlas coordinates): a centre on a shared
-/// edge is in neither, so neighbours never count as overlapping.
-fn inside(uv: &[DVec2; 3], resolution: u32) -> Vec<[u32; 2]> {
+/// The texel centres in triangle `uv` (atlas coordinates) with their barycentric coordinates
+/// there, each at least `margin` (0: the edges included); none for a triangle of no area.
+fn centres(uv: &[DVec2; 3], resolution: u32, margin: f64) -> Vec<([u32; 2], [f64; 3])> {
     let lo = uv[0].min(uv[1]).min(uv[2]);
     let hi = uv[0].max(uv[1]).max(uv[2]);
     let max = f64::from(resolution - 1);
@@ -178,18 +178,24 @@ fn inside(uv: &[DVec2; 3], resolution: u32) -> Vec<[u32; 2]> {
     if d.abs() < 1e-300 {
         return found;
     }
-    const EDGE: f64 = 1e-9;
     for y in span(lo.y, hi.y) {
         for x in span(lo.x, hi.x) {
             let p = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
             let b1 = (p - uv[0]).perp_dot(uv[2] - uv[0]) / d;
             let b2 = (uv[1] - uv[0]).perp_dot(p - uv[0]) / d;
-            if b1 > EDGE && b2 > EDGE && 1.0 - b1 - b2 > EDGE {
-                found.push([x, y]);
+            let b0 = 1.0 - b1 - b2;
+            if b0 >= margin && b1 >= margin && b2 >= margin {
+                found.push(([x, y], [b0, b1, b2]));
             }
         }
     }
     found
+}
+
+/// The texel centres strictly inside triangle `uv`: a centre on a shared edge is in neither
+/// triangle, so neighbours never count as overlapping.
+fn inside(uv: &[DVec2; 3], resolution: u32) -> impl Iterator<Item = [u32; 2]> {
+    centres(uv, resolution, 1e-9).into_iter().map(|(xy, _)| xy)
 }
 
 /// Why a mesh got no atlas.
@@ -601,26 +607,12 @@ fn texel(mesh: &Mesh, t: usize, barycentric: [f64; 3], coord: [u32; 2], area: f6
 /// The texel centres inside the triangle `uv` (atlas coordinates) not yet taken, each claimed in
 /// `index` for the texel numbered `next` on, with their barycentric coordinates.
 fn cover(uv: &[DVec2; 3], resolution: u32, index: &mut [u32], next: u32) -> Vec<([u32; 2], [f64; 3])> {
-    let lo = uv[0].min(uv[1]).min(uv[2]);
-    let hi = uv[0].max(uv[1]).max(uv[2]);
-    let max = f64::from(resolution - 1);
-    let span = |a: f64, b: f64| (a - 0.5).ceil().clamp(0.0, max) as u32..=(b - 0.5).floor().clamp(0.0, max) as u32;
-    let d = (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]);
     let mut covered = Vec::new();
-    if d.abs() < 1e-300 {
-        return covered;
-    }
-    for y in span(lo.y, hi.y) {
-        for x in span(lo.x, hi.x) {
-            let p = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-            let b1 = (p - uv[0]).perp_dot(uv[2] - uv[0]) / d;
-            let b2 = (uv[1] - uv[0]).perp_dot(p - uv[0]) / d;
-            let b0 = 1.0 - b1 - b2;
-            let slot = &mut index[(y * resolution + x) as usize];
-            if b0 >= 0.0 && b1 >= 0.0 && b2 >= 0.0 && *slot == NO_TEXEL {
-                *slot = next + covered.len() as u32;
-                covered.push(([x, y], [b0, b1, b2]));
-            }
+    for ([x, y], bary) in centres(uv, resolution, 0.0) {
+        let slot = &mut index[(y * resolution + x) as usize];
+        if *slot == NO_TEXEL {
+            *slot = next + covered.len() as u32;
+            covered.push(([x, y], bary));
         }
     }
     covered
