@@ -3,6 +3,7 @@
 
 use super::controls::{self, Orbit};
 use super::host::Host;
+use super::present::Marker;
 use super::viewer::Viewer;
 use super::{Args, Outcome};
 use anyhow::{Context, Result};
@@ -119,6 +120,7 @@ impl App {
         for index in std::mem::take(&mut self.moved_lights) {
             viewer.edit(SceneEdit::Light { index, light: self.lights[index].clone() })?;
         }
+        viewer.markers = markers(&self.lights, viewer, orbit, self.modifiers.control_key(), self.drag);
         let last = self.closing || self.args.frames.is_some_and(|n| self.frames + 1 >= n);
         let shot = last && self.args.screenshot.is_some();
         let image = viewer.draw(shot)?;
@@ -239,17 +241,35 @@ impl App {
     /// The light whose marker is under the cursor.
     fn pick_light(&self) -> Option<usize> {
         let (viewer, orbit) = (self.viewer.as_ref()?, self.orbit.as_ref()?);
-        let scene = viewer.renderer.scene();
-        let camera = CameraView::of_camera(&orbit.camera, scene);
+        let camera = CameraView::of_camera(&orbit.camera, viewer.renderer.scene());
         let size = orbit.camera.resolution.map(|v| v as f32);
-        let (centre, radius) = scene.bounds;
-        controls::pick_light(&self.lights, centre, radius, camera.projection * camera.view, self.cursor, size)
+        let (target, reach) = orbit.anchor_frame();
+        controls::pick_light(&self.lights, target, reach, camera.projection * camera.view, self.cursor, size)
     }
 
     fn fail(&mut self, event_loop: &ActiveEventLoop, error: anyhow::Error) {
         self.outcome = Some(Err(error));
         event_loop.exit();
     }
+}
+
+/// Rings over the lights' anchors while Ctrl is held or a light is dragged; none otherwise (so
+/// what is presented is the scene alone).
+fn markers(lights: &[Light], viewer: &Viewer, orbit: &Orbit, picking: bool, drag: Option<Drag>) -> Vec<Marker> {
+    let dragged = match drag {
+        Some(Drag::Light(i)) => Some(i),
+        _ => None,
+    };
+    if !picking && dragged.is_none() {
+        return Vec::new();
+    }
+    let camera = CameraView::of_camera(&orbit.camera, viewer.renderer.scene());
+    let size = orbit.camera.resolution.map(|v| v as f32);
+    let (target, reach) = orbit.anchor_frame();
+    controls::screen_anchors(lights, target, reach, camera.projection * camera.view, size)
+        .into_iter()
+        .map(|(i, at)| Marker { at, radius: 10.0, dragged: dragged == Some(i) })
+        .collect()
 }
 
 #[derive(Clone, Copy)]

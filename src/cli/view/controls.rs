@@ -63,6 +63,12 @@ impl Orbit {
         self.camera.eye = (self.target() + offset.normalize() * distance).to_array();
     }
 
+    /// Where directional lights are grabbed: towards each from the target, a third of the way
+    /// to the eye (so on screen unless the light is behind the eye or the view).
+    pub fn anchor_frame(&self) -> (Vec3, f32) {
+        (self.target(), (self.eye() - self.target()).length() / 3.0)
+    }
+
     /// Slide the camera and its target in the image plane so that the point under the cursor
     /// follows it: `dx`, `dy` in pixels of a window `height` pixels tall.
     pub fn pan(&mut self, dx: f32, dy: f32, height: f32) {
@@ -75,27 +81,25 @@ impl Orbit {
     }
 }
 
-/// Where a light is drawn from for picking: a point light's or spot's position, or for a
-/// directional light the point 1.5 radii from the centre towards it. None for the sky.
-pub fn light_anchor(light: &Light, centre: Vec3, radius: f32) -> Option<Vec3> {
+/// Where a light is grabbed: a point light's or spot's position, or for a directional light
+/// the point `reach` from `centre` towards it. None for the sky.
+pub fn light_anchor(light: &Light, centre: Vec3, reach: f32) -> Option<Vec3> {
     match light {
-        Light::Directional { direction, .. } => Some(centre + Vec3::from(*direction).normalize() * radius * 1.5),
+        Light::Directional { direction, .. } => Some(centre + Vec3::from(*direction).normalize() * reach),
         Light::Point { position, .. } | Light::Spot { position, .. } => Some(Vec3::from(*position)),
         _ => None,
     }
 }
 
-/// The light whose anchor lands nearest `cursor` (pixels) in a `size` window seen through
-/// `view_proj`, among those in front of the camera (no marker is drawn yet, so the nearest one
-/// is taken however far).
-pub fn pick_light(
+/// Where each light's anchor lands in a `size` window seen through `view_proj` (pixels), for
+/// the lights in front of the camera.
+pub fn screen_anchors(
     lights: &[Light],
     centre: Vec3,
-    radius: f32,
+    reach: f32,
     view_proj: Mat4,
-    cursor: [f32; 2],
     size: [f32; 2],
-) -> Option<usize> {
+) -> Vec<(usize, [f32; 2])> {
     let on_screen = |p: Vec3| {
         let clip = view_proj * p.extend(1.0);
         (clip.w > 0.0).then(|| [(clip.x / clip.w * 0.5 + 0.5) * size[0], (clip.y / clip.w * 0.5 + 0.5) * size[1]])
@@ -103,7 +107,23 @@ pub fn pick_light(
     lights
         .iter()
         .enumerate()
-        .filter_map(|(i, l)| light_anchor(l, centre, radius).and_then(on_screen).map(|p| (i, p)))
+        .filter_map(|(i, l)| light_anchor(l, centre, reach).and_then(on_screen).map(|p| (i, p)))
+        .collect()
+}
+
+/// The light whose anchor lands nearest `cursor` (pixels) in a `size` window seen through
+/// `view_proj`, among those in front of the camera (the nearest however far: the rings are
+/// drawn while Ctrl is held, so the user sees which).
+pub fn pick_light(
+    lights: &[Light],
+    centre: Vec3,
+    reach: f32,
+    view_proj: Mat4,
+    cursor: [f32; 2],
+    size: [f32; 2],
+) -> Option<usize> {
+    screen_anchors(lights, centre, reach, view_proj, size)
+        .into_iter()
         .map(|(i, p)| (i, (p[0] - cursor[0]).hypot(p[1] - cursor[1])))
         .min_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(i, _)| i)

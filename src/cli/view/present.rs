@@ -6,6 +6,30 @@ use super::host::Host;
 use anyhow::Result;
 use ash::vk;
 
+/// The most light markers the pass draws (`MAX_MARKERS` in viewer_present.frag).
+pub const MAX_MARKERS: usize = 6;
+
+/// `PresentPush` in glsl/examples/viewer_present.frag.
+#[repr(C)]
+#[derive(Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
+struct PresentPush {
+    exposure: f32,
+    markers: u32,
+    pad: [f32; 2],
+    marker: [[f32; 4]; MAX_MARKERS],
+}
+
+/// A ring drawn over the image where a light can be grabbed.
+#[derive(Clone, Copy, Debug)]
+pub struct Marker {
+    /// Centre in pixels.
+    pub at: [f32; 2],
+    /// Radius in pixels.
+    pub radius: f32,
+    /// Whether it is the light being dragged (drawn in another colour).
+    pub dragged: bool,
+}
+
 /// The pipeline, its one descriptor set (the HDR image) and the sampler that set holds.
 pub struct Present {
     device: ash::Device,
@@ -28,7 +52,8 @@ impl Present {
             .descriptor_count(1)
             .stage_flags(vk::ShaderStageFlags::FRAGMENT)];
         let sizes = [vk::DescriptorPoolSize { ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER, descriptor_count: 1 }];
-        let push = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::FRAGMENT, offset: 0, size: 4 }];
+        let size = size_of::<PresentPush>() as u32;
+        let push = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::FRAGMENT, offset: 0, size }];
         // SAFETY: valid create infos; everything is destroyed in `drop`.
         unsafe {
             let set_layout = device
@@ -82,8 +107,20 @@ impl Present {
         unsafe { self.device.update_descriptor_sets(&write, &[]) };
     }
 
-    /// Draw into `target` (in COLOR_ATTACHMENT_OPTIMAL) of `extent`, at `exposure`.
-    pub fn record(&self, cmd: vk::CommandBuffer, target: vk::ImageView, extent: vk::Extent2D, exposure: f32) {
+    /// Draw into `target` (in COLOR_ATTACHMENT_OPTIMAL) of `extent`, at `exposure`, with a
+    /// ring at each of `markers` (the first `MAX_MARKERS`).
+    pub fn record(
+        &self,
+        cmd: vk::CommandBuffer,
+        target: vk::ImageView,
+        extent: vk::Extent2D,
+        exposure: f32,
+        markers: &[Marker],
+    ) {
+        let mut push = PresentPush { exposure, markers: markers.len().min(MAX_MARKERS) as u32, ..Default::default() };
+        for (slot, m) in push.marker.iter_mut().zip(markers) {
+            *slot = [m.at[0], m.at[1], m.radius, f32::from(u8::from(m.dragged))];
+        }
         let colors = [vk::RenderingAttachmentInfo::default()
             .image_view(target)
             .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
@@ -105,7 +142,7 @@ impl Present {
             device.cmd_begin_rendering(cmd, &rendering);
             device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
             device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.layout, 0, &[self.set], &[]);
-            device.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::FRAGMENT, 0, &exposure.to_ne_bytes());
+            device.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::FRAGMENT, 0, bytemuck::bytes_of(&push));
             device.cmd_set_viewport(cmd, 0, &[viewport]);
             device.cmd_set_scissor(cmd, 0, &[extent.into()]);
             // translucent leaves the cull mode as its last draw set it (docs/GPU.md).

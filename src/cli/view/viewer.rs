@@ -52,6 +52,8 @@ pub struct Viewer {
     pub frame_ms: Vec<f64>,
     /// What changed before the latest frame (what its plan answered).
     pub last_change: Option<translucent::Change>,
+    /// Rings over the lights while the user picks one.
+    pub markers: Vec<super::present::Marker>,
 }
 
 impl Viewer {
@@ -80,6 +82,7 @@ impl Viewer {
             last_frame: None,
             frame_ms: Vec::new(),
             last_change: None,
+            markers: Vec::new(),
         })
     }
 
@@ -198,7 +201,7 @@ impl Viewer {
         );
         image_barrier(&device, cmd, image, (L::UNDEFINED, L::COLOR_ATTACHMENT_OPTIMAL), COLOR_WRITE, COLOR_WRITE);
         let exposure = self.renderer.scene().scene.file.render.exposure;
-        self.present.record(cmd, self.surfaces.swapchain.view(index), extent, exposure);
+        self.present.record(cmd, self.surfaces.swapchain.view(index), extent, exposure, &self.markers);
         if shot && self.surfaces.swapchain.copyable {
             self.copy_out(cmd, image)?;
             image_barrier(&device, cmd, image, (L::TRANSFER_SRC_OPTIMAL, L::PRESENT_SRC_KHR), COPY_READ, NOTHING);
