@@ -4,8 +4,8 @@
 //! command buffer and HDR image (`record_frame` with a `HostTarget`), and tone-maps that into
 //! the swapchain image with the renderer's own curve.
 //!
-//! Mouse: left drag orbits, right or middle drag pans, the wheel zooms, Ctrl + left drag on a
-//! light's marker turns that light about the scene. Keys: `m` model, `g` gather, `e` error
+//! Mouse: left drag orbits, right or middle drag pans, the wheel zooms, Ctrl + left drag turns
+//! the light whose ring (drawn while Ctrl is held) is nearest about the scene. Keys: `m` model, `g` gather, `e` error
 //! target (the scene prepared again, given to the renderer as `SceneEdit::Scene`), `r` resets
 //! the camera, `q` or Escape quits.
 
