@@ -29,8 +29,11 @@ struct Display {
 }
 
 impl Display {
-    fn start() -> Display {
-        let number = (90..400).find(|n| !Path::new(&format!("/tmp/.X{n}-lock")).exists()).expect("a free display");
+    /// A server on the first free display from `first` (each test its own range: the tests of
+    /// this file run in parallel).
+    fn start(first: u32) -> Display {
+        let number =
+            (first..first + 100).find(|n| !Path::new(&format!("/tmp/.X{n}-lock")).exists()).expect("a free display");
         let name = format!(":{number}");
         let server = Command::new("Xvfb")
             .args([&name, "-screen", "0", "1024x768x24", "-nolisten", "tcp"])
@@ -78,7 +81,7 @@ impl Drop for Display {
     }
 }
 
-/// Wait for the viewer to exit, at most three minutes.
+/// Wait for the viewer to exit, at most three minutes after it was asked to.
 fn finish(mut viewer: Child) -> Output {
     let started = Instant::now();
     while viewer.try_wait().expect("waiting on the viewer").is_none() {
@@ -115,7 +118,7 @@ fn scene_of_state(state: &serde_json::Value) -> PreparedScene {
 fn the_window_after_orbit_light_drag_and_resize_shows_the_headless_image_without_a_validation_message() {
     let dir = temp_dir("viewer");
     let (shot, state) = (dir.join("shot.png"), dir.join("state.json"));
-    let display = Display::start();
+    let display = Display::start(90);
     let viewer = Command::new(env!("CARGO_BIN_EXE_translucent"))
         .args(["view", "--screenshot", shot.to_str().unwrap(), "--state", state.to_str().unwrap()])
         .env("DISPLAY", &display.name)
@@ -150,4 +153,31 @@ fn the_window_after_orbit_light_drag_and_resize_shows_the_headless_image_without
     let differing = headless.iter().zip(window_image.as_raw()).filter(|(a, b)| a != b).count();
     eprintln!("window against headless: FLIP mean {flip:.2e}, {differing} bytes differ");
     assert!(flip <= FLIP_TOLERANCE, "FLIP mean {flip} over {FLIP_TOLERANCE} ({differing} bytes differ)");
+}
+
+/// Closing mid-frame: the window destroyed under the viewer while it draws (its surface lost)
+/// ends it as a close does, with status 0 and no validation message.
+#[test]
+fn a_window_destroyed_mid_frame_closes_the_viewer_without_a_validation_message() {
+    let display = Display::start(190);
+    let viewer = Command::new(env!("CARGO_BIN_EXE_translucent"))
+        .args(["view", "--samples", "2000"])
+        .env("DISPLAY", &display.name)
+        .env("TRANSLUCENT_VALIDATION", "1")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the translucent binary");
+    let window = display.xdotool(&["search", "--sync", "--name", "^translucent"]);
+    let window = window.lines().next().expect("the viewer's window").to_string();
+    // The title shows frames/s once frames are being drawn.
+    let started = Instant::now();
+    while !display.xdotool(&["getwindowname", &window]).contains("frames/s") {
+        assert!(started.elapsed() < Duration::from_secs(120), "the viewer drew nothing in two minutes");
+        sleep(Duration::from_millis(200));
+    }
+    display.xdotool(&["windowclose", &window]);
+    let output = finish(viewer);
+    assert!(output.status.success(), "the viewer failed: {}{}", text(&output.stdout), text(&output.stderr));
+    assert!(text(&output.stdout).contains(", 0 validation messages"), "{}", text(&output.stdout));
 }

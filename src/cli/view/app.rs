@@ -34,6 +34,9 @@ pub struct App {
     gpu_args: super::super::GpuArgs,
     scene: Scene,
     overrides: Overrides,
+    /// The scene prepared before the window opens (sampling takes seconds on a large mesh, and
+    /// a bad scene is better refused before a window appears); taken by the viewer.
+    prepared: Option<PreparedScene>,
     pub viewer: Option<Viewer>,
     window: Option<Window>,
     orbit: Option<Orbit>,
@@ -45,18 +48,23 @@ pub struct App {
     modifiers: ModifiersState,
     frames: u64,
     closing: bool,
+    /// The window's size as its last resize said: asked of X only when the window opens, since
+    /// a window destroyed under the viewer cannot be asked (winit panics).
+    size: PhysicalSize<u32>,
     title_at: Option<Instant>,
     pub outcome: Option<Result<Outcome>>,
 }
 
 impl App {
-    pub fn new(args: Args, gpu_args: super::super::GpuArgs, scene: Scene, overrides: Overrides) -> App {
+    pub fn new(args: Args, gpu_args: super::super::GpuArgs, scene: Scene, overrides: Overrides) -> Result<App> {
         let lights = scene.file.lights.clone();
-        App {
+        let prepared = Some(PreparedScene::new(&scene, &overrides)?);
+        Ok(App {
             args,
             gpu_args,
             scene,
             overrides,
+            prepared,
             viewer: None,
             window: None,
             orbit: None,
@@ -68,9 +76,10 @@ impl App {
             modifiers: ModifiersState::empty(),
             frames: 0,
             closing: false,
+            size: PhysicalSize::new(0, 0),
             title_at: None,
             outcome: None,
-        }
+        })
     }
 
     /// The window, the Vulkan on it and the renderer, at the scene's resolution.
@@ -81,9 +90,10 @@ impl App {
         let window = event_loop.create_window(attributes).context("opening a window (is DISPLAY set?)")?;
         let validation = self.gpu_args.options().validation;
         let host = Host::new(&window, self.gpu_args.device.as_deref(), validation)?;
-        let prepared = PreparedScene::new(&self.scene, &self.overrides)?;
+        let prepared = self.prepared.take().context("the window opens once")?;
         let radius = prepared.bounds.1;
         let size = window.inner_size();
+        self.size = size;
         let viewer =
             Viewer::new(host, prepared, vk::Extent2D { width: size.width, height: size.height }, self.args.vsync)?;
         let mut camera = self.scene.file.camera.clone();
@@ -97,10 +107,10 @@ impl App {
 
     /// Apply what the input changed, draw a frame, and end the loop when asked to.
     fn redraw(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
-        let (Some(window), Some(viewer), Some(orbit)) = (&self.window, &mut self.viewer, &mut self.orbit) else {
+        let (Some(_), Some(viewer), Some(orbit)) = (&self.window, &mut self.viewer, &mut self.orbit) else {
             return Ok(());
         };
-        let size = window.inner_size();
+        let size = self.size;
         if size.width == 0 || size.height == 0 {
             return Ok(()); // minimised: nothing to draw until the window comes back
         }
@@ -124,6 +134,12 @@ impl App {
         let last = self.closing || self.args.frames.is_some_and(|n| self.frames + 1 >= n);
         let shot = last && self.args.screenshot.is_some();
         let image = viewer.draw(shot)?;
+        if viewer.lost {
+            // The window was destroyed under the viewer: close as if asked to.
+            self.outcome = Some(Ok(Outcome::closed(self)));
+            event_loop.exit();
+            return Ok(());
+        }
         if viewer.stale && image.is_none() && shot {
             return Ok(()); // out of date: the next redraw remakes the swapchain and tries again
         }
@@ -299,7 +315,13 @@ impl ApplicationHandler for App {
                 Ok(())
             }
             WindowEvent::RedrawRequested => self.redraw(event_loop),
-            WindowEvent::Resized(_) => {
+            WindowEvent::Destroyed => {
+                self.outcome = Some(Ok(Outcome::closed(self)));
+                event_loop.exit();
+                Ok(())
+            }
+            WindowEvent::Resized(size) => {
+                self.size = size;
                 self.viewer.iter_mut().for_each(|v| v.stale = true);
                 Ok(())
             }

@@ -87,7 +87,7 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let event_loop = winit::event_loop::EventLoop::new()
         .context("no window system: the viewer needs X11 (DISPLAY; under CI, xvfb-run)")?;
     event_loop.set_control_flow(winit::event_loop::ControlFlow::Poll);
-    let mut app = app::App::new(args.clone(), gpu_args.clone(), scene, overrides);
+    let mut app = app::App::new(args.clone(), gpu_args.clone(), scene, overrides)?;
     event_loop.run_app(&mut app)?;
     let outcome = app.outcome.take();
     let (frames, median) =
@@ -107,7 +107,9 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
 
 fn write_outputs(args: &Args, outcome: &Outcome, state: State) -> Result<()> {
     if let Some(path) = &args.screenshot {
-        let image = outcome.image.as_ref().context("the swapchain's images cannot be copied from: no screenshot")?;
+        let image = outcome.image.as_ref().context(
+            "no screenshot: the window went before its last frame, or its swapchain images cannot be copied from",
+        )?;
         output::write_png(path, image.width(), image.height(), image.as_raw())?;
     }
     if let Some(path) = &args.state {

@@ -46,6 +46,9 @@ pub struct Viewer {
     vsync: bool,
     /// Set by a resize or an out-of-date swapchain: remake the swapchain before the next frame.
     pub stale: bool,
+    /// Set when the window's surface is gone (the window destroyed under the viewer): nothing
+    /// more can be presented, and the viewer closes.
+    pub lost: bool,
     /// The latest frame's pass timings read back, and its wall time from the previous frame.
     pub timings: FrameTimings,
     pub last_frame: Option<Instant>,
@@ -78,6 +81,7 @@ impl Viewer {
             frame: 0,
             vsync,
             stale: false,
+            lost: false,
             timings: FrameTimings { passes: Vec::new() },
             last_frame: None,
             frame_ms: Vec::new(),
@@ -125,7 +129,7 @@ impl Viewer {
 
     /// Draw and present one frame; with `shot`, also copy the presented image to the host and
     /// answer it (RGBA8, rows top to bottom). Answers `Ok(None)` without drawing when the
-    /// swapchain is out of date (`stale` is then set).
+    /// swapchain is out of date (`stale` is then set) or the surface is lost (`lost`).
     pub fn draw(&mut self, shot: bool) -> Result<Option<image::RgbaImage>> {
         let at = (self.frame % IN_FLIGHT as u64) as usize;
         let (fence, acquired, cmd) = {
@@ -149,6 +153,10 @@ impl Viewer {
             }
             Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => {
                 self.stale = true;
+                return Ok(None);
+            }
+            Err(vk::Result::ERROR_SURFACE_LOST_KHR) => {
+                self.lost = true;
                 return Ok(None);
             }
             Err(e) => return Err(e).context("vkAcquireNextImageKHR"),
@@ -290,6 +298,7 @@ impl Viewer {
             match swapchain.loader.queue_present(self.host.queue, &present) {
                 Ok(suboptimal) => self.stale |= suboptimal,
                 Err(vk::Result::ERROR_OUT_OF_DATE_KHR) => self.stale = true,
+                Err(vk::Result::ERROR_SURFACE_LOST_KHR) => self.lost = true,
                 Err(e) => return Err(e).context("vkQueuePresentKHR"),
             }
         }
