@@ -121,7 +121,7 @@ impl App {
             self.camera_moved = true;
         }
         if self.args.orbit {
-            orbit.orbit(3.0 / 0.4, 0.0);
+            orbit.turn(3.0);
             self.camera_moved = true;
         }
         if std::mem::take(&mut self.camera_moved) {

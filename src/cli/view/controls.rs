@@ -56,6 +56,12 @@ impl Orbit {
         self.camera.eye = (self.target() + turn * offset).to_array();
     }
 
+    /// Turn about the target by `degrees` about the up axis (`--orbit`: 3 a frame, as
+    /// `translucent render --moving camera` turns).
+    pub fn turn(&mut self, degrees: f32) {
+        self.orbit(degrees / DEGREES_PER_PIXEL, 0.0);
+    }
+
     /// Move the camera towards the target (`steps` > 0) or away, 10% of the distance a step.
     pub fn zoom(&mut self, steps: f32) {
         let offset = self.eye() - self.target();
