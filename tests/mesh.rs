@@ -608,3 +608,63 @@ fn a_flat_grid_is_simplified_only_where_its_vertex_values_do_not_vary() {
     // unit grid (it bounds more than the distance from the plane, which is zero).
     assert!(last.error < 1e-3, "{}", last.error);
 }
+
+// ---------------------------------------------------------------------------------------------
+// The file's own normals (OBJ `vn`, glTF `NORMAL`)
+
+/// A unit square in x and z, two triangles, every corner with the normal `n`, as OBJ text.
+fn square_with_normals(n: [f32; 3]) -> String {
+    format!("v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nvn {} {} {}\nf 1//1 3//1 2//1\nf 1//1 4//1 3//1\n", n[0], n[1], n[2])
+}
+
+#[test]
+fn a_files_normals_are_the_meshs_vertex_normals_and_turn_with_its_placement() {
+    let tilted = Vec3::new(0.0, 0.8, 0.6);
+    let mesh =
+        Mesh::from_obj_text(&square_with_normals([0.0, 1.6, 1.2]), "square.obj", &LoadOptions::default()).unwrap();
+    for n in mesh.vertex_normals() {
+        assert!((*n - tilted).length() < 1e-6, "{n}");
+    }
+    // Without `vn` the normals come from the face: straight up.
+    let plain = "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nf 1 3 2\nf 1 4 3\n";
+    let flat = Mesh::from_obj_text(plain, "plain.obj", &LoadOptions::default()).unwrap();
+    assert!(flat.vertex_normals().iter().all(|n| (*n - Vec3::Y).length() < 1e-6), "{:?}", flat.vertex_normals());
+    // Placed turned a quarter about x, the file's normal turns with it.
+    let placed = mesh.transformed(Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2)).unwrap();
+    let turned = Mat4::from_rotation_x(std::f32::consts::FRAC_PI_2).transform_vector3(tilted);
+    for n in placed.vertex_normals() {
+        assert!((*n - turned).length() < 1e-5, "{n} against {turned}");
+    }
+    // Loaded mirrored: the winding swaps and the normal mirrors with the surface.
+    let mirror = LoadOptions { transform: Mat4::from_scale(Vec3::new(1.0, -1.0, 1.0)), ..LoadOptions::default() };
+    let mirrored = Mesh::from_obj_text(&square_with_normals([0.0, 1.6, 1.2]), "square.obj", &mirror).unwrap();
+    for n in mirrored.vertex_normals() {
+        assert!((*n - Vec3::new(0.0, -0.8, 0.6)).length() < 1e-6, "{n}");
+    }
+}
+
+#[test]
+fn a_glb_primitives_normals_are_read_through_its_nodes_transform() {
+    let positions = [[0.0f32, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]];
+    let normals = [[0.0f32, 1.0, 0.0]; 3];
+    let mut bin: Vec<u8> = positions.iter().chain(&normals).flatten().flat_map(|x| x.to_le_bytes()).collect();
+    bin.extend([0u32, 1, 2].iter().flat_map(|i| i.to_le_bytes()));
+    // The node turns the triangle a quarter about z: +y becomes -x.
+    let json = r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0, "rotation": [0, 0, 0.70710678, 0.70710678]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2}]}],
+        "buffers": [{"byteLength": 84}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                        {"buffer": 0, "byteOffset": 36, "byteLength": 36},
+                        {"buffer": 0, "byteOffset": 72, "byteLength": 12}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 0, 1]},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3"},
+            {"bufferView": 2, "componentType": 5125, "count": 3, "type": "SCALAR"}
+        ]}"#;
+    let glb = translucent::mesh::glb_bytes(json.as_bytes(), &bin);
+    let mesh = Mesh::from_gltf_slice(&glb, "normals.glb", None, &LoadOptions::default()).unwrap();
+    for n in mesh.vertex_normals() {
+        assert!((*n - Vec3::NEG_X).length() < 1e-5, "{n}");
+    }
+}

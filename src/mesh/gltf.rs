@@ -3,6 +3,7 @@
 //! nodes' transforms, becomes part of one mesh, in node order, as the OBJ loader makes one mesh
 //! of an OBJ's groups.
 
+use super::corners::Corners;
 use super::glb::GltfNodePart;
 use super::obj::{LoadOptions, Loaded};
 use super::{Mesh, MeshError};
@@ -208,7 +209,7 @@ pub(super) fn parse(
     let buffers = buffers(&file, base).map_err(fail)?;
     let scene = file.scenes().nth(scene_of(&file).map_err(fail)?).expect("scene_of's scene");
     let mut out =
-        Loaded { positions: Vec::new(), triangles: Vec::new(), flip_winding: false, corner_uvs: Some(Vec::new()) };
+        Loaded { positions: Vec::new(), triangles: Vec::new(), flip_winding: false, corners: Corners::collecting() };
     let (roots, only): (Vec<(::gltf::Node, Mat4)>, _) = match select {
         Select::Whole => (scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect(), None),
         Select::Named(name) => (
@@ -466,19 +467,33 @@ fn append(
         if mirrored { [a, c, b] } else { [a, b, c] }
     }));
     out.positions.extend(positions);
-    // TEXCOORD_0 per corner, while every primitive so far had it (the atlas's own UVs).
+    // TEXCOORD_0 and NORMAL per corner, while every primitive so far had them.
     let uvs: Option<Vec<Vec2>> = reader
         .read_tex_coords(0)
         .map(|t| t.into_f32().map(Vec2::from).collect())
         .filter(|u: &Vec<Vec2>| u.len() == count);
-    match (uvs, out.corner_uvs.as_mut()) {
-        (Some(uvs), Some(corners)) => corners.extend(indices.chunks_exact(3).map(|t| {
-            let [a, b, c] = [t[0], t[1], t[2]].map(|i| uvs[i as usize]);
-            if mirrored { [a, c, b] } else { [a, b, c] }
-        })),
-        _ => out.corner_uvs = None,
+    match (uvs, out.corners.uvs.as_mut()) {
+        (Some(uvs), Some(corners)) => corners.extend(per_corner(&indices, &uvs, mirrored)),
+        _ => out.corners.uvs = None,
+    }
+    let turn = glam::Mat3::from_mat4(world).inverse().transpose();
+    let normals: Option<Vec<Vec3>> = reader
+        .read_normals()
+        .map(|n| n.map(|n| turn * Vec3::from(n)).collect())
+        .filter(|n: &Vec<Vec3>| n.len() == count);
+    match (normals, out.corners.normals.as_mut()) {
+        (Some(normals), Some(corners)) => corners.extend(per_corner(&indices, &normals, mirrored)),
+        _ => out.corners.normals = None,
     }
     Ok(())
+}
+
+/// A per-vertex attribute at each triangle's corners, in the winding the triangles were given.
+fn per_corner<T: Copy>(indices: &[u32], values: &[T], mirrored: bool) -> impl Iterator<Item = [T; 3]> {
+    indices.chunks_exact(3).map(move |t| {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| values[i as usize]);
+        if mirrored { [a, c, b] } else { [a, b, c] }
+    })
 }
 
 impl Mesh {

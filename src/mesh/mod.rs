@@ -11,6 +11,7 @@
 pub mod atlas;
 mod boundary;
 pub mod bvh;
+mod corners;
 mod curvature;
 mod enclosure;
 pub mod facing;
@@ -237,7 +238,7 @@ pub struct Mesh {
     ring: Vec<u32>,
     bounds: (Vec3, Vec3),
     report: MeshReport,
-    corner_uvs: Option<Vec<[glam::Vec2; 3]>>,
+    corners: corners::Corners,
 }
 
 impl Mesh {
@@ -261,29 +262,28 @@ impl Mesh {
     /// Build a mesh from positions and triangles in memory, with the same validation and
     /// clean-up as [`Mesh::load`].
     pub fn from_triangles(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Result<Mesh, MeshError> {
-        let loaded = obj::Loaded { positions, triangles, flip_winding: false, corner_uvs: None };
+        let loaded = obj::Loaded { positions, triangles, flip_winding: false, corners: corners::Corners::NONE };
         Mesh::build("<memory>".to_string(), loaded)
     }
 
-    /// This mesh's triangles, corner texture coordinates and clean-up over new `positions` (one
-    /// per vertex, e.g. moved into the scene): how a placed mesh keeps its own UVs.
-    pub fn with_positions(&self, positions: Vec<Vec3>) -> Result<Mesh, MeshError> {
+    /// This mesh moved by `m` (e.g. into the scene), with its clean-up done again: its corners'
+    /// texture coordinates kept and their normals turned as the surface is (a mirroring `m`
+    /// swaps the winding, so that faces keep facing out).
+    pub fn transformed(&self, m: glam::Mat4) -> Result<Mesh, MeshError> {
+        let mut corners = self.corners.clone();
+        corners.transform_normals(m);
         let loaded = obj::Loaded {
-            positions,
+            positions: self.positions.iter().map(|p| m.transform_point3(*p)).collect(),
             triangles: self.triangles.clone(),
-            flip_winding: false,
-            corner_uvs: self.corner_uvs.clone(),
+            flip_winding: m.determinant() < 0.0,
+            corners,
         };
         Mesh::build(self.report.source.clone(), loaded)
     }
 
     fn build(source: String, loaded: obj::Loaded) -> Result<Mesh, MeshError> {
-        let obj::Loaded { positions, triangles, flip_winding, mut corner_uvs } = loaded;
-        let unusable =
-            |c: &Vec<[glam::Vec2; 3]>| c.len() != triangles.len() || c.iter().flatten().any(|uv| !uv.is_finite());
-        if corner_uvs.as_ref().is_some_and(unusable) {
-            corner_uvs = None;
-        }
+        let obj::Loaded { positions, triangles, flip_winding, corners } = loaded;
+        let mut corners = corners.checked(triangles.len());
         let mut report = MeshReport {
             source: source.clone(),
             input_vertices: positions.len(),
@@ -316,11 +316,9 @@ impl Mesh {
             for t in &mut triangles {
                 t.swap(1, 2);
             }
-            for c in corner_uvs.iter_mut().flatten() {
-                c.swap(1, 2);
-            }
+            corners.swap_winding();
         }
-        report.degenerate_triangles = drop_degenerate(&positions, &mut triangles, corner_uvs.as_mut());
+        report.degenerate_triangles = drop_degenerate(&positions, &mut triangles, &mut corners);
         if triangles.is_empty() {
             return Err(MeshError::NoArea { source_name: source, degenerate: report.degenerate_triangles });
         }
@@ -334,6 +332,8 @@ impl Mesh {
         report.inconsistently_oriented_edges = topo.inconsistent_edges;
 
         let geo = curvature::compute(&positions, &triangles, &topo);
+        // The file's normals where it gives them: its shading, as it was authored.
+        let vertex_normals = corners.vertex_normals(&triangles, geo.vertex_normals);
         let total_area = geo.triangle_areas.iter().sum();
 
         let mut lo = Vec3::splat(f32::INFINITY);
@@ -346,7 +346,7 @@ impl Mesh {
         Ok(Mesh {
             positions,
             triangles,
-            vertex_normals: geo.vertex_normals,
+            vertex_normals,
             face_normals: geo.face_normals,
             triangle_areas: geo.triangle_areas,
             total_area,
@@ -360,7 +360,7 @@ impl Mesh {
             ring: topo.ring,
             bounds: (lo, hi),
             report,
-            corner_uvs,
+            corners,
         })
     }
 
@@ -368,7 +368,7 @@ impl Mesh {
     /// triangle some (OBJ `vt`, glTF `TEXCOORD_0`); what the texture gather's atlas uses when
     /// its charts do not overlap (`atlas::Atlas::new`).
     pub fn corner_uvs(&self) -> Option<&[[glam::Vec2; 3]]> {
-        self.corner_uvs.as_deref()
+        self.corners.uvs.as_deref()
     }
 
     /// Vertex positions (one per vertex, after welding and clean-up).
@@ -510,23 +510,17 @@ fn is_degenerate(positions: &[Vec3], t: &[u32; 3]) -> bool {
     area.is_nan() || area <= DEGENERATE_AREA_RATIO * longest
 }
 
-/// Merge vertices whose positions are bit-identical (after folding -0.0 into 0.0). Returns the
-/// new positions, the re-indexed triangles and how many vertices were merged away.
-/// Drop the triangles of zero area (and their corners' texture coordinates); how many.
-fn drop_degenerate(
-    positions: &[Vec3],
-    triangles: &mut Vec<[u32; 3]>,
-    corner_uvs: Option<&mut Vec<[glam::Vec2; 3]>>,
-) -> usize {
-    let before = triangles.len();
-    if let Some(corners) = corner_uvs {
-        let mut kept = triangles.iter().map(|t| !is_degenerate(positions, t));
-        corners.retain(|_| kept.next().unwrap_or(false));
-    }
-    triangles.retain(|t| !is_degenerate(positions, t));
-    before - triangles.len()
+/// Drop the triangles of zero area (and their corners' attributes); how many.
+fn drop_degenerate(positions: &[Vec3], triangles: &mut Vec<[u32; 3]>, corners: &mut corners::Corners) -> usize {
+    let keep: Vec<bool> = triangles.iter().map(|t| !is_degenerate(positions, t)).collect();
+    corners.retain(&keep);
+    let mut k = keep.iter();
+    triangles.retain(|_| *k.next().unwrap_or(&false));
+    keep.iter().filter(|&&k| !k).count()
 }
 
+/// Merge vertices whose positions are bit-identical (after folding -0.0 into 0.0). Returns the
+/// new positions, the re-indexed triangles and how many vertices were merged away.
 fn weld(positions: Vec<Vec3>, mut triangles: Vec<[u32; 3]>) -> (Vec<Vec3>, Vec<[u32; 3]>, usize) {
     use std::collections::HashMap;
     let mut first: HashMap<[u32; 3], u32> = HashMap::with_capacity(positions.len());

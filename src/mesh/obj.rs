@@ -57,8 +57,8 @@ pub(super) struct Loaded {
     pub positions: Vec<Vec3>,
     pub triangles: Vec<[u32; 3]>,
     pub flip_winding: bool,
-    /// Per triangle, its corners' texture coordinates, when every triangle has them.
-    pub corner_uvs: Option<Vec<[glam::Vec2; 3]>>,
+    /// Per triangle, its corners' texture coordinates and normals, where every triangle has them.
+    pub corners: super::corners::Corners,
 }
 
 pub(super) fn load(path: &Path, options: &LoadOptions) -> Result<Loaded, MeshError> {
@@ -82,21 +82,30 @@ pub(super) fn parse(text: &str, source_name: &str, options: &LoadOptions) -> Res
 
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
-    // tobj's single index splits a vertex wherever its texture coordinate differs, so each
-    // vertex it gives has one; welding later joins the positions, and the corners keep theirs.
-    let mut corner_uvs = Some(Vec::new());
+    // tobj's single index splits a vertex wherever its texture coordinate or normal differs, so
+    // each vertex it gives has one of each the file has; welding later joins the positions, and
+    // the corners keep theirs.
+    let mut corners = super::corners::Corners::collecting();
     for model in &models {
         let base = positions.len() as u32;
-        let uvs = &model.mesh.texcoords;
-        if uvs.len() != model.mesh.positions.len() / 3 * 2 {
-            corner_uvs = None;
+        let (mesh, count) = (&model.mesh, model.mesh.positions.len() / 3);
+        let faces = || mesh.indices.chunks_exact(3);
+        if mesh.texcoords.len() != 2 * count {
+            corners.uvs = None;
         }
-        if let Some(corners) = corner_uvs.as_mut() {
-            let uv = |i: u32| glam::Vec2::new(uvs[2 * i as usize], uvs[2 * i as usize + 1]);
-            corners.extend(model.mesh.indices.chunks_exact(3).map(|c| [uv(c[0]), uv(c[1]), uv(c[2])]));
+        if let Some(uvs) = corners.uvs.as_mut() {
+            let uv = |i: u32| glam::Vec2::new(mesh.texcoords[2 * i as usize], mesh.texcoords[2 * i as usize + 1]);
+            uvs.extend(faces().map(|c| [uv(c[0]), uv(c[1]), uv(c[2])]));
         }
-        positions.extend(model.mesh.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
-        triangles.extend(model.mesh.indices.chunks_exact(3).map(|c| [c[0] + base, c[1] + base, c[2] + base]));
+        if mesh.normals.len() != 3 * count {
+            corners.normals = None;
+        }
+        if let Some(normals) = corners.normals.as_mut() {
+            let n = |i: u32| Vec3::from_slice(&mesh.normals[3 * i as usize..3 * i as usize + 3]);
+            normals.extend(faces().map(|c| [n(c[0]), n(c[1]), n(c[2])]));
+        }
+        positions.extend(mesh.positions.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])));
+        triangles.extend(faces().map(|c| [c[0] + base, c[1] + base, c[2] + base]));
     }
     if triangles.is_empty() {
         return Err(MeshError::NoFaces { source_name });
@@ -105,8 +114,9 @@ pub(super) fn parse(text: &str, source_name: &str, options: &LoadOptions) -> Res
         for p in &mut positions {
             *p = options.transform.transform_point3(*p * options.scale);
         }
+        corners.transform_normals(options.transform);
     }
-    Ok(Loaded { positions, triangles, flip_winding: options.mirrors(), corner_uvs })
+    Ok(Loaded { positions, triangles, flip_winding: options.mirrors(), corners })
 }
 
 fn parse_error(source_name: &str, line: usize, problem: ObjProblem, text: &str) -> MeshError {

@@ -579,8 +579,7 @@ fn transform_mesh(mesh: Mesh, t: &super::Transform) -> Result<(Mesh, Option<Arc<
     if m == Mat4::IDENTITY {
         return Ok((mesh, None));
     }
-    let positions = mesh.positions().iter().map(|p| m.transform_point3(*p)).collect();
-    let placed = mesh.with_positions(positions)?;
+    let placed = mesh.transformed(m)?;
     Ok((placed, Some(Arc::new(mesh))))
 }
 
