@@ -244,8 +244,9 @@ pub struct Mesh {
 impl Mesh {
     /// Load an OBJ file: polygons are triangulated (as fans, by tobj), all objects and groups are
     /// merged into one mesh with one index per vertex, then `options` scales and transforms the
-    /// positions. Materials, normals and texture coordinates in the file are ignored: normals are
-    /// recomputed from the geometry.
+    /// positions. Materials are ignored; normals (`vn`) and texture coordinates (`vt`) are kept
+    /// per triangle corner where every face has them: the normals become the vertex normals
+    /// (else they are computed from the faces), the coordinates the texture gather's atlas.
     pub fn load(path: impl AsRef<std::path::Path>, options: &LoadOptions) -> Result<Mesh, MeshError> {
         let path = path.as_ref();
         let loaded = if is_gltf(path) { load_gltf(path, options)? } else { obj::load(path, options)? };
