@@ -429,3 +429,18 @@ fn a_renderer_given_another_preparation_draws_what_a_renderer_made_for_it_draws(
         assert!(edited != before, "the other settings drew the same image");
     });
 }
+
+/// `Output::Display` is for a host's image (the viewer's swapchain); the renderer's own image is
+/// tone-mapped by its own pass, so asking for it there is refused before anything is made.
+#[test]
+fn display_output_on_the_renderers_own_image_is_refused() {
+    with_gpu(|gpu| {
+        let options = translucent::RendererOptions {
+            output: translucent::render::options::Output::Display,
+            ..translucent::RendererOptions::default()
+        };
+        let scene = PreparedScene::new(&Scene::builtin(), &Overrides { samples: Some(400), ..Overrides::default() });
+        let made = Renderer::with_options(gpu, scene.unwrap(), translucent::TargetDesc::Own, options);
+        assert!(matches!(made, Err(translucent::RenderError::DisplayOnOwnTarget)), "{:?}", made.err());
+    });
+}

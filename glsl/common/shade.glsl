@@ -42,6 +42,11 @@ layout(constant_id = 2) const bool SHADE_DIRECTIONAL_KEYS = false;
 // constant count is unrolled, and each light's record is then read at a constant index, once for
 // all the lanes, where a CPU driver loads a storage buffer at a varying index lane by lane.
 layout(constant_id = 3) const uint SHADE_KEY_LIGHTS = 0u;
+// A host's display output (`RendererOptions::output = Output::Display`): the tone map's curve
+// at the scene's exposure applied here, so that a swapchain image (8-bit UNORM) can be the
+// target itself; linear radiance otherwise.
+layout(constant_id = 4) const bool SHADE_DISPLAY = false;
+layout(constant_id = 5) const float SHADE_EXPOSURE = 1.0;
 #endif
 layout(std430, set = 0, binding = 0) readonly buffer Lights { Light lights[]; };
 layout(set = 0, binding = 1) uniform sampler2DArrayShadow shadow_maps;
@@ -116,11 +121,21 @@ vec3 shade_radiance(vec3 v_position, vec3 v_normal, vec3 v_exitance, vec3 v_envi
 }
 
 #ifndef SHADE_COMPUTE
+#include "tonemap.glsl"
+
+// What the attachment takes: linear radiance, or with SHADE_DISPLAY display sRGB (non-finite
+// radiance drawn black, as the tone map draws it).
+vec4 shade_output(vec3 radiance) {
+    if (!SHADE_DISPLAY) return vec4(radiance, 1.0);
+    if (any(isnan(radiance)) || any(isinf(radiance))) radiance = vec3(0.0);
+    return vec4(display_curve(radiance * SHADE_EXPOSURE), 1.0);
+}
+
 void main() {
     if (shade_skips(SHADE_SKIP_ALL)) {
         // The inputs the pipeline's shading reads, no more: an opaque surface's pipeline has no
         // use for the exitance, and an input read nowhere is not interpolated.
-        out_radiance = vec4((SHADE_TRANSLUCENT ? v_exitance : vec3(0.0)) + v_environment, 1.0);
+        out_radiance = shade_output((SHADE_TRANSLUCENT ? v_exitance : vec3(0.0)) + v_environment);
 #ifdef PIXEL_GATHER
         out_surface = vec4(0.0);
 #endif
@@ -133,7 +148,7 @@ void main() {
     out_radiance = vec4(radiance, exitance_to_radiance);
     out_surface = vec4(v_position, SHADE_TRANSLUCENT ? push.eye_object.w + 1.0 : 0.0);
 #else
-    out_radiance = vec4(radiance, 1.0);
+    out_radiance = shade_output(radiance);
 #endif
 }
 #endif

@@ -109,6 +109,10 @@ pub enum RenderError {
         /// `Renderer::MAX_FRAMES_IN_FLIGHT`.
         max: usize,
     },
+    /// `Output::Display` asked of a renderer that draws into its own image (which its own tone
+    /// map already turns into display values).
+    #[error("RendererOptions::output = Display is for a host target; the renderer's own image is tone-mapped already")]
+    DisplayOnOwnTarget,
     /// `RendererOptions::samples` this renderer cannot draw at.
     #[error("samples {given:?}: {reason} (this device supports {supported:?})")]
     Samples {

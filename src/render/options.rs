@@ -29,6 +29,21 @@ pub struct RendererOptions {
     /// a host target only, and a count the device supports for colour and depth attachments
     /// (`framebufferColorSampleCounts`, `framebufferDepthSampleCounts`).
     pub samples: vk::SampleCountFlags,
+    /// What the host's colour image receives: linear radiance (`Output::Linear`, the default),
+    /// or display values (`Output::Display`). A host target only.
+    pub output: Output,
+}
+
+/// What the shading pass writes into a host's colour image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Output {
+    /// Linear radiance, for the host's own tone map or post pass.
+    #[default]
+    Linear,
+    /// Display sRGB in [0, 1]: the tone map's curve (exposure from the scene, the ACES fit, the
+    /// sRGB transfer function) applied in the shading pass, for an 8-bit UNORM image such as a
+    /// swapchain's, which then needs no pass of the host's between translucent and the present.
+    Display,
 }
 
 impl Default for RendererOptions {
@@ -37,6 +52,7 @@ impl Default for RendererOptions {
             frames_in_flight: FRAMES_IN_FLIGHT,
             depth: DepthTest::STANDARD,
             samples: vk::SampleCountFlags::TYPE_1,
+            output: Output::Linear,
         }
     }
 }
@@ -56,6 +72,9 @@ impl RendererOptions {
         } else {
             None
         };
+        if self.output == Output::Display && target == TargetDesc::Own {
+            return Err(RenderError::DisplayOnOwnTarget);
+        }
         if let Some(reason) = reason {
             return Err(RenderError::Samples { given: samples, supported, reason });
         }
@@ -74,4 +93,3 @@ impl RendererOptions {
         Ok(())
     }
 }
-

@@ -89,6 +89,8 @@ pub struct ShadeOptions {
     pub depth: DepthTest,
     /// Samples per pixel of the attachments.
     pub samples: vk::SampleCountFlags,
+    /// Display output (`Output::Display`): the exposure the tone curve is applied at.
+    pub display: Option<f32>,
 }
 
 /// A per-vertex vec4 stream (exitance, cached irradiance) at `binding`, read at `location`.
@@ -131,8 +133,9 @@ impl ShadePass {
         let keys = unrolled_key_lights(resources.scene.key_light_count);
         let variant =
             |translucent: u32, radius: u32, directional: u32| -> GpuResult<(GraphicsPipeline, DescriptorSet)> {
-                let desc =
-                    GraphicsDesc { specialization: vec![translucent, radius, directional, keys], ..desc.clone() };
+                let (display, exposure) = options.display.map_or((0, 1.0f32), |e| (1, e));
+                let specialization = vec![translucent, radius, directional, keys, display, exposure.to_bits()];
+                let desc = GraphicsDesc { specialization, ..desc.clone() };
                 let pipeline = GraphicsPipeline::new(gpu, &desc)?;
                 let set = pipeline.descriptor_set(&bindings)?;
                 Ok((pipeline, set))
@@ -280,9 +283,10 @@ impl RenderPass for ShadePass {
 }
 
 impl ShadeOptions {
-    /// What the shading pass takes of the host's choices.
-    pub fn of(options: &RendererOptions) -> ShadeOptions {
-        ShadeOptions { depth: options.depth, samples: options.samples }
+    /// What the shading pass takes of the host's choices, and of the scene its exposure.
+    pub fn of(options: &RendererOptions, exposure: f32) -> ShadeOptions {
+        let display = (options.output == super::options::Output::Display).then_some(exposure);
+        ShadeOptions { depth: options.depth, samples: options.samples, display }
     }
 }
 
@@ -291,7 +295,7 @@ impl RegisteredPass for ShadePass {
     const REBUILT_ON: &'static [Rebuild] = &[Rebuild::SceneData];
 
     fn build(c: &PassContext) -> Result<Option<Self>, RenderError> {
-        let options = ShadeOptions::of(c.options);
+        let options = ShadeOptions::of(c.options, c.scene.scene.file.render.exposure);
         Ok(Some(ShadePass::new(c.gpu, c.target, &c.resources, c.needs.pixel_gather, options)?))
     }
 }

@@ -1,6 +1,6 @@
-//! The viewer's present pass: one triangle over the window that tone-maps the HDR image
-//! translucent drew into the swapchain image, with the tone-map pass's curve
-//! (glsl/examples/viewer_present.frag, glsl/common/tonemap.glsl).
+//! The viewer's one pass of its own: rings over the swapchain image where the lights can be
+//! grabbed, while the user picks one (glsl/examples/viewer_present.frag). translucent draws the
+//! image itself in display values (`Output::Display`), so there is no tone-map pass here.
 
 use super::host::Host;
 use anyhow::Result;
@@ -13,9 +13,8 @@ pub const MAX_MARKERS: usize = 6;
 #[repr(C)]
 #[derive(Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
 struct PresentPush {
-    exposure: f32,
     markers: u32,
-    pad: [f32; 2],
+    pad: [u32; 3],
     marker: [[f32; 4]; MAX_MARKERS],
 }
 
@@ -30,13 +29,9 @@ pub struct Marker {
     pub dragged: bool,
 }
 
-/// The pipeline, its one descriptor set (the HDR image) and the sampler that set holds.
+/// The rings' pipeline.
 pub struct Present {
     device: ash::Device,
-    set_layout: vk::DescriptorSetLayout,
-    pool: vk::DescriptorPool,
-    set: vk::DescriptorSet,
-    sampler: vk::Sampler,
     layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
     format: vk::Format,
@@ -46,43 +41,15 @@ impl Present {
     /// The pass for swapchain images of `format`.
     pub fn new(host: &Host, format: vk::Format) -> Result<Present> {
         let device = &host.device;
-        let binding = [vk::DescriptorSetLayoutBinding::default()
-            .binding(0)
-            .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-            .descriptor_count(1)
-            .stage_flags(vk::ShaderStageFlags::FRAGMENT)];
-        let sizes = [vk::DescriptorPoolSize { ty: vk::DescriptorType::COMBINED_IMAGE_SAMPLER, descriptor_count: 1 }];
         let size = size_of::<PresentPush>() as u32;
         let push = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::FRAGMENT, offset: 0, size }];
-        // SAFETY: valid create infos; everything is destroyed in `drop`.
-        unsafe {
-            let set_layout = device
-                .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&binding), None)?;
-            let pool = device.create_descriptor_pool(
-                &vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes),
-                None,
-            )?;
-            let layouts = [set_layout];
-            let allocate = vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts);
-            let set = device.allocate_descriptor_sets(&allocate)?[0];
-            let sampler = device.create_sampler(&vk::SamplerCreateInfo::default(), None)?;
-            let layout = device.create_pipeline_layout(
-                &vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts).push_constant_ranges(&push),
-                None,
-            )?;
-            let mut present = Present {
-                device: device.clone(),
-                set_layout,
-                pool,
-                set,
-                sampler,
-                layout,
-                pipeline: vk::Pipeline::null(),
-                format,
-            };
-            present.pipeline = pipeline(device, layout, format)?;
-            Ok(present)
-        }
+        // SAFETY: valid create info; destroyed in `drop`.
+        let layout = unsafe {
+            device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&push), None)
+        }?;
+        let mut present = Present { device: device.clone(), layout, pipeline: vk::Pipeline::null(), format };
+        present.pipeline = pipeline(device, layout, format)?;
+        Ok(present)
     }
 
     /// The swapchain image format this pass draws.
@@ -90,41 +57,20 @@ impl Present {
         self.format
     }
 
-    /// Point the pass at `hdr` (in SHADER_READ_ONLY_OPTIMAL when drawn). Only while no frame
-    /// that reads the set is in flight.
-    pub fn bind(&self, hdr: vk::ImageView) {
-        let image = [vk::DescriptorImageInfo {
-            sampler: self.sampler,
-            image_view: hdr,
-            image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-        }];
-        let write = [vk::WriteDescriptorSet::default()
-            .dst_set(self.set)
-            .dst_binding(0)
-            .descriptor_type(vk::DescriptorType::COMBINED_IMAGE_SAMPLER)
-            .image_info(&image)];
-        // SAFETY: the set is not in use (the caller waits for the device first).
-        unsafe { self.device.update_descriptor_sets(&write, &[]) };
-    }
-
-    /// Draw into `target` (in COLOR_ATTACHMENT_OPTIMAL) of `extent`, at `exposure`, with a
-    /// ring at each of `markers` (the first `MAX_MARKERS`).
-    pub fn record(
-        &self,
-        cmd: vk::CommandBuffer,
-        target: vk::ImageView,
-        extent: vk::Extent2D,
-        exposure: f32,
-        markers: &[Marker],
-    ) {
-        let mut push = PresentPush { exposure, markers: markers.len().min(MAX_MARKERS) as u32, ..Default::default() };
+    /// Draw `markers` (the first `MAX_MARKERS`) over `target` (in COLOR_ATTACHMENT_OPTIMAL,
+    /// kept) of `extent`; nothing without markers.
+    pub fn record(&self, cmd: vk::CommandBuffer, target: vk::ImageView, extent: vk::Extent2D, markers: &[Marker]) {
+        if markers.is_empty() {
+            return;
+        }
+        let mut push = PresentPush { markers: markers.len().min(MAX_MARKERS) as u32, ..Default::default() };
         for (slot, m) in push.marker.iter_mut().zip(markers) {
             *slot = [m.at[0], m.at[1], m.radius, f32::from(u8::from(m.dragged))];
         }
         let colors = [vk::RenderingAttachmentInfo::default()
             .image_view(target)
             .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::DONT_CARE)
+            .load_op(vk::AttachmentLoadOp::LOAD)
             .store_op(vk::AttachmentStoreOp::STORE)];
         let rendering =
             vk::RenderingInfo::default().render_area(extent.into()).layer_count(1).color_attachments(&colors);
@@ -137,11 +83,10 @@ impl Present {
             max_depth: 1.0,
         };
         let device = &self.device;
-        // SAFETY: `cmd` is recording outside any rendering; the set points at a live image.
+        // SAFETY: `cmd` is recording outside any rendering; the target is a live view.
         unsafe {
             device.cmd_begin_rendering(cmd, &rendering);
             device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
-            device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.layout, 0, &[self.set], &[]);
             device.cmd_push_constants(cmd, self.layout, vk::ShaderStageFlags::FRAGMENT, 0, bytemuck::bytes_of(&push));
             device.cmd_set_viewport(cmd, 0, &[viewport]);
             device.cmd_set_scissor(cmd, 0, &[extent.into()]);
@@ -159,9 +104,6 @@ impl Drop for Present {
         unsafe {
             self.device.destroy_pipeline(self.pipeline, None);
             self.device.destroy_pipeline_layout(self.layout, None);
-            self.device.destroy_sampler(self.sampler, None);
-            self.device.destroy_descriptor_pool(self.pool, None);
-            self.device.destroy_descriptor_set_layout(self.set_layout, None);
         }
     }
 }

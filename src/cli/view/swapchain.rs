@@ -1,14 +1,11 @@
-//! The window's swapchain and the viewer's own HDR colour and depth images at its size, which
-//! translucent draws into as a `HostTarget`. Both are remade together when the window's size
-//! changes or the swapchain goes out of date.
+//! The window's swapchain and a depth image at its size: translucent draws into the swapchain
+//! image itself as a `HostTarget` (`Output::Display`), with that depth. Both are remade together
+//! when the window's size changes or the swapchain goes out of date.
 
 use super::host::Host;
 use anyhow::{Context, Result, anyhow};
 use ash::vk;
 
-/// What translucent draws into: linear radiance in RGBA32F (the renderer's own image's format,
-/// so that the window's tone map sees the same values `translucent render` does).
-pub const HDR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 /// The depth image's format.
 pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
@@ -184,9 +181,8 @@ impl Drop for Image {
     }
 }
 
-/// The swapchain with the HDR and depth images translucent draws into, all of one size.
+/// The swapchain and the depth image translucent draws with, of one size.
 pub struct Surfaces {
-    pub hdr: Image,
     pub depth: Image,
     pub swapchain: Swapchain,
 }
@@ -196,9 +192,7 @@ impl Surfaces {
         let old = old.map_or(vk::SwapchainKHR::null(), |s| s.swapchain.handle);
         let swapchain = Swapchain::new(host, size, vsync, old)?;
         let extent = swapchain.extent;
-        let hdr =
-            Image::new(host, HDR_FORMAT, extent, vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED)?;
         let depth = Image::new(host, DEPTH_FORMAT, extent, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?;
-        Ok(Surfaces { hdr, depth, swapchain })
+        Ok(Surfaces { depth, swapchain })
     }
 }

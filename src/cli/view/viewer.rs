@@ -1,12 +1,12 @@
 //! One window's worth of Vulkan and translucent: acquire a swapchain image, record translucent's
-//! frame into the viewer's HDR target and tone-map it into the image in the viewer's own
-//! command buffer, submit, present. Out-of-date and suboptimal swapchains and window resizes
+//! frame into it (display values, `Output::Display`) in the viewer's own command buffer,
+//! submit, present. Out-of-date and suboptimal swapchains and window resizes
 //! remake the swapchain and the targets at the next frame; a minimised window draws nothing.
 
 use super::frames::{Readback, Slots, image_barrier};
 use super::host::Host;
 use super::present::Present;
-use super::swapchain::{DEPTH_FORMAT, HDR_FORMAT, Surfaces};
+use super::swapchain::{DEPTH_FORMAT, Surfaces};
 use anyhow::{Context, Result};
 use ash::vk;
 use std::sync::Arc;
@@ -18,7 +18,6 @@ use translucent::{FrameTimings, Gpu, GpuOptions, PreparedScene, Renderer, Render
 pub const IN_FLIGHT: usize = 2;
 
 type Scope = (vk::PipelineStageFlags2, vk::AccessFlags2);
-const SAMPLED: Scope = (vk::PipelineStageFlags2::FRAGMENT_SHADER, vk::AccessFlags2::SHADER_SAMPLED_READ);
 const COLOR_WRITE: Scope = (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE);
 const NOTHING: Scope = (vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE);
 const COPY_READ: Scope = (vk::PipelineStageFlags2::COPY, vk::AccessFlags2::TRANSFER_READ);
@@ -66,10 +65,9 @@ impl Viewer {
         // renderer and the Gpu before the host (field order), and the device was made with
         // translucent's required features, as `vulkan()` declares.
         let gpu = unsafe { Gpu::from_host(host.vulkan(), &GpuOptions::default()) }?;
-        let renderer = new_renderer(&gpu, scene)?;
         let surfaces = Surfaces::new(&host, size, vsync, None)?;
+        let renderer = new_renderer(&gpu, scene, surfaces.swapchain.format)?;
         let present = Present::new(&host, surfaces.swapchain.format)?;
-        present.bind(surfaces.hdr.view);
         let slots = Slots::new(&host, IN_FLIGHT)?;
         Ok(Viewer {
             renderer,
@@ -119,9 +117,9 @@ impl Viewer {
         let surfaces = Surfaces::new(&self.host, size, self.vsync, Some(&self.surfaces))?;
         self.surfaces = surfaces;
         if self.present.format() != self.surfaces.swapchain.format {
-            self.present = Present::new(&self.host, self.surfaces.swapchain.format)?;
+            // translucent's pipelines were made for the first format; the surface keeps it.
+            anyhow::bail!("the window's swapchain format changed from {:?}", self.present.format());
         }
-        self.present.bind(self.surfaces.hdr.view);
         self.shot = None;
         self.stale = false;
         Ok(())
@@ -187,29 +185,31 @@ impl Viewer {
             .map(|b| to_rgba(b.bytes(), self.surfaces.swapchain.extent, self.surfaces.swapchain.format)))
     }
 
-    /// Everything one frame records into `cmd`: translucent into the HDR image, the tone map
-    /// into swapchain image `index`, and with `shot` a copy of it to the host.
+    /// Everything one frame records into `cmd`: translucent into swapchain image `index` in
+    /// display values, the rings over it while the user picks a light, and with `shot` a copy
+    /// of it to the host.
     fn record(&mut self, cmd: vk::CommandBuffer, index: u32, shot: bool) -> Result<translucent::RecordedFrame> {
         let device = self.host.device.clone();
-        let (hdr, depth) = (self.surfaces.hdr.image, self.surfaces.depth.image);
+        let depth = self.surfaces.depth.image;
         let image = self.surfaces.swapchain.images[index as usize];
         let extent = self.surfaces.swapchain.extent;
         use vk::ImageLayout as L;
-        // Cleared by translucent (`load: false`): the old contents never matter.
-        image_barrier(&device, cmd, hdr, (L::UNDEFINED, L::COLOR_ATTACHMENT_OPTIMAL), SAMPLED, COLOR_WRITE);
-        image_barrier(&device, cmd, depth, (L::UNDEFINED, L::DEPTH_ATTACHMENT_OPTIMAL), DEPTH, DEPTH);
-        let recorded = self.renderer.record_frame(cmd, Some(&self.target()))?;
-        image_barrier(
-            &device,
-            cmd,
-            hdr,
-            (L::COLOR_ATTACHMENT_OPTIMAL, L::SHADER_READ_ONLY_OPTIMAL),
-            COLOR_WRITE,
-            SAMPLED,
-        );
+        // Cleared by translucent (`load: false`): the old contents never matter. The image's
+        // barrier waits at colour output, where the submission waits for the acquire.
         image_barrier(&device, cmd, image, (L::UNDEFINED, L::COLOR_ATTACHMENT_OPTIMAL), COLOR_WRITE, COLOR_WRITE);
-        let exposure = self.renderer.scene().scene.file.render.exposure;
-        self.present.record(cmd, self.surfaces.swapchain.view(index), extent, exposure, &self.markers);
+        image_barrier(&device, cmd, depth, (L::UNDEFINED, L::DEPTH_ATTACHMENT_OPTIMAL), DEPTH, DEPTH);
+        let recorded = self.renderer.record_frame(cmd, Some(&self.target(index)))?;
+        if !self.markers.is_empty() {
+            // The rings load what translucent wrote: its writes first.
+            let after = [vk::MemoryBarrier2::default()
+                .src_stage_mask(COLOR_WRITE.0)
+                .src_access_mask(COLOR_WRITE.1)
+                .dst_stage_mask(COLOR_WRITE.0)
+                .dst_access_mask(COLOR_WRITE.1 | vk::AccessFlags2::COLOR_ATTACHMENT_READ)];
+            // SAFETY: `cmd` is recording outside any rendering.
+            unsafe { device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&after)) };
+        }
+        self.present.record(cmd, self.surfaces.swapchain.view(index), extent, &self.markers);
         if shot && self.surfaces.swapchain.copyable {
             self.copy_out(cmd, image)?;
             image_barrier(&device, cmd, image, (L::TRANSFER_SRC_OPTIMAL, L::PRESENT_SRC_KHR), COPY_READ, NOTHING);
@@ -221,12 +221,14 @@ impl Viewer {
         Ok(recorded)
     }
 
-    /// The HDR and depth images as translucent's target, cleared to the scene's background.
-    fn target(&self) -> HostTarget {
-        let extent = self.surfaces.swapchain.extent;
+    /// Swapchain image `index` and the depth image as translucent's target, cleared to the
+    /// scene's background.
+    fn target(&self, index: u32) -> HostTarget {
+        let swapchain = &self.surfaces.swapchain;
+        let (extent, format) = (swapchain.extent, swapchain.format);
         let single = vk::SampleCountFlags::TYPE_1;
         HostTarget {
-            color: HostAttachment { view: self.surfaces.hdr.view, format: HDR_FORMAT, extent, samples: single },
+            color: HostAttachment { view: swapchain.view(index), format, extent, samples: single },
             depth: HostAttachment { view: self.surfaces.depth.view, format: DEPTH_FORMAT, extent, samples: single },
             resolve: None,
             extent,
@@ -318,9 +320,11 @@ impl Drop for Viewer {
     }
 }
 
-fn new_renderer(gpu: &Arc<Gpu>, scene: PreparedScene) -> Result<Renderer> {
-    let target = TargetDesc::Host { color_format: HDR_FORMAT, depth_format: DEPTH_FORMAT };
-    let options = RendererOptions { frames_in_flight: IN_FLIGHT, ..RendererOptions::default() };
+/// translucent drawing display values into swapchain images of `format` (`Output::Display`).
+fn new_renderer(gpu: &Arc<Gpu>, scene: PreparedScene, format: vk::Format) -> Result<Renderer> {
+    let target = TargetDesc::Host { color_format: format, depth_format: DEPTH_FORMAT };
+    let output = translucent::render::options::Output::Display;
+    let options = RendererOptions { frames_in_flight: IN_FLIGHT, output, ..RendererOptions::default() };
     Ok(Renderer::with_options(gpu, scene, target, options)?)
 }
 
