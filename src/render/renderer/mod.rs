@@ -262,6 +262,19 @@ impl Renderer {
         Ok(())
     }
 
+    /// What the shading pass clears the colour to: the background's radiance, or under
+    /// `Output::Display` its display value, as the tone map would draw it (so that a host's
+    /// swapchain image shows what `translucent render` writes).
+    fn clear_color(&self) -> [f32; 3] {
+        match self.options.output {
+            crate::render::options::Output::Linear => self.background,
+            crate::render::options::Output::Display => {
+                let exposure = f64::from(self.scene.scene.file.render.exposure);
+                self.background.map(|c| f32::from(crate::render::tonemap::display_value(f64::from(c), exposure)) / 255.0)
+            }
+        }
+    }
+
     /// Identifies this renderer's frames: a number no other renderer of this process has.
     fn id(&self) -> usize {
         self.id

@@ -311,7 +311,7 @@ impl Renderer {
             shadow_layers,
             view_proj: self.camera.projection * self.camera.view,
             eye: self.camera.eye,
-            background: self.background,
+            background: self.clear_color(),
             exposure: self.scene.scene.file.render.exposure,
             target,
             hazards: &self.hazards,
