@@ -1,13 +1,13 @@
 //! `translucent view [SCENE]`: the scene in a window, live. The viewer is a host engine of its
 //! own (docs/GPU.md, "Embedding"): it makes the instance, the device and the swapchain, gives
-//! them to translucent through `Gpu::from_host`, records translucent's frame into its own
-//! command buffer and HDR image (`record_frame` with a `HostTarget`), and tone-maps that into
-//! the swapchain image with the renderer's own curve.
+//! them to translucent through `Gpu::from_host`, and records translucent's frame into its own
+//! command buffer, straight into the swapchain image (`record_frame` with a `HostTarget`, and
+//! `Output::Display`: the shading pass applies the tone map's curve).
 //!
 //! Mouse: left drag orbits, right or middle drag pans, the wheel zooms, Ctrl + left drag turns
-//! the light whose ring (drawn while Ctrl is held) is nearest about the scene. Keys: `m` model, `g` gather, `e` error
-//! target (the scene prepared again, given to the renderer as `SceneEdit::Scene`), `r` resets
-//! the camera, `q` or Escape quits.
+//! the light whose ring (drawn while Ctrl is held) is nearest about the scene. Keys: `m` model,
+//! `g` gather, `e` error target (the scene prepared again, given to the renderer as
+//! `SceneEdit::Scene`), `r` resets the camera, `q` or Escape quits.
 
 mod app;
 mod controls;
