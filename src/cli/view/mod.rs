@@ -67,7 +67,9 @@ struct State {
     lights: Vec<Option<[f32; 3]>>,
     /// Spots' axes, per light (null for the others).
     spot_directions: Vec<Option<[f32; 3]>>,
+    /// Frames presented.
     frames: u64,
+    /// Median wall time between frames over the latest `viewer::KEPT_FRAME_TIMES` of them.
     median_frame_ms: Option<f64>,
     validation_messages: usize,
 }
@@ -90,8 +92,7 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let mut app = app::App::new(args.clone(), gpu_args.clone(), scene, overrides)?;
     event_loop.run_app(&mut app)?;
     let outcome = app.outcome.take();
-    let (frames, median) =
-        app.viewer.as_ref().map_or((0, None), |v| (v.frame_ms.len() as u64 + 1, median(&v.frame_ms)));
+    let (frames, median) = app.viewer.as_ref().map_or((0, None), |v| (v.frame, median(v.frame_ms.iter().copied())));
     drop(app); // the viewer's Vulkan before the validation count
     let outcome = outcome.unwrap_or_else(|| bail!("the window closed before it was drawn"))?;
     let messages = host::validation_messages();
@@ -146,8 +147,8 @@ impl State {
     }
 }
 
-fn median(values: &[f64]) -> Option<f64> {
-    let mut v = values.to_vec();
+fn median(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let mut v: Vec<f64> = values.collect();
     v.sort_by(f64::total_cmp);
     v.get(v.len() / 2).copied()
 }
@@ -155,7 +156,7 @@ fn median(values: &[f64]) -> Option<f64> {
 /// The window's title: frames per second over the last frames, the passes' GPU time, the
 /// plan's reason for each pass of the latest frame, the settings and the predicted error.
 fn title(viewer: &viewer::Viewer) -> String {
-    let recent = &viewer.frame_ms[viewer.frame_ms.len().saturating_sub(30)..];
+    let recent = viewer.frame_ms.iter().rev().take(30).copied();
     let fps = median(recent).map_or_else(|| "-".into(), |ms| format!("{:.1}", 1e3 / ms));
     let mut passes: Vec<_> = viewer.timings.passes.iter().map(|(p, ms)| (p.name(), *ms)).collect();
     passes.sort_by(|a, b| b.1.total_cmp(&a.1));

@@ -14,6 +14,9 @@ use std::time::Instant;
 use translucent::render::target::{HostAttachment, HostSync, HostTarget};
 use translucent::{FrameTimings, Gpu, GpuOptions, PreparedScene, Renderer, RendererOptions, SceneEdit, TargetDesc};
 
+/// Frame times the viewer keeps: its summary's median is over at most this many latest frames.
+pub const KEPT_FRAME_TIMES: usize = 4096;
+
 /// Frames the viewer has in flight: the CPU records one while the device runs the other.
 pub const IN_FLIGHT: usize = 2;
 
@@ -41,7 +44,8 @@ pub struct Viewer {
     present: Present,
     surfaces: Surfaces,
     host: Host,
-    frame: u64,
+    /// Frames presented so far.
+    pub frame: u64,
     vsync: bool,
     /// Set by a resize or an out-of-date swapchain: remake the swapchain before the next frame.
     pub stale: bool,
@@ -51,7 +55,9 @@ pub struct Viewer {
     /// The latest frame's pass timings read back, and its wall time from the previous frame.
     pub timings: FrameTimings,
     pub last_frame: Option<Instant>,
-    pub frame_ms: Vec<f64>,
+    /// The wall time of the latest frames, at most `KEPT_FRAME_TIMES` (a viewer left open for
+    /// hours keeps no more).
+    pub frame_ms: std::collections::VecDeque<f64>,
     /// What changed before the latest frame (what its plan answered).
     pub last_change: Option<translucent::Change>,
     /// Rings over the lights while the user picks one.
@@ -82,7 +88,7 @@ impl Viewer {
             lost: false,
             timings: FrameTimings { passes: Vec::new() },
             last_frame: None,
-            frame_ms: Vec::new(),
+            frame_ms: std::collections::VecDeque::with_capacity(KEPT_FRAME_TIMES),
             last_change: None,
             markers: Vec::new(),
         })
@@ -172,7 +178,10 @@ impl Viewer {
         self.frame += 1;
         let now = Instant::now();
         if let Some(then) = self.last_frame.replace(now) {
-            self.frame_ms.push((now - then).as_secs_f64() * 1e3);
+            if self.frame_ms.len() == KEPT_FRAME_TIMES {
+                self.frame_ms.pop_front();
+            }
+            self.frame_ms.push_back((now - then).as_secs_f64() * 1e3);
         }
         if !shot {
             return Ok(None);
