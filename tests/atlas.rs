@@ -4,9 +4,9 @@
 
 mod common;
 
-use common::{load_asset, subcommand, temp_dir, text};
+use common::{load_asset, subcommand, temp_dir, text, triangle_glb};
 use translucent::mesh::atlas::{Atlas, AtlasSource, ChartsReason};
-use translucent::mesh::{LoadOptions, Mesh, glb_bytes};
+use translucent::mesh::{LoadOptions, Mesh};
 
 /// An `n` x `n` grid of squares over the unit square in x and z, two triangles each, with the
 /// texture coordinates `uv(x, z)` at each vertex, as OBJ text.
@@ -70,22 +70,8 @@ fn overlapping_or_tiled_uvs_and_none_at_all_fall_back_to_charts_saying_why() {
 fn a_glb_primitives_texcoords_reach_the_atlas() {
     let positions = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
     let uvs = [[0.0f32, 0.0], [0.5, 0.0], [0.0, 0.5]];
-    let mut bin: Vec<u8> = positions.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
-    bin.extend(uvs.iter().flatten().flat_map(|x| x.to_le_bytes()));
-    bin.extend([0u32, 1, 2].iter().flat_map(|i| i.to_le_bytes()));
-    let json = r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2}]}],
-        "buffers": [{"byteLength": 72}],
-        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
-                        {"buffer": 0, "byteOffset": 36, "byteLength": 24},
-                        {"buffer": 0, "byteOffset": 60, "byteLength": 12}],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
-            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"},
-            {"bufferView": 2, "componentType": 5125, "count": 3, "type": "SCALAR"}
-        ]}"#;
-    let mesh =
-        Mesh::from_gltf_slice(&glb_bytes(json.as_bytes(), &bin), "uv.glb", None, &LoadOptions::default()).unwrap();
+    let glb = triangle_glb(positions, "TEXCOORD_0", "VEC2", uvs.as_flattened(), serde_json::json!({"mesh": 0}));
+    let mesh = Mesh::from_gltf_slice(&glb, "uv.glb", None, &LoadOptions::default()).unwrap();
     let corners = mesh.corner_uvs().expect("TEXCOORD_0 read");
     assert_eq!(corners[0].map(|c| c.to_array()), uvs);
     assert_eq!(Atlas::new(&mesh, 32).unwrap().source, AtlasSource::OwnUvs);

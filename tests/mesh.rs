@@ -647,22 +647,10 @@ fn a_files_normals_are_the_meshs_vertex_normals_and_turn_with_its_placement() {
 fn a_glb_primitives_normals_are_read_through_its_nodes_transform() {
     let positions = [[0.0f32, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]];
     let normals = [[0.0f32, 1.0, 0.0]; 3];
-    let mut bin: Vec<u8> = positions.iter().chain(&normals).flatten().flat_map(|x| x.to_le_bytes()).collect();
-    bin.extend([0u32, 1, 2].iter().flat_map(|i| i.to_le_bytes()));
     // The node turns the triangle a quarter about z: +y becomes -x.
-    let json = r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0, "rotation": [0, 0, 0.70710678, 0.70710678]}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2}]}],
-        "buffers": [{"byteLength": 84}],
-        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
-                        {"buffer": 0, "byteOffset": 36, "byteLength": 36},
-                        {"buffer": 0, "byteOffset": 72, "byteLength": 12}],
-        "accessors": [
-            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 0, 1]},
-            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3"},
-            {"bufferView": 2, "componentType": 5125, "count": 3, "type": "SCALAR"}
-        ]}"#;
-    let glb = translucent::mesh::glb_bytes(json.as_bytes(), &bin);
+    let sin_cos_45 = std::f32::consts::FRAC_1_SQRT_2; // a quarter turn's quaternion components
+    let node = serde_json::json!({"mesh": 0, "rotation": [0.0, 0.0, sin_cos_45, sin_cos_45]});
+    let glb = common::triangle_glb(positions, "NORMAL", "VEC3", normals.as_flattened(), node);
     let mesh = Mesh::from_gltf_slice(&glb, "normals.glb", None, &LoadOptions::default()).unwrap();
     for n in mesh.vertex_normals() {
         assert!((*n - Vec3::NEG_X).length() < 1e-5, "{n}");

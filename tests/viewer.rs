@@ -60,6 +60,22 @@ impl Display {
         text(&output.stdout)
     }
 
+    /// `translucent view ARGS` on this display with validation on, and its window once it is
+    /// mapped.
+    fn open_viewer(&self, args: &[&str]) -> (Child, String) {
+        let viewer = Command::new(env!("CARGO_BIN_EXE_translucent"))
+            .arg("view")
+            .args(args)
+            .env("DISPLAY", &self.name)
+            .env("TRANSLUCENT_VALIDATION", "1")
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the translucent binary");
+        let window = self.xdotool(&["search", "--sync", "--name", "^translucent"]);
+        (viewer, window.lines().next().expect("the viewer's window").to_string())
+    }
+
     /// Press button 1 at `from`, move to `to` in steps, release.
     fn drag(&self, window: &str, from: (i32, i32), to: (i32, i32)) {
         self.xdotool(&["mousemove", "--window", window, &from.0.to_string(), &from.1.to_string(), "mousedown", "1"]);
@@ -119,16 +135,8 @@ fn the_window_after_orbit_light_drag_and_resize_shows_the_headless_image_without
     let dir = temp_dir("viewer");
     let (shot, state) = (dir.join("shot.png"), dir.join("state.json"));
     let display = Display::start(90);
-    let viewer = Command::new(env!("CARGO_BIN_EXE_translucent"))
-        .args(["view", "--screenshot", shot.to_str().unwrap(), "--state", state.to_str().unwrap()])
-        .env("DISPLAY", &display.name)
-        .env("TRANSLUCENT_VALIDATION", "1")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the translucent binary");
-    let window = display.xdotool(&["search", "--sync", "--name", "^translucent"]);
-    let window = window.lines().next().expect("the viewer's window").to_string();
+    let (viewer, window) =
+        display.open_viewer(&["--screenshot", shot.to_str().unwrap(), "--state", state.to_str().unwrap()]);
     sleep(Duration::from_secs(2));
     display.xdotool(&["windowfocus", "--sync", &window]);
     // Sideways: the sky stays in view, so the background is compared too.
@@ -161,16 +169,7 @@ fn the_window_after_orbit_light_drag_and_resize_shows_the_headless_image_without
 #[test]
 fn a_window_destroyed_mid_frame_closes_the_viewer_without_a_validation_message() {
     let display = Display::start(190);
-    let viewer = Command::new(env!("CARGO_BIN_EXE_translucent"))
-        .args(["view", "--samples", "2000"])
-        .env("DISPLAY", &display.name)
-        .env("TRANSLUCENT_VALIDATION", "1")
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the translucent binary");
-    let window = display.xdotool(&["search", "--sync", "--name", "^translucent"]);
-    let window = window.lines().next().expect("the viewer's window").to_string();
+    let (viewer, window) = display.open_viewer(&["--samples", "2000"]);
     // The title shows frames/s once frames are being drawn.
     let started = Instant::now();
     while !display.xdotool(&["getwindowname", &window]).contains("frames/s") {

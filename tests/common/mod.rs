@@ -22,6 +22,42 @@ use translucent::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
 // ---------------------------------------------------------------------------------------------
 // Files
 
+/// A `.glb` of one triangle: `positions`, one more per-vertex attribute `name` of glTF type
+/// `kind` (`"VEC2"` or `"VEC3"`, `values` its floats, vertex by vertex), indices 0, 1, 2, placed
+/// by the node JSON `node` (e.g. `{"mesh": 0}`). The buffer views' offsets are computed here.
+pub fn triangle_glb(
+    positions: [[f32; 3]; 3],
+    name: &str,
+    kind: &str,
+    values: &[f32],
+    node: serde_json::Value,
+) -> Vec<u8> {
+    let mut bin: Vec<u8> = positions.iter().flatten().flat_map(|x| x.to_le_bytes()).collect();
+    let extra = bin.len();
+    bin.extend(values.iter().flat_map(|x| x.to_le_bytes()));
+    let indices = bin.len();
+    bin.extend([0u32, 1, 2].iter().flat_map(|i| i.to_le_bytes()));
+    let (lo, hi) = positions.iter().fold(([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]), |(lo, hi), p| {
+        (std::array::from_fn(|i| lo[i].min(p[i])), std::array::from_fn(|i| hi[i].max(p[i])))
+    });
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [node],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, name: 1}, "indices": 2}]}],
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": extra},
+            {"buffer": 0, "byteOffset": extra, "byteLength": indices - extra},
+            {"buffer": 0, "byteOffset": indices, "byteLength": bin.len() - indices}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": lo, "max": hi},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": kind},
+            {"bufferView": 2, "componentType": 5125, "count": 3, "type": "SCALAR"}
+        ]
+    });
+    translucent::mesh::glb_bytes(json.to_string().as_bytes(), &bin)
+}
+
 /// A path relative to the repository root.
 pub fn repo_path(relative: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(relative)
