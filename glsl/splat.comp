@@ -87,8 +87,8 @@ float sample_visibility(Light l, vec3 p, vec3 n, vec3 wi, vec3 face) {
 
 // Irradiance transmitted at `p` (normal `n`, face normal `face`, index ratio `eta`) from lights
 // [first, end). `beam` gathers each light's refracted direction inside (Snell's law) weighted by
-// the flux it transmits (the sum over channels).
-vec3 transmitted(uint first, uint end, vec3 p, vec3 n, vec3 face, float eta, inout vec3 beam) {
+// the flux it transmits (the sum over channels), `flux` that flux.
+vec3 transmitted(uint first, uint end, vec3 p, vec3 n, vec3 face, float eta, inout vec3 beam, inout float flux) {
     vec3 e = vec3(0.0);
     for (uint l = first; l < end; ++l) {
         vec3 wi, irradiance;
@@ -98,6 +98,7 @@ vec3 transmitted(uint first, uint end, vec3 p, vec3 n, vec3 face, float eta, ino
         float v = sample_visibility(lights[l], p, n, wi, face);
         vec3 t = irradiance * (cos_i * dipole_fresnel_transmittance(cos_i, eta) * v);
         e += t;
+        flux += t.r + t.g + t.b;
         float cos_t = sqrt(max(1.0 - (1.0 - cos_i * cos_i) / (eta * eta), 0.0));
         beam += (t.r + t.g + t.b) * (-(wi - n * cos_i) / eta - n * cos_t);
     }
@@ -117,20 +118,25 @@ void main() {
         environment = kept_environment[i].xyz;
     } else {
         vec3 unused = vec3(0.0);
-        environment = transmitted(push.key_light_count, push.light_count, p, n, face, o.eta, unused);
+        float unused_flux = 0.0;
+        environment = transmitted(push.key_light_count, push.light_count, p, n, face, o.eta, unused, unused_flux);
         kept_environment[i] = vec4(environment, 0.0);
     }
     vec3 weighted = vec3(0.0);
+    float key_flux = 0.0;
     uint key_lights = SPLAT_KEY_LIGHTS > 0u ? SPLAT_KEY_LIGHTS : push.key_light_count;
-    vec3 e = transmitted(0u, key_lights, p, n, face, o.eta, weighted) + environment;
+    vec3 e = transmitted(0u, key_lights, p, n, face, o.eta, weighted, key_flux) + environment;
+    // The direction unit, its length in w: the transport kernel's entry basis reads the sum
+    // itself (transport.comp), the between-points single scattering the direction.
     float length_sq = dot(weighted, weighted);
-    vec4 beam = vec4(length_sq > 0.0 ? weighted * inversesqrt(length_sq) : -n, 0.0);
+    vec4 beam = length_sq > 0.0 ? vec4(weighted * inversesqrt(length_sq), sqrt(length_sq)) : vec4(-n, 0.0);
     float area = s.position_area.w;
     if (push.environment_kept != 0u) {
         // The near energy depends on the sample's area and material alone, and whatever
         // changes those also splats the environment anew: it is the one written before, and
         // six Taylor remainders a sample (30 exponentials) are left out of a key light's frame.
         splat[i].irradiance_area = vec4(e, area);
+        splat[i].near_energy.w = key_flux;
         splat[i].beam = beam;
         return;
     }
@@ -139,5 +145,5 @@ void main() {
     for (int c = 0; c < 3; ++c) {
         near_energy[c] = dipole_near_energy(o.dipole[c], b);
     }
-    splat[i] = SplatRecord(vec4(e, area), vec4(near_energy, 0.0), beam);
+    splat[i] = SplatRecord(vec4(e, area), vec4(near_energy, key_flux), beam);
 }

@@ -1,31 +1,40 @@
 #version 450
 // The transport kernel (src/optics/transport.rs, its f64 twin): the dipole's exitance at the
 // vertices of an object with material.model = "transport" (those of its level of detail this
-// frame), scaled per patch of its surface to the radiative transfer through its own mesh:
-//     F_I = sum_J W_IJ Phi_J / A_I,   Phi_J = sum_(samples s in J) A_s E_t(s)
+// frame), scaled per patch of its surface to the radiative transfer through its own mesh, the
+// entry direction carried in the kernel's basis (1, mu - mu_bar, t . u_JI):
+//     F_I = sum_J (W0_IJ Phi_J + Wmu_IJ Phimu_J + Wt_IJ T_J . u_JI) / A_I
+//     Phi_J = sum_(samples s in J) A_s E_t(s), Phimu_J and T_J alike weighted by the sample's
+//     mu_s - mu_bar and t_s (SampleFlux::from_splat), u_JI the unit direction in J's tangent
+//     plane towards I's centre (Patches::toward)
 //     D_I = sum_(level's vertices v in I) a_v M_d(v) / sum a_v   (a_v: the level's dual cells)
 //     M(v) = M_d(v) sum_I w_vI F_I / sum_I w_vI D_I   (its eight nearest patches)
 // Each level of detail has its own patch records (its vertices, its D), sharing the object's W.
 // Three stages (push `stage.x`), each one dispatch per object, a barrier between them:
-//   0: one workgroup per patch: Phi and D, summed over its items in shared memory;
-//   1: one invocation per patch: F, its row of W against every patch's Phi;
+//   0: one workgroup per patch: Phi, Phimu, T and D, summed over its items in shared memory;
+//   1: one invocation per patch: F, its rows of W against every patch's fluxes;
 //   2: one invocation per vertex: the scale, in the channels push.stage.w names (the others
 //      take single scattering between points, which the pass before wrote), where the blended
 //      D is positive and the ratio finite (else the dipole's value stays).
 // Bindings: 0 = splat (SplatRecord[], read), 1 = exitance (vec4 per vertex, read by stage 0,
 // written by stage 2), 2 = patches (TransportPatchRecord[]), 3 = items (uvec2: index, area
-// bits), 4 = the kernels' W (vec4 per pair, rgb), 5 = sums (three vec4 per patch: Phi, D, F;
-// written by stages 0 and 1), 6 = neighbours (four uvec4 per vertex: (patch relative to the
-// level's first record, weight bits) pairs), 7 = level vertices (uint[], object-relative).
+// bits), 4 = the kernels' rows (three vec4 per pair, rgb: W0, Wmu, Wt), 5 = sums (SUMS vec4
+// per patch: Phi, D, F, Phimu, T_r, T_g, T_b; written by stages 0 and 1), 6 = neighbours (four
+// uvec4 per vertex: (patch relative to the level's first record, weight bits) pairs), 7 = level
+// vertices (uint[], object-relative), 8 = samples (SampleRecord[]: the normals).
 // Push: TransportPush.
 #include "scene.glsl"
 
 layout(local_size_x = 64) in;
 
 struct TransportPatchRecord {
-    uvec4 items;    // x: first item; y: vertices; z: samples (after them); w: W's row
-    vec4 area;      // x: area
+    uvec4 items;    // x: first item; y: vertices; z: samples (after them); w: its rows' first entry
+    vec4 area;      // x: area; y: mu_bar, the mean cosine of the kernel's entries
+    vec4 centre;    // xyz: centre
+    vec4 normal;    // xyz: unit mean normal (0 where the patch's normals cancel)
 };
+
+const uint SUMS = 7u;
 
 layout(std430, set = 0, binding = 0) readonly buffer Splat { SplatRecord splat[]; };
 layout(std430, set = 0, binding = 1) buffer Exitance { vec4 exitance[]; };
@@ -35,6 +44,7 @@ layout(std430, set = 0, binding = 4) readonly buffer TransportMatrix { vec4 matr
 layout(std430, set = 0, binding = 5) buffer TransportSums { vec4 sums[]; };
 layout(std430, set = 0, binding = 6) readonly buffer TransportNeighbours { uvec4 neighbours[]; };
 layout(std430, set = 0, binding = 7) readonly buffer LevelVertices { uint level_vertices[]; };
+layout(std430, set = 0, binding = 8) readonly buffer Samples { SampleRecord samples[]; };
 
 struct TransportPush {
     uvec4 stage;    // x: the stage; y: the object's first patch; z: its patches; w: the
@@ -45,13 +55,37 @@ struct TransportPush {
 layout(push_constant) uniform Push { TransportPush push; };
 
 shared vec3 part_phi[64];
+shared vec3 part_mu[64];
+shared vec3 part_t[3 * 64];
 shared vec4 part_d[64];
 
-// Stage 0: patch `p`'s Phi and D, its items split over the workgroup.
+// Sample item `it`'s weighted irradiance into the lane's sums: A_s E_t, and that times
+// mu_s - mu_bar and times t_s (SampleFlux::from_splat).
+void add_sample(uvec2 it, float mu_bar, inout vec3 phi, inout vec3 phi_mu, inout vec3 t[3]) {
+    SplatRecord r = splat[it.x];
+    vec3 e = r.irradiance_area.rgb;
+    vec3 n = samples[it.x].normal;
+    float w = e.r + e.g + e.b;
+    float mu = mu_bar;
+    vec3 tilt = vec3(0.0);
+    if (w > 0.0) {
+        vec3 d_key = r.beam.xyz * r.beam.w;
+        float along = dot(d_key, n);
+        mu = (-along + (w - r.near_energy.w) * mu_bar) / w;
+        tilt = (d_key - n * along) / w;
+    }
+    vec3 f = uintBitsToFloat(it.y) * e;
+    phi += f;
+    phi_mu += f * (mu - mu_bar);
+    for (int c = 0; c < 3; ++c) t[c] += tilt * f[c];
+}
+
+// Stage 0: patch `p`'s Phi, Phimu, T and D, its items split over the workgroup.
 void patch_sums(uint p) {
     TransportPatchRecord r = patches[p];
     uint lane = gl_LocalInvocationID.x;
-    vec3 phi = vec3(0.0);
+    vec3 phi = vec3(0.0), phi_mu = vec3(0.0);
+    vec3 t[3] = vec3[3](vec3(0.0), vec3(0.0), vec3(0.0));
     vec4 d = vec4(0.0);
     for (uint k = lane; k < r.items.y; k += 64u) {
         uvec2 it = items[r.items.x + k];
@@ -59,36 +93,53 @@ void patch_sums(uint p) {
         d += vec4(a * exitance[it.x].rgb, a);
     }
     for (uint k = lane; k < r.items.z; k += 64u) {
-        uvec2 it = items[r.items.x + r.items.y + k];
-        phi += uintBitsToFloat(it.y) * splat[it.x].irradiance_area.rgb;
+        add_sample(items[r.items.x + r.items.y + k], r.area.y, phi, phi_mu, t);
     }
     part_phi[lane] = phi;
+    part_mu[lane] = phi_mu;
+    for (uint c = 0u; c < 3u; ++c) part_t[3u * lane + c] = t[c];
     part_d[lane] = d;
     barrier();
     for (uint half_ = 32u; half_ > 0u; half_ >>= 1) {
         if (lane < half_) {
             part_phi[lane] += part_phi[lane + half_];
+            part_mu[lane] += part_mu[lane + half_];
+            for (uint c = 0u; c < 3u; ++c) part_t[3u * lane + c] += part_t[3u * (lane + half_) + c];
             part_d[lane] += part_d[lane + half_];
         }
         barrier();
     }
     if (lane == 0u) {
-        sums[3u * p] = vec4(part_phi[0], 0.0);
+        sums[SUMS * p] = vec4(part_phi[0], 0.0);
         // The dipole's mean over the level's vertices in the patch (0 where it has none).
         vec4 s = part_d[0];
-        sums[3u * p + 1u] = vec4(s.w > 0.0 ? s.rgb / s.w : vec3(0.0), 0.0);
+        sums[SUMS * p + 1u] = vec4(s.w > 0.0 ? s.rgb / s.w : vec3(0.0), 0.0);
+        sums[SUMS * p + 3u] = vec4(part_mu[0], 0.0);
+        for (uint c = 0u; c < 3u; ++c) sums[SUMS * p + 4u + c] = vec4(part_t[c], 0.0);
     }
 }
 
-// Stage 1: patch `p`'s F from its row of W.
+// The unit direction in patch `from`'s tangent plane towards `to`'s centre (Patches::toward).
+vec3 toward(TransportPatchRecord from, vec3 to) {
+    vec3 d = to - from.centre.xyz;
+    vec3 u = d - from.normal.xyz * dot(d, from.normal.xyz);
+    float l2 = dot(u, u);
+    return l2 > 0.0 ? u * inversesqrt(l2) : vec3(0.0);
+}
+
+// Stage 1: patch `p`'s F from its rows of the kernel.
 void patch_transport(uint p) {
     TransportPatchRecord r = patches[p];
     uint first = push.stage.y;
     vec3 f = vec3(0.0);
     for (uint j = 0u; j < push.stage.z; ++j) {
-        f += matrix[r.items.w + j].rgb * sums[3u * (first + j)].rgb;
+        uint q = SUMS * (first + j), m = r.items.w + 3u * j;
+        vec3 u = toward(patches[first + j], r.centre.xyz);
+        vec3 tu = vec3(dot(sums[q + 4u].xyz, u), dot(sums[q + 5u].xyz, u), dot(sums[q + 6u].xyz, u));
+        f += matrix[m].rgb * sums[q].rgb + matrix[m + 1u].rgb * sums[q + 3u].rgb + matrix[m + 2u].rgb * tu;
     }
-    sums[3u * p + 2u] = vec4(f / r.area.x, 0.0);
+    // Linear in the entry: never below zero (TransportKernel::transport_exitance).
+    sums[SUMS * p + 2u] = vec4(max(f / r.area.x, vec3(0.0)), 0.0);
 }
 
 // Stage 2: vertex `i` of the level scaled by its neighbours' blend.
@@ -100,7 +151,7 @@ void scale_vertex(uint i) {
     for (uint k = 0u; k < 4u; ++k) {
         uvec4 pair = neighbours[push.vertices.z + 4u * rel + k];
         float w0 = uintBitsToFloat(pair.y), w1 = uintBitsToFloat(pair.w);
-        uint p0 = 3u * (first + pair.x), p1 = 3u * (first + pair.z);
+        uint p0 = SUMS * (first + pair.x), p1 = SUMS * (first + pair.z);
         f += w0 * sums[p0 + 2u].rgb + w1 * sums[p1 + 2u].rgb;
         d += w0 * sums[p0 + 1u].rgb + w1 * sums[p1 + 1u].rgb;
     }

@@ -57,9 +57,11 @@ uint pack_octahedral(vec3 n) {
 // One sample's splat output (splat.comp writes it, the gathers read it).
 struct SplatRecord {
     vec4 irradiance_area;   // rgb: transmitted irradiance E_i; w: area weight
-    vec4 near_energy;       // rgb: near-field energy per channel (dipole_near_energy); w: 0
+    vec4 near_energy;       // rgb: near-field energy per channel (dipole_near_energy); w: the key
+                            // lights' transmitted flux (the sum over channels)
     vec4 beam;              // xyz: direction inside after refraction, the key lights' weighted
-                            // by transmitted flux (unit; -n where none reaches); w: 0
+                            // by transmitted flux (unit; -n where none reaches); w: the length
+                            // of that weighted sum (0 where none reaches)
 };
 
 // One node of an object's sample hierarchy (sampling::SampleTree, packed by TreeNodeRecord):

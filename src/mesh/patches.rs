@@ -109,6 +109,17 @@ impl Patches {
         self.centres.is_empty()
     }
 
+    /// The unit direction in patch `from`'s tangent plane towards patch `to`'s centre (zero
+    /// for the patch itself, or one straight along its normal): the axis along which the
+    /// transport kernel reads an entry's sideways tilt (`optics::transport`). It follows a rigid
+    /// move, as the centres do.
+    pub fn toward(&self, from: usize, to: usize) -> DVec3 {
+        let (a, b) = (&self.centres[from], &self.centres[to]);
+        let n = DVec3::new(a[3], a[4], a[5]).normalize_or_zero();
+        let d = DVec3::new(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+        (d - n * d.dot(n)).normalize_or_zero()
+    }
+
     /// The features of a surface point at `p` with normal `n`.
     pub fn features(&self, p: DVec3, n: DVec3) -> Features {
         let n = n.normalize_or_zero() * self.radius;

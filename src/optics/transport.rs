@@ -4,13 +4,29 @@
 //! shape returns light the half-space loses (on a 2 cm marble sphere the dipole is 26% too
 //! dark).
 //!
-//! `W_IJ` is the flux that leaves through patch `I` per unit flux transmitted into patch `J`,
-//! entering uniformly over `J` straight in along the inward normal: estimated once by random
-//! walks in the mesh (`reference::rte_mesh::kernel`), with no light or camera in it. Per
-//! frame, with `Phi_J` the transmitted flux into `J` (the splat's `E_t` times the samples'
-//! areas) and `M_d` the dipole's exitance at the vertices:
+//! The light enters along its own refracted direction `d`, which the kernel carries in a
+//! low-order basis: per pair of patches, the flux that leaves through `I` per unit flux
+//! transmitted into `J` is
 //!
-//! - `F_I = sum_J W_IJ Phi_J / A_I`, the kernel's exitance averaged over `I`;
+//! `W_IJ(d) = W0_IJ + Wmu_IJ (mu - mu_bar) + Wt_IJ (t . u_JI)`,
+//!
+//! `mu` the cosine of `d` with the inward normal, `t` its tangential part, `u_JI` the unit
+//! direction in `J`'s tangent plane towards `I` (`Patches::toward`) and `mu_bar` the mean cosine
+//! of the walks' entries ([`EntryBasis`]). The three rows are the least-squares projection of
+//! the walks' response on that basis, estimated once by random walks in the mesh
+//! (`reference::rte_mesh::kernel`) with entry directions drawn as diffuse light refracts in,
+//! with no light or camera in it. A kernel of the normal entry alone was -10% at a marble
+//! sphere's terminator, where grazing light refracts into a beam running sideways just under
+//! the surface (docs/PHYSICS.md, "The transport kernel").
+//!
+//! Per frame, with `E_t` the splat's transmitted irradiance at a sample, `mu_s` and `t_s` its
+//! lights' refracted cosine and tangential direction averaged by their flux, and `M_d` the
+//! dipole's exitance at the vertices:
+//!
+//! - `Phi_J = sum A_s E_t`, `Phimu_J = sum A_s E_t (mu_s - mu_bar)` and `T_J = sum A_s E_t t_s`
+//!   over the samples in `J` ([`PatchFlux`]);
+//! - `F_I = sum_J (W0_IJ Phi_J + Wmu_IJ Phimu_J + Wt_IJ T_J . u_JI) / A_I`, the kernel's
+//!   exitance averaged over `I`;
 //! - `D_I = sum_(v in I) A_v M_d(v) / A_I`, the dipole's, alike (`A_v` the vertex's dual cell);
 //! - `M(v) = M_d(v) sum_I w_vI F_I / sum_I w_vI D_I` over the vertex's nearest patches with
 //!   the weights of `Patches::neighbours`.
@@ -22,14 +38,122 @@
 
 use crate::mesh::Mesh;
 use crate::mesh::patches::Patches;
+use glam::DVec3;
+
+/// How far the tilt row reaches, in patch radii (`Patches::radius`): `Wt_IJ` is walked only
+/// between patches whose centres are closer, and is 0 beyond. Farther, the entry's tilt moves
+/// little light while its row's estimate is the noisiest of the three (the tilt's weight is
+/// `t . u / E[(t . u)^2]`). On the 2 cm marble sphere, per band of incidence against the photon
+/// reference at 24 and 48 divisions, a reach of 3 took the terminator's bias from -10% to -3 to
+/// -6%, where an unbounded one added 3 to 7 points of noise and bias on the unlit side
+/// (docs/PHYSICS.md, "The transport kernel").
+pub const TILT_REACH: f64 = 3.0;
+
+/// How the kernel's walks enter, and the moments of that entry the basis needs: directions
+/// refracted from diffuse light, `sin^2 theta_t` uniform on `[0, S]` with `S = min(1,
+/// 1/eta^2)` (a cosine-weighted incidence has `sin^2 theta_i` uniform, and Snell's law divides
+/// it by `eta^2`), the azimuth uniform.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EntryBasis {
+    /// `S`, the largest `sin^2 theta_t`.
+    pub s_max: f64,
+}
+
+impl EntryBasis {
+    /// The entry into a medium of relative index `eta`.
+    pub fn new(eta: f64) -> EntryBasis {
+        EntryBasis { s_max: (1.0 / (eta * eta)).min(1.0) }
+    }
+
+    /// The entry's cosine `mu = sqrt(1 - S u)` and azimuth `2 pi v` for uniform `u`, `v`.
+    pub fn sample(&self, u: f64, v: f64) -> (f64, f64) {
+        ((1.0 - self.s_max * u).max(0.0).sqrt(), std::f64::consts::TAU * v)
+    }
+
+    /// `mu_bar = E[mu] = 2 (1 - (1 - S)^(3/2)) / (3 S)`.
+    pub fn mu_mean(&self) -> f64 {
+        let s = self.s_max;
+        2.0 * (1.0 - (1.0 - s).powf(1.5)) / (3.0 * s)
+    }
+
+    /// `Var mu = E[mu^2] - mu_bar^2`, `E[mu^2] = 1 - S / 2`.
+    pub fn mu_variance(&self) -> f64 {
+        (1.0 - self.s_max / 2.0 - self.mu_mean().powi(2)).max(0.0)
+    }
+
+    /// `E[(t . u)^2] = E[sin^2 theta_t] / 2 = S / 4` for any unit tangent `u`.
+    pub fn tilt_variance(&self) -> f64 {
+        self.s_max / 4.0
+    }
+}
+
+/// Per patch and channel, the transmitted fluxes the kernel's three rows act on.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PatchFlux {
+    /// `Phi_J`.
+    pub phi: PerPatch,
+    /// `Phimu_J`.
+    pub phi_mu: PerPatch,
+    /// `T_J`, per channel a tangential vector.
+    pub tilt: Vec<[DVec3; 3]>,
+}
+
+/// One sample's part of [`PatchFlux`]: its patch, its area, its transmitted irradiance per
+/// channel, and its lights' flux-weighted refracted cosine `mu_s` and tangential direction
+/// `t_s` ([`SampleFlux::from_splat`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampleFlux {
+    /// Its patch.
+    pub patch: u32,
+    /// Its area `A_s`.
+    pub area: f64,
+    /// `E_t`, RGB.
+    pub e: [f64; 3],
+    /// `mu_s`.
+    pub mu: f64,
+    /// `t_s`.
+    pub tilt: DVec3,
+}
+
+impl SampleFlux {
+    /// A sample's part from what the splat writes: `e` its transmitted irradiance (every
+    /// light's), `d_key` the key lights' refracted directions summed weighted by their
+    /// transmitted flux (the sum over channels) and `w_key` that flux, `n` its outward normal.
+    /// The other lights' (the environment's directions) are taken to enter as the kernel's
+    /// walks do, diffusely: at `mu_bar`, without tilt. So, with `w` the flux of every light,
+    /// `mu_s = (-d_key . n + (w - w_key) mu_bar) / w` and `t_s = (d_key - (d_key . n) n) / w`.
+    pub fn from_splat(
+        patch: u32,
+        area: f64,
+        e: [f64; 3],
+        (d_key, w_key): (DVec3, f64),
+        n: DVec3,
+        mu_bar: f64,
+    ) -> SampleFlux {
+        let w = e.iter().sum::<f64>();
+        let (mu, tilt) = if w > 0.0 {
+            let along = d_key.dot(n);
+            ((-along + (w - w_key) * mu_bar) / w, (d_key - n * along) / w)
+        } else {
+            (mu_bar, DVec3::ZERO)
+        };
+        SampleFlux { patch, area, e, mu, tilt }
+    }
+}
 
 /// The kernel of one object (see the module's documentation).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TransportKernel {
     /// The patches it is tabulated between.
     pub patches: Patches,
-    /// Per channel, `W_IJ` at `[I * K + J]`, `K` patches.
+    /// Per channel, `W0_IJ` at `[I * K + J]`, `K` patches.
     pub flux: [Vec<f64>; 3],
+    /// Per channel, `Wmu_IJ`, alike.
+    pub depth: [Vec<f64>; 3],
+    /// Per channel, `Wt_IJ`, alike.
+    pub sideways: [Vec<f64>; 3],
+    /// `mu_bar` of the walks' entry ([`EntryBasis::mu_mean`]).
+    pub mu_mean: f64,
     /// Walks per patch and channel it was estimated with.
     pub walks: u64,
 }
@@ -38,27 +162,50 @@ pub struct TransportKernel {
 pub type PerPatch = Vec<[f64; 3]>;
 
 impl TransportKernel {
-    /// `Phi_J`: per patch, the transmitted flux of `points`, each (its patch, its area, its
-    /// transmitted irradiance `E_t`).
-    pub fn patch_flux(&self, points: impl Iterator<Item = (u32, f64, [f64; 3])>) -> PerPatch {
-        let mut phi = vec![[0.0; 3]; self.patches.len()];
-        for (j, area, e) in points {
-            (0..3).for_each(|c| phi[j as usize][c] += area * e[c]);
+    /// The fluxes of `points` per patch ([`PatchFlux`]).
+    pub fn patch_flux(&self, points: impl Iterator<Item = SampleFlux>) -> PatchFlux {
+        let k = self.patches.len();
+        let mut flux = PatchFlux { phi: vec![[0.0; 3]; k], phi_mu: vec![[0.0; 3]; k], tilt: vec![[DVec3::ZERO; 3]; k] };
+        for s in points {
+            let j = s.patch as usize;
+            for c in 0..3 {
+                let f = s.area * s.e[c];
+                flux.phi[j][c] += f;
+                flux.phi_mu[j][c] += f * (s.mu - self.mu_mean);
+                flux.tilt[j][c] += s.tilt * f;
+            }
         }
-        phi
+        flux
     }
 
-    /// `F_I`: per patch, the kernel's exitance averaged over it under the fluxes `phi`.
-    pub fn transport_exitance(&self, phi: &[[f64; 3]]) -> PerPatch {
+    /// `F_I`: per patch, the kernel's exitance averaged over it under the fluxes `flux` (at
+    /// least 0), its
+    /// patches `placed` where the object stands now ([`TransportKernel::placed`]: the tilt's
+    /// axes follow a rigid move).
+    pub fn transport_exitance(&self, flux: &PatchFlux, placed: &Patches) -> PerPatch {
         let k = self.patches.len();
         (0..k)
             .map(|i| {
-                [0, 1, 2].map(|c| {
-                    let row = &self.flux[c][i * k..(i + 1) * k];
-                    row.iter().zip(phi).map(|(w, p)| w * p[c]).sum::<f64>() / self.patches.area[i]
-                })
+                let mut f = [0.0; 3];
+                for j in 0..k {
+                    let u = placed.toward(j, i);
+                    for (c, f) in f.iter_mut().enumerate() {
+                        let at = i * k + j;
+                        *f += self.flux[c][at] * flux.phi[j][c]
+                            + self.depth[c][at] * flux.phi_mu[j][c]
+                            + self.sideways[c][at] * flux.tilt[j][c].dot(u);
+                    }
+                }
+                // The basis is linear in the entry: where a noisy or strongly tilted row would
+                // take a patch below zero, it receives nothing.
+                f.map(|f| (f / self.patches.area[i]).max(0.0))
             })
             .collect()
+    }
+
+    /// Its three rows, `W0`, `Wmu` and `Wt`, each per channel.
+    pub fn rows(&self) -> impl Iterator<Item = &[Vec<f64>; 3]> {
+        [&self.flux, &self.depth, &self.sideways].into_iter()
     }
 
     /// `D_I`: per patch, the dipole's exitance `dipole` (per vertex) averaged over it by the
@@ -92,15 +239,16 @@ impl TransportKernel {
 
     /// The model's exitance at every vertex from the dipole's `dipole` at the vertices whose
     /// `cells` are positive (the whole mesh's dual cells, or a level of detail's) and the
-    /// fluxes `phi` (the f64 twin of `glsl/transport.comp`), each vertex blended from `near`
-    /// (per vertex, its `Patches::neighbours`); the others as they are.
+    /// fluxes `flux` (the f64 twin of `glsl/transport.comp`), each vertex blended from `near`
+    /// (per vertex, its `Patches::neighbours` among the patches `placed`); the others as they
+    /// are.
     pub fn exitance(
         &self,
-        phi: &[[f64; 3]],
+        (flux, placed): (&PatchFlux, &Patches),
         (dipole, cells): (&[[f64; 3]], &[f64]),
         near: &[Vec<(u32, f64)>],
     ) -> Vec<[f64; 3]> {
-        let (f, d) = (self.transport_exitance(phi), self.dipole_exitance(dipole, cells));
+        let (f, d) = (self.transport_exitance(flux, placed), self.dipole_exitance(dipole, cells));
         (0..dipole.len())
             .map(|v| if cells[v] > 0.0 { Self::scaled(dipole[v], &near[v], &f, &d) } else { dipole[v] })
             .collect()
@@ -137,8 +285,9 @@ impl TransportKernel {
         self.patches.of_vertex[mesh.triangles()[triangle as usize][corner] as usize]
     }
 
-    /// Bytes of device memory the kernel takes (`W` as f32 RGBA per pair of patches).
+    /// Bytes of device memory the kernel takes (its three rows as f32 RGBA per pair of
+    /// patches).
     pub fn device_bytes(&self) -> u64 {
-        (self.patches.len() as u64).pow(2) * 16
+        (self.patches.len() as u64).pow(2) * 16 * 3
     }
 }

@@ -11,9 +11,9 @@ pub(crate) mod json_null;
 pub mod rte;
 pub mod rte_cache;
 pub mod rte_mesh;
-pub mod transport_cache;
 pub mod single;
 pub mod texture;
+pub mod transport_cache;
 pub mod tree;
 pub mod truth;
 
@@ -149,8 +149,53 @@ pub fn transmitted_irradiance_known(
     eps: f64,
     known: Visibility,
 ) -> (DVec3, u64, u64) {
+    let mut e = DVec3::ZERO;
+    let (reached, blocked) = each_transmitted(scene, occluders, (p, n, eps), known, |_, irradiance, cos_i, _| {
+        e += irradiance * (cos_i * fresnel::fresnel_transmittance(cos_i, eta));
+    });
+    (e, reached, blocked)
+}
+
+/// What the transport kernel's entry basis reads at a surface point (`optics::transport`), as
+/// `glsl/splat.comp` forms it: the transmitted irradiance `E_t` (as [`transmitted_irradiance`]),
+/// the key lights' refracted directions summed weighted by their transmitted flux (the sum
+/// over channels), and that flux.
+pub fn transmitted_entry(
+    scene: &PreparedScene,
+    occluders: &Bvh,
+    (p, n): (DVec3, DVec3),
+    eta: f64,
+    eps: f64,
+) -> (DVec3, DVec3, f64) {
+    let nn = n.normalize();
+    let keys = crate::scene::lights::key_light_count(&scene.lights);
+    let (mut e, mut d_key, mut w_key) = (DVec3::ZERO, DVec3::ZERO, 0.0);
+    each_transmitted(scene, occluders, (p, n, eps), Visibility::TRACE_ALL, |wi, irradiance, cos_i, l| {
+        let e_l = irradiance * (cos_i * fresnel::fresnel_transmittance(cos_i, eta));
+        e += e_l;
+        if l < keys
+            && let Some(d) = crate::optics::directional_dipole::refract_in(wi, nn, eta)
+        {
+            d_key += d * e_l.element_sum();
+            w_key += e_l.element_sum();
+        }
+    });
+    (e, d_key, w_key)
+}
+
+/// Calls `f` with the direction towards, irradiance, incidence cosine and index of each light that
+/// reaches a surface point at `p` with shading normal `n` (rays offset by `eps`), the
+/// visibility of the lights outside `known.trace` taken from `known`; returns the bit masks of
+/// the first 64 lights that reach it and that a caster blocks.
+fn each_transmitted(
+    scene: &PreparedScene,
+    occluders: &Bvh,
+    (p, n, eps): (DVec3, DVec3, f64),
+    known: Visibility,
+    mut f: impl FnMut(DVec3, DVec3, f64, usize),
+) -> (u64, u64) {
     let n = n.normalize();
-    let (mut e, mut reached, mut blocked) = (DVec3::ZERO, 0u64, 0u64);
+    let (mut reached, mut blocked) = (0u64, 0u64);
     for (i, l) in scene.lights.iter().enumerate() {
         let (wi, irradiance, dist) = light_incidence(l, p);
         let cos_i = n.dot(wi);
@@ -169,10 +214,10 @@ pub fn transmitted_irradiance_known(
             blocked |= bit;
             continue;
         }
-        e += irradiance * (cos_i * fresnel::fresnel_transmittance(cos_i, eta));
+        f(wi, irradiance, cos_i, i);
         reached |= bit;
     }
-    (e, reached, blocked)
+    (reached, blocked)
 }
 
 /// Radiant exitance at every vertex of every object (zero for opaque ones), from per-sample

@@ -4,9 +4,9 @@
 //!
 //! The file `kernel-KEY.json` sits in the cache folder. Its key hashes what the walk depends
 //! on: the object's placed mesh, its three channels' coefficients, the [`KernelSettings`] (the
-//! patches the mesh gets) and [`VERSION`]. It carries a checksum of its values. A file that is unreadable, foreign, edited
-//! or damaged, or whose patches do not fit the mesh, is never used: it is walked anew and
-//! replaced, with a warning naming the file and why.
+//! patches the mesh gets) and [`VERSION`]. It carries a checksum of its values. A file that is
+//! unreadable, foreign, edited or damaged, or whose patches do not fit the mesh, is never used:
+//! it is walked anew and replaced, with a warning naming the file and why.
 
 use super::rte_cache::RteCacheError;
 use super::rte_mesh::{KernelSettings, object_kernel};
@@ -15,8 +15,9 @@ use crate::optics::transport::TransportKernel;
 use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
 use std::path::Path;
 
-/// The version of the kernel's walk: a change to what it computes bumps it.
-pub const VERSION: u32 = 2;
+/// The version of the kernel's walk: a change to what it computes bumps it (3: the entry
+/// direction's basis, `optics::transport::EntryBasis`).
+pub const VERSION: u32 = 3;
 
 /// One object's kernel, as cached.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -43,7 +44,8 @@ impl CachedKernel {
         k.patches.centres.iter().flatten().for_each(|&x| h.f64(x));
         k.patches.area.iter().chain(&k.patches.cells).for_each(|&x| h.f64(x));
         h.f64(k.patches.radius);
-        k.flux.iter().flatten().for_each(|&x| h.f64(x));
+        k.rows().flatten().flatten().for_each(|&x| h.f64(x));
+        h.f64(k.mu_mean);
         format!("{:016x}", h.0)
     }
 
@@ -60,14 +62,17 @@ impl CachedKernel {
         if p.of_vertex.len() != vertices || p.cells.len() != vertices {
             return Some(format!("{} vertices, the mesh has {vertices}", p.of_vertex.len()));
         }
-        if p.area.len() != k || self.kernel.flux.iter().any(|f| f.len() != k * k) {
+        if p.area.len() != k || self.kernel.rows().flatten().any(|f| f.len() != k * k) {
             return Some(format!("its tables do not hold {k} patches"));
         }
         if p.of_vertex.iter().any(|&i| i as usize >= k) {
             return Some(format!("a vertex names a patch past its {k}"));
         }
         let bad = |x: &f64| !x.is_finite() || *x < 0.0;
-        if self.kernel.flux.iter().flatten().any(bad) || p.area.iter().any(|a| bad(a) || *a == 0.0) {
+        let rows_bad = self.kernel.flux.iter().flatten().any(bad)
+            || self.kernel.rows().flatten().flatten().any(|x| !x.is_finite())
+            || !(self.kernel.mu_mean > 0.0 && self.kernel.mu_mean <= 1.0);
+        if rows_bad || p.area.iter().any(|a| bad(a) || *a == 0.0) {
             return Some("it holds a negative, zero-area or non-finite value".into());
         }
         None
@@ -145,7 +150,8 @@ pub fn model_exitance(
     truth: &[Vec<[f64; 3]>],
     dir: &Path,
 ) -> Result<Vec<Vec<[f64; 3]>>, RteCacheError> {
-    use super::{occluders, ray_offset, transmitted_irradiance};
+    use super::{occluders, ray_offset, transmitted_entry};
+    use crate::optics::transport::SampleFlux;
     let casters = occluders(base);
     let partial = truth.iter().flatten().any(|m| !m[0].is_finite());
     let gathered = partial.then(|| super::gather(base, &super::splat(base, &casters)));
@@ -159,13 +165,16 @@ pub fn model_exitance(
         let (positions, normals) = (o.mesh.positions(), o.mesh.vertex_normals());
         let eps = ray_offset(base);
         let points = positions.iter().zip(normals).enumerate().map(|(v, (p, n))| {
-            let e = transmitted_irradiance(base, &casters, p.as_dvec3(), n.as_dvec3(), material.eta, eps).0;
-            (k.patches.of_vertex[v], k.patches.cells[v], e.to_array())
+            let (p, n) = (p.as_dvec3(), n.as_dvec3().normalize());
+            let (e, d_key, w_key) = transmitted_entry(base, &casters, (p, n), material.eta, eps);
+            let (patch, area) = (k.patches.of_vertex[v], k.patches.cells[v]);
+            SampleFlux::from_splat(patch, area, e.to_array(), (d_key, w_key), n, k.mu_mean)
         });
         let phi = k.patch_flux(points);
         let whole = gathered.as_ref().map_or(truth.as_slice(), |g| g[index].as_slice());
-        let (f, d) = (k.transport_exitance(&phi), k.dipole_exitance(whole, &k.patches.cells));
-        let near = TransportKernel::vertex_neighbours(&k.placed(&o.mesh), &o.mesh);
+        let placed = k.placed(&o.mesh);
+        let (f, d) = (k.transport_exitance(&phi, &placed), k.dipole_exitance(whole, &k.patches.cells));
+        let near = TransportKernel::vertex_neighbours(&placed, &o.mesh);
         out.push(
             truth
                 .iter()

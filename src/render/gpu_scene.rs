@@ -3,12 +3,12 @@
 //! write and read between frames (splat output, exitance, cached environment irradiance). The
 //! passes get their inputs from here; only lights and object records change after creation.
 
-pub use super::ranges::{LevelRange, DrawRange, Receiver, TextureRange, ObjectRange};
-use super::resource::{Resource, SceneBuffers};
+pub use super::ranges::{DrawRange, LevelRange, ObjectRange, Receiver, TextureRange};
 use super::records::{
     BeamNodeRecord, BeamSourceRecord, BvhNodeRecord, BvhTriangleRecord, LightGpu, NodePowerRecord, ObjectRecord,
     ReceiverGroupRecord, SampleRecord, SplatRecord, TreeNodeRecord, Vertex,
 };
+use super::resource::{Resource, SceneBuffers};
 use crate::gpu::{Buffer, BufferDesc, Gpu, GpuResult};
 use crate::mesh::enclosure;
 use crate::optics::kernel::NEAR_BLEND_RADIUS;
@@ -467,7 +467,7 @@ impl GpuScene {
                 transport_patches: upload(gpu, "transport patches", &t.patches, none)?,
                 transport_items: upload(gpu, "transport items", &t.items, none)?,
                 transport_matrix: upload(gpu, "transport matrix", &t.matrix, none)?,
-                transport_sums: sized("transport sums", 48, t.patches.len().max(1))?,
+                transport_sums: sized("transport sums", 16 * 7, t.patches.len().max(1))?,
                 transport_neighbours: upload(gpu, "transport neighbours", &t.neighbours, none)?,
                 receiver_cones: upload(gpu, "receiver cones", &receiver_cones(scene, &l.levels), none)?,
                 // Generation 0, which no gather marks: every receiver stale.

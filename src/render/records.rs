@@ -137,22 +137,32 @@ pub fn pack_octahedral(n: glam::Vec3) -> u32 {
 pub struct SplatRecord {
     /// rgb: transmitted irradiance E_i; w: the sample's area.
     pub irradiance_area: [f32; 4],
-    /// rgb: near-field energy per channel (`optics::kernel::near_energy`).
+    /// rgb: near-field energy per channel (`optics::kernel::near_energy`); w: the key lights'
+    /// transmitted flux, summed over the channels.
     pub near_energy: [f32; 4],
     /// xyz: the direction light travels inside after refracting in, the key lights' directions
-    /// weighted by their transmitted flux (unit; `-n` where no key light reaches); w: 0. The
-    /// between-points single scattering reads it (glsl/beam_gather.comp).
+    /// weighted by their transmitted flux (unit; `-n` where no key light reaches); w: the
+    /// length of that weighted sum. The between-points single scattering reads the direction
+    /// (glsl/beam_gather.comp), the transport kernel's entry basis the sum
+    /// (`optics::transport::SampleFlux::from_splat`).
     pub beam: [f32; 4],
 }
 
 impl SplatRecord {
-    /// Pack one sample's splat output as splat.comp writes it (the w of `near_energy` and of
-    /// `beam` is 0).
+    /// Pack one sample's splat output with no key light's direction (the w of `near_energy` and
+    /// of `beam` 0: the transport kernel takes its light as entering diffusely).
     pub fn new(irradiance: [f32; 3], area: f32, near_energy: [f32; 3], beam: [f32; 3]) -> SplatRecord {
         let [e0, e1, e2] = irradiance;
         let [n0, n1, n2] = near_energy;
         let [b0, b1, b2] = beam;
         SplatRecord { irradiance_area: [e0, e1, e2, area], near_energy: [n0, n1, n2, 0.0], beam: [b0, b1, b2, 0.0] }
+    }
+
+    /// What the transport kernel's entry basis reads: the key lights' flux-weighted sum of
+    /// refracted directions and their flux.
+    pub fn key_entry(&self) -> ([f32; 3], f32) {
+        let [x, y, z, w] = self.beam;
+        ([x * w, y * w, z * w], self.near_energy[3])
     }
 }
 

@@ -27,7 +27,7 @@ pub struct TransportPush {
 }
 
 /// glsl/transport.comp's bindings, in binding order.
-const BINDINGS: [Resource; 8] = [
+const BINDINGS: [Resource; 9] = [
     Resource::Splat,
     Resource::Exitance,
     Resource::TransportPatches,
@@ -36,6 +36,7 @@ const BINDINGS: [Resource; 8] = [
     Resource::TransportSums,
     Resource::TransportNeighbours,
     Resource::LevelVertices,
+    Resource::Samples,
 ];
 
 /// The three stages of glsl/transport.comp, one dispatch per object each.

@@ -11,10 +11,14 @@ use crate::scene::build::{PreparedObject, PreparedScene};
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct TransportPatchRecord {
     /// x: its first entry in the items; y: its vertices at this level (entries from x); z: its
-    /// samples (entries after them); w: its row's first entry in the matrix.
+    /// samples (entries after them); w: its rows' first entry in the matrix.
     pub items: [u32; 4],
-    /// x: its area; y, z, w: 0.
+    /// x: its area; y: the kernel's `mu_bar` (`TransportKernel::mu_mean`); z, w: 0.
     pub area: [f32; 4],
+    /// xyz: its centre; w: 0.
+    pub centre: [f32; 4],
+    /// xyz: its unit mean normal (0 where its normals cancel); w: 0.
+    pub normal: [f32; 4],
 }
 
 /// Where one level of detail of an object's kernel lies in the packed buffers.
@@ -40,7 +44,8 @@ pub struct PackedTransport {
     pub patches: Vec<TransportPatchRecord>,
     /// Per patch record, its level's vertices then its samples: (absolute index, area bits).
     pub items: Vec<[u32; 2]>,
-    /// Each kernel's `W` row by row, RGB and 0.
+    /// Each kernel's rows pair by pair (`[(I K + J) 3 + b]`, `b` the basis: `W0`, `Wmu`,
+    /// `Wt`), RGB and 0.
     pub matrix: Vec<[f32; 4]>,
     /// Per vertex of every kernel's object, four `uvec4`s: eight (patch, weight bits) pairs,
     /// the patches relative to a level's first record.
@@ -78,8 +83,10 @@ impl PackedTransport {
             samples[i as usize].push([first_sample + s as u32, (sample.area as f32).to_bits()]);
         }
         let first_row = self.matrix.len() as u32;
-        self.matrix
-            .extend((0..k * k).map(|ij| [0, 1, 2].map(|c| kernel.flux[c][ij] as f32)).map(|[r, g, b]| [r, g, b, 0.0]));
+        let rows: Vec<&[Vec<f64>; 3]> = kernel.rows().collect();
+        for ij in 0..k * k {
+            self.matrix.extend(rows.iter().map(|w| [w[0][ij] as f32, w[1][ij] as f32, w[2][ij] as f32, 0.0]));
+        }
         let first_neighbour = self.neighbours.len() as u32;
         for near in TransportKernel::vertex_neighbours(&placed, &o.mesh) {
             let mut pairs = [[0u32; 2]; crate::mesh::patches::NEIGHBOURS];
@@ -103,10 +110,15 @@ impl PackedTransport {
                     let first_item = self.items.len() as u32;
                     self.items.extend(&vertices[i]);
                     self.items.extend(&samples[i]);
-                    let (nv, ns, row) = (vertices[i].len() as u32, samples[i].len() as u32, first_row + (i * k) as u32);
+                    let (nv, ns) = (vertices[i].len() as u32, samples[i].len() as u32);
+                    let row = first_row + (i * k * 3) as u32;
+                    let c = placed.centres[i];
+                    let n = glam::DVec3::new(c[3], c[4], c[5]).normalize_or_zero();
                     self.patches.push(TransportPatchRecord {
                         items: [first_item, nv, ns, row],
-                        area: [placed.area[i] as f32, 0.0, 0.0, 0.0],
+                        area: [placed.area[i] as f32, kernel.mu_mean as f32, 0.0, 0.0],
+                        centre: [c[0] as f32, c[1] as f32, c[2] as f32, 0.0],
+                        normal: [n.x as f32, n.y as f32, n.z as f32, 0.0],
                     });
                 }
                 LevelTransport {

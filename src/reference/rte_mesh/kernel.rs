@@ -1,18 +1,23 @@
 //! The transport kernel's walks (`optics::transport`): for each patch `J` of the mesh
-//! (`mesh::patches`), walks that enter uniformly over its vertices' cells straight in along the
-//! inward shading normal (the entry of [`ModelEntry::Normal`](super::ModelEntry)) and walk the
-//! radiative transfer as the photon walk does (`walk`, expected-value splitting at the
-//! boundary); the flux each leaves through patch `I`'s cells, summed and divided by the walks,
-//! is `W_IJ`. Each patch has its own random stream, so the kernel does not depend on the
-//! threads.
+//! (`mesh::patches`), walks that enter uniformly over its vertices' cells along a direction
+//! drawn as diffuse light refracts in about the inward shading normal
+//! (`optics::transport::EntryBasis`) and walk the radiative transfer as the photon walk does
+//! (`walk`, expected-value splitting at the boundary). The flux `O_I` each leaves through patch
+//! `I`'s cells, weighted by the entry's basis function over its variance and averaged over the
+//! walks, is the least-squares coefficient of that basis: `W0_IJ = E[O_I]`,
+//! `Wmu_IJ = E[O_I (mu - mu_bar)] / Var mu` and `Wt_IJ = E[O_I (t . u_JI)] / E[(t . u)^2]` (the
+//! basis functions are orthogonal under the entry's distribution: the tilt is odd in the
+//! azimuth), `Wt` only within `TILT_REACH` patch radii. Each patch has its own random stream, so
+//! the kernel does not depend on the threads.
 
 use super::geometry::Geometry;
 use super::tally::Exit;
 use super::walk::{Start, walk};
 use crate::mesh::Mesh;
 use crate::mesh::patches::Patches;
-use crate::optics::transport::TransportKernel;
+use crate::optics::transport::{EntryBasis, TILT_REACH, TransportKernel};
 use crate::reference::rte::{Medium, chunk_rng};
+use glam::DVec3;
 use rand::RngExt;
 use rand_pcg::Pcg64;
 use rayon::prelude::*;
@@ -37,38 +42,55 @@ pub fn transport_kernel(
         }
     }
     let done = AtomicUsize::new(0);
-    let columns: Vec<[Vec<f64>; 3]> = corners
+    let entry = EntryBasis::new(media[0].eta);
+    let columns: Vec<Column> = corners
         .par_iter()
         .enumerate()
         .map(|(j, list)| {
-            let col = column(&geometry, media, &patches, list, walks, chunk_rng(seed, j as u64));
+            let at = Entering { patch: j, corners: list, entry };
+            let col = column(&geometry, media, &patches, &at, walks, chunk_rng(seed, j as u64));
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, k);
             col
         })
         .collect();
-    let mut flux = [vec![0.0; k * k], vec![0.0; k * k], vec![0.0; k * k]];
+    let table = || [vec![0.0; k * k], vec![0.0; k * k], vec![0.0; k * k]];
+    let (mut flux, mut depth, mut sideways) = (table(), table(), table());
     for (j, col) in columns.iter().enumerate() {
         for c in 0..3 {
             for i in 0..k {
-                flux[c][i * k + j] = col[c][i];
+                flux[c][i * k + j] = col[0][c][i];
+                depth[c][i * k + j] = col[1][c][i];
+                sideways[c][i * k + j] = col[2][c][i];
             }
         }
     }
-    TransportKernel { patches, flux, walks }
+    TransportKernel { patches, flux, depth, sideways, mu_mean: entry.mu_mean(), walks }
 }
 
-/// Patch `j`'s column of the kernel: per channel, the flux out of each patch per unit flux into
-/// `j`, from `walks` walks entering over `corners` (triangle, corner, area of its cell there).
+/// One patch's column of the kernel's three rows (`W0`, `Wmu`, `Wt`), per channel and patch.
+type Column = [[Vec<f64>; 3]; 3];
+
+/// Where one patch's walks enter: the patch, its vertices' corners (triangle, corner, area of
+/// its cell there) and the entry's directions.
+struct Entering<'a> {
+    patch: usize,
+    corners: &'a [(usize, usize, f64)],
+    entry: EntryBasis,
+}
+
+/// A patch's column of the kernel: per row of the basis and channel, the flux out of each patch
+/// per unit flux in, from `walks` walks entering as `at` says.
 fn column(
     geometry: &Geometry,
     media: &[Medium; 3],
     patches: &Patches,
-    corners: &[(usize, usize, f64)],
+    at: &Entering,
     walks: u64,
     mut rng: Pcg64,
-) -> [Vec<f64>; 3] {
+) -> Column {
     let k = patches.len();
-    let mut out = [vec![0.0; k], vec![0.0; k], vec![0.0; k]];
+    let mut out: Column = std::array::from_fn(|_| [vec![0.0; k], vec![0.0; k], vec![0.0; k]]);
+    let corners = at.corners;
     if corners.is_empty() || walks == 0 {
         return out;
     }
@@ -80,6 +102,8 @@ fn column(
         })
         .collect();
     let total = cdf[cdf.len() - 1];
+    let toward: Vec<DVec3> = (0..k).map(|i| reached(patches, at.patch, i)).collect();
+    let (mu_bar, mu_var, tilt_var) = (at.entry.mu_mean(), at.entry.mu_variance(), at.entry.tilt_variance());
     let mut exits: Vec<Exit> = Vec::new();
     for _ in 0..walks {
         let x = rng.random::<f64>() * total;
@@ -87,19 +111,48 @@ fn column(
         let bary = point_in_cell(corner, &mut rng);
         let p = geometry.mesh.point(t, bary);
         let inward = -geometry.shading_normal(t, bary);
-        let d = if inward.dot(geometry.normals[t]) < 0.0 { inward } else { -geometry.normals[t] };
+        let (d, tilt) = entry_direction(inward, -geometry.normals[t], &at.entry, &mut rng);
+        let depth = if mu_var > 0.0 { (d.dot(inward) - mu_bar) / mu_var } else { 0.0 };
         for (channel, medium) in media.iter().enumerate() {
             exits.clear();
             let start = Start { p, d, triangle: t, channel, weight: 1.0 };
             walk(geometry, medium, &start, true, &mut rng, &mut exits);
             for e in &exits {
-                out[channel][patches.of_vertex[e.vertex] as usize] += e.weight;
+                let i = patches.of_vertex[e.vertex] as usize;
+                out[0][channel][i] += e.weight;
+                out[1][channel][i] += e.weight * depth;
+                out[2][channel][i] += e.weight * tilt.dot(toward[i]) / tilt_var;
             }
         }
     }
     let n = walks as f64;
-    out.iter_mut().for_each(|col| col.iter_mut().for_each(|w| *w /= n));
+    out.iter_mut().flatten().for_each(|col| col.iter_mut().for_each(|w| *w /= n));
     out
+}
+
+/// The tilt's axis from patch `j` towards patch `i` (`Patches::toward`), 0 beyond
+/// `TILT_REACH` patch radii: the tilt row is walked only there.
+fn reached(patches: &Patches, j: usize, i: usize) -> DVec3 {
+    let (a, b) = (&patches.centres[j], &patches.centres[i]);
+    let d2: f64 = (0..3).map(|x| (a[x] - b[x]).powi(2)).sum();
+    let reach = TILT_REACH * patches.radius;
+    if d2 <= reach * reach { patches.toward(j, i) } else { DVec3::ZERO }
+}
+
+/// An entry direction about the inward shading normal `inward` drawn from `entry`, and its
+/// tangential part; redrawn while it would not enter through the face (inward geometric normal
+/// `face`), and straight along `face` after eight tries (a shading normal far off its face).
+fn entry_direction(inward: DVec3, face: DVec3, entry: &EntryBasis, rng: &mut Pcg64) -> (DVec3, DVec3) {
+    let (a, b) = inward.any_orthonormal_pair();
+    for _ in 0..8 {
+        let (mu, phi) = entry.sample(rng.random::<f64>(), rng.random::<f64>());
+        let tilt = (a * phi.cos() + b * phi.sin()) * (1.0 - mu * mu).max(0.0).sqrt();
+        let d = inward * mu + tilt;
+        if d.dot(face) > 0.0 {
+            return (d, tilt);
+        }
+    }
+    (face, face - inward * face.dot(inward))
 }
 
 /// A uniform point of a triangle's cell of `corner` (where its barycentric coordinate is the

@@ -140,15 +140,20 @@ impl Renderer {
 
     /// Splat output of every sample, in scene order: (irradiance RGB, area).
     pub fn splat_irradiance(&self) -> Result<Vec<([f32; 3], f32)>, RenderError> {
+        Ok(self
+            .splat_records()?
+            .iter()
+            .map(|s| ([s.irradiance_area[0], s.irradiance_area[1], s.irradiance_area[2]], s.irradiance_area[3]))
+            .collect())
+    }
+
+    /// The splat's whole record of every sample, in scene order.
+    pub fn splat_records(&self) -> Result<Vec<crate::render::records::SplatRecord>, RenderError> {
         // A scene without samples still has a buffer, of 16 bytes: less than one record.
         if self.scene.sample_count() == 0 {
             return Ok(Vec::new());
         }
-        let all: Vec<crate::render::records::SplatRecord> = self.gpu_scene.buffers.splat.read()?;
-        Ok(all
-            .iter()
-            .map(|s| ([s.irradiance_area[0], s.irradiance_area[1], s.irradiance_area[2]], s.irradiance_area[3]))
-            .collect())
+        Ok(self.gpu_scene.buffers.splat.read()?)
     }
 
     /// Where the last frame's non-finite values are, pass by pass and object by object (the
