@@ -6,20 +6,22 @@
 //     F_I = sum_J (W0_IJ Phi_J + Wmu_IJ Phimu_J + Wt_IJ T_J . u_JI) / A_I
 //     Phi_J = sum_(samples s in J) A_s E_t(s), Phimu_J and T_J alike weighted by the sample's
 //     mu_s - mu_bar and t_s (SampleFlux::from_splat), u_JI the unit direction in J's tangent
-//     plane towards I's centre (Patches::toward)
+//     plane towards I's centre (Patches::toward); Wmu and Wt are 0 beyond ENTRY_REACH patch
+//     radii, so each patch lists the J within it (TransportKernel::near)
 //     D_I = sum_(level's vertices v in I) a_v M_d(v) / sum a_v   (a_v: the level's dual cells)
 //     M(v) = M_d(v) sum_I w_vI F_I / sum_I w_vI D_I   (its eight nearest patches)
 // Each level of detail has its own patch records (its vertices, its D), sharing the object's W.
 // Three stages (push `stage.x`), each one dispatch per object, a barrier between them:
-//   0: one workgroup per patch: Phi, Phimu, T and D, summed over its items in shared memory;
+//   0: one invocation per patch: Phi, Phimu, T and D, summed over its items;
 //   1: one invocation per patch: F, its rows of W against every patch's fluxes;
 //   2: one invocation per vertex: the scale, in the channels push.stage.w names (the others
 //      take single scattering between points, which the pass before wrote), where the blended
 //      D is positive and the ratio finite (else the dipole's value stays).
 // Bindings: 0 = splat (SplatRecord[], read), 1 = exitance (vec4 per vertex, read by stage 0,
 // written by stage 2), 2 = patches (TransportPatchRecord[]), 3 = items (uvec2: index, area
-// bits), 4 = the kernels' rows (three vec4 per pair, rgb: W0, Wmu, Wt), 5 = sums (SUMS vec4
-// per patch: Phi, D, F, Phimu, T_r, T_g, T_b; written by stages 0 and 1), 6 = neighbours (four
+// bits), 4 = the kernels' rows (W0: a vec4 per pair, rgb; then per patch its near list, two
+// vec4 per J: Wmu rgb with J in w, exact as a float; Wt rgb), 5 = sums (SUMS vec4 per patch:
+// Phi, D, F, Phimu, T_r, T_g, T_b; written by stages 0 and 1), 6 = neighbours (four
 // uvec4 per vertex: (patch relative to the level's first record, weight bits) pairs), 7 = level
 // vertices (uint[], object-relative), 8 = samples (SampleRecord[]: the normals).
 // Push: TransportPush.
@@ -32,6 +34,7 @@ struct TransportPatchRecord {
     vec4 area;      // x: area; y: mu_bar, the mean cosine of the kernel's entries
     vec4 centre;    // xyz: centre
     vec4 normal;    // xyz: unit mean normal (0 where the patch's normals cancel)
+    uvec4 near;     // x: its near list's first entry in the rows; y: its length
 };
 
 const uint SUMS = 7u;
@@ -54,11 +57,6 @@ struct TransportPush {
 };
 layout(push_constant) uniform Push { TransportPush push; };
 
-shared vec3 part_phi[64];
-shared vec3 part_mu[64];
-shared vec3 part_t[3 * 64];
-shared vec4 part_d[64];
-
 // Sample item `it`'s weighted irradiance into the lane's sums: A_s E_t, and that times
 // mu_s - mu_bar and times t_s (SampleFlux::from_splat).
 void add_sample(uvec2 it, float mu_bar, inout vec3 phi, inout vec3 phi_mu, inout vec3 t[3]) {
@@ -80,43 +78,26 @@ void add_sample(uvec2 it, float mu_bar, inout vec3 phi, inout vec3 phi_mu, inout
     for (int c = 0; c < 3; ++c) t[c] += tilt * f[c];
 }
 
-// Stage 0: patch `p`'s Phi, Phimu, T and D, its items split over the workgroup.
+// Stage 0: patch `p`'s Phi, Phimu, T and D, one invocation walking its items (a workgroup per
+// patch summing in shared memory took 7 ms more on lavapipe: six arrays through six barriers).
 void patch_sums(uint p) {
     TransportPatchRecord r = patches[p];
-    uint lane = gl_LocalInvocationID.x;
     vec3 phi = vec3(0.0), phi_mu = vec3(0.0);
     vec3 t[3] = vec3[3](vec3(0.0), vec3(0.0), vec3(0.0));
     vec4 d = vec4(0.0);
-    for (uint k = lane; k < r.items.y; k += 64u) {
+    for (uint k = 0u; k < r.items.y; ++k) {
         uvec2 it = items[r.items.x + k];
         float a = uintBitsToFloat(it.y);
         d += vec4(a * exitance[it.x].rgb, a);
     }
-    for (uint k = lane; k < r.items.z; k += 64u) {
+    for (uint k = 0u; k < r.items.z; ++k) {
         add_sample(items[r.items.x + r.items.y + k], r.area.y, phi, phi_mu, t);
     }
-    part_phi[lane] = phi;
-    part_mu[lane] = phi_mu;
-    for (uint c = 0u; c < 3u; ++c) part_t[3u * lane + c] = t[c];
-    part_d[lane] = d;
-    barrier();
-    for (uint half_ = 32u; half_ > 0u; half_ >>= 1) {
-        if (lane < half_) {
-            part_phi[lane] += part_phi[lane + half_];
-            part_mu[lane] += part_mu[lane + half_];
-            for (uint c = 0u; c < 3u; ++c) part_t[3u * lane + c] += part_t[3u * (lane + half_) + c];
-            part_d[lane] += part_d[lane + half_];
-        }
-        barrier();
-    }
-    if (lane == 0u) {
-        sums[SUMS * p] = vec4(part_phi[0], 0.0);
-        // The dipole's mean over the level's vertices in the patch (0 where it has none).
-        vec4 s = part_d[0];
-        sums[SUMS * p + 1u] = vec4(s.w > 0.0 ? s.rgb / s.w : vec3(0.0), 0.0);
-        sums[SUMS * p + 3u] = vec4(part_mu[0], 0.0);
-        for (uint c = 0u; c < 3u; ++c) sums[SUMS * p + 4u + c] = vec4(part_t[c], 0.0);
-    }
+    sums[SUMS * p] = vec4(phi, 0.0);
+    // The dipole's mean over the level's vertices in the patch (0 where it has none).
+    sums[SUMS * p + 1u] = vec4(d.w > 0.0 ? d.rgb / d.w : vec3(0.0), 0.0);
+    sums[SUMS * p + 3u] = vec4(phi_mu, 0.0);
+    for (uint c = 0u; c < 3u; ++c) sums[SUMS * p + 4u + c] = vec4(t[c], 0.0);
 }
 
 // The unit direction in patch `from`'s tangent plane towards `to`'s centre (Patches::toward).
@@ -133,10 +114,14 @@ void patch_transport(uint p) {
     uint first = push.stage.y;
     vec3 f = vec3(0.0);
     for (uint j = 0u; j < push.stage.z; ++j) {
-        uint q = SUMS * (first + j), m = r.items.w + 3u * j;
+        f += matrix[r.items.w + j].rgb * sums[SUMS * (first + j)].rgb;
+    }
+    for (uint k = 0u; k < r.near.y; ++k) {
+        vec4 mu = matrix[r.near.x + 2u * k], tilt = matrix[r.near.x + 2u * k + 1u];
+        uint j = uint(mu.w), q = SUMS * (first + j);
         vec3 u = toward(patches[first + j], r.centre.xyz);
         vec3 tu = vec3(dot(sums[q + 4u].xyz, u), dot(sums[q + 5u].xyz, u), dot(sums[q + 6u].xyz, u));
-        f += matrix[m].rgb * sums[q].rgb + matrix[m + 1u].rgb * sums[q + 3u].rgb + matrix[m + 2u].rgb * tu;
+        f += mu.rgb * sums[q + 3u].rgb + tilt.rgb * tu;
     }
     // Linear in the entry: never below zero (TransportKernel::transport_exitance).
     sums[SUMS * p + 2u] = vec4(max(f / r.area.x, vec3(0.0)), 0.0);
@@ -167,7 +152,7 @@ void scale_vertex(uint i) {
 void main() {
     uint stage = push.stage.x;
     if (stage == 0u) {
-        patch_sums(push.stage.y + gl_WorkGroupID.x);
+        if (gl_GlobalInvocationID.x < push.stage.z) patch_sums(push.stage.y + gl_GlobalInvocationID.x);
     } else if (stage == 1u) {
         if (gl_GlobalInvocationID.x < push.stage.z) patch_transport(push.stage.y + gl_GlobalInvocationID.x);
     } else if (gl_GlobalInvocationID.x < push.vertices.y) {

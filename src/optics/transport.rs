@@ -12,7 +12,8 @@
 //!
 //! `mu` the cosine of `d` with the inward normal, `t` its tangential part, `u_JI` the unit
 //! direction in `J`'s tangent plane towards `I` (`Patches::toward`) and `mu_bar` the mean cosine
-//! of the walks' entries ([`EntryBasis`]). The three rows are the least-squares projection of
+//! of the walks' entries ([`EntryBasis`]); `Wmu` and `Wt` are 0 between patches more than
+//! [`ENTRY_REACH`] patch radii apart ([`TransportKernel::near`] lists those within). The three rows are the least-squares projection of
 //! the walks' response on that basis, estimated once by random walks in the mesh
 //! (`reference::rte_mesh::kernel`) with entry directions drawn as diffuse light refracts in,
 //! with no light or camera in it. A kernel of the normal entry alone was -10% at a marble
@@ -40,14 +41,14 @@ use crate::mesh::Mesh;
 use crate::mesh::patches::Patches;
 use glam::DVec3;
 
-/// How far the tilt row reaches, in patch radii (`Patches::radius`): `Wt_IJ` is walked only
-/// between patches whose centres are closer, and is 0 beyond. Farther, the entry's tilt moves
-/// little light while its row's estimate is the noisiest of the three (the tilt's weight is
-/// `t . u / E[(t . u)^2]`). On the 2 cm marble sphere, per band of incidence against the photon
-/// reference at 24 and 48 divisions, a reach of 3 took the terminator's bias from -10% to -3 to
-/// -6%, where an unbounded one added 3 to 7 points of noise and bias on the unlit side
+/// How far the entry's rows reach, in patch radii (`Patches::radius`): `Wmu_IJ` and `Wt_IJ`
+/// are walked only between patches whose centres are closer, and are 0 beyond. Farther, the
+/// entry's depth and tilt move little light while their rows' estimates are the noisiest (their
+/// weights are the basis functions over their variances). On the 2 cm marble sphere, against
+/// the photon reference at 24 and 48 divisions, this reach took the terminator's bias from -10%
+/// to -3 to -5%, where unbounded rows added 3 to 7 points of noise and bias on the unlit side
 /// (docs/PHYSICS.md, "The transport kernel").
-pub const TILT_REACH: f64 = 3.0;
+pub const ENTRY_REACH: f64 = 3.0;
 
 /// How the kernel's walks enter, and the moments of that entry the basis needs: directions
 /// refracted from diffuse light, `sin^2 theta_t` uniform on `[0, S]` with `S = min(1,
@@ -184,16 +185,18 @@ impl TransportKernel {
     /// axes follow a rigid move).
     pub fn transport_exitance(&self, flux: &PatchFlux, placed: &Patches) -> PerPatch {
         let k = self.patches.len();
+        let near = self.near();
         (0..k)
             .map(|i| {
                 let mut f = [0.0; 3];
                 for j in 0..k {
+                    (0..3).for_each(|c| f[c] += self.flux[c][i * k + j] * flux.phi[j][c]);
+                }
+                for &j in &near[i] {
+                    let (j, at) = (j as usize, i * k + j as usize);
                     let u = placed.toward(j, i);
                     for (c, f) in f.iter_mut().enumerate() {
-                        let at = i * k + j;
-                        *f += self.flux[c][at] * flux.phi[j][c]
-                            + self.depth[c][at] * flux.phi_mu[j][c]
-                            + self.sideways[c][at] * flux.tilt[j][c].dot(u);
+                        *f += self.depth[c][at] * flux.phi_mu[j][c] + self.sideways[c][at] * flux.tilt[j][c].dot(u);
                     }
                 }
                 // The basis is linear in the entry: where a noisy or strongly tilted row would
@@ -201,6 +204,14 @@ impl TransportKernel {
                 f.map(|f| (f / self.patches.area[i]).max(0.0))
             })
             .collect()
+    }
+
+    /// Per patch `I`, the patches `J` whose `Wmu_IJ` or `Wt_IJ` is not 0 in some channel (those
+    /// within [`ENTRY_REACH`]), ascending.
+    pub fn near(&self) -> Vec<Vec<u32>> {
+        let k = self.patches.len();
+        let nonzero = |at: usize| (0..3).any(|c| self.depth[c][at] != 0.0 || self.sideways[c][at] != 0.0);
+        (0..k).map(|i| (0..k).filter(|&j| nonzero(i * k + j)).map(|j| j as u32).collect()).collect()
     }
 
     /// Its three rows, `W0`, `Wmu` and `Wt`, each per channel.
@@ -285,9 +296,10 @@ impl TransportKernel {
         self.patches.of_vertex[mesh.triangles()[triangle as usize][corner] as usize]
     }
 
-    /// Bytes of device memory the kernel takes (its three rows as f32 RGBA per pair of
-    /// patches).
+    /// Bytes of device memory the kernel takes: `W0` as f32 RGBA per pair of patches, and
+    /// two RGBA per pair within the reach ([`TransportKernel::near`]).
     pub fn device_bytes(&self) -> u64 {
-        (self.patches.len() as u64).pow(2) * 16 * 3
+        let near: usize = self.near().iter().map(Vec::len).sum();
+        (self.patches.len() as u64).pow(2) * 16 + near as u64 * 32
     }
 }

@@ -15,9 +15,9 @@ use crate::optics::transport::TransportKernel;
 use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
 use std::path::Path;
 
-/// The version of the kernel's walk: a change to what it computes bumps it (3: the entry
-/// direction's basis, `optics::transport::EntryBasis`).
-pub const VERSION: u32 = 3;
+/// The version of the kernel's walk: a change to what it computes bumps it (4: the entry
+/// direction's basis, `optics::transport::EntryBasis`, within `ENTRY_REACH`).
+pub const VERSION: u32 = 4;
 
 /// One object's kernel, as cached.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

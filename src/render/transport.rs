@@ -85,8 +85,7 @@ impl RenderPass for TransportPass {
             vertices: [t.vertices[0], t.vertices[1], t.first_neighbour, t.first_entry],
         };
         for t in Self::planned(frame) {
-            // One workgroup of 64 per patch.
-            self.pipeline.dispatch(cmd, &self.set, &push(0, &t), [64 * t.patches[1], 1, 1]);
+            self.pipeline.dispatch(cmd, &self.set, &push(0, &t), [t.patches[1], 1, 1]);
         }
         frame.before(cmd, &[write(Resource::TransportSums, Access::ComputeReadWrite)]);
         for t in Self::planned(frame) {

@@ -19,6 +19,9 @@ pub struct TransportPatchRecord {
     pub centre: [f32; 4],
     /// xyz: its unit mean normal (0 where its normals cancel); w: 0.
     pub normal: [f32; 4],
+    /// x: its first entry-row entry in the matrix; y: their count (`TransportKernel::near`);
+    /// z, w: 0.
+    pub near: [u32; 4],
 }
 
 /// Where one level of detail of an object's kernel lies in the packed buffers.
@@ -44,8 +47,9 @@ pub struct PackedTransport {
     pub patches: Vec<TransportPatchRecord>,
     /// Per patch record, its level's vertices then its samples: (absolute index, area bits).
     pub items: Vec<[u32; 2]>,
-    /// Each kernel's rows pair by pair (`[(I K + J) 3 + b]`, `b` the basis: `W0`, `Wmu`,
-    /// `Wt`), RGB and 0.
+    /// Each kernel's `W0` row by row (`[I K + J]`), RGB and 0; then per patch `I` its entry
+    /// rows within the reach, two entries per `J`: `Wmu_IJ` RGB with `J` (exact as an f32), `Wt_IJ` RGB
+    /// and 0.
     pub matrix: Vec<[f32; 4]>,
     /// Per vertex of every kernel's object, four `uvec4`s: eight (patch, weight bits) pairs,
     /// the patches relative to a level's first record.
@@ -83,9 +87,17 @@ impl PackedTransport {
             samples[i as usize].push([first_sample + s as u32, (sample.area as f32).to_bits()]);
         }
         let first_row = self.matrix.len() as u32;
-        let rows: Vec<&[Vec<f64>; 3]> = kernel.rows().collect();
-        for ij in 0..k * k {
-            self.matrix.extend(rows.iter().map(|w| [w[0][ij] as f32, w[1][ij] as f32, w[2][ij] as f32, 0.0]));
+        self.matrix
+            .extend((0..k * k).map(|ij| [0, 1, 2].map(|c| kernel.flux[c][ij] as f32)).map(|[r, g, b]| [r, g, b, 0.0]));
+        let mut near_rows = Vec::with_capacity(k);
+        for (i, near) in kernel.near().iter().enumerate() {
+            near_rows.push([self.matrix.len() as u32, near.len() as u32]);
+            for &j in near {
+                let at = i * k + j as usize;
+                let (mu, t) = ([0, 1, 2].map(|c| kernel.depth[c][at] as f32), [0, 1, 2].map(|c| kernel.sideways[c][at] as f32));
+                self.matrix.push([mu[0], mu[1], mu[2], j as f32]);
+                self.matrix.push([t[0], t[1], t[2], 0.0]);
+            }
         }
         let first_neighbour = self.neighbours.len() as u32;
         for near in TransportKernel::vertex_neighbours(&placed, &o.mesh) {
@@ -111,7 +123,7 @@ impl PackedTransport {
                     self.items.extend(&vertices[i]);
                     self.items.extend(&samples[i]);
                     let (nv, ns) = (vertices[i].len() as u32, samples[i].len() as u32);
-                    let row = first_row + (i * k * 3) as u32;
+                    let row = first_row + (i * k) as u32;
                     let c = placed.centres[i];
                     let n = glam::DVec3::new(c[3], c[4], c[5]).normalize_or_zero();
                     self.patches.push(TransportPatchRecord {
@@ -119,6 +131,7 @@ impl PackedTransport {
                         area: [placed.area[i] as f32, kernel.mu_mean as f32, 0.0, 0.0],
                         centre: [c[0] as f32, c[1] as f32, c[2] as f32, 0.0],
                         normal: [n.x as f32, n.y as f32, n.z as f32, 0.0],
+                        near: [near_rows[i][0], near_rows[i][1], 0, 0],
                     });
                 }
                 LevelTransport {

@@ -7,7 +7,7 @@
 //! walks, is the least-squares coefficient of that basis: `W0_IJ = E[O_I]`,
 //! `Wmu_IJ = E[O_I (mu - mu_bar)] / Var mu` and `Wt_IJ = E[O_I (t . u_JI)] / E[(t . u)^2]` (the
 //! basis functions are orthogonal under the entry's distribution: the tilt is odd in the
-//! azimuth), `Wt` only within `TILT_REACH` patch radii. Each patch has its own random stream, so
+//! azimuth), `Wmu` and `Wt` only within `ENTRY_REACH` patch radii. Each patch has its own random stream, so
 //! the kernel does not depend on the threads.
 
 use super::geometry::Geometry;
@@ -15,7 +15,7 @@ use super::tally::Exit;
 use super::walk::{Start, walk};
 use crate::mesh::Mesh;
 use crate::mesh::patches::Patches;
-use crate::optics::transport::{EntryBasis, TILT_REACH, TransportKernel};
+use crate::optics::transport::{EntryBasis, ENTRY_REACH, TransportKernel};
 use crate::reference::rte::{Medium, chunk_rng};
 use glam::DVec3;
 use rand::RngExt;
@@ -102,7 +102,8 @@ fn column(
         })
         .collect();
     let total = cdf[cdf.len() - 1];
-    let toward: Vec<DVec3> = (0..k).map(|i| reached(patches, at.patch, i)).collect();
+    let near: Vec<bool> = (0..k).map(|i| within_reach(patches, at.patch, i)).collect();
+    let toward: Vec<DVec3> = (0..k).map(|i| if near[i] { patches.toward(at.patch, i) } else { DVec3::ZERO }).collect();
     let (mu_bar, mu_var, tilt_var) = (at.entry.mu_mean(), at.entry.mu_variance(), at.entry.tilt_variance());
     let mut exits: Vec<Exit> = Vec::new();
     for _ in 0..walks {
@@ -120,7 +121,9 @@ fn column(
             for e in &exits {
                 let i = patches.of_vertex[e.vertex] as usize;
                 out[0][channel][i] += e.weight;
-                out[1][channel][i] += e.weight * depth;
+                if near[i] {
+                    out[1][channel][i] += e.weight * depth;
+                }
                 out[2][channel][i] += e.weight * tilt.dot(toward[i]) / tilt_var;
             }
         }
@@ -130,13 +133,12 @@ fn column(
     out
 }
 
-/// The tilt's axis from patch `j` towards patch `i` (`Patches::toward`), 0 beyond
-/// `TILT_REACH` patch radii: the tilt row is walked only there.
-fn reached(patches: &Patches, j: usize, i: usize) -> DVec3 {
+/// Whether patches `j` and `i` are within `ENTRY_REACH` patch radii: the entry's depth and
+/// tilt rows are walked only there.
+fn within_reach(patches: &Patches, j: usize, i: usize) -> bool {
     let (a, b) = (&patches.centres[j], &patches.centres[i]);
     let d2: f64 = (0..3).map(|x| (a[x] - b[x]).powi(2)).sum();
-    let reach = TILT_REACH * patches.radius;
-    if d2 <= reach * reach { patches.toward(j, i) } else { DVec3::ZERO }
+    d2 <= (ENTRY_REACH * patches.radius).powi(2)
 }
 
 /// An entry direction about the inward shading normal `inward` drawn from `entry`, and its
