@@ -13,8 +13,9 @@
 //! `mu` the cosine of `d` with the inward normal, `t` its tangential part, `u_JI` the unit
 //! direction in `J`'s tangent plane towards `I` (`Patches::toward`) and `mu_bar` the mean cosine
 //! of the walks' entries ([`EntryBasis`]); `Wmu` and `Wt` are 0 between patches more than
-//! [`ENTRY_REACH`] patch radii apart ([`TransportKernel::near`] lists those within). The three rows are the least-squares projection of
-//! the walks' response on that basis, estimated once by random walks in the mesh
+//! [`ENTRY_REACH`] patch radii apart ([`TransportKernel::near`] lists those within). The three
+//! rows are the least-squares projection of the walks' response on that basis, estimated once
+//! by random walks in the mesh
 //! (`reference::rte_mesh::kernel`) with entry directions drawn as diffuse light refracts in,
 //! with no light or camera in it. A kernel of the normal entry alone was -10% at a marble
 //! sphere's terminator, where grazing light refracts into a beam running sideways just under
@@ -26,8 +27,9 @@
 //!
 //! - `Phi_J = sum A_s E_t`, `Phimu_J = sum A_s E_t (mu_s - mu_bar)` and `T_J = sum A_s E_t t_s`
 //!   over the samples in `J` ([`PatchFlux`]);
-//! - `F_I = sum_J (W0_IJ Phi_J + Wmu_IJ Phimu_J + Wt_IJ T_J . u_JI) / A_I`, the kernel's
-//!   exitance averaged over `I`;
+//! - `F_I = max(0, sum_J (W0_IJ Phi_J + Wmu_IJ Phimu_J + Wt_IJ T_J . u_JI)) / A_I`, the
+//!   kernel's exitance averaged over `I` (the basis is linear in the entry, and may extrapolate
+//!   below zero);
 //! - `D_I = sum_(v in I) A_v M_d(v) / A_I`, the dipole's, alike (`A_v` the vertex's dual cell);
 //! - `M(v) = M_d(v) sum_I w_vI F_I / sum_I w_vI D_I` over the vertex's nearest patches with
 //!   the weights of `Patches::neighbours`.
@@ -301,5 +303,35 @@ impl TransportKernel {
     pub fn device_bytes(&self) -> u64 {
         let near: usize = self.near().iter().map(Vec::len).sum();
         (self.patches.len() as u64).pow(2) * 16 + near as u64 * 32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::EntryBasis;
+
+    #[test]
+    fn the_entrys_closed_form_moments_are_those_of_its_samples() {
+        for eta in [1.0, 1.3, 1.5] {
+            let entry = EntryBasis::new(eta);
+            let n = 200_000;
+            let (mut m1, mut m2, mut t2) = (0.0, 0.0, 0.0);
+            for k in 0..n {
+                // A stratified grid in (u, v): the sample mean converges fast.
+                let (u, v) = ((k as f64 + 0.5) / n as f64, ((k * 7919) % n) as f64 / n as f64);
+                let (mu, phi) = entry.sample(u, v);
+                m1 += mu;
+                m2 += mu * mu;
+                t2 += (1.0 - mu * mu) * phi.cos().powi(2);
+            }
+            let (m1, m2, t2) = (m1 / n as f64, m2 / n as f64, t2 / n as f64);
+            assert!((m1 - entry.mu_mean()).abs() < 1e-4, "eta {eta}: mean {m1} against {}", entry.mu_mean());
+            assert!((m2 - m1 * m1 - entry.mu_variance()).abs() < 1e-4, "eta {eta}: variance");
+            assert!(
+                (t2 - entry.tilt_variance()).abs() < 1e-3,
+                "eta {eta}: tilt {t2} against {}",
+                entry.tilt_variance()
+            );
+        }
     }
 }

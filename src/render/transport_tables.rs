@@ -94,7 +94,8 @@ impl PackedTransport {
             near_rows.push([self.matrix.len() as u32, near.len() as u32]);
             for &j in near {
                 let at = i * k + j as usize;
-                let (mu, t) = ([0, 1, 2].map(|c| kernel.depth[c][at] as f32), [0, 1, 2].map(|c| kernel.sideways[c][at] as f32));
+                let (mu, t) =
+                    ([0, 1, 2].map(|c| kernel.depth[c][at] as f32), [0, 1, 2].map(|c| kernel.sideways[c][at] as f32));
                 self.matrix.push([mu[0], mu[1], mu[2], j as f32]);
                 self.matrix.push([t[0], t[1], t[2], 0.0]);
             }

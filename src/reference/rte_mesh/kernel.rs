@@ -15,7 +15,7 @@ use super::tally::Exit;
 use super::walk::{Start, walk};
 use crate::mesh::Mesh;
 use crate::mesh::patches::Patches;
-use crate::optics::transport::{EntryBasis, ENTRY_REACH, TransportKernel};
+use crate::optics::transport::{ENTRY_REACH, EntryBasis, TransportKernel};
 use crate::reference::rte::{Medium, chunk_rng};
 use glam::DVec3;
 use rand::RngExt;
