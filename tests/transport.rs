@@ -135,6 +135,38 @@ fn tilting_the_entry_towards_a_nearby_patch_sends_it_more_light_and_the_entry_ro
     }
 }
 
+#[test]
+fn the_kernel_is_reciprocal_flux_from_j_to_i_equals_flux_from_i_to_j_within_its_noise() {
+    // The radiative transfer is reciprocal: under uniform irradiance, the flux that J sends out
+    // through I equals what I sends through J, A_J W0_IJ = A_I W0_JI. The walks enter as
+    // diffuse light refracts in and leave through the Fresnel boundary, the same angular weight
+    // both ways up to Fresnel's transmittance, which the sphere's patches share.
+    let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
+    let kernel =
+        object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 24 * 4000, seed: 5 }, &quiet).unwrap();
+    let (k, area) = (kernel.patches.len(), &kernel.patches.area);
+    for c in 0..3 {
+        let w = &kernel.flux[c];
+        // The pairs that exchange at least a twentieth of what a patch sends itself: farther, a
+        // few hundred of the walks reach, and the ratio is noise.
+        let floor = 0.05 * (0..k).map(|i| area[i] * w[i * k + i]).sum::<f64>() / k as f64;
+        let mut logs = Vec::new();
+        for i in 0..k {
+            for j in (i + 1)..k {
+                let (ij, ji) = (area[j] * w[i * k + j], area[i] * w[j * k + i]);
+                if ij.min(ji) > floor {
+                    logs.push((ij / ji).ln());
+                }
+            }
+        }
+        let mean = logs.iter().sum::<f64>() / logs.len() as f64;
+        let within = logs.iter().filter(|l| l.abs() < 0.2).count() as f64 / logs.len() as f64;
+        eprintln!("channel {c}: mean log ratio {mean:.4}, share within 20% {within:.3}, pairs {}", logs.len());
+        assert!(mean.abs() < 0.05, "channel {c}: A_J W_IJ / A_I W_JI averages exp({mean:.4})");
+        assert!(within > 0.9, "channel {c}: only {within:.3} of the pairs are reciprocal within 20%");
+    }
+}
+
 /// The splat's record per sample.
 type Splat = Vec<SplatRecord>;
 
