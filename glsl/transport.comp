@@ -3,7 +3,7 @@
 // vertices of an object with material.model = "transport" (those of its level of detail this
 // frame), scaled per patch of its surface to the radiative transfer through its own mesh, the
 // entry direction carried in the kernel's basis (1, mu - mu_bar, t . u_JI):
-//     F_I = sum_J (W0_IJ Phi_J + Wmu_IJ Phimu_J + Wt_IJ T_J . u_JI) / A_I
+//     F_I = max(0, sum_J (W0_IJ Phi_J + Wmu_IJ Phimu_J + Wt_IJ T_J . u_JI)) / A_I
 //     Phi_J = sum_(samples s in J) A_s E_t(s), Phimu_J and T_J alike weighted by the sample's
 //     mu_s - mu_bar and t_s (SampleFlux::from_splat), u_JI the unit direction in J's tangent
 //     plane towards I's centre (Patches::toward); Wmu and Wt are 0 beyond ENTRY_REACH patch
@@ -78,8 +78,9 @@ void add_sample(uvec2 it, float mu_bar, inout vec3 phi, inout vec3 phi_mu, inout
     for (int c = 0; c < 3; ++c) t[c] += tilt * f[c];
 }
 
-// Stage 0: patch `p`'s Phi, Phimu, T and D, one invocation walking its items (a workgroup per
-// patch summing in shared memory took 7 ms more on lavapipe: six arrays through six barriers).
+// Stage 0: patch `p`'s Phi, Phimu, T and D, one invocation walking its items (a patch has a
+// few hundred; a workgroup per patch summing six arrays through shared memory and six barriers
+// was no faster on lavapipe).
 void patch_sums(uint p) {
     TransportPatchRecord r = patches[p];
     vec3 phi = vec3(0.0), phi_mu = vec3(0.0);
