@@ -116,7 +116,7 @@ fn tilting_the_entry_towards_a_nearby_patch_sends_it_more_light_and_the_entry_ro
     let kernel =
         object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 24 * 2000, seed: 4 }, &quiet).unwrap();
     let (k, p) = (kernel.patches.len(), &kernel.patches);
-    let distance = |i: usize, j: usize| (0..3).map(|x| (p.centres[i][x] - p.centres[j][x]).powi(2)).sum::<f64>().sqrt();
+    let distance = |i: usize, j: usize| p.centre(i).distance(p.centre(j));
     for c in 0..3 {
         let (mut near, mut out_of_reach) = (0.0, 0usize);
         for i in 0..k {

@@ -114,10 +114,20 @@ impl Patches {
     /// transport kernel reads an entry's sideways tilt (`optics::transport`). It follows a rigid
     /// move, as the centres do.
     pub fn toward(&self, from: usize, to: usize) -> DVec3 {
-        let (a, b) = (&self.centres[from], &self.centres[to]);
-        let n = DVec3::new(a[3], a[4], a[5]).normalize_or_zero();
-        let d = DVec3::new(b[0] - a[0], b[1] - a[1], b[2] - a[2]);
+        let (n, d) = (self.normal(from), self.centre(to) - self.centre(from));
         (d - n * d.dot(n)).normalize_or_zero()
+    }
+
+    /// Patch `i`'s centre's position.
+    pub fn centre(&self, i: usize) -> DVec3 {
+        let c = &self.centres[i];
+        DVec3::new(c[0], c[1], c[2])
+    }
+
+    /// Patch `i`'s unit mean normal (zero where its normals cancel).
+    pub fn normal(&self, i: usize) -> DVec3 {
+        let c = &self.centres[i];
+        DVec3::new(c[3], c[4], c[5]).normalize_or_zero()
     }
 
     /// The features of a surface point at `p` with normal `n`.

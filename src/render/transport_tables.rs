@@ -48,8 +48,8 @@ pub struct PackedTransport {
     /// Per patch record, its level's vertices then its samples: (absolute index, area bits).
     pub items: Vec<[u32; 2]>,
     /// Each kernel's `W0` row by row (`[I K + J]`), RGB and 0; then per patch `I` its entry
-    /// rows within the reach, two entries per `J`: `Wmu_IJ` RGB with `J` (exact as an f32), `Wt_IJ` RGB
-    /// and 0.
+    /// rows within the reach, two entries per `J`: `Wmu_IJ` RGB with `J` (exact as an f32),
+    /// `Wt_IJ` RGB and 0.
     pub matrix: Vec<[f32; 4]>,
     /// Per vertex of every kernel's object, four `uvec4`s: eight (patch, weight bits) pairs,
     /// the patches relative to a level's first record.
@@ -125,12 +125,11 @@ impl PackedTransport {
                     self.items.extend(&samples[i]);
                     let (nv, ns) = (vertices[i].len() as u32, samples[i].len() as u32);
                     let row = first_row + (i * k) as u32;
-                    let c = placed.centres[i];
-                    let n = glam::DVec3::new(c[3], c[4], c[5]).normalize_or_zero();
+                    let (c, n) = (placed.centre(i), placed.normal(i));
                     self.patches.push(TransportPatchRecord {
                         items: [first_item, nv, ns, row],
                         area: [placed.area[i] as f32, kernel.mu_mean as f32, 0.0, 0.0],
-                        centre: [c[0] as f32, c[1] as f32, c[2] as f32, 0.0],
+                        centre: [c.x as f32, c.y as f32, c.z as f32, 0.0],
                         normal: [n.x as f32, n.y as f32, n.z as f32, 0.0],
                         near: [near_rows[i][0], near_rows[i][1], 0, 0],
                     });

@@ -7,8 +7,8 @@
 //! walks, is the least-squares coefficient of that basis: `W0_IJ = E[O_I]`,
 //! `Wmu_IJ = E[O_I (mu - mu_bar)] / Var mu` and `Wt_IJ = E[O_I (t . u_JI)] / E[(t . u)^2]` (the
 //! basis functions are orthogonal under the entry's distribution: the tilt is odd in the
-//! azimuth), `Wmu` and `Wt` only within `ENTRY_REACH` patch radii. Each patch has its own random stream, so
-//! the kernel does not depend on the threads.
+//! azimuth), `Wmu` and `Wt` only within `ENTRY_REACH` patch radii. Each patch has its own
+//! random stream, so the kernel does not depend on the threads.
 
 use super::geometry::Geometry;
 use super::tally::Exit;
@@ -136,9 +136,7 @@ fn column(
 /// Whether patches `j` and `i` are within `ENTRY_REACH` patch radii: the entry's depth and
 /// tilt rows are walked only there.
 fn within_reach(patches: &Patches, j: usize, i: usize) -> bool {
-    let (a, b) = (&patches.centres[j], &patches.centres[i]);
-    let d2: f64 = (0..3).map(|x| (a[x] - b[x]).powi(2)).sum();
-    d2 <= (ENTRY_REACH * patches.radius).powi(2)
+    patches.centre(j).distance_squared(patches.centre(i)) <= (ENTRY_REACH * patches.radius).powi(2)
 }
 
 /// An entry direction about the inward shading normal `inward` drawn from `entry`, and its
