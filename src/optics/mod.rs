@@ -19,6 +19,9 @@
 //! - [`kernel`]: the near-field kernel: what one sample point of area `dA` contributes to a
 //!   receiver at distance `r` in the discrete dipole sum (seed Eq. 11), so that the sum conserves
 //!   energy whatever the ratio of diffusion length to sample spacing.
+//! - [`model_error`]: the dipole's error against the radiative transfer equation, predicted
+//!   from the object's size against the medium's lengths and the albedo (what `model = "auto"`
+//!   weighs).
 //! - [`presets`]: the measured materials of Jensen et al. 2001 and Narasimhan et al. 2006.
 //! - [`single_scatter`]: the single-scattering reflectance of a half-space (Jensen et al. 2001,
 //!   Eq. 3), the first-order term the dipole leaves out.
@@ -35,6 +38,7 @@ pub mod fresnel;
 pub mod gpu;
 pub mod kernel;
 pub mod material;
+pub mod model_error;
 pub mod presets;
 pub mod quadrature;
 pub mod single_scatter;

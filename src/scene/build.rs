@@ -343,6 +343,7 @@ fn placed_object(
         atlas: None,
         transport: None,
         kernel_dropped: None,
+        model: None,
     }
 }
 
@@ -380,6 +381,7 @@ fn sample_objects(scene: &Scene, objects: &mut [PreparedObject], only: Option<us
             })?;
             let count = Some(o.samples.len());
             o.density = Some(super::accuracy::choose_count(&dipoles, facts, count, file.render.max_error).1);
+            o.choose_model(file.render.max_error);
             continue;
         }
         let (count, density) =
@@ -393,6 +395,7 @@ fn sample_objects(scene: &Scene, objects: &mut [PreparedObject], only: Option<us
             .with_context(|| format!("{}: object[{i}] ({}): sampling", scene.name, o.name))?
             .points;
         o.density = Some(density);
+        o.choose_model(file.render.max_error);
     }
     Ok(())
 }

@@ -169,7 +169,8 @@ pub enum MaterialSpec {
         /// GGX roughness of the dielectric specular lobe (default 0.35; 0 to 1).
         #[serde(default = "roughness")]
         roughness: f32,
-        /// Which model each channel takes (default `"dipole"`; `"auto"`, `"single"`).
+        /// Which model each channel takes (default `"auto"`; `"dipole"`, `"single"`,
+        /// `"transport"`).
         #[serde(default)]
         model: ScatteringModel,
     },
@@ -494,11 +495,12 @@ named_choices!(GatherMode, "gather mode", {
 pub enum ScatteringModel {
     /// The dipole in every channel (the paper's model, and the one the study's exact integral
     /// measures the sum against)
-    #[default]
     Dipole,
     /// Per channel: single scattering between points where the reduced albedo is under 0.3
     /// (`optics::beam_single::ALBEDO_BELOW`), where it is closer to the radiative transfer than
-    /// the dipole; the dipole elsewhere
+    /// the dipole; elsewhere the transport kernel where the dipole's predicted error against the
+    /// light is over `render.max_error` in a closed mesh (`scene::model_choice`), else the dipole
+    #[default]
     Auto,
     /// Single scattering between points in every channel
     Single,

@@ -8,6 +8,7 @@ mod check;
 pub mod format;
 pub mod gltf;
 pub mod lights;
+pub mod model_choice;
 pub mod needs;
 mod object;
 mod warnings;

@@ -62,6 +62,9 @@ pub struct ObjectFacts {
     /// How its sample count was chosen and the per-vertex error predicted for it
     /// (`scene::accuracy`); `None` for an opaque object.
     pub density: Option<super::accuracy::Density>,
+    /// Which model each channel takes, why, and the error predicted against the light
+    /// (`scene::model_choice`); `None` for an opaque object.
+    pub model: Option<super::model_choice::ModelChoice>,
 }
 
 /// Where an object's material asks for the transport kernel (`optics::transport`), what it
@@ -92,12 +95,14 @@ impl std::fmt::Display for KernelState {
             KernelState::Scales { patches, walks } => write!(
                 f,
                 "transport kernel ({patches} patches, {walks} walks each) scales the dipole's exitance after the \
-                 gather to the transport through this mesh (material.model = \"transport\")"
+                 gather to the transport through this mesh"
             ),
             KernelState::NotAttached => {
-                write!(f, "material.model = \"transport\" but no kernel is attached: the dipole alone")
+                write!(f, "the transport kernel is chosen but none is attached: the dipole alone")
             }
-            KernelState::Dropped { why } => write!(f, "transport kernel dropped: {why}; the dipole alone until one is attached")
+            KernelState::Dropped { why } => {
+                write!(f, "transport kernel dropped: {why}; the dipole alone until one is attached")
+            }
         }
     }
 }
@@ -180,6 +185,7 @@ impl ObjectFacts {
                 })
                 .collect(),
             density: object.density.clone(),
+            model: object.model.clone(),
         }
     }
 }

@@ -63,6 +63,8 @@ pub struct PreparedObject {
     pub transport: Option<std::sync::Arc<crate::optics::transport::TransportKernel>>,
     /// Why a kernel it had was dropped (it takes the dipole until one is attached again).
     pub kernel_dropped: Option<KernelDropped>,
+    /// Which model each channel takes and why (translucent objects only; `material.model`).
+    pub model: Option<super::model_choice::ModelChoice>,
 }
 
 /// Why an object's transport kernel no longer holds, so that it was dropped.
@@ -97,9 +99,26 @@ impl PreparedObject {
         }
     }
 
-    /// Whether its material asks for the transport kernel (`material.model = "transport"`).
+    /// Whether its material asks for the transport kernel: `material.model = "transport"`, or
+    /// `"auto"` where the dipole's predicted error is over `render.max_error`
+    /// (`scene::model_choice`).
     pub fn wants_transport(&self) -> bool {
         matches!(&self.material, ResolvedMaterial::Translucent { model: super::ScatteringModel::Transport, .. })
+            || self.model.as_ref().is_some_and(super::model_choice::ModelChoice::kernel)
+    }
+
+    /// Chooses each channel's model anew (`scene::model_choice`) for `render.max_error`
+    /// `target`: after sampling, and after a material edit.
+    pub fn choose_model(&mut self, target: f64) {
+        use super::model_choice::{ModelChoice, object_size};
+        self.model = match &self.material {
+            ResolvedMaterial::Translucent { dipoles, model, .. } => {
+                let curvature_radius = self.density.as_ref().map_or(f64::INFINITY, |d| d.facts.curvature_radius);
+                let size = object_size(&self.mesh, curvature_radius);
+                Some(ModelChoice::choose(*model, dipoles, size, target))
+            }
+            ResolvedMaterial::Opaque { .. } => None,
+        };
     }
 
     /// The hierarchy over its samples for the hierarchical gather (built on each call; the

@@ -225,6 +225,9 @@ pub struct ObjectPlan {
     /// Its sample count and the per-vertex error predicted for it (`scene::accuracy`;
     /// translucent objects only).
     pub density: Option<crate::scene::accuracy::Density>,
+    /// Which model each channel takes, why, and the error predicted for it against the light
+    /// (`scene::model_choice`; translucent objects only).
+    pub model: Option<crate::scene::model_choice::ModelChoice>,
 }
 
 impl ObjectPlan {
@@ -354,6 +357,9 @@ impl fmt::Display for Plan {
             }
             if let Some(d) = &o.density {
                 writeln!(f, "    {d}")?;
+            }
+            if let Some(m) = &o.model {
+                writeln!(f, "    models: {m}")?;
             }
             for (c, ch) in ["R", "G", "B"].iter().zip(&o.channels) {
                 let t = match ch.transport {

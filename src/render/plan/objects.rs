@@ -2,11 +2,11 @@
 //! splatted and gathered this frame.
 
 use super::frame::Frame;
+use super::receivers::{ReceiverScope, SWEEP_FRAMES, Sweep};
 use super::{
     Change, ChannelFigures, ChannelPlan, ChannelReason, LOCAL_PIXELS, LOCAL_SPACING, LOD_EDGE_PIXELS, LOD_ERROR_PIXELS,
     LevelReason, ObjectPlan, ObjectReason, SplatLights, Transport,
 };
-use super::receivers::{ReceiverScope, SWEEP_FRAMES, Sweep};
 use crate::scene::TransportMode;
 use crate::scene::needs::{LevelFacts, ObjectFacts};
 use glam::Vec3;
@@ -126,7 +126,9 @@ impl Frame<'_> {
                 ReceiverScope::of(facts, policy, mode, history.generation, false, Some(Sweep { chunk, of }))
             }
             // A gather that aggregates the splat makes a new generation; no gather, none.
-            _ if gather => ReceiverScope::of(facts, policy, mode, history.generation.wrapping_add(1).max(1), true, None),
+            _ if gather => {
+                ReceiverScope::of(facts, policy, mode, history.generation.wrapping_add(1).max(1), true, None)
+            }
             _ => ReceiverScope::of(facts, policy, mode, history.generation, false, None),
         };
         let kept = history.environment_kept && !self.environment_stale && change != Change::Material(i);
@@ -151,6 +153,7 @@ impl Frame<'_> {
             level,
             level_why,
             density: facts.density.clone(),
+            model: facts.model.clone(),
         }
     }
 

@@ -21,6 +21,7 @@ fn object(radius: f32, spacing: f64, profile: f64) -> ObjectFacts {
             locked: false,
         }],
         density: None,
+        model: None,
     }
 }
 

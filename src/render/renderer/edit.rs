@@ -103,18 +103,18 @@ impl Renderer {
         if self.gpu_scene.beams[object].is_some() {
             return Err(RenderError::MaterialWithBeamTables(object));
         }
+        let target = self.scene.scene.file.render.max_error;
         let o = &mut self.scene.objects[object];
         let crate::scene::build::ResolvedMaterial::Translucent { material: m, dipoles, mm_per_unit, .. } =
             &mut o.material
         else {
             return Err(RenderError::OpaqueObject(object));
         };
-        *dipoles = material
-            .dipoles(*mm_per_unit)
-            .map_err(|source| RenderError::InvalidMaterial { object, source })?;
+        *dipoles = material.dipoles(*mm_per_unit).map_err(|source| RenderError::InvalidMaterial { object, source })?;
         // The one copy: the prepared object's. A later move (`SceneEdit::Transform`) keeps it,
         // and `scene().scene.file` stays the file as it was read.
         *m = material;
+        o.choose_model(target);
         // The kernel is the old medium's: the object takes the dipole until one is attached.
         if o.transport.take().is_some() {
             o.kernel_dropped = Some(crate::scene::build::KernelDropped::MaterialEdited);
