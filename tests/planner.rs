@@ -281,6 +281,14 @@ fn plan_prints_every_change_and_its_json_has_the_documented_fields() {
         assert!(bunny.get(key).is_some(), "{key} missing from {bunny}");
     }
     assert_eq!(bunny["channels"][0]["transport"], "gather");
+    // docs/PHYSICS.md, "Which model a channel takes": the default model weighed the dipole's
+    // predicted error against the light, over the 1% target on the bunny, so the kernel.
+    let model = &bunny["model"]["channels"][0];
+    assert_eq!(model["takes"], "kernel", "{model}");
+    assert_eq!(model["reason"]["why"], "dipole_over_target", "{model}");
+    assert!(model["dipole"]["error"].as_f64().is_some_and(|e| e > 0.01), "{model}");
+    assert!(model["predicted"].as_f64().is_some_and(|e| e < model["dipole"]["error"].as_f64().unwrap()), "{model}");
+    assert_eq!(bunny["transport"]["state"], "scales", "plan walks or reads the kernel it chose: {bunny}");
     assert!(json["objects"][0]["channels"][0]["profile_radius"].as_f64().unwrap() > 0.0);
     // docs/PLAN.md, "The sample count": the facts and each channel's terms.
     let density = &bunny["density"];
@@ -442,5 +450,36 @@ fn display_output_on_the_renderers_own_image_is_refused() {
         let scene = PreparedScene::new(&Scene::builtin(), &Overrides { samples: Some(400), ..Overrides::default() });
         let made = Renderer::with_options(gpu, scene.unwrap(), translucent::TargetDesc::Own, options);
         assert!(matches!(made, Err(translucent::RenderError::DisplayOnOwnTarget)), "{:?}", made.err());
+    });
+}
+
+/// `model = "auto"` (the default) takes the transport kernel where the dipole's predicted error
+/// against the light is over `render.max_error`, and the dipole where it is within: a 2 cm
+/// marble sphere is predicted about 25% off, so a 1% target walks the kernel and a 40% one does
+/// not; a material edit chooses anew.
+#[test]
+fn auto_takes_the_kernel_only_where_the_dipoles_predicted_error_is_over_the_target() {
+    let text = std::fs::read_to_string(repo_path("assets/scenes/sphere-marble.toml")).unwrap();
+    let at = |t: f64| prepare(&text, &Overrides { max_error: Some(t), ..Overrides::default() });
+    let tight = at(0.01);
+    assert!(tight.objects[0].wants_transport(), "{:?}", tight.objects[0].model);
+    let loose = at(0.4);
+    assert!(!loose.objects[0].wants_transport(), "{:?}", loose.objects[0].model);
+    let dipole = text.replace("mm_per_unit = 1000.0", "mm_per_unit = 1000.0, model = \"dipole\"");
+    let named = prepare(&dipole, &Overrides { max_error: Some(0.01), ..Overrides::default() });
+    assert!(!named.objects[0].wants_transport(), "{:?}", named.objects[0].model);
+    // A medium a thousand times denser in a sphere as large: its diffusion length is a thousandth,
+    // near the half-space, where the dipole is within 40% and a 40% target keeps it.
+    with_gpu(|gpu| {
+        let mut renderer = Renderer::new(gpu, loose).unwrap();
+        let marble = Material::preset("marble").unwrap();
+        let dense = Material {
+            sigma_a: marble.sigma_a.map(|s| s * 1000.0),
+            sigma_s_prime: marble.sigma_s_prime.map(|s| s * 1000.0),
+            ..marble
+        };
+        renderer.edit(SceneEdit::Material { object: 0, material: dense }).unwrap();
+        let choice = renderer.scene().objects[0].model.clone().unwrap();
+        assert!(choice.channels.iter().all(|c| c.dipole.error < 0.05), "{choice}");
     });
 }

@@ -83,8 +83,8 @@ impl ModelChoice {
         let single = model.single_channels(dipoles.map(|d| d.alpha_prime));
         let facts = dipoles.map(|d| ModelFacts::new(d.alpha_prime, d.diffusion_length(), d.mean_free_path(), size));
         let dipole = facts.map(|f| model_error::dipole_error(&f));
-        // NaN counts as over: `!(e <= target)`.
-        let over = (0..3).any(|c| !single[c] && !(dipole[c].error <= target));
+        // NaN counts as over.
+        let over = (0..3).any(|c| !single[c] && (dipole[c].error.is_nan() || dipole[c].error > target));
         let (rest, why) = match model {
             ScatteringModel::Dipole | ScatteringModel::Single => (ChannelModel::Dipole, ModelReason::Named),
             ScatteringModel::Transport => (ChannelModel::Kernel, ModelReason::Named),
