@@ -361,6 +361,12 @@ impl fmt::Display for Plan {
             if let Some(m) = &o.model {
                 writeln!(f, "    models: {m}")?;
             }
+            if let (Some(d), Some(m)) = (&o.density, &o.model) {
+                let total = m.total(d.predicted.map(|c| c.error));
+                let pct = |e: Option<f64>| e.map_or("not predicted".to_string(), |e| format!("{:.3}%", 100.0 * e));
+                let [r, g, b] = total.map(pct);
+                writeln!(f, "    predicted total error against the light: R {r}, G {g}, B {b}")?;
+            }
             for (c, ch) in ["R", "G", "B"].iter().zip(&o.channels) {
                 let t = match ch.transport {
                     Transport::Local => "local ",
