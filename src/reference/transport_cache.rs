@@ -16,8 +16,9 @@ use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
 use std::path::Path;
 
 /// The version of the kernel's walk: a change to what it computes bumps it (4: the entry
-/// direction's basis, `optics::transport::EntryBasis`, within `ENTRY_REACH`).
-pub const VERSION: u32 = 4;
+/// direction's basis, `optics::transport::EntryBasis`, within `ENTRY_REACH`; 5: the channels
+/// walk on common random numbers).
+pub const VERSION: u32 = 5;
 
 /// One object's kernel, as cached.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

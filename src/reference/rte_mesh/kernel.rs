@@ -19,6 +19,7 @@ use crate::optics::transport::{ENTRY_REACH, EntryBasis, TransportKernel};
 use crate::reference::rte::{Medium, chunk_rng};
 use glam::DVec3;
 use rand::RngExt;
+use rand::SeedableRng as _;
 use rand_pcg::Pcg64;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -114,10 +115,13 @@ fn column(
         let inward = -geometry.shading_normal(t, bary);
         let (d, tilt) = entry_direction(inward, -geometry.normals[t], &at.entry, &mut rng);
         let depth = if mu_var > 0.0 { (d.dot(inward) - mu_bar) / mu_var } else { 0.0 };
+        // The three channels walk on the same random numbers, so that their noise is alike
+        // and a patch's scale errs in brightness rather than in hue.
+        let shared = rng.random::<u64>();
         for (channel, medium) in media.iter().enumerate() {
             exits.clear();
             let start = Start { p, d, triangle: t, channel, weight: 1.0 };
-            walk(geometry, medium, &start, true, &mut rng, &mut exits);
+            walk(geometry, medium, &start, true, &mut Pcg64::seed_from_u64(shared), &mut exits);
             for e in &exits {
                 let i = patches.of_vertex[e.vertex] as usize;
                 out[0][channel][i] += e.weight;
