@@ -128,8 +128,12 @@ void main() {
     vec3 e = transmitted(0u, key_lights, p, n, face, o.eta, weighted, key_flux) + environment;
     // The direction unit, its length in w: the transport kernel's entry basis reads the sum
     // itself (transport.comp), the between-points single scattering the direction.
-    float length_sq = dot(weighted, weighted);
-    vec4 beam = length_sq > 0.0 ? vec4(weighted * inversesqrt(length_sq), sqrt(length_sq)) : vec4(-n, 0.0);
+    // Through its largest component: a light bright enough that the sum's square overflows
+    // (past about 1e19) keeps its direction and length.
+    float big = max(max(abs(weighted.x), abs(weighted.y)), abs(weighted.z));
+    vec3 unit = big > 0.0 && !isinf(big) ? weighted / big : vec3(0.0);
+    float unit_length = length(unit);
+    vec4 beam = unit_length > 0.0 ? vec4(unit / unit_length, big * unit_length) : vec4(-n, 0.0);
     float area = s.position_area.w;
     if (push.environment_kept != 0u) {
         // The near energy depends on the sample's area and material alone, and whatever

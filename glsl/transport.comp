@@ -16,7 +16,7 @@
 //   1: one invocation per patch: F, its rows of W against every patch's fluxes;
 //   2: one invocation per vertex: the scale, in the channels push.stage.w names (the others
 //      take single scattering between points, which the pass before wrote), where the blended
-//      D is positive and the ratio finite (else the dipole's value stays).
+//      D is positive and the scaled value finite (else the dipole's value stays).
 // Bindings: 0 = splat (SplatRecord[], read), 1 = exitance (vec4 per vertex, read by stage 0,
 // written by stage 2), 2 = patches (TransportPatchRecord[]), 3 = items (uvec2: index, area
 // bits), 4 = the kernels' rows (W0: a vec4 per pair, rgb; then per patch its near list, two
@@ -143,9 +143,10 @@ void scale_vertex(uint i) {
     }
     vec4 m = exitance[v];
     for (int c = 0; c < 3; ++c) {
-        float ratio = f[c] / d[c];
+        // An overflowed dipole exitance times a zero ratio would be NaN: keep the dipole's.
+        float s = m[c] * (f[c] / d[c]);
         bool scaled = (push.stage.w & (1u << uint(c))) != 0u;
-        if (scaled && d[c] > 0.0 && !isinf(ratio) && !isnan(ratio)) m[c] *= ratio;
+        if (scaled && d[c] > 0.0 && !isinf(s) && !isnan(s)) m[c] = s;
     }
     exitance[v] = m;
 }

@@ -237,7 +237,8 @@ impl TransportKernel {
     }
 
     /// `M(v)`: the dipole's `m` at a point with patch neighbours `near` scaled by the ratio of
-    /// the blended `F` and `D`; `m` itself where the dipole's blend is not positive.
+    /// the blended `F` and `D`; `m` itself where the dipole's blend is not positive or the
+    /// scaled value is not finite (an overflowed `m` or `D` stays the dipole's, never NaN).
     pub fn scaled(m: [f64; 3], near: &[(u32, f64)], f: &[[f64; 3]], d: &[[f64; 3]]) -> [f64; 3] {
         [0, 1, 2].map(|c| {
             let (mut sf, mut sd) = (0.0, 0.0);
@@ -245,8 +246,8 @@ impl TransportKernel {
                 sf += w * f[i as usize][c];
                 sd += w * d[i as usize][c];
             }
-            let r = sf / sd;
-            if sd > 0.0 && r.is_finite() { m[c] * r } else { m[c] }
+            let scaled = m[c] * (sf / sd);
+            if sd > 0.0 && scaled.is_finite() { scaled } else { m[c] }
         })
     }
 
