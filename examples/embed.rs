@@ -17,11 +17,11 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use translucent::SceneEdit;
 use translucent::gpu::{EnabledFeatures, Gpu, GpuOptions, HostVulkan, required_features};
-use translucent::render::target::HostSync;
-use translucent::render::plan::Pass;
 use translucent::render::camera::CameraView;
 use translucent::render::options::RendererOptions;
+use translucent::render::plan::Pass;
 use translucent::render::renderer::Renderer;
+use translucent::render::target::HostSync;
 use translucent::render::target::{DepthConvention, DepthTest, HostAttachment, HostTarget, TargetDesc};
 use translucent::scene::Scene;
 use translucent::scene::build::{Overrides, PreparedScene};
@@ -853,7 +853,13 @@ fn render_frames(engine: &Engine, gpu: Arc<Gpu>, options: &Options) -> Result<Ru
     let renderer_options = RendererOptions { depth: options.depth, ..RendererOptions::default() };
     let prepare = |text: &str| {
         let scene = Scene::parse(text, "embedded scene", None).map_err(|e| e.to_string())?;
-        PreparedScene::new(&scene, &Overrides::default()).map_err(|e| e.to_string())
+        let mut prepared = PreparedScene::new(&scene, &Overrides::default()).map_err(|e| e.to_string())?;
+        // The transport kernels `model = "auto"` chose, walked once and cached as the CLI's are.
+        let dir = translucent::reference::truth::default_cache_dir();
+        let settings = translucent::reference::rte_mesh::KernelSettings::default();
+        translucent::reference::transport_cache::attach(&mut prepared.objects, &settings, &dir, &|_, _, _| {})
+            .map_err(|e| e.to_string())?;
+        Ok::<_, String>(prepared)
     };
     let prepared = prepare(SPHERE_SCENE)?;
     let renderer_for = |scene| Renderer::with_options(&gpu, scene, target, renderer_options).map_err(|e| e.to_string());

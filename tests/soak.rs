@@ -22,8 +22,13 @@ use translucent::{Overrides, PreparedScene, RecordedFrame, Renderer, RendererOpt
 /// Frames between checkpoints (and between renderers of another frames-in-flight count).
 const SEGMENT: usize = 50;
 
+/// The embedding example's sphere with the dipole in every channel: under `"auto"` a material
+/// edited to ketchup would give it single scattering's beam tables, after which a material edit
+/// is refused (`RenderError::MaterialWithBeamTables`), as the soak's random edits may not be.
 fn sphere() -> PreparedScene {
-    let scene = Scene::parse(embed::SPHERE_SCENE, "sphere", None).unwrap();
+    let (from, to) = ("mm_per_unit = 1000.0 }", "mm_per_unit = 1000.0, model = \"dipole\" }");
+    assert!(embed::SPHERE_SCENE.contains(from));
+    let scene = Scene::parse(&embed::SPHERE_SCENE.replacen(from, to, 1), "sphere", None).unwrap();
     PreparedScene::new(&scene, &Overrides::default()).unwrap()
 }
 

@@ -27,7 +27,9 @@ const IRRADIANCE: f32 = 1.0;
 /// R_d,total is 0.98, at 1 m per unit with 400 samples; the test prints it).
 const EXITANCE_TOLERANCE: f32 = 1e-3;
 
-/// A row of small spheres, one per material, lit from the side and above, seen from the front.
+/// A row of small spheres, one per material, lit from the side and above, seen from the front, in
+/// the dipole (`"auto"` would take single scattering between points, which the pixel gather
+/// refuses, for the dark channels).
 fn scene_text(materials: &[&MeasuredMaterial], mm_per_unit: f64, count: usize) -> String {
     let n = materials.len() as f32;
     let mut s = format!(
@@ -39,7 +41,7 @@ fn scene_text(materials: &[&MeasuredMaterial], mm_per_unit: f64, count: usize) -
         s.push_str(&format!(
             "\n[[object]]\nshape = {{ type = \"sphere\", radius = 0.01, divisions = 10 }}\n\
              transform = {{ translate = [{}, 0.0, 0.0] }}\n\
-             material = {{ type = \"translucent\", preset = \"{}\", mm_per_unit = {mm_per_unit:e} }}\n",
+             material = {{ type = \"translucent\", preset = \"{}\", mm_per_unit = {mm_per_unit:e}, model = \"dipole\" }}\n",
             0.03 * i as f32,
             m.name
         ));

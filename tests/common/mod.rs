@@ -173,7 +173,9 @@ pub fn with_gpu<R>(f: impl FnOnce(&Arc<Gpu>) -> R) -> R {
 // ---------------------------------------------------------------------------------------------
 // Scenes and frames
 
-/// A large translucent plane (size in mm, with 1 unit = 1 mm) under light from straight above.
+/// A large translucent plane (size in mm, with 1 unit = 1 mm) under light from straight above,
+/// in the dipole in every channel (the tests on it measure the dipole's sum; `"auto"` would give
+/// a dark preset's channels single scattering between points).
 pub fn plane_scene(preset: &str, size: f32, samples: usize, extra: &str) -> String {
     format!(
         r#"
@@ -184,7 +186,7 @@ resolution = [64, 64]
 
 [[object]]
 shape = {{ type = "plane", size = {size}, divisions = 48 }}
-material = {{ type = "translucent", preset = "{preset}", mm_per_unit = 1.0 }}
+material = {{ type = "translucent", preset = "{preset}", mm_per_unit = 1.0, model = "dipole" }}
 casts_shadow = false
 
 [[light]]
