@@ -456,7 +456,8 @@ fn display_output_on_the_renderers_own_image_is_refused() {
 /// `model = "auto"` (the default) takes the transport kernel where the dipole's predicted error
 /// against the light is over `render.max_error`, and the dipole where it is within: a 2 cm
 /// marble sphere is predicted 20 to 24% off, so a 1% target walks the kernel and a 40% one does
-/// not; a material edit chooses anew.
+/// not; a material edit chooses anew, and one that would need single scattering's tables is
+/// refused.
 #[test]
 fn auto_takes_the_kernel_only_where_the_dipoles_predicted_error_is_over_the_target() {
     let text = std::fs::read_to_string(repo_path("assets/scenes/sphere-marble.toml")).unwrap();
@@ -481,5 +482,11 @@ fn auto_takes_the_kernel_only_where_the_dipoles_predicted_error_is_over_the_targ
         renderer.edit(SceneEdit::Material { object: 0, material: dense }).unwrap();
         let choice = renderer.scene().objects[0].model.clone().unwrap();
         assert!(choice.channels.iter().all(|c| c.dipole.error < 0.05), "{choice}");
+        // Ketchup's dark channels would take single scattering, whose tables were not built
+        // with this scene: refused, the object unchanged.
+        let ketchup = Material::preset("ketchup").unwrap();
+        let refused = renderer.edit(SceneEdit::Material { object: 0, material: ketchup }).unwrap_err();
+        assert!(refused.to_string().contains("single scattering between points"), "{refused}");
+        assert_eq!(renderer.scene().objects[0].model.clone().unwrap(), choice);
     });
 }

@@ -42,11 +42,12 @@ pub enum RenderError {
          use render.gather \"vertex\", \"hierarchical\", \"sparse\" or \"texture\", or material.model = \"dipole\""
     )]
     SingleScatteringOnPixelGather(usize),
-    /// `SceneEdit::Material` of an object whose `model` takes single scattering between points: its
-    /// kernel tables are built with the scene's GPU data.
+    /// `SceneEdit::Material` of an object whose `model` takes single scattering between points
+    /// before or after the edit: its kernel tables are built with the scene's GPU data.
     #[error(
-        "set_material: object {0}'s material.model takes single scattering between points, whose tables are built \
-         once with the scene; load the scene with the new material instead"
+        "set_material: object {0}'s material.model takes single scattering between points, before or after the \
+         edit, whose tables are built once with the scene; load the scene with the new material instead, or give \
+         it model = \"dipole\""
     )]
     MaterialWithBeamTables(usize),
     /// `resize` of a renderer drawing into a host's target.

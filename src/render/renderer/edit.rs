@@ -97,7 +97,9 @@ impl Renderer {
 
     /// Replace object `object`'s translucent material (new coefficients, same samples): its
     /// record is re-packed and uploaded by the next frame, which reruns its splat and gather
-    /// (`Change::Material`). Errors when the object is opaque or the index is out of range.
+    /// (`Change::Material`). Errors when the object is opaque or the index is out of range, and
+    /// where its model takes single scattering between points before or after the edit (its
+    /// tables are built with the scene).
     fn set_material(&mut self, object: usize, material: crate::optics::Material) -> Result<(), RenderError> {
         self.check_object(object)?;
         if self.gpu_scene.beams[object].is_some() {
@@ -105,12 +107,18 @@ impl Renderer {
         }
         let target = self.scene.scene.file.render.max_error;
         let o = &mut self.scene.objects[object];
-        let crate::scene::build::ResolvedMaterial::Translucent { material: m, dipoles, mm_per_unit, .. } =
+        let crate::scene::build::ResolvedMaterial::Translucent { material: m, dipoles, mm_per_unit, model, .. } =
             &mut o.material
         else {
             return Err(RenderError::OpaqueObject(object));
         };
-        *dipoles = material.dipoles(*mm_per_unit).map_err(|source| RenderError::InvalidMaterial { object, source })?;
+        let edited =
+            material.dipoles(*mm_per_unit).map_err(|source| RenderError::InvalidMaterial { object, source })?;
+        // A channel the edit would give single scattering has no tables to take it from.
+        if model.single_channels(edited.map(|d| d.alpha_prime)).contains(&true) {
+            return Err(RenderError::MaterialWithBeamTables(object));
+        }
+        *dipoles = edited;
         // The one copy: the prepared object's. A later move (`SceneEdit::Transform`) keeps it,
         // and `scene().scene.file` stays the file as it was read.
         *m = material;
