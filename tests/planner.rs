@@ -149,8 +149,12 @@ fn relative_rmse(a: &[f32], b: &[f32]) -> f64 {
 #[test]
 fn ketchup_at_metre_scale_goes_local_in_green_and_blue_and_matches_a_dense_gather() {
     // A 1 m ketchup ball: green and blue diffuse about a millimetre, far under a pixel (about
-    // 4 mm here) and far under the sample spacing.
-    let text = format!("{}{}", stage([0.0, 0.6, 2.4], 96), sphere(0.5, [0.0; 3], "ketchup", 1000.0, false));
+    // 4 mm here) and far under the sample spacing. The dipole in every channel: `"auto"` gives
+    // the dark channels single scattering between points, which no local transport stands in for.
+    let ball = sphere(0.5, [0.0; 3], "ketchup", 1000.0, false)
+        .replace("mm_per_unit = 1000 }", "mm_per_unit = 1000, model = \"dipole\" }");
+    assert!(ball.contains("model = \"dipole\""), "{ball}");
+    let text = format!("{}{}", stage([0.0, 0.6, 2.4], 96), ball);
     with_gpu(|gpu| {
         let prepared = prepare(&text, &Overrides::default());
         let mut auto = Renderer::new(gpu, prepared).unwrap();
