@@ -29,10 +29,7 @@ pub fn enclosure(positions: &[Vec3], triangles: &[[u32; 3]]) -> Enclosure {
     if triangles.is_empty() || repeated || !edges.iter().all(reversed) {
         return Enclosure::Open;
     }
-    // About the first vertex, so that far-off surfaces keep their digits.
-    let origin = positions[triangles[0][0] as usize].as_dvec3();
-    let at = |i: u32| positions[i as usize].as_dvec3() - origin;
-    let volume: f64 = triangles.iter().map(|t| at(t[0]).dot(at(t[1]).cross(at(t[2])))).sum();
+    let volume = signed_volume(positions, triangles);
     if volume > 0.0 {
         Enclosure::Outward
     } else if volume < 0.0 {
@@ -41,6 +38,17 @@ pub fn enclosure(positions: &[Vec3], triangles: &[[u32; 3]]) -> Enclosure {
         // Closed but flat (two triangles back to back): both sides are outside.
         Enclosure::Open
     }
+}
+
+/// The signed volume a closed surface of `triangles` over `positions` encloses (the divergence
+/// theorem: the sum of `p0 . (p1 x p2) / 6`), positive when wound counter-clockwise seen from
+/// outside; 0 without triangles. Taken about the first vertex, so that far-off surfaces keep
+/// their digits.
+pub fn signed_volume(positions: &[Vec3], triangles: &[[u32; 3]]) -> f64 {
+    let Some(first) = triangles.first() else { return 0.0 };
+    let origin = positions[first[0] as usize].as_dvec3();
+    let at = |i: u32| positions[i as usize].as_dvec3() - origin;
+    triangles.iter().map(|t| at(t[0]).dot(at(t[1]).cross(at(t[2])))).sum::<f64>() / 6.0
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@ mod boundary;
 pub mod bvh;
 mod corners;
 mod curvature;
-mod enclosure;
+pub(crate) mod enclosure;
 pub mod facing;
 mod glb;
 #[cfg(feature = "gltf")]

@@ -150,16 +150,7 @@ pub fn object_size(mesh: &Mesh, curvature_radius: f64) -> (f64, bool) {
     if !mesh.report().is_closed_manifold() {
         return (curvature_radius, false);
     }
-    let p = mesh.positions();
-    // The divergence theorem: V = sum p0 . (p1 x p2) / 6.
-    let volume: f64 = mesh
-        .triangles()
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| p[i as usize].as_dvec3());
-            a.dot(b.cross(c)) / 6.0
-        })
-        .sum();
+    let volume = crate::mesh::enclosure::signed_volume(mesh.positions(), mesh.triangles());
     let area = mesh.total_area();
     if area > 0.0 { (3.0 * volume.abs() / area, true) } else { (curvature_radius, true) }
 }
