@@ -201,6 +201,7 @@ fn study_rejects_a_bad_sweep_selection_naming_the_flag_and_writes_nothing() {
         ("--rte-walk", "photons", "only with --physics"),
         ("--rte-receivers", "100", "only with --physics"),
         ("--models", "single", "only with --physics"),
+        ("--render-models", "dipole,transport", "only with --physics"),
     ] {
         let run = translucent(&["study", "-o", out.to_str().unwrap(), flag, value], &[]);
         let err = text(&run.stderr);
@@ -335,10 +336,7 @@ fn a_truth_level_over_the_memory_limit_is_refused_naming_level_estimate_and_limi
     let scene = repo_path("tests/scenes/study-tiny.toml");
     let run = study_cli(&dir, scene.to_str().unwrap(), &["--quick", "--truth-memory", "1M"]);
     let stderr = refused(&dir, &run);
-    assert!(
-        stderr.contains("would need about") && stderr.contains("more than the 1.0 MiB limit given"),
-        "{stderr}"
-    );
+    assert!(stderr.contains("would need about") && stderr.contains("more than the 1.0 MiB limit given"), "{stderr}");
     assert!(stderr.contains("E_t points") && stderr.contains("--truth-memory"), "{stderr}");
     let cached = std::fs::read_dir(dir.join("cache")).map_or(0, |d| d.filter(|e| e.is_ok()).count());
     assert_eq!(cached, 0, "a truth or temporary file was left in the cache");
@@ -542,14 +540,66 @@ fn study_with_physics_splits_each_rows_error_into_model_discretisation_and_total
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Issue 49, part 4: `--render-models dipole,transport` sweeps the renderer once per model.
+/// Each model's rows are measured against its own exact exitance and all against the one
+/// reference: the dipole's rows need no precompute and the transport rows carry their kernel's
+/// walk time; the model error is one figure per model, and the two differ; every row's total
+/// error keeps within the triangle inequality's bound of its own model and discretisation
+/// errors; and light.png and study.md's section rank the configurations against the light.
+#[test]
+fn study_render_models_sweeps_each_model_against_the_one_reference_with_its_precompute() {
+    let dir = temp_dir("study-render-models");
+    let (scene, out, cache) = (repo_path("tests/scenes/study-tiny.toml"), dir.join("out"), dir.join("cache"));
+    let args = [
+        "study",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--quick",
+        "--physics",
+        "--rte-walk",
+        "adjoint",
+        "--rte-photons",
+        "256",
+        "--render-models",
+        "dipole,transport",
+        "--truth-cache",
+        cache.to_str().unwrap(),
+    ];
+    let run = translucent(&args, &[]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    let (w, h) = image::image_dimensions(out.join("light.png")).expect("light.png");
+    assert_eq!((w, h), (960, 640));
+    let md = std::fs::read_to_string(out.join("study.md")).unwrap();
+    assert!(md.contains("## The models against the light") && md.contains("| transport | "), "{md}");
+    assert!(text(&run.stdout).contains("against the light <="), "{}", text(&run.stdout));
+    let rows = csv_rows(&std::fs::read_to_string(out.join("study.csv")).unwrap());
+    let of = |m: &str| rows.iter().filter(|r| r["model"] == m).collect::<Vec<_>>();
+    let (dipole, transport) = (of("dipole"), of("transport"));
+    assert_eq!(dipole.len(), 7);
+    assert_eq!(transport.len(), 7);
+    assert!(dipole.iter().all(|r| r["precompute_s"].parse::<f64>().unwrap() == 0.0));
+    assert!(transport.iter().all(|r| r["precompute_s"].parse::<f64>().unwrap() > 0.0));
+    let model = |r: &Row| channels(r, "model_rel_rms");
+    assert!(dipole.iter().all(|&r| model(r) == model(dipole[0])));
+    assert!(transport.iter().all(|&r| model(r) == model(transport[0])));
+    assert_ne!(model(dipole[0]), model(transport[0]), "the kernel's exact exitance is not the dipole's");
+    for r in dipole.iter().chain(&transport).copied() {
+        let (m, d, t, n) = (model(r), channels(r, "rel_rms"), channels(r, "total_rel_rms"), channels(r, "rte_noise"));
+        for c in 0..3 {
+            assert!(t[c].is_finite() && t[c] <= m[c] + d[c] * (1.0 + m[c]) + 3.0 * n[c], "channel {c}: {r:?}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `--physics` with a budget that budgets nothing is refused before any work, naming the flag,
 /// with a non-zero exit and no output folder.
 #[test]
 fn study_physics_refuses_an_empty_budget_naming_the_flag_and_writes_nothing() {
     let dir = temp_dir("study-physics-bad");
     let out = dir.join("out");
-    for (flag, value) in
-    [
+    for (flag, value) in [
         ("--rte-stderr", "0"),
         ("--rte-stderr", "nan"),
         ("--rte-photons", "0"),
@@ -557,6 +607,7 @@ fn study_physics_refuses_an_empty_budget_naming_the_flag_and_writes_nothing() {
         ("--rte-walk", "sideways"),
         ("--rte-receivers", "0"),
         ("--models", "nonsense"),
+        ("--render-models", "nonsense"),
     ] {
         let run = translucent(&["study", "-o", out.to_str().unwrap(), "--physics", flag, value], &[]);
         let err = text(&run.stderr);

@@ -94,5 +94,5 @@ pub fn attach_kernels(
     });
     bar.finish_and_clear();
     use anyhow::Context as _;
-    result.context("material.model = \"transport\": walking the transport kernel inside the mesh")
+    result.map(drop).context("material.model = \"transport\": walking the transport kernel inside the mesh")
 }

@@ -19,7 +19,8 @@ use translucent::study::{self, Event, StudyConfig, report};
 pub struct Args {
     /// Scene file (TOML); the built-in marble bunny when omitted
     pub scene: Option<PathBuf>,
-    /// Folder for study.csv, study.md, study.png and truth.png (made if missing)
+    /// Folder for study.csv, study.md, study.png, truth.png and, with --physics, light.png (made if
+    /// missing)
     #[arg(short, long)]
     pub output: PathBuf,
     /// A few configurations and one seed (seconds on a small scene), instead of the full sweep
@@ -110,6 +111,12 @@ pub struct Args {
     /// photon count, and so the reference, then depends on the machine)
     #[arg(long, allow_hyphen_values = true, value_name = "SECONDS")]
     pub rte_seconds: Option<f64>,
+    /// With --physics: sweep the renderer once per model, comma-separated (dipole, auto,
+    /// single, transport), each forced on every translucent material and measured against the
+    /// one reference; light.png then plots total error against frame time across them, with
+    /// the Pareto front (default: the scene's own models)
+    #[arg(long, value_delimiter = ',', value_name = "MODEL,...")]
+    pub render_models: Vec<String>,
 }
 
 /// The seed of `--physics`'s photons: fixed, so a study is reproducible where the photon or
@@ -127,6 +134,7 @@ fn physics(args: &Args) -> Result<Option<MeshOptions>> {
             ("--rte-walk", args.rte_walk.is_some()),
             ("--rte-receivers", args.rte_receivers.is_some()),
             ("--models", !args.models.is_empty()),
+            ("--render-models", !args.render_models.is_empty()),
         ];
         if let Some((flag, _)) = given.into_iter().find(|g| g.1) {
             bail!("{flag}: only with --physics (it sets the radiative-transfer reference and its comparisons)");
@@ -331,6 +339,12 @@ fn config(args: &Args) -> Result<StudyConfig> {
     }
     config.physics = physics(args)?;
     config.models = models(args)?;
+    config.render_models = args
+        .render_models
+        .iter()
+        .map(|m| m.parse().map_err(|e: String| anyhow::anyhow!("--render-models {m:?}: {e}")))
+        .collect::<Result<Vec<_>>>()
+        .map(distinct)?;
     Ok(config)
 }
 
@@ -363,13 +377,24 @@ pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
     let physics = study.physics.as_ref().map_or(String::new(), |p| study::physics::markdown(p, &study.rows));
     let preamble = preamble(&study, &scene, &config, &device) + &reference_timing(&study) + &physics;
     let summaries = report::summarise(&study.rows);
+    let preamble = preamble + &study::models::markdown(&study.rows, &summaries);
     let md = report::markdown(&format!("Accuracy study: {}", scene.name), &preamble, &summaries);
-    let plot = report_plot(&summaries, &scene.name)?;
-    write_outputs(&args.output, &study, chosen, md, &plot)?;
-    for target in report::TARGETS {
-        match report::fastest_meeting(&summaries, target) {
-            Some(s) => out!("error <= {:>4}%: {} at {:.1} ms", target * 100.0, s.label(), s.frame_ms),
-            None => out!("error <= {:>4}%: no configuration in the sweep", target * 100.0),
+    let plot = report_plot(&summaries, &format!("{}: error against frame time", scene.name))?;
+    let light = study::models::against_light(&summaries);
+    let light_plot = match light.is_empty() {
+        true => None,
+        false => Some(report_plot(
+            &study::models::with_precompute(&light),
+            &format!("{}: error against the light (RTE reference)", scene.name),
+        )?),
+    };
+    write_outputs(&args.output, &study, chosen, md, (&plot, light_plot.as_deref()))?;
+    for (what, summaries) in [("error", &summaries), ("against the light", &light)] {
+        for target in report::TARGETS.into_iter().filter(|_| !summaries.is_empty()) {
+            match report::fastest_meeting(summaries, target) {
+                Some(s) => out!("{what} <= {:>4}%: {} at {:.1} ms", target * 100.0, s.label(), s.frame_ms),
+                None => out!("{what} <= {:>4}%: no configuration in the sweep", target * 100.0),
+            }
         }
     }
     if let Some(p) = &study.physics {
@@ -569,16 +594,17 @@ fn reference_timing(study: &study::Study) -> String {
 }
 
 /// What a study writes into its folder, in [`write_outputs`]' order.
-const OUTPUT_NAMES: [&str; 5] = ["study.csv", "study.md", "study.png", "truth.png", "error.png"];
+const OUTPUT_NAMES: [&str; 6] = ["study.csv", "study.md", "study.png", "truth.png", "error.png", "light.png"];
 
-/// Write study.csv, study.md, study.png, truth.png (where the truth has an image) and
+/// Write study.csv, study.md, study.png and light.png (`plots`: error against the truth and,
+/// with `--physics`, against the light), truth.png (where the truth has an image) and
 /// error.png (for `chosen`) into `output`, all or none (`OutputSet`).
 fn write_outputs(
     output: &Path,
     study: &study::Study,
     chosen: Option<(Method, usize, Gather)>,
     md: String,
-    plot: &[u8],
+    (plot, light): (&[u8], Option<&[u8]>),
 ) -> Result<()> {
     let outputs: Vec<PathBuf> = OUTPUT_NAMES.iter().map(|n| output.join(n)).collect();
     let [w, h] = study.prepared.scene.file.camera.resolution;
@@ -593,6 +619,9 @@ fn write_outputs(
     text(&mut set, &outputs[0], report::csv(&study.rows))?;
     text(&mut set, &outputs[1], md)?;
     set.png(&outputs[2], 960, 640, plot)?;
+    if let Some(light) = light {
+        set.png(&outputs[5], 960, 640, light)?;
+    }
     if let Some(image) = &study.truth_image {
         set.png(&outputs[3], w, h, &image.ldr)?;
     }
@@ -618,7 +647,6 @@ fn write_outputs(
     Ok(())
 }
 
-fn report_plot(summaries: &[report::Summary], name: &str) -> Result<Vec<u8>> {
-    translucent::study::plot::error_vs_time(summaries, &format!("{name}: error against frame time"), 960, 640)
-        .map_err(anyhow::Error::msg)
+fn report_plot(summaries: &[report::Summary], title: &str) -> Result<Vec<u8>> {
+    translucent::study::plot::error_vs_time(summaries, title, 960, 640).map_err(anyhow::Error::msg)
 }

@@ -17,8 +17,8 @@ use std::path::Path;
 
 /// The version of the kernel's walk: a change to what it computes bumps it (4: the entry
 /// direction's basis, `optics::transport::EntryBasis`, within `ENTRY_REACH`; 5: the channels
-/// walk on common random numbers).
-pub const VERSION: u32 = 5;
+/// walk on common random numbers; 6: the walk's wall time is kept, [`CachedKernel::walk_seconds`]).
+pub const VERSION: u32 = 6;
 
 /// One object's kernel, as cached.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -29,6 +29,8 @@ pub struct CachedKernel {
     pub key: String,
     /// The kernel.
     pub kernel: TransportKernel,
+    /// Wall time of the walk that made it, seconds (the precompute a study reports).
+    pub walk_seconds: f64,
     /// [`CachedKernel::digest`] of its values.
     pub checksum: String,
 }
@@ -47,6 +49,7 @@ impl CachedKernel {
         h.f64(k.patches.radius);
         k.rows().flatten().flatten().for_each(|&x| h.f64(x));
         h.f64(k.mu_mean);
+        h.f64(self.walk_seconds);
         format!("{:016x}", h.0)
     }
 
@@ -105,39 +108,55 @@ pub fn cached(
     dir: &Path,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<(TransportKernel, bool), RteCacheError> {
+    cached_timed(o, settings, dir, progress).map(|(kernel, cached, _)| (kernel, cached))
+}
+
+/// [`cached`], with the wall time of the walk that made the kernel, seconds (this run's, or
+/// the one recorded in the file).
+pub fn cached_timed(
+    o: &PreparedObject,
+    settings: &KernelSettings,
+    dir: &Path,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<(TransportKernel, bool, f64), RteCacheError> {
     let key = content_key(o, settings);
     let path = dir.join(format!("kernel-{key}.json"));
     let usable = |c: &CachedKernel| c.unusable_for(o, &key);
     if let Some(c) = read_cached(&path, ("transport kernel cache", "walking it anew"), usable) {
-        return Ok((c.kernel, true));
+        return Ok((c.kernel, true, c.walk_seconds));
     }
     if let Some(why) = folder_problem(dir) {
         return Err(RteCacheError::Folder { path: dir.to_path_buf(), why });
     }
+    let start = std::time::Instant::now();
     let kernel = object_kernel(o, settings, progress)?;
-    let mut cached = CachedKernel { version: VERSION, key: key.clone(), kernel, checksum: String::new() };
+    let walk_seconds = start.elapsed().as_secs_f64();
+    let mut cached = CachedKernel { version: VERSION, key: key.clone(), kernel, walk_seconds, checksum: String::new() };
     cached.checksum = cached.digest();
     let json = serde_json::to_vec(&cached).map_err(|error| RteCacheError::Json { path: path.clone(), error })?;
     write_replacing(&path, &json).map_err(|error| RteCacheError::Io { path: path.clone(), error })?;
-    Ok((cached.kernel, false))
+    Ok((cached.kernel, false, walk_seconds))
 }
 
 /// Attaches a kernel (cached in `dir`, or walked) to every object of `objects` whose material
 /// asks for one (`PreparedObject::wants_transport`) and has none; `progress` hears each
-/// object's index and its patches done and count.
+/// object's index and its patches done and count. Returns the walks' wall time over the
+/// kernels attached, seconds ([`cached_timed`]: the time recorded where a kernel was cached).
 pub fn attach(
     objects: &mut [PreparedObject],
     settings: &KernelSettings,
     dir: &Path,
     progress: &(dyn Fn(usize, usize, usize) + Sync),
-) -> Result<(), RteCacheError> {
+) -> Result<f64, RteCacheError> {
+    let mut seconds = 0.0;
     for (i, o) in objects.iter_mut().enumerate() {
         if o.wants_transport() && o.transport.is_none() {
-            let (kernel, _) = cached(o, settings, dir, &|done, of| progress(i, done, of))?;
+            let (kernel, _, walked) = cached_timed(o, settings, dir, &|done, of| progress(i, done, of))?;
             o.transport = Some(std::sync::Arc::new(kernel));
+            seconds += walked;
         }
     }
-    Ok(())
+    Ok(seconds)
 }
 
 /// The transport model's exact exitance per object and vertex (`study --physics --models

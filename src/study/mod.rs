@@ -6,6 +6,7 @@
 //! measures the tone-mapped images' FLIP error, `raster` draws per-vertex error on the model.
 
 pub mod flip;
+pub mod models;
 pub mod physics;
 pub mod plot;
 pub mod raster;
@@ -55,6 +56,9 @@ pub struct StudyConfig {
     pub physics: Option<MeshOptions>,
     /// With `physics`: the models measured beside the dipole.
     pub models: Vec<physics::Model>,
+    /// The models the renderer is swept with, each forced on every translucent material
+    /// (`models`); empty: the scene's own.
+    pub render_models: Vec<crate::scene::ScatteringModel>,
 }
 
 impl StudyConfig {
@@ -82,6 +86,7 @@ impl StudyConfig {
             sweep: true,
             physics: None,
             models: Vec::new(),
+            render_models: Vec::new(),
         }
     }
 
@@ -99,12 +104,13 @@ impl StudyConfig {
             sweep: true,
             physics: None,
             models: Vec::new(),
+            render_models: Vec::new(),
         }
     }
 
-    /// Configurations times seeds, and the scene's own row.
+    /// Configurations times seeds, and the scene's own row, per model rendered.
     pub fn runs(&self) -> usize {
-        self.configurations().len() + usize::from(self.own)
+        (self.configurations().len() + usize::from(self.own)) * self.render_models.len().max(1)
     }
 
     /// The sweep's configurations, in order.
@@ -417,55 +423,51 @@ pub fn run(
     if !base.has_translucent() {
         return Err(StudyError::NothingTranslucent);
     }
-    let (mut truth, truth_cached) =
+    let (dipole, truth_cached) =
         truth::cached(&base, &config.truth, truth_dir, &|l, d, n| progress(Event::Truth(l, d, n)))?;
-    // A material with model = "transport": its kernel scales the renderer's exitance, so the
-    // truth is the dipole's exact integral scaled by it in f64 (single scattering between
-    // points in its channels of low albedo).
-    let mut base = base;
-    if base.objects.iter().any(|o| o.wants_transport()) {
-        use crate::reference::{rte_mesh::KernelSettings, transport_cache};
-        transport_cache::attach(&mut base.objects, &KernelSettings::default(), truth_dir, &|_, _, _| {})?;
-        let scaled = transport_cache::model_exitance(&base, &truth.exitance, truth_dir)?;
-        // Its channels of single scattering between points, as the renderer draws them.
-        let scaled = physics::with_single_between_points(&base, scaled);
-        for ((t, s), o) in truth.exitance.iter_mut().zip(scaled).zip(&base.objects) {
-            if o.wants_transport() {
-                *t = s;
-            }
-        }
-    }
     if truth_cached {
         progress(Event::TruthCached);
     }
-    if !truth.exitance.iter().flatten().flatten().any(|&m| m > 0.0) {
+    if !dipole.exitance.iter().flatten().flatten().any(|&m| m > 0.0) {
         return Err(StudyError::NothingLit);
     }
+    // Each model renders against its own exact exitance: a kernel scales the dipole's, and
+    // single scattering between points replaces it in the channels that take it.
+    let forced: Vec<Option<crate::scene::ScatteringModel>> = match config.render_models.as_slice() {
+        [] => vec![None],
+        list => list.iter().copied().map(Some).collect(),
+    };
+    let models =
+        forced.into_iter().map(|m| models::prepare(&base, m, &dipole, truth_dir)).collect::<Result<Vec<_>, _>>()?;
+    let (base, truth) = (models[0].base.clone(), models[0].truth.clone());
     let physics = match &config.physics {
         Some(options) => Some(physics::Physics::measure(&base, &truth, options, &config.models, truth_dir, progress)?),
         None => None,
     };
-    let truth_image = truth_image(gpu, &base, &truth)?;
-
-    let bench = Bench {
-        gpu,
-        base: &base,
-        frames: config.frames,
-        truth: &truth,
-        truth_image: truth_image.as_ref(),
-        scene: &scene.name,
-        physics: physics.as_ref(),
-    };
+    let images = models.iter().map(|m| truth_image(gpu, &m.base, &m.truth)).collect::<Result<Vec<_>, _>>()?;
     let (mut rows, mut exitances) = (Vec::new(), Vec::new());
     let total = config.runs();
-    let own = config.own.then(|| own_configuration(&base));
-    for run in own.into_iter().chain(config.configurations()) {
-        progress(Event::Run(rows.len(), total, run.label()));
-        let (row, exitance) = bench.measure(run)?;
-        rows.push(row);
-        exitances.push(exitance);
+    for (model, image) in models.iter().zip(&images) {
+        let bench = Bench {
+            gpu,
+            model,
+            frames: config.frames,
+            truth_image: image.as_ref(),
+            scene: &scene.name,
+            physics: physics.as_ref(),
+            model_error: physics.as_ref().map(|p| vertex_error_f64(&p.exitance, &model.truth.exitance).rel_rms),
+        };
+        let own = config.own.then(|| own_configuration(&model.base));
+        for run in own.into_iter().chain(config.configurations()) {
+            let prefix = if model.name().is_empty() { String::new() } else { format!("{}: ", model.name()) };
+            progress(Event::Run(rows.len(), total, prefix + &run.label()));
+            let (row, exitance) = bench.measure(run)?;
+            rows.push(row);
+            exitances.push(exitance);
+        }
     }
     let reference = time_reference(&base, &rows)?;
+    let truth_image = images.into_iter().next().flatten();
     Ok(Study { rows, truth, truth_cached, truth_image, prepared: base, exitance: exitances, reference, physics })
 }
 
@@ -539,16 +541,19 @@ impl Configuration {
 /// What every configuration of a study is measured with and against.
 struct Bench<'a> {
     gpu: &'a Arc<Gpu>,
-    /// The scene prepared once (geometry and lights); each configuration resamples it.
-    base: &'a PreparedScene,
+    /// The model rendered: the scene prepared once under it (geometry, lights and kernels; each
+    /// configuration resamples it) and its exact exitance.
+    model: &'a models::RenderModel,
     /// Timed frames per configuration (`StudyConfig::frames`).
     frames: usize,
-    truth: &'a Truth,
+    /// The truth's image, for the model whose truth it shades.
     truth_image: Option<&'a Images>,
     /// The scene's name, for the rows.
     scene: &'a str,
     /// With `--physics`: the radiative-transfer reference, for the model and total errors.
     physics: Option<&'a physics::Physics>,
+    /// With `--physics`: the model's exact exitance against the reference, per channel.
+    model_error: Option<[f64; 3]>,
 }
 
 impl Bench<'_> {
@@ -557,14 +562,15 @@ impl Bench<'_> {
     /// row, and its per-vertex exitance for `--error-image`.
     fn measure(&self, run: Configuration) -> Result<(Row, Option<Exitance>), StudyError> {
         let Configuration { method, count, seed, gather, own } = run;
-        let (prepared, sampling_ms) = configure(self.base, run)?;
+        let (base, truth) = (&self.model.base, &self.model.truth);
+        let (prepared, sampling_ms) = configure(base, run)?;
         let predicted = predicted(&prepared, method, gather.0);
         let mut renderer = Renderer::new(self.gpu, prepared)?;
         renderer.frame(&renderer.plan(Change::Everything))?;
         let exitance = if gather.0 == GatherMode::Pixel {
             None
         } else {
-            Some((0..self.base.objects.len()).map(|i| renderer.exitance(i)).collect::<Result<Vec<_>, _>>()?)
+            Some((0..base.objects.len()).map(|i| renderer.exitance(i)).collect::<Result<Vec<_>, _>>()?)
         };
         let image = images(&renderer)?;
         // A moving light's frame: splat, gather and shade (the study's subject), each pass in a
@@ -576,11 +582,13 @@ impl Bench<'_> {
             timings.push(renderer.frame_isolated(&plan)?);
         }
         let pass = |p: Pass| median(timings.iter().map(|t| t.get(p).unwrap_or(0.0)).collect());
-        let error = exitance.as_ref().map(|e| vertex_error(&self.truth.exitance, e));
+        let error = exitance.as_ref().map(|e| vertex_error(&truth.exitance, e));
         let nan = [f64::NAN; 3];
         let total = self.physics.zip(exitance.as_ref()).map(|(p, e)| vertex_error(&p.exitance, e));
         let row = Row {
             scene: self.scene.to_string(),
+            model: self.model.name().to_string(),
+            precompute_s: self.model.precompute_s,
             default: own,
             predicted,
             sampler: if gather.0 == GatherMode::Texture { "atlas" } else { method.name() }.to_string(),
@@ -598,7 +606,7 @@ impl Bench<'_> {
             p99: error.map_or(nan, |e| e.p99),
             max: error.map_or(nan, |e| e.max),
             bias: error.map_or(nan, |e| e.bias),
-            model_rel_rms: self.physics.map_or(nan, |p| p.model.rel_rms),
+            model_rel_rms: self.model_error.unwrap_or(nan),
             total_rel_rms: total.map_or(nan, |e| e.rel_rms),
             rte_noise: self.physics.map_or(nan, |p| p.noise),
             image_rel_rmse: self.truth_image.map_or(f64::NAN, |t| image_rel_rmse(&t.hdr, &image.hdr)),

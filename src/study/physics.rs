@@ -123,8 +123,11 @@ impl Physics {
             models.iter().skip(1).map(|(name, m)| (name.clone(), vertex_error_f64(&exitance, m))).collect();
         let cosines = light_cosines(base);
         let bands = models.iter().map(|(name, m)| (name.clone(), band_errors(&exitance, m, &cosines))).collect();
-        let model_name =
-            if base.objects.iter().any(|o| o.wants_transport()) { "dipole scaled by its transport kernel" } else { "dipole" };
+        let model_name = if base.objects.iter().any(|o| o.wants_transport()) {
+            "dipole scaled by its transport kernel"
+        } else {
+            "dipole"
+        };
         Ok(Physics {
             model_name,
             exitance,
@@ -478,8 +481,14 @@ pub fn markdown(physics: &Physics, rows: &[Row]) -> String {
     }
     alternatives_table(&mut out, physics);
     bands_table(&mut out, physics);
-    split_table(&mut out, rows);
-    crossover_table(&mut out, rows, physics.model.rel_rms);
+    // Per model rendered (`study --render-models`), each against its own exact exitance.
+    for (name, rows) in super::models::by_model(rows) {
+        if !name.is_empty() {
+            let _ = writeln!(out, "\n### `material.model = \"{name}\"`");
+        }
+        split_table(&mut out, &rows);
+        crossover_table(&mut out, &rows, rows.first().map_or(physics.model.rel_rms, |r| r.model_rel_rms));
+    }
     out
 }
 
@@ -512,17 +521,9 @@ fn bands_table(out: &mut String, p: &Physics) {
     let _ = writeln!(out, "|---|---|---|---:|---:|---:|");
     for (name, bands) in &p.bands {
         for (e, (.., band)) in bands.iter().zip(BANDS) {
-            let cell = |c: usize| format!("{} % ({:+.1} %)", percent(e.rel_rms[c]), 100.0 * e.bias[c]);
-            let _ = writeln!(
-                out,
-                "| {name} | {band} | {}, {}, {} | {} | {} | {} |",
-                e.lit[0],
-                e.lit[1],
-                e.lit[2],
-                cell(0),
-                cell(1),
-                cell(2)
-            );
+            let cells = [0, 1, 2].map(|c| format!("{} % ({:+.1} %)", percent(e.rel_rms[c]), 100.0 * e.bias[c]));
+            let lit = e.lit.map(|n| n.to_string()).join(", ");
+            let _ = writeln!(out, "| {name} | {band} | {lit} | {} |", cells.join(" | "));
         }
     }
 }
@@ -625,14 +626,8 @@ fn crossover_table(out: &mut String, rows: &[Row], model: [f64; 3]) {
             Some(n) => n.to_string(),
         };
         let counts = x.counts.iter().map(usize::to_string).collect::<Vec<_>>().join(", ");
-        let _ = writeln!(
-            out,
-            "| {} | {counts} | {} | {} | {} |",
-            md_cell(&x.curve),
-            cell(x.from[0]),
-            cell(x.from[1]),
-            cell(x.from[2])
-        );
+        let from = x.from.map(cell).join(" | ");
+        let _ = writeln!(out, "| {} | {counts} | {from} |", md_cell(&x.curve));
     }
 }
 
@@ -643,6 +638,8 @@ mod tests {
     fn row(samples: usize, seed: u64, err: [f64; 3]) -> Row {
         Row {
             scene: "s".into(),
+            model: String::new(),
+            precompute_s: 0.0,
             default: false,
             sampler: "turk".into(),
             samples,

@@ -315,6 +315,9 @@ mod tests {
 
     fn summary(sampler: &str, samples: usize, gather: &str, frame_ms: f64, error: f64) -> Summary {
         Summary {
+            model: String::new(),
+            total: f64::NAN,
+            precompute_s: 0.0,
             sampler: sampler.into(),
             samples,
             gather: gather.into(),

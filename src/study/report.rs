@@ -11,6 +11,12 @@ use std::fmt::Write as _;
 pub struct Row {
     /// Scene name (commas are replaced in the CSV so the file needs no quoting).
     pub scene: String,
+    /// The `material.model` forced on the scene for this row (`study --render-models`);
+    /// empty: the scene's own.
+    pub model: String,
+    /// Wall time of the precompute this row's model needs (its transport kernels' walks),
+    /// seconds; 0 without one.
+    pub precompute_s: f64,
     /// The scene's own configuration (its error target's count and gather), not the sweep's.
     pub default: bool,
     /// Sample placement: `random`, `turk`, `feature` or `poisson`.
@@ -104,6 +110,8 @@ pub const COLUMNS: &[&str] = &[
     "rte_noise_r",
     "rte_noise_g",
     "rte_noise_b",
+    "model",
+    "precompute_s",
 ];
 
 /// Error targets (as fractions) the report finds the fastest configuration for.
@@ -144,6 +152,8 @@ pub fn csv(rows: &[Row]) -> String {
         for channels in [&row.model_rel_rms, &row.total_rel_rms, &row.rte_noise] {
             fields.extend(channels.iter().map(f64::to_string));
         }
+        fields.push(csv_text(&row.model));
+        fields.push(row.precompute_s.to_string());
         debug_assert_eq!(fields.len(), COLUMNS.len());
         out.push_str(&fields.join(","));
         out.push('\n');
@@ -185,6 +195,8 @@ pub fn pareto(points: &[(f64, f64)]) -> Vec<bool> {
 /// One configuration with its seeds combined.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Summary {
+    /// The model forced ([`Row::model`]; empty: the scene's own).
+    pub model: String,
     /// Sample placement.
     pub sampler: String,
     /// Requested sample count.
@@ -215,17 +227,33 @@ pub struct Summary {
     pub predicted_worst: f64,
     /// Mean over seeds of the measured error of the worst channel (per-vertex relative RMS).
     pub error_worst: f64,
+    /// Mean over seeds of the total error against the light, mean of r, g, b
+    /// ([`Row::total_rel_rms`]; NaN without `--physics`).
+    pub total: f64,
+    /// Mean over seeds of [`Row::precompute_s`].
+    pub precompute_s: f64,
 }
 
 impl Summary {
     /// Short name of the configuration, as used in tables and plot legends.
     pub fn label(&self) -> String {
-        format!("{} {} + {}", self.sampler, self.samples, curve_gather(&self.gather, self.epsilon))
+        format!(
+            "{}{} {} + {}",
+            self.model_prefix(),
+            self.sampler,
+            self.samples,
+            curve_gather(&self.gather, self.epsilon)
+        )
     }
 
     /// Name of the curve this configuration lies on: everything but the sample count.
     pub fn curve(&self) -> String {
-        format!("{} + {}", self.sampler, curve_gather(&self.gather, self.epsilon))
+        format!("{}{} + {}", self.model_prefix(), self.sampler, curve_gather(&self.gather, self.epsilon))
+    }
+
+    /// `transport: ` where a model was forced, else nothing.
+    fn model_prefix(&self) -> String {
+        if self.model.is_empty() { String::new() } else { format!("{}: ", self.model) }
     }
 }
 
@@ -258,11 +286,12 @@ fn mean(values: impl Iterator<Item = f64>) -> f64 {
 ///
 /// Rows of different scenes would be merged: pass one scene's rows at a time.
 pub fn summarise(rows: &[Row]) -> Vec<Summary> {
-    type Key = (String, String, usize, Option<u64>);
+    type Key = (String, String, String, usize, Option<u64>);
     let mut groups: BTreeMap<Key, Vec<&Row>> = BTreeMap::new();
     for row in rows {
         // Sort epsilon numerically: the bits of a non-negative float order like the float.
-        let key = (row.gather.clone(), sampler_label(row), row.samples, row.epsilon.map(|e| e.max(0.0).to_bits()));
+        let epsilon = row.epsilon.map(|e| e.max(0.0).to_bits());
+        let key = (row.model.clone(), row.gather.clone(), sampler_label(row), row.samples, epsilon);
         groups.entry(key).or_default().push(row);
     }
     groups
@@ -273,6 +302,7 @@ pub fn summarise(rows: &[Row]) -> Vec<Summary> {
             let lo = errors.iter().copied().fold(f64::INFINITY, f64::min);
             let hi = errors.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             Summary {
+                model: first.model.clone(),
                 sampler: sampler_label(first),
                 samples: first.samples,
                 gather: first.gather.clone(),
@@ -287,6 +317,8 @@ pub fn summarise(rows: &[Row]) -> Vec<Summary> {
                 predicted: mean(group.iter().map(|r| r.predicted.iter().sum::<f64>() / 3.0)),
                 predicted_worst: mean(group.iter().map(|r| worst(&r.predicted))),
                 error_worst: mean(group.iter().map(|r| worst(&r.rel_rms))),
+                total: mean(group.iter().map(|r| r.total_rel_rms.iter().sum::<f64>() / 3.0)),
+                precompute_s: mean(group.iter().map(|r| r.precompute_s)),
             }
         })
         .collect()
@@ -546,6 +578,8 @@ mod tests {
     fn row(sampler: &str, samples: usize, gather: &str, seed: u64, frame_ms: f64, err: f64) -> Row {
         Row {
             scene: "bunny, marble".into(),
+            model: String::new(),
+            precompute_s: 0.0,
             sampler: sampler.into(),
             samples,
             gather: gather.into(),
