@@ -127,7 +127,20 @@ fn scene_of_state(state: &serde_json::Value) -> PreparedScene {
             _ => {}
         }
     }
-    PreparedScene::new(&scene, &Overrides::default()).unwrap()
+    let mut prepared = PreparedScene::new(&scene, &Overrides::default()).unwrap();
+    attach_kernels(&mut prepared);
+    prepared
+}
+
+/// The transport kernels `model = "auto"` chose for `prepared`, from the cache the viewer reads
+/// (walked there by the first test that needs them, while the others wait, so that no two walk
+/// the bunny's at once).
+fn attach_kernels(prepared: &mut PreparedScene) {
+    use translucent::reference::{rte_mesh::KernelSettings, transport_cache, truth};
+    static WALK: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _one = WALK.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let dir = truth::default_cache_dir();
+    transport_cache::attach(&mut prepared.objects, &KernelSettings::default(), &dir, &|_, _, _| {}).unwrap();
 }
 
 #[test]
@@ -135,6 +148,7 @@ fn the_window_after_orbit_light_drag_and_resize_shows_the_headless_image_without
     let dir = temp_dir("viewer");
     let (shot, state) = (dir.join("shot.png"), dir.join("state.json"));
     let display = Display::start(90);
+    attach_kernels(&mut PreparedScene::new(&Scene::builtin(), &Overrides::default()).unwrap());
     let (viewer, window) =
         display.open_viewer(&["--screenshot", shot.to_str().unwrap(), "--state", state.to_str().unwrap()]);
     sleep(Duration::from_secs(2));
@@ -169,6 +183,7 @@ fn the_window_after_orbit_light_drag_and_resize_shows_the_headless_image_without
 #[test]
 fn a_window_destroyed_mid_frame_closes_the_viewer_without_a_validation_message() {
     let display = Display::start(190);
+    attach_kernels(&mut PreparedScene::new(&Scene::builtin(), &Overrides::default()).unwrap());
     let (viewer, window) = display.open_viewer(&["--samples", "2000"]);
     // The title shows frames/s once frames are being drawn.
     let started = Instant::now();

@@ -17,8 +17,8 @@ use crate::reference::rte::RteProgress;
 use crate::reference::rte_cache::RteCacheError;
 use crate::reference::rte_mesh::MeshOptions;
 use crate::reference::truth::{self, LIT_FLOOR, Truth, TruthOptions};
-use crate::render::plan::{Change, Pass};
 use crate::render::error::RenderError;
+use crate::render::plan::{Change, Pass};
 use crate::render::renderer::Renderer;
 use crate::sampling::{self, Method, SampleOptions};
 use crate::scene::build::{Overrides, PreparedScene, ResolvedMaterial};
@@ -437,8 +437,7 @@ pub fn run(
         [] => vec![None],
         list => list.iter().copied().map(Some).collect(),
     };
-    let models =
-        forced.into_iter().map(|m| models::prepare(&base, m, &dipole, truth_dir)).collect::<Result<Vec<_>, _>>()?;
+    let models = models::prepare(&base, &forced, &dipole, truth_dir)?;
     let (base, truth) = (models[0].base.clone(), models[0].truth.clone());
     let physics = match &config.physics {
         Some(options) => Some(physics::Physics::measure(&base, &truth, options, &config.models, truth_dir, progress)?),

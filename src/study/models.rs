@@ -7,6 +7,7 @@
 
 use super::StudyError;
 use super::report::Summary;
+use crate::reference::directional::FINENESS;
 use crate::reference::rte_mesh::KernelSettings;
 use crate::reference::transport_cache;
 use crate::reference::truth::Truth;
@@ -39,33 +40,43 @@ impl RenderModel {
     }
 }
 
-/// `base` under `forced` (`None`: as its materials say), against `dipole`, the dipole's exact
-/// integral over it; kernels are read from or walked into `dir`.
+/// `base` under each of `forced` (`None`: as its materials say), against `dipole`, the
+/// dipole's exact integral over it; kernels are read from or walked into `dir`. Single
+/// scattering between points, a long integral, is computed once for every model that needs it.
 pub fn prepare(
     base: &PreparedScene,
-    forced: Option<ScatteringModel>,
+    forced: &[Option<ScatteringModel>],
     dipole: &Truth,
     dir: &Path,
-) -> Result<RenderModel, StudyError> {
-    let mut base = base.clone();
-    let target = base.scene.file.render.max_error;
-    for o in &mut base.objects {
-        if let (Some(m), ResolvedMaterial::Translucent { model, .. }) = (forced, &mut o.material) {
-            *model = m;
-            o.transport = None;
-            o.choose_model(target);
+) -> Result<Vec<RenderModel>, StudyError> {
+    let single = std::cell::OnceCell::new();
+    let mut out = Vec::new();
+    for &forced in forced {
+        let mut base = base.clone();
+        let target = base.scene.file.render.max_error;
+        for o in &mut base.objects {
+            if let (Some(m), ResolvedMaterial::Translucent { model, .. }) = (forced, &mut o.material) {
+                *model = m;
+                o.transport = None;
+                o.choose_model(target);
+            }
         }
+        let precompute_s = transport_cache::attach(&mut base.objects, &KernelSettings::default(), dir, &|_, _, _| {})?;
+        let between = || single.get_or_init(|| crate::reference::single::between_points(&base, FINENESS)).as_slice();
+        let truth = Truth { exitance: exact_exitance(&base, &dipole.exitance, between, dir)?, ..dipole.clone() };
+        out.push(RenderModel { forced, base, truth, precompute_s });
     }
-    let precompute_s = transport_cache::attach(&mut base.objects, &KernelSettings::default(), dir, &|_, _, _| {})?;
-    let truth = Truth { exitance: exact_exitance(&base, &dipole.exitance, dir)?, ..dipole.clone() };
-    Ok(RenderModel { forced, base, truth, precompute_s })
+    Ok(out)
 }
 
 /// Per object, vertex and channel, the exact exitance of the model each channel of `base`
 /// takes (see [`RenderModel::truth`]); NaN where `dipole` is (off a truth's receivers).
-fn exact_exitance(
+/// `single` gives single scattering between points (the same for every model: it depends on
+/// the geometry, media and lights alone).
+fn exact_exitance<'a>(
     base: &PreparedScene,
     dipole: &[Vec<[f64; 3]>],
+    single: impl FnOnce() -> &'a [Vec<[f64; 3]>],
     dir: &Path,
 ) -> Result<Vec<Vec<[f64; 3]>>, StudyError> {
     let takes = |o: &crate::scene::build::PreparedObject, m: ChannelModel| {
@@ -76,11 +87,7 @@ fn exact_exitance(
     } else {
         None
     };
-    let single = base
-        .objects
-        .iter()
-        .any(|o| takes(o, ChannelModel::Single))
-        .then(|| crate::reference::single::between_points(base, crate::reference::directional::FINENESS));
+    let single = base.objects.iter().any(|o| takes(o, ChannelModel::Single)).then(single);
     let mut out = dipole.to_vec();
     for (i, (o, exitance)) in base.objects.iter().zip(&mut out).enumerate() {
         let Some(choice) = &o.model else { continue };
@@ -92,7 +99,7 @@ fn exact_exitance(
                 m[c] = match choice.channels[c].takes {
                     ChannelModel::Dipole => m[c],
                     ChannelModel::Kernel => kernel.as_ref().map_or(m[c], |k| k[i][v][c]),
-                    ChannelModel::Single => single.as_ref().map_or(m[c], |s| s[i][v][c]),
+                    ChannelModel::Single => single.map_or(m[c], |s| s[i][v][c]),
                 };
             }
         }
@@ -175,4 +182,46 @@ pub fn markdown(rows: &[super::report::Row], summaries: &[Summary]) -> String {
         let _ = writeln!(out, "| {} % | {cell} |", percent(t));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn summary(model: &str, frame_ms: f64, total: f64, precompute_s: f64) -> Summary {
+        Summary {
+            model: model.into(),
+            sampler: "turk".into(),
+            samples: 100,
+            gather: "vertex".into(),
+            epsilon: None,
+            seeds: 1,
+            frame_ms,
+            error: 0.5,
+            error_spread: 0.0,
+            flip_mean: f64::NAN,
+            image_rel_rmse: f64::NAN,
+            sampling_ms: 1.0,
+            predicted: f64::NAN,
+            predicted_worst: f64::NAN,
+            error_worst: 0.5,
+            total,
+            precompute_s,
+        }
+    }
+
+    #[test]
+    fn against_the_light_a_configuration_reads_its_total_error_and_one_without_is_left_out() {
+        let s = [summary("dipole", 2.0, 0.3, 0.0), summary("transport", 2.5, f64::NAN, 8.0)];
+        let light = against_light(&s);
+        assert_eq!(light.len(), 1);
+        assert_eq!((light[0].model.as_str(), light[0].error), ("dipole", 0.3));
+    }
+
+    #[test]
+    fn the_legend_names_a_model_with_its_precompute_only_where_it_has_one() {
+        let s = [summary("dipole", 2.0, 0.3, 0.0), summary("transport", 2.5, 0.1, 7.773), summary("", 2.5, 0.1, 1.0)];
+        let named: Vec<String> = with_precompute(&s).into_iter().map(|s| s.model).collect();
+        assert_eq!(named, ["dipole", "transport (7.77 s precompute)", "(1.00 s precompute)"]);
+    }
 }

@@ -233,12 +233,23 @@ impl Chart<'_> {
         chart.draw_series(self.front.iter().map(|&p| Cross::new(p, 6, BLACK.stroke_width(2))))?;
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
+            .position(self.legend_corner())
             .label_font(("sans-serif", 12))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .draw()?;
         Ok(root.present()?)
+    }
+
+    /// Where the legend covers no point: the upper right, as error falls with time, unless the
+    /// points lie in the chart's upper half (error against the light, which the model bounds),
+    /// then the lower right.
+    fn legend_corner(&self) -> SeriesLabelPosition {
+        let (y0, y1) = self.y;
+        let middle = (y0 * y1).sqrt();
+        let points = self.curves.values().flatten().map(|s| point(s).1);
+        let (above, all) = points.fold((0, 0), |(a, n), y| (a + usize::from(y > middle), n + 1));
+        if 2 * above > all { SeriesLabelPosition::LowerRight } else { SeriesLabelPosition::UpperRight }
     }
 
     /// Each error target as a dashed line across the chart, labelled at its left end.

@@ -12,7 +12,7 @@ pub struct Row {
     /// Scene name (commas are replaced in the CSV so the file needs no quoting).
     pub scene: String,
     /// The `material.model` forced on the scene for this row (`study --render-models`);
-    /// empty: the scene's own.
+    /// empty (`own` in the CSV): each material's own.
     pub model: String,
     /// Wall time of the precompute this row's model needs (its transport kernels' walks),
     /// seconds; 0 without one.
@@ -152,7 +152,8 @@ pub fn csv(rows: &[Row]) -> String {
         for channels in [&row.model_rel_rms, &row.total_rel_rms, &row.rte_noise] {
             fields.extend(channels.iter().map(f64::to_string));
         }
-        fields.push(csv_text(&row.model));
+        // `own`: each material's own model (no `--render-models`).
+        fields.push(if row.model.is_empty() { "own".to_string() } else { csv_text(&row.model) });
         fields.push(row.precompute_s.to_string());
         debug_assert_eq!(fields.len(), COLUMNS.len());
         out.push_str(&fields.join(","));

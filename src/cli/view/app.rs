@@ -58,7 +58,11 @@ pub struct App {
 impl App {
     pub fn new(args: Args, gpu_args: super::super::GpuArgs, scene: Scene, overrides: Overrides) -> Result<App> {
         let lights = scene.file.lights.clone();
-        let prepared = Some(PreparedScene::new(&scene, &overrides)?);
+        // The kernels `model = "auto"` or `"transport"` chose, as `render` attaches them, so the
+        // window shows what `render` writes (walked once with a progress bar, then cached).
+        let mut prepared = PreparedScene::new(&scene, &overrides)?;
+        super::super::attach_kernels(&mut prepared, None)?;
+        let prepared = Some(prepared);
         Ok(App {
             args,
             gpu_args,
@@ -210,7 +214,8 @@ impl App {
             }
         }
         file.lights.clone_from(&self.lights);
-        let prepared = PreparedScene::new(&self.scene, &self.overrides)?;
+        let mut prepared = PreparedScene::new(&self.scene, &self.overrides)?;
+        super::super::attach_kernels(&mut prepared, None)?;
         if let Some(viewer) = &mut self.viewer {
             viewer.rebuild(prepared)?;
             self.camera_moved = true;
