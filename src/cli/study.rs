@@ -283,12 +283,7 @@ fn parse_size(spec: &str) -> Result<u64> {
 fn config(args: &Args) -> Result<StudyConfig> {
     let mut config = if args.quick { StudyConfig::quick() } else { StudyConfig::full() };
     if !args.samplers.is_empty() {
-        config.samplers = args
-            .samplers
-            .iter()
-            .map(|s| s.parse().map_err(|e: String| anyhow::anyhow!("--samplers {s:?}: {e}")))
-            .collect::<Result<Vec<_>>>()
-            .map(distinct)?;
+        config.samplers = parse_each("--samplers", &args.samplers)?;
     }
     if !args.counts.is_empty() {
         if let Some(&n) = args.counts.iter().find(|&&n| n == 0 || n > MAX_SAMPLE_COUNT) {
@@ -339,13 +334,15 @@ fn config(args: &Args) -> Result<StudyConfig> {
     }
     config.physics = physics(args)?;
     config.models = models(args)?;
-    config.render_models = args
-        .render_models
-        .iter()
-        .map(|m| m.parse().map_err(|e: String| anyhow::anyhow!("--render-models {m:?}: {e}")))
-        .collect::<Result<Vec<_>>>()
-        .map(distinct)?;
+    config.render_models = parse_each("--render-models", &args.render_models)?;
     Ok(config)
+}
+
+/// Each item of a comma list given to `flag`, parsed and kept once; an item that does not
+/// parse is an error naming the flag and the item.
+fn parse_each<T: std::str::FromStr<Err = String> + PartialEq>(flag: &str, items: &[String]) -> Result<Vec<T>> {
+    let parsed = items.iter().map(|s| s.parse().map_err(|e: String| anyhow::anyhow!("{flag} {s:?}: {e}")));
+    parsed.collect::<Result<Vec<T>>>().map(distinct)
 }
 
 pub fn run(gpu_args: &super::GpuArgs, args: &Args) -> Result<()> {
