@@ -56,10 +56,9 @@ pub struct Row {
     /// The error model's prediction for this row per channel (`sampling::density`, worst
     /// object; NaN where it makes none: samplers other than Turk's, the pixel gather).
     pub predicted: [f64; 3],
-    /// With `--physics`, per channel: the model error, the exact exitance of the row's model (the
-    /// dipole's integral, scaled by a kernel or replaced by single scattering between points in
-    /// the channels that take them) against the radiative-transfer reference (relative RMS per
-    /// vertex; the same on every row of a model). NaN without.
+    /// With `--physics`, per channel: the model error, the row's model's exact exitance
+    /// (`study::models`) against the radiative-transfer reference (relative RMS per vertex; the
+    /// same on every row of a model). NaN without.
     pub model_rel_rms: [f64; 3],
     /// With `--physics`, per channel: the total error, the renderer against the
     /// radiative-transfer reference (relative RMS per vertex). NaN without, or for the pixel
