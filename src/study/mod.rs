@@ -437,12 +437,17 @@ pub fn run(
         [] => vec![None],
         list => list.iter().copied().map(Some).collect(),
     };
-    let models = models::prepare(&base, &forced, &dipole, truth_dir)?;
-    let (base, truth) = (models[0].base.clone(), models[0].truth.clone());
+    let single = models::BetweenPoints::new(&base);
+    let models = models::prepare(&base, &forced, (&dipole, &single), truth_dir)?;
+    let first = (models[0].base.clone(), models[0].truth.clone());
     let physics = match &config.physics {
-        Some(options) => Some(physics::Physics::measure(&base, &truth, options, &config.models, truth_dir, progress)?),
+        Some(options) => {
+            let (base, truth) = (&first.0, &first.1);
+            Some(physics::Physics::measure(base, (truth, &single), options, &config.models, truth_dir, progress)?)
+        }
         None => None,
     };
+    let (base, truth) = first;
     let images = models.iter().map(|m| truth_image(gpu, &m.base, &m.truth)).collect::<Result<Vec<_>, _>>()?;
     let (mut rows, mut exitances) = (Vec::new(), Vec::new());
     let total = config.runs();

@@ -40,16 +40,35 @@ impl RenderModel {
     }
 }
 
+/// Single scattering between points over a scene (`reference::single::between_points`, a long
+/// integral), computed at most once however many models of a study read it: it depends on the
+/// geometry, media and lights alone, not on the model.
+pub struct BetweenPoints<'a> {
+    base: &'a PreparedScene,
+    exitance: std::cell::OnceCell<Vec<Vec<[f64; 3]>>>,
+}
+
+impl<'a> BetweenPoints<'a> {
+    /// Over `base`, not computed yet.
+    pub fn new(base: &'a PreparedScene) -> BetweenPoints<'a> {
+        BetweenPoints { base, exitance: std::cell::OnceCell::new() }
+    }
+
+    /// Per object, vertex and channel; computed on the first call.
+    pub fn get(&self) -> &[Vec<[f64; 3]>] {
+        self.exitance.get_or_init(|| crate::reference::single::between_points(self.base, FINENESS))
+    }
+}
+
 /// `base` under each of `forced` (`None`: as its materials say), against `dipole`, the
-/// dipole's exact integral over it; kernels are read from or walked into `dir`. Single
-/// scattering between points, a long integral, is computed once for every model that needs it.
+/// dipole's exact integral over it, and `single`, single scattering between points over it;
+/// kernels are read from or walked into `dir`.
 pub fn prepare(
     base: &PreparedScene,
     forced: &[Option<ScatteringModel>],
-    dipole: &Truth,
+    (dipole, single): (&Truth, &BetweenPoints<'_>),
     dir: &Path,
 ) -> Result<Vec<RenderModel>, StudyError> {
-    let single = std::cell::OnceCell::new();
     let mut out = Vec::new();
     for &forced in forced {
         let mut base = base.clone();
@@ -62,8 +81,7 @@ pub fn prepare(
             }
         }
         let precompute_s = transport_cache::attach(&mut base.objects, &KernelSettings::default(), dir, &|_, _, _| {})?;
-        let between = || single.get_or_init(|| crate::reference::single::between_points(&base, FINENESS)).as_slice();
-        let truth = Truth { exitance: exact_exitance(&base, &dipole.exitance, between, dir)?, ..dipole.clone() };
+        let truth = Truth { exitance: exact_exitance(&base, &dipole.exitance, single, dir)?, ..dipole.clone() };
         out.push(RenderModel { forced, base, truth, precompute_s });
     }
     Ok(out)
@@ -71,12 +89,11 @@ pub fn prepare(
 
 /// Per object, vertex and channel, the exact exitance of the model each channel of `base`
 /// takes (see [`RenderModel::truth`]); NaN where `dipole` is (off a truth's receivers).
-/// `single` gives single scattering between points (the same for every model: it depends on
-/// the geometry, media and lights alone).
-fn exact_exitance<'a>(
+/// `single` gives single scattering between points, read only where a channel takes it.
+fn exact_exitance(
     base: &PreparedScene,
     dipole: &[Vec<[f64; 3]>],
-    single: impl FnOnce() -> &'a [Vec<[f64; 3]>],
+    single: &BetweenPoints<'_>,
     dir: &Path,
 ) -> Result<Vec<Vec<[f64; 3]>>, StudyError> {
     let takes = |o: &crate::scene::build::PreparedObject, m: ChannelModel| {
@@ -87,7 +104,7 @@ fn exact_exitance<'a>(
     } else {
         None
     };
-    let single = base.objects.iter().any(|o| takes(o, ChannelModel::Single)).then(single);
+    let single = base.objects.iter().any(|o| takes(o, ChannelModel::Single)).then(|| single.get());
     let mut out = dipole.to_vec();
     for (i, (o, exitance)) in base.objects.iter().zip(&mut out).enumerate() {
         let Some(choice) = &o.model else { continue };

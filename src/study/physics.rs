@@ -84,7 +84,7 @@ impl Physics {
     /// stored there) and the model error of `truth` against it. `progress` hears of the walk.
     pub fn measure(
         base: &PreparedScene,
-        truth: &Truth,
+        (truth, single): (&Truth, &super::models::BetweenPoints<'_>),
         options: &MeshOptions,
         models: &[Model],
         dir: &Path,
@@ -118,7 +118,7 @@ impl Physics {
         let model = vertex_error_f64(&exitance, &truth.exitance);
         let noise = noise(&exitance, &stderr);
         let walks = reference.objects.iter().flatten().map(|o| o.photons).max().unwrap_or(1);
-        let models = alternative_models(base, &truth.exitance, models, (options, walks), dir)?;
+        let models = alternative_models(base, (&truth.exitance, single), models, (options, walks), dir)?;
         let alternatives =
             models.iter().skip(1).map(|(name, m)| (name.clone(), vertex_error_f64(&exitance, m))).collect();
         let cosines = light_cosines(base);
@@ -244,7 +244,7 @@ impl std::str::FromStr for Model {
 /// over a large mesh takes many minutes).
 fn alternative_models(
     base: &PreparedScene,
-    truth: &[Exitance],
+    (truth, between): (&[Exitance], &super::models::BetweenPoints<'_>),
     models: &[Model],
     reference: (&MeshOptions, u64),
     dir: &Path,
@@ -253,13 +253,12 @@ fn alternative_models(
     use crate::reference::directional;
     let fineness = directional::FINENESS;
     let single = || crate::reference::single::exitance(base);
-    let beam = || crate::reference::single::between_points(base, fineness);
     let variant = |d, s| directional::exitance_with(base, d, s, fineness, None);
     let mut out = vec![("dipole".to_string(), truth.to_vec())];
     for &m in models {
         let exitance = match m {
-            Model::Between => beam(),
-            Model::PerChannel => per_channel_choice(base, truth, &beam()),
+            Model::Between => between.get().to_vec(),
+            Model::PerChannel => per_channel_choice(base, truth, between.get()),
             Model::DipoleSingle => truth
                 .iter()
                 .zip(&single())
@@ -273,7 +272,7 @@ fn alternative_models(
             Model::TransportSlanted => transport(base, reference, ModelEntry::Slanted)?,
             Model::Kernel => {
                 let scaled = crate::reference::transport_cache::model_exitance(base, truth, dir)?;
-                with_single_between_points(base, scaled)
+                with_single_between_points(base, scaled, between)
             }
         };
         out.push((m.label(), exitance));
@@ -310,13 +309,16 @@ fn transport(
 
 /// `exitance` with single scattering between points in the channels whose reduced albedo is
 /// under `optics::beam_single::ALBEDO_BELOW`, as `material.model = "transport"` renders them
-/// (the between-points reference computed only where a channel takes it).
-pub fn with_single_between_points(base: &PreparedScene, exitance: Vec<Exitance>) -> Vec<Exitance> {
+/// (`between` read only where a channel takes it).
+pub fn with_single_between_points(
+    base: &PreparedScene,
+    exitance: Vec<Exitance>,
+    between: &super::models::BetweenPoints<'_>,
+) -> Vec<Exitance> {
     if !base.objects.iter().any(|o| low_albedo(&o.material).contains(&true)) {
         return exitance;
     }
-    let beam = crate::reference::single::between_points(base, crate::reference::directional::FINENESS);
-    per_channel_choice(base, &exitance, &beam)
+    per_channel_choice(base, &exitance, between.get())
 }
 
 /// Per object, vertex and channel: `single` where the channel's reduced albedo is under
