@@ -28,8 +28,8 @@
 // order (uint[]), 6 = node power (NodePowerRecord[], written by stage 0, read by stage 1),
 // 7 = receiver order (uint[]), 8 = receiver records (ReceiverGroupRecord[], one per receiver), 9 = group items
 // (uint[]), 10 = exitance (vec4 per vertex, written by stage 1), 11 = boundary distances (vec2
-// per vertex, mesh::Mesh::boundary_distances), 12 = receiver state (uvec2 per vertex, picked by
-// glsl/receiver_view.comp where push.only_picked). Push: GatherTreePush.
+// per vertex, mesh::Mesh::boundary_distances), 12 = receiver state (uvec2 per vertex, bit 0 of
+// y picked to gather by glsl/receiver_view.comp where push.only_picked). Push: GatherTreePush.
 #include "dipole.glsl"
 #include "scene.glsl"
 #include "gather.glsl"
@@ -127,7 +127,7 @@ void main() {
     uint v = receiver_order[push.first_receiver + k];
     // The rest hold exitance gathered under this generation of the splat, or wait their turn;
     // they leave before the object's record is loaded.
-    if (push.only_picked != 0u && receiver_state[v].y == 0u) return;
+    if (push.only_picked != 0u && (receiver_state[v].y & 1u) == 0u) return;
     ObjectRecord o = objects[push.object];
     vec3 x = vertex_position(vertices[v]);
     uvec4 list = receiver_groups[push.first_group + k].items;

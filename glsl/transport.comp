@@ -17,14 +17,20 @@
 //   2: one invocation per vertex: the scale, in the channels push.stage.w names (the others
 //      take single scattering between points, which the pass before wrote), where the blended
 //      D is positive and the scaled value finite (else the dipole's value stays).
+// Gathered visible-first (glsl/receiver_view.comp), a frame gathers (state GATHER) and scales
+// (FINISH) only some vertices, and D needs every vertex of a patch: so stage 0 keeps each
+// vertex's dipole value, as the gather left it, in `dipole` (w: the generation, push.frame.x),
+// reads D from there, and stage 2 scales the FINISH vertices from there. push.frame.y = 1:
+// every vertex was gathered and is scaled (a scope of every receiver).
 // Bindings: 0 = splat (SplatRecord[], read), 1 = exitance (vec4 per vertex, read by stage 0,
 // written by stage 2), 2 = patches (TransportPatchRecord[]), 3 = items (uvec2: index, area
 // bits), 4 = the kernels' rows (W0: a vec4 per pair, rgb; then per patch its near list, two
 // vec4 per J: Wmu rgb with J in w, exact as a float; Wt rgb), 5 = sums (SUMS vec4 per patch:
 // Phi, D, F, Phimu, T_r, T_g, T_b; written by stages 0 and 1), 6 = neighbours (four
 // uvec4 per vertex: (patch relative to the level's first record, weight bits) pairs), 7 = level
-// vertices (uint[], object-relative), 8 = samples (SampleRecord[]: the normals).
-// Push: TransportPush.
+// vertices (uint[], object-relative), 8 = samples (SampleRecord[]: the normals), 9 = receiver
+// state (uvec2 per vertex: generation, GATHER | FINISH), 10 = transport dipole (vec4 per vertex:
+// the dipole's exitance, w the generation's bits). Push: TransportPush.
 #include "scene.glsl"
 
 layout(local_size_x = 64) in;
@@ -48,12 +54,18 @@ layout(std430, set = 0, binding = 5) buffer TransportSums { vec4 sums[]; };
 layout(std430, set = 0, binding = 6) readonly buffer TransportNeighbours { uvec4 neighbours[]; };
 layout(std430, set = 0, binding = 7) readonly buffer LevelVertices { uint level_vertices[]; };
 layout(std430, set = 0, binding = 8) readonly buffer Samples { SampleRecord samples[]; };
+layout(std430, set = 0, binding = 9) readonly buffer ReceiverState { uvec2 receiver_state[]; };
+layout(std430, set = 0, binding = 10) buffer TransportDipole { vec4 dipole[]; };
+
+#define GATHER 1u  // glsl/receiver_view.comp: gathered this frame
+#define FINISH 2u  // glsl/receiver_view.comp: scaled this frame
 
 struct TransportPush {
     uvec4 stage;    // x: the stage; y: the object's first patch; z: its patches; w: the
                     // channels it scales (bit c)
     uvec4 vertices; // x: its first vertex; y: the level's vertices; z: the object's first
                     // neighbour entry; w: the level's first entry in level_vertices
+    uvec4 frame;    // x: the splat generation; y: 1 where every vertex was gathered
 };
 layout(push_constant) uniform Push { TransportPush push; };
 
@@ -78,6 +90,15 @@ void add_sample(uvec2 it, float mu_bar, inout vec3 phi, inout vec3 phi_mu, inout
     for (int c = 0; c < 3; ++c) t[c] += tilt * f[c];
 }
 
+// Vertex v's dipole exitance this generation; kept in `dipole` where this frame gathered it
+// (each vertex lies in one patch of the level: one writer).
+vec3 dipole_value(uint v) {
+    if (push.frame.y == 0u && (receiver_state[v].y & GATHER) == 0u) return dipole[v].rgb;
+    vec3 m = exitance[v].rgb;
+    dipole[v] = vec4(m, uintBitsToFloat(push.frame.x));
+    return m;
+}
+
 // Stage 0: patch `p`'s Phi, Phimu, T and D, one invocation walking its items (a patch has a
 // few hundred; a workgroup per patch summing six arrays through shared memory and six barriers
 // was no faster on lavapipe).
@@ -89,7 +110,7 @@ void patch_sums(uint p) {
     for (uint k = 0u; k < r.items.y; ++k) {
         uvec2 it = items[r.items.x + k];
         float a = uintBitsToFloat(it.y);
-        d += vec4(a * exitance[it.x].rgb, a);
+        d += vec4(a * dipole_value(it.x), a);
     }
     for (uint k = 0u; k < r.items.z; ++k) {
         add_sample(items[r.items.x + r.items.y + k], r.area.y, phi, phi_mu, t);
@@ -132,6 +153,9 @@ void patch_transport(uint p) {
 void scale_vertex(uint i) {
     uint rel = level_vertices[push.vertices.w + i];
     uint v = push.vertices.x + rel;
+    // Gathered visible-first, the rest wait their turn (and hold the dipole's value or an older
+    // generation's).
+    if (push.frame.y == 0u && (receiver_state[v].y & FINISH) == 0u) return;
     uint first = push.stage.y;
     vec3 f = vec3(0.0), d = vec3(0.0);
     for (uint k = 0u; k < 4u; ++k) {
@@ -141,7 +165,7 @@ void scale_vertex(uint i) {
         f += w0 * sums[p0 + 2u].rgb + w1 * sums[p1 + 2u].rgb;
         d += w0 * sums[p0 + 1u].rgb + w1 * sums[p1 + 1u].rgb;
     }
-    vec4 m = exitance[v];
+    vec4 m = vec4(dipole[v].rgb, exitance[v].w);
     for (int c = 0; c < 3; ++c) {
         // An overflowed dipole exitance times a zero ratio would be NaN: keep the dipole's.
         float s = m[c] * (f[c] / d[c]);

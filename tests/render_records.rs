@@ -20,6 +20,7 @@ use translucent::render::shade::ShadePush;
 use translucent::render::shadow::ShadowPush;
 use translucent::render::splat::SplatPush;
 use translucent::render::tonemap::TonemapPush;
+use translucent::render::transport::TransportPush;
 use translucent::render::vertex_light::VertexLightPush;
 
 /// (field name, std430 offset) of `struct NAME { ... };` in `source`, for the member types used
@@ -306,15 +307,37 @@ fn push_cases() -> [PushCase; 12] {
     ]
 }
 
-/// The push blocks of the steps inside a pass (the hierarchical gather's pick of receivers).
-fn step_push_cases() -> [PushCase; 1] {
-    [(
-        "receiver_view.comp",
-        include_str!("../glsl/receiver_view.comp"),
-        "ReceiverViewPush",
-        size_of::<ReceiverViewPush>(),
-        &["view_proj", "eye", "first_receiver", "receiver_count", "generation", "flags", "sweep", "reach", "pad"],
-    )]
+/// The push blocks of the steps inside a pass (the hierarchical gather's pick of receivers),
+/// and of the passes that follow the gather (`push_cases` holds the rest: one list would pass
+/// a screen).
+fn step_push_cases() -> [PushCase; 2] {
+    [
+        (
+            "receiver_view.comp",
+            include_str!("../glsl/receiver_view.comp"),
+            "ReceiverViewPush",
+            size_of::<ReceiverViewPush>(),
+            &[
+                "view_proj",
+                "eye",
+                "first_receiver",
+                "receiver_count",
+                "generation",
+                "flags",
+                "sweep",
+                "reach",
+                "stage",
+                "kernel",
+            ],
+        ),
+        (
+            "transport.comp",
+            include_str!("../glsl/transport.comp"),
+            "TransportPush",
+            size_of::<TransportPush>(),
+            &["stage", "vertices", "frame"],
+        ),
+    ]
 }
 
 #[test]

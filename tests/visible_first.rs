@@ -1,6 +1,7 @@
 //! The hierarchical gather's visible-first receivers (`render::plan::receivers`): after a
 //! change it recomputes the receivers an eye may see and sweeps the rest over the next frames,
-//! and every image, and every readback, equals a gather of every receiver.
+//! and every image, and every readback, equals a gather of every receiver: with the dipole alone
+//! and with a transport kernel scaling the bunny's exitance.
 
 mod common;
 
@@ -8,19 +9,27 @@ use common::{builtin, with_gpu};
 use glam::Vec3;
 use std::sync::Arc;
 use translucent::gpu::Gpu;
+use translucent::reference::rte_mesh::{KernelSettings, object_kernel};
+use translucent::render::camera::CameraView;
 use translucent::render::edit::SceneEdit;
 use translucent::render::plan::{Change, ReceiverScope, SWEEP_FRAMES, View};
-use translucent::render::receiver_view::seen_receivers;
+use translucent::render::receiver_view::{FINISH, GATHER, kernel_gathered, seen_receivers};
 use translucent::render::renderer::Renderer;
 use translucent::render::target::DepthConvention;
-use translucent::scene::build::Overrides;
-use translucent::scene::{GatherMode, ReceiverPolicy, lights};
+use translucent::scene::build::{Overrides, PreparedScene};
+use translucent::scene::needs::KernelState;
+use translucent::scene::{Camera, GatherMode, ReceiverPolicy, lights};
 
 /// The built-in scene gathered hierarchically at 400 samples, its receivers under `policy`.
-fn renderer(gpu: &Arc<Gpu>, policy: ReceiverPolicy) -> Renderer {
+fn prepared(policy: ReceiverPolicy) -> PreparedScene {
     let overrides =
         Overrides { gather: Some(GatherMode::Hierarchical), receivers: Some(policy), ..Overrides::default() };
-    Renderer::new(gpu, builtin(&overrides)).expect("renderer")
+    builtin(&overrides)
+}
+
+/// A renderer of `prepared(policy)`.
+fn renderer(gpu: &Arc<Gpu>, policy: ReceiverPolicy) -> Renderer {
+    Renderer::new(gpu, prepared(policy)).expect("renderer")
 }
 
 /// Render the frame the pending change calls for; the image and the bunny's receiver scope.
@@ -65,6 +74,73 @@ fn every_image_of_a_light_drag_and_an_orbit_equals_a_gather_of_every_receiver() 
         // exitance, and a camera frame gathers nothing.
         let plan = visible.plan(Change::Camera);
         assert!(!plan.objects[0].gather, "{plan}");
+    });
+}
+
+/// The bunny's vertices the last frame marked to gather, and to scale.
+fn marked(renderer: &Renderer) -> (Vec<u32>, Vec<u32>) {
+    let state: Vec<[u32; 2]> = renderer.scene_data().buffers().receiver_state().read().expect("state");
+    let count = renderer.scene().objects[0].mesh.positions().len() as u32;
+    let with = |bit: u32| (0..count).filter(|&v| state[v as usize][1] & bit != 0).collect();
+    (with(GATHER), with(FINISH))
+}
+
+#[test]
+fn with_a_transport_kernel_every_image_and_readback_visible_first_equals_a_gather_of_every_receiver() {
+    // A small kernel: what is tested is which vertices are gathered and scaled, not its noise.
+    let settings = KernelSettings { patches: 128, walks: 128 * 20, seed: 3 };
+    let kernel = Arc::new(object_kernel(&prepared(ReceiverPolicy::Every).objects[0], &settings, &|_, _| {}).unwrap());
+    with_gpu(|gpu| {
+        let with_kernel = |policy| {
+            let mut scene = prepared(policy);
+            scene.objects[0].transport = Some(kernel.clone());
+            let mut r = Renderer::new(gpu, scene).expect("renderer");
+            // Close to the head: a quarter of the level's vertices may be seen, and the patches
+            // they blend leave some of the rest unneeded.
+            let file = &r.scene().scene.file.camera;
+            let close = Camera { eye: [-0.03, 0.045, 0.05], target: [-0.01, 0.035, 0.0], ..file.clone() };
+            r.edit(SceneEdit::Camera(CameraView::of_camera(&close, r.scene()))).unwrap();
+            r
+        };
+        let (mut visible, mut every) = (with_kernel(ReceiverPolicy::VisibleFirst), with_kernel(ReceiverPolicy::Every));
+        let plan = visible.plan(Change::Everything);
+        assert!(matches!(plan.objects[0].transport, Some(KernelState::Scales { .. })), "{plan}");
+        let (image, scope) = frame(&mut visible);
+        assert!(matches!(scope, ReceiverScope::VisibleFirst { fresh: true, sweep: None, .. }), "{scope:?}");
+        // The patches of the scaled vertices are gathered whole: more gathered than scaled,
+        // as the host twin counts them.
+        let (gathered, scaled) = marked(&visible);
+        let (level, bunny) = (plan.objects[0].level, &visible.scene().objects[0]);
+        let count = bunny.levels[level].vertices.len();
+        let (g, s) = (gathered.len(), scaled.len());
+        assert!(s > 0 && s < g && g < count, "{s} scaled, {g} gathered of the level's {count}");
+        let view = View::of_camera(&visible.camera(), visible.scene().scene.file.camera.resolution[1]);
+        let seen = seen_receivers(bunny, level, &view, DepthConvention::Standard);
+        assert_eq!(scaled, seen);
+        assert_eq!(gathered, kernel_gathered(bunny, level, &seen));
+        assert_eq!(image, frame(&mut every).0, "first frame");
+        for step in 0..(2 + SWEEP_FRAMES as usize + 3) {
+            for r in [&mut visible, &mut every] {
+                let edit = if step < 2 {
+                    let light = &r.scene().scene.file.lights[0];
+                    SceneEdit::Light { index: 0, light: lights::orbit(light, Vec3::ZERO, 25.0).unwrap() }
+                } else {
+                    SceneEdit::Camera(r.camera().orbited(Vec3::ZERO, 40.0))
+                };
+                r.edit(edit).unwrap();
+            }
+            let (a, scope) = frame(&mut visible);
+            assert_eq!(a, frame(&mut every).0, "frame {step} ({scope:?})");
+        }
+        assert!(!visible.plan(Change::Camera).objects[0].gather, "the sweep has finished");
+        // After a light move, a readback finishes the sweep: the scaled exitance of every vertex.
+        for r in [&mut visible, &mut every] {
+            let light = &r.scene().scene.file.lights[0];
+            r.edit(SceneEdit::Light { index: 0, light: lights::orbit(light, Vec3::ZERO, 25.0).unwrap() }).unwrap();
+            frame(r);
+        }
+        let level = |r: &Renderer| r.exitance_at_level(0).expect("exitance");
+        assert_eq!(level(&visible), level(&every));
     });
 }
 

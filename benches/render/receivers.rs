@@ -3,7 +3,9 @@
 //! default scene at 512x512, renderers stepped side by side (alternating, so outside load falls
 //! on both alike), GPU timestamps; then the frame with one of the 17 lights moving against one
 //! with all of them changed; then the gather's time against the share of the mesh an eye may
-//! see, the camera zoomed in at the level of detail the default view draws.
+//! see, the camera zoomed in at the level of detail the default view draws; then the same with
+//! the bunny's transport kernel attached (what `model = "auto"` draws), whose pick adds every
+//! vertex of the patches the seen ones blend.
 
 use super::{FRAMES, WARM_UP, step};
 use glam::{Mat4, Vec3};
@@ -11,15 +13,31 @@ use std::sync::Arc;
 use translucent::SceneEdit;
 use translucent::gpu::{Gpu, median};
 use translucent::render::plan::{Change, Pass, SWEEP_FRAMES};
+use translucent::render::receiver_view::GATHER;
 use translucent::render::renderer::Renderer;
-use translucent::scene::ReceiverPolicy;
-use translucent::scene::build::Overrides;
+use translucent::scene::build::{Overrides, PreparedScene};
+use translucent::scene::{ReceiverPolicy, Scene};
 
 /// Light-moving frames per renderer after the warm-up: the two rows alternate.
 const RECEIVER_FRAMES: usize = 3 * FRAMES;
 
 fn renderer(gpu: &Arc<Gpu>, policy: ReceiverPolicy) -> Renderer {
     super::default_renderer(gpu, Overrides { receivers: Some(policy), ..Overrides::default() })
+}
+
+/// The default scene at 512x512 with the bunny's transport kernel attached (read from the
+/// cache, or walked there first), its receivers under `policy`.
+fn kernel_renderer(gpu: &Arc<Gpu>, policy: ReceiverPolicy) -> Renderer {
+    use translucent::reference::{rte_mesh::KernelSettings, transport_cache, truth};
+    let overrides = Overrides { receivers: Some(policy), resolution: Some([512, 512]), ..Overrides::default() };
+    let mut prepared = PreparedScene::new(&Scene::builtin(), &overrides).expect("default scene");
+    let dir = truth::default_cache_dir();
+    transport_cache::attach(&mut prepared.objects, &KernelSettings::default(), &dir, &|_, _, _| {})
+        .expect("transport kernel");
+    assert!(prepared.objects[0].transport.is_some(), "model = \"auto\" takes the bunny's kernel");
+    let mut renderer = Renderer::new(gpu, prepared).expect("renderer");
+    renderer.frame(&renderer.plan(Change::Everything)).expect("first frame");
+    renderer
 }
 
 /// Median gather and frame time by timestamps of each renderer, stepped side by side through
@@ -51,11 +69,12 @@ fn side_by_side(rows: &mut [Renderer], change: Change, frames: usize, level: Opt
     (times.iter_mut().map(|(g, t)| [median(g), median(t)]).collect(), same)
 }
 
-/// Share of object 0's receivers at its level the last frame's pick marked.
+/// Share of object 0's receivers at its level the last frame's pick marked to gather.
 fn picked_share(r: &Renderer, level: usize) -> f64 {
     let state: Vec<[u32; 2]> = r.scene_data().buffers().receiver_state().read().expect("receiver state");
     let level = &r.scene().objects[0].levels[level];
-    level.vertices.iter().filter(|&&v| state[v as usize][1] == 1).count() as f64 / level.vertices.len() as f64
+    let gathered = level.vertices.iter().filter(|&&v| state[v as usize][1] & GATHER != 0).count();
+    gathered as f64 / level.vertices.len() as f64
 }
 
 pub fn receivers(gpu: &Arc<Gpu>) {
@@ -101,9 +120,25 @@ pub fn receivers(gpu: &Arc<Gpu>) {
     println!(
         "\nGather against the share of the mesh an eye may see (camera zoomed in, level {level}, key light moving):"
     );
-    println!("  {:>6} {:>8} {:>16} {:>20} {:>7}", "zoom", "share", "every gather ms", "visible_first ms", "ratio");
+    zoomed(&mut rows, level, &[1.0, 1.5, 2.0, 3.0, 4.0, 6.0]);
+
+    let mut kernel = [kernel_renderer(gpu, ReceiverPolicy::Every), kernel_renderer(gpu, ReceiverPolicy::VisibleFirst)];
+    println!(
+        "\nThe same with the bunny's transport kernel (model = \"auto\"; the gather's slot includes the transport \
+         pass), level {level}, key light moving:"
+    );
+    zoomed(&mut kernel, level, &[1.0, 2.0, 4.0]);
+}
+
+/// The gather by timestamps of `rows` (every receiver, then visible first) at each of `zooms`,
+/// side by side at `level`, with the share of the level's receivers the second gathered.
+fn zoomed(rows: &mut [Renderer; 2], level: usize, zooms: &[f32]) {
+    println!(
+        "  {:>6} {:>8} {:>16} {:>20} {:>7} {:>12}",
+        "zoom", "share", "every gather ms", "visible_first ms", "ratio", "frame ratio"
+    );
     let camera = rows[0].camera();
-    for zoom in [1.0f32, 1.5, 2.0, 3.0, 4.0, 6.0] {
+    for &zoom in zooms {
         let zoomed = translucent::render::camera::CameraView {
             projection: Mat4::from_scale(Vec3::new(zoom, zoom, 1.0)) * camera.projection,
             ..camera
@@ -111,9 +146,10 @@ pub fn receivers(gpu: &Arc<Gpu>) {
         for r in rows.iter_mut() {
             r.edit(SceneEdit::Camera(zoomed)).expect("camera");
         }
-        let (m, same) = side_by_side(&mut rows, Change::Light(0), FRAMES, Some(level));
+        let (m, same) = side_by_side(rows, Change::Light(0), FRAMES, Some(level));
         assert!(same, "visible-first images differ from every receiver's at zoom {zoom}");
         let share = picked_share(&rows[1], level);
-        println!("  {zoom:>6.1} {share:>8.2} {:>16.2} {:>20.2} {:>7.2}", m[0][0], m[1][0], m[1][0] / m[0][0]);
+        let ratio = [m[1][0] / m[0][0], m[1][1] / m[0][1]];
+        println!("  {zoom:>6.1} {share:>8.2} {:>16.2} {:>20.2} {:>7.2} {:>12.2}", m[0][0], m[1][0], ratio[0], ratio[1]);
     }
 }

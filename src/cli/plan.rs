@@ -105,22 +105,28 @@ fn atlases(prepared: &PreparedScene) -> impl Iterator<Item = (usize, &Atlas)> {
 }
 
 /// Each gathered object's receivers an eye may see, counted on the host as the GPU picks them
-/// (`receiver_view::seen_receivers`), in every plan that gathers visible-first; counted once per
-/// level.
+/// (`receiver_view::seen_receivers`), and for an object a transport kernel scales those its
+/// patches add (`receiver_view::kernel_gathered`), in every plan that gathers visible-first;
+/// counted once per level.
 fn count_seen(prepared: &PreparedScene, view: &plan::View, frames: &mut [(Change, plan::Plan)]) {
     use translucent::render::plan::ReceiverScope;
-    use translucent::render::receiver_view::seen_receivers;
+    use translucent::render::receiver_view::{kernel_gathered, seen_receivers};
     use translucent::render::target::DepthConvention;
+    use translucent::scene::needs::KernelState;
     let mut counted = std::collections::HashMap::new();
     for o in frames.iter_mut().flat_map(|(_, p)| p.objects.iter_mut()) {
         if !o.gather || !matches!(o.receivers, ReceiverScope::VisibleFirst { .. }) {
             continue;
         }
         let object = &prepared.objects[o.object];
-        let seen = *counted.entry((o.object, o.level)).or_insert_with(|| {
+        let (seen, more) = *counted.entry((o.object, o.level)).or_insert_with(|| {
             let of = object.levels.get(o.level).map_or(0, |l| l.vertices.len());
-            [seen_receivers(object, o.level, view, DepthConvention::Standard).len(), of]
+            let seen = seen_receivers(object, o.level, view, DepthConvention::Standard);
+            let kernel = o.transport.is_some_and(|t| matches!(t, KernelState::Scales { .. }));
+            let more = kernel.then(|| kernel_gathered(object, o.level, &seen).len() - seen.len());
+            ([seen.len(), of], more)
         });
         o.receivers_seen = Some(seen);
+        o.receivers_for_kernel = more;
     }
 }

@@ -428,6 +428,8 @@ impl GpuScene {
         let beam_source_count = if any_beams { p.tree_order.len() + p.tree_nodes.len() } else { 1 };
         let t = super::transport_tables::pack(scene, &p.firsts, &l.levels);
         let zeros = vec![[0f32; 4]; p.vertices.len()];
+        // The transport pass keeps each kernel vertex's dipole value, indexed like the exitance.
+        let kernel_vertices = if t.objects.iter().any(Option::is_some) { p.vertices.len() } else { 0 };
         let sized = |name, item: usize, count: usize| storage(gpu, name, (item * count) as u64, none);
         // Made in the order they always were, vertices then indices first.
         let vertices = upload(gpu, "vertices", &p.vertices, vertex_usage)?;
@@ -469,6 +471,9 @@ impl GpuScene {
                 transport_matrix: upload(gpu, "transport matrix", &t.matrix, none)?,
                 transport_sums: sized("transport sums", 16 * 7, t.patches.len().max(1))?,
                 transport_neighbours: upload(gpu, "transport neighbours", &t.neighbours, none)?,
+                // Generation 0 everywhere: no patch needed, no dipole value current.
+                transport_needed: upload(gpu, "transport needed", &vec![0u32; t.patches.len()], none)?,
+                transport_dipole: upload(gpu, "transport dipole", &vec![[0f32; 4]; kernel_vertices], none)?,
                 receiver_cones: upload(gpu, "receiver cones", &receiver_cones(scene, &l.levels), none)?,
                 // Generation 0, which no gather marks: every receiver stale.
                 receiver_state: upload(gpu, "receiver state", &vec![[0u32; 2]; p.vertices.len()], none)?,
@@ -538,6 +543,13 @@ impl GpuScene {
     pub fn level(&self, object: usize, level: usize) -> LevelRange {
         let levels = &self.levels[object];
         levels[level.min(levels.len() - 1)]
+    }
+
+    /// Where object `object`'s transport kernel lies at level of detail `level` (its coarsest
+    /// where it has fewer), if it has one.
+    pub fn transport_at(&self, object: usize, level: usize) -> Option<super::transport_tables::LevelTransport> {
+        let levels = self.transport.get(object)?.as_ref()?;
+        levels.get(level.min(levels.len().checked_sub(1)?)).copied()
     }
 
     /// Entry `j` of `receivers` at level of detail `level`: its `coarser_receivers` entry, or

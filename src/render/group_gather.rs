@@ -107,10 +107,8 @@ impl GroupGather {
             || frame.scene.receivers.iter().enumerate().filter(|(_, r)| frame.plan.gathers(r.object as usize));
         let at = |j: usize, r: &Receiver| frame.scene.receiver_at(j, frame.plan.level(r.object as usize));
         if let Some(view) = &self.view {
-            for (j, r) in planned() {
-                view.record(cmd, frame, at(j, r), frame.plan.receivers(r.object as usize));
-            }
-            frame.before(cmd, &[read(Resource::ReceiverState, Access::ComputeRead)]);
+            let picks: Vec<_> = planned().map(|(j, r)| (at(j, r), frame.plan.receivers(r.object as usize))).collect();
+            view.record(cmd, frame, &picks);
         }
         for (j, r) in planned().filter(|(_, r)| frame.plan.receivers(r.object as usize).fresh()) {
             self.record_stage0(cmd, frame, j, r);

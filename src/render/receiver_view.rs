@@ -2,31 +2,52 @@
 //! step of `gather_tree` before its stage 1, one dispatch per object whose plan scopes its
 //! receivers `VisibleFirst` (`plan::receivers`). It marks in `ReceiverState` the receivers not
 //! yet gathered under the object's splat generation that an eye may see or that fall in this
-//! frame's chunk of the sweep; stage 1 gathers those alone.
+//! frame's chunk of the sweep; stage 1 gathers those alone. For an object whose exitance a
+//! transport kernel scales (`transport`), two more stages add the vertices of every patch a
+//! picked vertex blends, whose dipole value is older: the kernel's ratio needs each such patch's
+//! mean dipole exitance, so they are gathered too (once per generation), and scaled in turn.
 //!
 //! Bindings: `BINDINGS`, in binding order. Push: `ReceiverViewPush`.
 
 use super::cull::{culled_faces, hidden_faces};
 use super::gpu_scene::Receiver;
-use super::graph::{Resource, Resources, Use, compute_uses_read_write};
+use super::graph::{Resource, Resources, Use, compute_uses_read_write, read, write};
 use super::pass::FrameInputs;
 use super::plan::{ReceiverScope, Sweep, View};
 use super::target::{DepthConvention, DepthTest};
-use crate::gpu::{ComputePipeline, DescriptorSet, Gpu, GpuResult};
+use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use crate::mesh::enclosure;
 use crate::mesh::facing::{faces_eye, longest_edge, vertex_cones};
+use crate::optics::transport::TransportKernel;
 use crate::scene::build::PreparedObject;
 use ash::vk;
 use std::sync::Arc;
 
 /// glsl/receiver_view.comp's bindings, in binding order.
-const BINDINGS: [Resource; 4] =
-    [Resource::Vertices, Resource::ReceiverOrder, Resource::ReceiverCones, Resource::ReceiverState];
+const BINDINGS: [Resource; 9] = [
+    Resource::Vertices,
+    Resource::ReceiverOrder,
+    Resource::ReceiverCones,
+    Resource::ReceiverState,
+    Resource::TransportNeighbours,
+    Resource::TransportPatches,
+    Resource::TransportItems,
+    Resource::TransportNeeded,
+    Resource::TransportDipole,
+];
 
 /// Pick the receivers an eye may see (`VIEW_TEST` in the GLSL).
 const VIEW_TEST: u32 = 1;
 /// Test the facing cone too: the shading pass culls the faces no eye ray reaches.
 const FACING_TEST: u32 = 2;
+/// A transport kernel scales the object's exitance: mark the picked vertices to be scaled, and
+/// gather what their patches need.
+const KERNEL: u32 = 4;
+
+/// `ReceiverState`'s y bit: stage 1 of the gather computes the vertex's dipole exitance.
+pub const GATHER: u32 = 1;
+/// `ReceiverState`'s y bit: the transport pass scales the vertex this frame.
+pub const FINISH: u32 = 2;
 
 /// `ReceiverViewPush` in glsl/receiver_view.comp.
 #[repr(C)]
@@ -48,8 +69,12 @@ pub struct ReceiverViewPush {
     pub sweep: [u32; 2],
     /// The drawn level's longest edge (`LevelRange::reach`).
     pub reach: f32,
-    /// Pads the block to 16 bytes.
-    pub pad: u32,
+    /// 0: the pick; for a kernel's object, 1: its picked vertices stamp their patches; 2: the
+    /// stamped patches mark their vertices to gather.
+    pub stage: u32,
+    /// A kernel's object: the level's first patch record and patch count, the object's first
+    /// neighbour entry and first vertex (`LevelTransport`); 0 otherwise.
+    pub kernel: [u32; 4],
 }
 
 /// The f32 twin of the pick's view test on the host: the vertices (object-relative, ascending)
@@ -78,6 +103,26 @@ pub fn seen_receivers(object: &PreparedObject, level: usize, view: &View, conven
         .collect()
 }
 
+/// The host twin of the two stages for an object a transport kernel scales, on a frame of
+/// change (no dipole value current): the vertices (object-relative, ascending) of `object`'s
+/// level `level` that the gather computes when the pick chose `picked` (object-relative,
+/// ascending): those, and every vertex of the level in a patch one of them blends
+/// (`TransportKernel::vertex_neighbours`). `picked` itself where no kernel scales the object.
+pub fn kernel_gathered(object: &PreparedObject, level: usize, picked: &[u32]) -> Vec<u32> {
+    let (Some(kernel), Some(drawn)) =
+        (object.transport.as_ref().filter(|_| object.wants_transport()), object.levels.get(level))
+    else {
+        return picked.to_vec();
+    };
+    let blends = TransportKernel::vertex_neighbours(&kernel.placed(&object.mesh), &object.mesh);
+    let mut needed = vec![false; kernel.patches.len()];
+    for &v in picked {
+        blends[v as usize].iter().for_each(|&(p, _)| needed[p as usize] = true);
+    }
+    let in_needed = |v: u32| needed[kernel.patches.of_vertex[v as usize] as usize];
+    drawn.vertices.iter().copied().filter(|&v| in_needed(v) || picked.binary_search(&v).is_ok()).collect()
+}
+
 /// The pipeline and its set, and the depth test that decides whether shading culls.
 pub struct ReceiverView {
     pipeline: ComputePipeline,
@@ -93,32 +138,66 @@ impl ReceiverView {
         Ok(ReceiverView { pipeline, set, depth })
     }
 
-    /// What it reads, and the state it reads and writes.
+    /// What it reads, and the state (and the kernels' stamps) it reads and writes.
     pub fn uses() -> Vec<Use> {
-        compute_uses_read_write(&BINDINGS, &[Resource::ReceiverState])
+        compute_uses_read_write(&BINDINGS, &[Resource::ReceiverState, Resource::TransportNeeded])
     }
 
-    /// Mark the receivers of `at` (object `at.object`'s receivers at the level drawn) that
-    /// `scope` gathers; nothing for a scope of every receiver.
-    pub fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs, at: &Receiver, scope: ReceiverScope) {
-        let ReceiverScope::VisibleFirst { generation, sweep, .. } = scope else { return };
+    /// Mark the receivers each of `picks` gathers (object `at.object`'s receivers at the level
+    /// drawn, under `scope`; nothing for a scope of every receiver), then, for the objects a
+    /// kernel scales, stamp their picked vertices' patches and mark those patches' vertices.
+    /// Ends with the state readable by the gather.
+    pub fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs, picks: &[(&Receiver, ReceiverScope)]) {
+        let pushes: Vec<ReceiverViewPush> =
+            picks.iter().filter_map(|&(at, scope)| self.push(frame, at, scope)).collect();
+        for push in &pushes {
+            self.pipeline.dispatch(cmd, &self.set, push, [push.receiver_count, 1, 1]);
+        }
+        let kernels: Vec<&ReceiverViewPush> = pushes.iter().filter(|p| p.flags & KERNEL != 0).collect();
+        if !kernels.is_empty() {
+            frame.before(cmd, &[write(Resource::ReceiverState, Access::ComputeReadWrite)]);
+            for push in &kernels {
+                self.pipeline.dispatch(
+                    cmd,
+                    &self.set,
+                    &ReceiverViewPush { stage: 1, ..**push },
+                    [push.receiver_count, 1, 1],
+                );
+            }
+            frame.before(cmd, &[write(Resource::TransportNeeded, Access::ComputeReadWrite)]);
+            for push in &kernels {
+                self.pipeline.dispatch(
+                    cmd,
+                    &self.set,
+                    &ReceiverViewPush { stage: 2, ..**push },
+                    [push.kernel[1], 1, 1],
+                );
+            }
+        }
+        frame.before(cmd, &[read(Resource::ReceiverState, Access::ComputeRead)]);
+    }
+
+    /// The pick's push block for `at` under `scope`; `None` for a scope of every receiver.
+    fn push(&self, frame: &FrameInputs, at: &Receiver, scope: ReceiverScope) -> Option<ReceiverViewPush> {
+        let ReceiverScope::VisibleFirst { generation, sweep, .. } = scope else { return None };
         let object = at.object as usize;
         let level = frame.scene.level(object, frame.plan.level(object));
         let perspective = frame.view_proj.row(3).truncate() != glam::Vec3::ZERO;
         let culls = self.depth.compare != vk::CompareOp::ALWAYS
             && culled_faces(frame.plan, &level, frame.view_proj, self.depth.convention) != vk::CullModeFlags::NONE;
         let facing = perspective && culls;
-        let push = ReceiverViewPush {
+        let kernel = frame.scene.transport_at(object, frame.plan.level(object));
+        Some(ReceiverViewPush {
             view_proj: frame.view_proj.to_cols_array_2d(),
             eye: if facing { frame.eye.extend(1.0).to_array() } else { [0.0; 4] },
             first_receiver: at.first_receiver,
             receiver_count: at.vertex_count,
             generation,
-            flags: VIEW_TEST | if facing { FACING_TEST } else { 0 },
+            flags: VIEW_TEST | if facing { FACING_TEST } else { 0 } | if kernel.is_some() { KERNEL } else { 0 },
             sweep: sweep.map_or([0, 0], |s: Sweep| s.range(at.vertex_count)),
             reach: level.reach,
-            pad: 0,
-        };
-        self.pipeline.dispatch(cmd, &self.set, &push, [at.vertex_count, 1, 1]);
+            stage: 0,
+            kernel: kernel.map_or([0; 4], |t| [t.patches[0], t.patches[1], t.first_neighbour, t.vertices[0]]),
+        })
     }
 }

@@ -145,6 +145,12 @@ declare_resources! {
         TransportSums: transport_sums = "TransportSums",
         /// Per vertex of a kernel's object, its patch neighbours (`SceneBuffers::transport_neighbours`).
         TransportNeighbours: transport_neighbours = "TransportNeighbours",
+        /// Per patch record, the splat generation that last needed its vertices' dipole values
+        /// (`glsl/receiver_view.comp`; `SceneBuffers::transport_needed`).
+        TransportNeeded: transport_needed = "TransportNeeded",
+        /// Per vertex of a kernel's object, its dipole exitance and the generation it was
+        /// gathered under (`glsl/transport.comp`; `SceneBuffers::transport_dipole`).
+        TransportDipole: transport_dipole = "TransportDipole",
         /// Per vertex, its facing cone (`mesh::facing::vertex_cones`; `SceneBuffers::receiver_cones`).
         ReceiverCones: receiver_cones = "ReceiverCones",
         /// Per vertex, the splat generation its exitance was gathered under and whether this

@@ -5,10 +5,14 @@
 //! dipole gather and the between-points pass (`pass::GatherThen`): stage 0 sums each patch's
 //! transmitted flux and dipole exitance, stage 1 applies the kernel, stage 2 scales each vertex.
 //!
+//! Gathered visible-first, a frame scales only the vertices `receiver_view` marked, from the
+//! dipole values stage 0 keeps per vertex (`Resource::TransportDipole`).
+//!
 //! Bindings: `BINDINGS`, in binding order. Push: `TransportPush`.
 
 use super::graph::{Resource, Resources, Use, compute_uses_read_write, read, write};
 use super::pass::{AfterGather, FrameInputs, RenderPass};
+use super::plan::ReceiverScope;
 use super::transport_tables::LevelTransport;
 use crate::gpu::{Access, ComputePipeline, DescriptorSet, Gpu, GpuResult};
 use ash::vk;
@@ -24,10 +28,14 @@ pub struct TransportPush {
     /// x: the object's first vertex; y: the level's vertex count; z: the object's first
     /// neighbour entry; w: the level's first entry in `level_vertices`.
     pub vertices: [u32; 4],
+    /// x: the object's splat generation (`ReceiverScope::VisibleFirst`); y: 1 where the gather
+    /// recomputed every receiver (`ReceiverScope::Every`), 0 where it took the ones
+    /// `receiver_view` marked; z, w: 0.
+    pub frame: [u32; 4],
 }
 
 /// glsl/transport.comp's bindings, in binding order.
-const BINDINGS: [Resource; 9] = [
+const BINDINGS: [Resource; 11] = [
     Resource::Splat,
     Resource::Exitance,
     Resource::TransportPatches,
@@ -37,6 +45,8 @@ const BINDINGS: [Resource; 9] = [
     Resource::TransportNeighbours,
     Resource::LevelVertices,
     Resource::Samples,
+    Resource::ReceiverState,
+    Resource::TransportDipole,
 ];
 
 /// The three stages of glsl/transport.comp, one dispatch per object each.
@@ -58,11 +68,10 @@ impl TransportPass {
     }
 
     /// The gathered objects with a kernel this frame, at the level each is gathered at.
-    fn planned<'a>(frame: &'a FrameInputs) -> impl Iterator<Item = LevelTransport> + 'a {
-        frame.scene.transport.iter().enumerate().filter_map(|(i, t)| {
-            let levels = t.as_ref().filter(|_| frame.plan.gathers(i))?;
-            levels.get(frame.plan.level(i).min(levels.len() - 1)).copied()
-        })
+    fn planned<'a>(frame: &'a FrameInputs) -> impl Iterator<Item = (LevelTransport, ReceiverScope)> + 'a {
+        (0..frame.scene.transport.len())
+            .filter(|&i| frame.plan.gathers(i))
+            .filter_map(|i| Some((frame.scene.transport_at(i, frame.plan.level(i))?, frame.plan.receivers(i))))
     }
 }
 
@@ -75,25 +84,32 @@ impl AfterGather for TransportPass {
 
 impl RenderPass for TransportPass {
     fn uses(&self, _: &FrameInputs) -> Vec<Use> {
-        // The exitance is read by stage 0 and written by stage 2; the sums by all three.
-        compute_uses_read_write(&BINDINGS, &[Resource::Exitance, Resource::TransportSums])
+        // The exitance is read by stage 0 and written by stage 2; the sums by all three; the
+        // dipole values written by stage 0 and read by stage 2.
+        let rw = [Resource::Exitance, Resource::TransportSums, Resource::TransportDipole];
+        compute_uses_read_write(&BINDINGS, &rw)
     }
 
     fn record(&self, cmd: vk::CommandBuffer, frame: &FrameInputs) {
-        let push = |stage, t: &LevelTransport| TransportPush {
+        let push = |stage, (t, scope): &(LevelTransport, ReceiverScope)| TransportPush {
             stage: [stage, t.patches[0], t.patches[1], t.channels],
             vertices: [t.vertices[0], t.vertices[1], t.first_neighbour, t.first_entry],
+            frame: match *scope {
+                ReceiverScope::VisibleFirst { generation, .. } => [generation, 0, 0, 0],
+                ReceiverScope::Every { .. } => [0, 1, 0, 0],
+            },
         };
         for t in Self::planned(frame) {
-            self.pipeline.dispatch(cmd, &self.set, &push(0, &t), [t.patches[1], 1, 1]);
+            self.pipeline.dispatch(cmd, &self.set, &push(0, &t), [t.0.patches[1], 1, 1]);
         }
-        frame.before(cmd, &[write(Resource::TransportSums, Access::ComputeReadWrite)]);
+        let stage0 = [Resource::TransportSums, Resource::TransportDipole];
+        frame.before(cmd, &stage0.map(|r| write(r, Access::ComputeReadWrite)));
         for t in Self::planned(frame) {
-            self.pipeline.dispatch(cmd, &self.set, &push(1, &t), [t.patches[1], 1, 1]);
+            self.pipeline.dispatch(cmd, &self.set, &push(1, &t), [t.0.patches[1], 1, 1]);
         }
         frame.before(cmd, &[read(Resource::TransportSums, Access::ComputeRead)]);
         for t in Self::planned(frame) {
-            self.pipeline.dispatch(cmd, &self.set, &push(2, &t), [t.vertices[1], 1, 1]);
+            self.pipeline.dispatch(cmd, &self.set, &push(2, &t), [t.0.vertices[1], 1, 1]);
         }
     }
 }

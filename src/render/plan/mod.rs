@@ -212,6 +212,11 @@ pub struct ObjectPlan {
     /// does); `None` otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub receivers_seen: Option<[usize; 2]>,
+    /// Of the receivers at its level, how many a frame of change gathers besides those an eye
+    /// may see because they lie in a patch the seen ones' transport kernel blends
+    /// (`receiver_view::kernel_gathered`), where the caller counted them; `None` otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub receivers_for_kernel: Option<usize>,
     /// Why it is (or is not) splatted and gathered (`splat` and `gather` follow from it).
     pub why: ObjectReason,
     /// Whether its gathered exitance still needs recomputing after this frame (lights or its
@@ -351,7 +356,13 @@ impl fmt::Display for Plan {
                     (ReceiverScope::VisibleFirst { sweep: Some(s), .. }, Some([_, of])) => {
                         writeln!(f, ": {} of the level's {of} receivers in the chunk", s.range(of as u32)[1])?
                     }
-                    (_, Some([seen, of])) => writeln!(f, ": {seen} of the level's {of} may be seen")?,
+                    (_, Some([seen, of])) => {
+                        write!(f, ": {seen} of the level's {of} may be seen")?;
+                        match o.receivers_for_kernel {
+                            Some(more) => writeln!(f, ", and {more} more in the patches their kernel blends")?,
+                            None => writeln!(f)?,
+                        }
+                    }
                     (_, None) => writeln!(f)?,
                 }
             }

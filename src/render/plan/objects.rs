@@ -149,6 +149,7 @@ impl Frame<'_> {
             gather,
             receivers,
             receivers_seen: None,
+            receivers_for_kernel: None,
             why,
             level,
             level_why,

@@ -6,7 +6,6 @@
 //! change. A receiver that comes into view before its chunk is gathered the frame it does, so
 //! every image equals a full gather's; the chunks only bound how long the unseen ones wait.
 
-use crate::scene::needs::KernelState;
 use crate::scene::needs::ObjectFacts;
 use crate::scene::{GatherMode, ReceiverPolicy};
 use std::fmt;
@@ -67,8 +66,8 @@ pub enum EveryReason {
     Asked,
     /// Its gather is not the hierarchical one (`render.gather`).
     GatherMode,
-    /// A pass after the gather (single scattering between points, a transport kernel) reads
-    /// or rescales every receiver's exitance.
+    /// A pass after the gather (single scattering between points) reads or rescales every
+    /// receiver's exitance.
     AfterGather,
     /// The host reads the exitance of every vertex (`Renderer::record_exitance`).
     HostReadsExitance,
@@ -85,8 +84,9 @@ impl ReceiverScope {
         fresh: bool,
         sweep: Option<Sweep>,
     ) -> Self {
-        let after_gather =
-            facts.single.iter().any(Option::is_some) || matches!(facts.transport, Some(KernelState::Scales { .. }));
+        // A transport kernel's pass keeps what it needs per vertex (`receiver_view`); single
+        // scattering between points does not.
+        let after_gather = facts.single.iter().any(Option::is_some);
         let why = match () {
             _ if policy == ReceiverPolicy::Every => EveryReason::Asked,
             _ if gather != GatherMode::Hierarchical => EveryReason::GatherMode,

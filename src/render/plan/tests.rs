@@ -396,7 +396,7 @@ fn a_sweep_starts_again_at_a_new_level_and_a_change_makes_a_new_generation() {
 }
 
 #[test]
-fn every_receiver_is_gathered_where_the_scene_asks_or_another_gather_or_pass_needs_it() {
+fn every_receiver_is_gathered_where_the_scene_asks_or_another_gather_or_between_points_needs_it() {
     let mut planner = Planner::new(1, Change::Everything);
     let asked = hierarchical(crate::scene::ReceiverPolicy::Every);
     let every = step(&mut planner, &asked, &view(), Change::Everything);
@@ -408,4 +408,9 @@ fn every_receiver_is_gathered_where_the_scene_asks_or_another_gather_or_pass_nee
     single.objects[0].single = [Some(0.1), None, None];
     let o = step(&mut Planner::new(1, Change::Everything), &single, &view(), Change::Everything);
     assert_eq!(o.receivers, ReceiverScope::Every { why: EveryReason::AfterGather });
+    // A transport kernel's pass keeps the dipole values it needs: visible first still.
+    let mut kernel = hierarchical(crate::scene::ReceiverPolicy::VisibleFirst);
+    kernel.objects[0].transport = Some(crate::scene::needs::KernelState::Scales { patches: 48, walks: 4800 });
+    let o = step(&mut Planner::new(1, Change::Everything), &kernel, &view(), Change::Everything);
+    assert!(matches!(o.receivers, ReceiverScope::VisibleFirst { fresh: true, .. }), "{:?}", o.receivers);
 }
