@@ -127,7 +127,7 @@ pub fn receivers(gpu: &Arc<Gpu>) {
         "\nThe same with the bunny's transport kernel (model = \"auto\"; the gather's slot includes the transport \
          pass), level {level}, key light moving:"
     );
-    zoomed(&mut kernel, level, &[1.0, 2.0, 4.0]);
+    zoomed(&mut kernel, level, &[1.0, 4.0, 6.0]);
 }
 
 /// The gather by timestamps of `rows` (every receiver, then visible first) at each of `zooms`,
