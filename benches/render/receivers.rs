@@ -120,7 +120,7 @@ pub fn receivers(gpu: &Arc<Gpu>) {
     println!(
         "\nGather against the share of the mesh an eye may see (camera zoomed in, level {level}, key light moving):"
     );
-    zoomed(&mut rows, level, &[1.0, 1.5, 2.0, 3.0, 4.0, 6.0]);
+    zoomed(&mut rows, level, &[1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 10.0, 16.0]);
 
     let mut kernel = [kernel_renderer(gpu, ReceiverPolicy::Every), kernel_renderer(gpu, ReceiverPolicy::VisibleFirst)];
     println!(
