@@ -46,6 +46,24 @@ fn picked(renderer: &Renderer) -> (usize, usize) {
     (state[..count].iter().filter(|s| s[1] == 1).count(), count)
 }
 
+/// Two light moves, then an orbit long enough to finish the sweep and go past it, by
+/// `degrees` (light, camera) a step, both renderers alike: each frame's images are equal.
+fn drag_and_orbit(visible: &mut Renderer, every: &mut Renderer, [light, camera]: [f32; 2]) {
+    for step in 0..(2 + SWEEP_FRAMES as usize + 3) {
+        for r in [&mut *visible, &mut *every] {
+            let edit = if step < 2 {
+                let moved = lights::orbit(&r.scene().scene.file.lights[0], Vec3::ZERO, light).unwrap();
+                SceneEdit::Light { index: 0, light: moved }
+            } else {
+                SceneEdit::Camera(r.camera().orbited(Vec3::ZERO, camera))
+            };
+            r.edit(edit).unwrap();
+        }
+        let (a, scope) = frame(visible);
+        assert_eq!(a, frame(every).0, "frame {step} ({scope:?})");
+    }
+}
+
 #[test]
 fn every_image_of_a_light_drag_and_an_orbit_equals_a_gather_of_every_receiver() {
     with_gpu(|gpu| {
@@ -56,20 +74,7 @@ fn every_image_of_a_light_drag_and_an_orbit_equals_a_gather_of_every_receiver() 
         let (first, count) = picked(&visible);
         assert!(first > 0 && first < count * 3 / 4, "the first frame picked {first} of {count} vertices");
         assert_eq!(image, frame(&mut every).0, "first frame");
-        // Two light moves, then an orbit long enough to finish the sweep and go past it.
-        for step in 0..(2 + SWEEP_FRAMES as usize + 3) {
-            for r in [&mut visible, &mut every] {
-                let edit = if step < 2 {
-                    let light = &r.scene().scene.file.lights[0];
-                    SceneEdit::Light { index: 0, light: lights::orbit(light, Vec3::ZERO, 20.0).unwrap() }
-                } else {
-                    SceneEdit::Camera(r.camera().orbited(Vec3::ZERO, 25.0))
-                };
-                r.edit(edit).unwrap();
-            }
-            let (a, scope) = frame(&mut visible);
-            assert_eq!(a, frame(&mut every).0, "frame {step} ({scope:?})");
-        }
+        drag_and_orbit(&mut visible, &mut every, [20.0, 25.0]);
         // The sweep has finished: every vertex of the level holds the last generation's
         // exitance, and a camera frame gathers nothing.
         let plan = visible.plan(Change::Camera);
@@ -119,19 +124,7 @@ fn with_a_transport_kernel_every_image_and_readback_visible_first_equals_a_gathe
         assert_eq!(scaled, seen);
         assert_eq!(gathered, kernel_gathered(bunny, level, &seen));
         assert_eq!(image, frame(&mut every).0, "first frame");
-        for step in 0..(2 + SWEEP_FRAMES as usize + 3) {
-            for r in [&mut visible, &mut every] {
-                let edit = if step < 2 {
-                    let light = &r.scene().scene.file.lights[0];
-                    SceneEdit::Light { index: 0, light: lights::orbit(light, Vec3::ZERO, 25.0).unwrap() }
-                } else {
-                    SceneEdit::Camera(r.camera().orbited(Vec3::ZERO, 40.0))
-                };
-                r.edit(edit).unwrap();
-            }
-            let (a, scope) = frame(&mut visible);
-            assert_eq!(a, frame(&mut every).0, "frame {step} ({scope:?})");
-        }
+        drag_and_orbit(&mut visible, &mut every, [25.0, 40.0]);
         assert!(!visible.plan(Change::Camera).objects[0].gather, "the sweep has finished");
         // After a light move, a readback finishes the sweep: the scaled exitance of every vertex.
         for r in [&mut visible, &mut every] {

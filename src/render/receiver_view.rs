@@ -154,24 +154,13 @@ impl ReceiverView {
             self.pipeline.dispatch(cmd, &self.set, push, [push.receiver_count, 1, 1]);
         }
         let kernels: Vec<&ReceiverViewPush> = pushes.iter().filter(|p| p.flags & KERNEL != 0).collect();
-        if !kernels.is_empty() {
-            frame.before(cmd, &[write(Resource::ReceiverState, Access::ComputeReadWrite)]);
+        // Stage 1 reads the pick's marks, stage 2 the patches' stamps: each after a barrier.
+        let stages = [(1, Resource::ReceiverState), (2, Resource::TransportNeeded)];
+        for (stage, after) in stages.into_iter().filter(|_| !kernels.is_empty()) {
+            frame.before(cmd, &[write(after, Access::ComputeReadWrite)]);
             for push in &kernels {
-                self.pipeline.dispatch(
-                    cmd,
-                    &self.set,
-                    &ReceiverViewPush { stage: 1, ..**push },
-                    [push.receiver_count, 1, 1],
-                );
-            }
-            frame.before(cmd, &[write(Resource::TransportNeeded, Access::ComputeReadWrite)]);
-            for push in &kernels {
-                self.pipeline.dispatch(
-                    cmd,
-                    &self.set,
-                    &ReceiverViewPush { stage: 2, ..**push },
-                    [push.kernel[1], 1, 1],
-                );
+                let threads = if stage == 1 { push.receiver_count } else { push.kernel[1] };
+                self.pipeline.dispatch(cmd, &self.set, &ReceiverViewPush { stage, ..**push }, [threads, 1, 1]);
             }
         }
         frame.before(cmd, &[read(Resource::ReceiverState, Access::ComputeRead)]);
