@@ -8,7 +8,7 @@ mod common;
 use glam::DVec3;
 use translucent::optics::transport::{SampleFlux, TransportKernel};
 use translucent::reference::rte::{Budget, Medium, half_space_reflectance};
-use translucent::reference::rte_mesh::{KernelSettings, object_kernel};
+use translucent::reference::rte_mesh::{KernelSettings, object_kernel, object_kernel_walks};
 use translucent::reference::transport_cache;
 use translucent::render::edit::SceneEdit;
 use translucent::render::plan::Change;
@@ -163,7 +163,8 @@ fn the_kernel_is_reciprocal_flux_from_j_to_i_equals_flux_from_i_to_j_within_its_
     // both ways up to Fresnel's transmittance, which the sphere's patches share.
     let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
     let kernel =
-        object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 24 * 4000, seed: 5 }, &quiet).unwrap();
+        object_kernel_walks(&scene.objects[0], &KernelSettings { patches: 24, walks: 24 * 4000, seed: 5 }, &quiet)
+            .unwrap();
     let (k, area) = (kernel.patches.len(), &kernel.patches.area);
     for c in 0..3 {
         let w = &kernel.flux[c];
@@ -184,6 +185,41 @@ fn the_kernel_is_reciprocal_flux_from_j_to_i_equals_flux_from_i_to_j_within_its_
         eprintln!("channel {c}: mean log ratio {mean:.4}, share within 20% {within:.3}, pairs {}", logs.len());
         assert!(mean.abs() < 0.05, "channel {c}: A_J W_IJ / A_I W_JI averages exp({mean:.4})");
         assert!(within > 0.9, "channel {c}: only {within:.3} of the pairs are reciprocal within 20%");
+    }
+}
+
+#[test]
+fn averaging_each_pair_with_its_reciprocal_brings_the_kernel_closer_to_one_of_twelve_times_the_walks() {
+    // The walks entering J and those entering I estimate A_J W0_IJ = A_I W0_JI independently:
+    // their mean should have about half the variance, an RMS error about 0.7 times either's.
+    let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
+    let at = |walks: u64, seed| KernelSettings { patches: 24, walks: 24 * walks, seed };
+    let fine = object_kernel(&scene.objects[0], &at(12_000, 9), &quiet).unwrap();
+    let raw = object_kernel_walks(&scene.objects[0], &at(1_000, 5), &quiet).unwrap();
+    let averaged = raw.clone().reciprocal();
+    let (k, area) = (fine.patches.len(), &fine.patches.area);
+    let off_diagonal = |w: &[f64], f: &[f64]| {
+        let pairs = (0..k * k).filter(|at| at / k != at % k);
+        let (e2, f2) = pairs.fold((0.0, 0.0), |(e, s), at| (e + (w[at] - f[at]).powi(2), s + f[at] * f[at]));
+        (e2 / f2).sqrt()
+    };
+    for c in 0..3 {
+        let (raw_error, averaged_error) =
+            (off_diagonal(&raw.flux[c], &fine.flux[c]), off_diagonal(&averaged.flux[c], &fine.flux[c]));
+        eprintln!(
+            "channel {c}: off-diagonal W0 from the fine kernel's, walks {raw_error:.4}, averaged {averaged_error:.4}"
+        );
+        assert!(averaged_error < 0.85 * raw_error, "channel {c}: averaged {averaged_error:.4}, walks {raw_error:.4}");
+        let w = &averaged.flux[c];
+        for (i, j) in (0..k).flat_map(|i| (0..k).map(move |j| (i, j))) {
+            let (ij, ji) = (area[j] * w[i * k + j], area[i] * w[j * k + i]);
+            assert!((ij - ji).abs() <= 1e-12 * ij.abs().max(ji.abs()), "channel {c}: pair {i}, {j} not reciprocal");
+        }
+        assert_eq!(
+            (0..k).map(|i| w[i * k + i]).collect::<Vec<_>>(),
+            (0..k).map(|i| raw.flux[c][i * k + i]).collect::<Vec<_>>(),
+            "channel {c}: a patch's own entry has no partner and stays"
+        );
     }
 }
 

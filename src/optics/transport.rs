@@ -208,6 +208,28 @@ impl TransportKernel {
             .collect()
     }
 
+    /// The kernel with each pair's `W0` replaced by the mean of its two estimates. The transfer
+    /// is reciprocal: under a uniform irradiance what `J` sends out through `I` equals what `I`
+    /// sends out through `J`, `A_J W0_IJ = A_I W0_JI` (the walks enter as diffuse light
+    /// refracts in and leave through the same Fresnel boundary). The walks entering `J` and
+    /// those entering `I` estimate that one number on independent streams, so their mean has
+    /// about half the variance of either; the far pairs, which a few walks reach, gain most.
+    /// `Wmu` and `Wt` have no such partner and are kept.
+    pub fn reciprocal(mut self) -> TransportKernel {
+        let (k, area) = (self.patches.len(), &self.patches.area);
+        for w in &mut self.flux {
+            for i in 0..k {
+                for j in (i + 1)..k {
+                    let both = 0.5 * (area[j] * w[i * k + j] + area[i] * w[j * k + i]);
+                    if area[i] > 0.0 && area[j] > 0.0 {
+                        (w[i * k + j], w[j * k + i]) = (both / area[j], both / area[i]);
+                    }
+                }
+            }
+        }
+        self
+    }
+
     /// Per patch `I`, the patches `J` whose `Wmu_IJ` or `Wt_IJ` is not 0 in some channel (those
     /// within [`ENTRY_REACH`]), ascending.
     pub fn near(&self) -> Vec<Vec<u32>> {

@@ -17,8 +17,9 @@ use std::path::Path;
 
 /// The version of the kernel's walk: a change to what it computes bumps it (4: the entry
 /// direction's basis, `optics::transport::EntryBasis`, within `ENTRY_REACH`; 5: the channels
-/// walk on common random numbers; 6: the walk's wall time is kept, [`CachedKernel::walk_seconds`]).
-pub const VERSION: u32 = 6;
+/// walk on common random numbers; 6: the walk's wall time is kept, [`CachedKernel::walk_seconds`];
+/// 7: `W0` averaged with its reciprocal estimate, `TransportKernel::reciprocal`).
+pub const VERSION: u32 = 7;
 
 /// One object's kernel, as cached.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -55,8 +55,8 @@ pub use tally::relative_stderr;
 use super::rte::{Budget, Medium, Progress, RteError, chunk_rng, run_rounds};
 use super::{occluders, ray_offset};
 use crate::mesh::Mesh;
-use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
 use crate::scene::accuracy::receiver_subset;
+use crate::scene::build::{PreparedObject, PreparedScene, ResolvedMaterial};
 use beam::Entry;
 use geometry::Geometry;
 use sources::{Lighting, Sources};
@@ -319,9 +319,20 @@ impl KernelSettings {
 /// The fewest vertices per patch: a patch's dipole exitance is averaged over its vertices.
 pub const VERTICES_PER_PATCH: usize = 8;
 
-/// Object `o`'s transport kernel, walked (`kernel::transport_kernel`); `progress` hears the
+/// Object `o`'s transport kernel: its walks ([`object_kernel_walks`]) with each pair's `W0`
+/// averaged with its reciprocal estimate (`TransportKernel::reciprocal`); `progress` hears the
 /// patches done and their count. An opaque object or an open mesh is refused.
 pub fn object_kernel(
+    o: &PreparedObject,
+    settings: &KernelSettings,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<crate::optics::transport::TransportKernel, RteError> {
+    object_kernel_walks(o, settings, progress).map(crate::optics::transport::TransportKernel::reciprocal)
+}
+
+/// Object `o`'s transport kernel as its walks estimate it (`kernel::transport_kernel`), each
+/// entry from the walks entering its own patch alone: what the reciprocity test checks.
+pub fn object_kernel_walks(
     o: &PreparedObject,
     settings: &KernelSettings,
     progress: &(dyn Fn(usize, usize) + Sync),
@@ -449,7 +460,11 @@ irradiance = [1.0, 1.0, 1.0]
 
     fn run(scene: &PreparedScene, photons: u64, seed: u64, method: Method) -> Vec<ObjectExitance> {
         let options = MeshOptions { budget: Budget::photons(photons), seed, walk: Walk::Photons };
-        exitance_by(scene, &options, &quiet, method, Entry::Refracted).unwrap().into_iter().map(Option::unwrap).collect()
+        exitance_by(scene, &options, &quiet, method, Entry::Refracted)
+            .unwrap()
+            .into_iter()
+            .map(Option::unwrap)
+            .collect()
     }
 
     /// Per object and channel, the flux that left (exitance times cell area, summed).
