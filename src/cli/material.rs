@@ -117,7 +117,7 @@ fn half_space_rte(dipoles: &[Dipole; 3], args: &Args) -> anyhow::Result<[Orders;
         bail!("--rte-photons: 0 photons estimate nothing (e.g. --rte-photons 1000000)");
     }
     let budget = Budget { max_photons: args.rte_photons, relative_stderr: Some(args.rte_stderr), max_seconds: None };
-    let bar = indicatif::ProgressBar::new(args.rte_photons);
+    let bar = super::progress::bar(args.rte_photons);
     let mut out = Vec::new();
     for (d, channel) in dipoles.iter().zip(["R", "G", "B"]) {
         let progress = |p: RteProgress| {

@@ -12,6 +12,7 @@ macro_rules! out {
 pub mod devices;
 pub mod material;
 pub mod plan;
+pub mod progress;
 pub mod render;
 pub mod sample;
 #[cfg(feature = "study")]
@@ -78,19 +79,20 @@ pub fn attach_kernels(
     dir: Option<&std::path::Path>,
 ) -> anyhow::Result<()> {
     use translucent::reference::{rte_mesh::KernelSettings, transport_cache, truth};
-    if !prepared.objects.iter().any(|o| o.wants_transport()) {
+    let Some(first) = prepared.objects.iter().find(|o| o.wants_transport()).map(|o| o.name.clone()) else {
         return Ok(());
-    }
+    };
     let dir = dir.map_or_else(truth::default_cache_dir, std::path::Path::to_path_buf);
-    let bar = indicatif::ProgressBar::new(0).with_style(
+    let bar = progress::bar(0).with_message(first).with_style(
         indicatif::ProgressStyle::with_template("transport kernel of {msg}: {bar:30} {pos}/{len} patches, {elapsed}")
             .expect("a valid template"),
     );
     let names: Vec<String> = prepared.objects.iter().map(|o| o.name.clone()).collect();
+    // The length first: a log writes the first draw, which should not read 0/0.
     let result = transport_cache::attach(&mut prepared.objects, &KernelSettings::default(), &dir, &|i, done, of| {
-        bar.set_message(names[i].clone());
         bar.set_length(of as u64);
         bar.set_position(done as u64);
+        bar.set_message(names[i].clone());
     });
     bar.finish_and_clear();
     use anyhow::Context as _;

@@ -225,7 +225,7 @@ fn prepare(args: &Args) -> Result<PreparedScene> {
         // Exported exitance is every vertex's.
         level_of_detail: (args.full_detail || args.export_exitance.is_some()).then_some(false),
     };
-    let spinner = ProgressBar::new_spinner().with_message(format!("preparing {} (meshes, sample points)", scene.name));
+    let spinner = super::progress::spinner().with_message(format!("preparing {} (meshes, sample points)", scene.name));
     spinner.enable_steady_tick(std::time::Duration::from_millis(120));
     let prepared = PreparedScene::new(&scene, &overrides);
     spinner.finish_and_clear();
@@ -268,7 +268,7 @@ struct Timed {
 /// first is not counted when there are more (it builds everything and warms caches).
 fn run_frames(renderer: &mut Renderer, args: &Args, moving: Change) -> Result<Timed> {
     let progress = if args.frames > 1 {
-        ProgressBar::new(args.frames as u64)
+        super::progress::bar(args.frames as u64)
             .with_style(ProgressStyle::with_template("frames {bar:30} {pos}/{len} {elapsed}").unwrap())
     } else {
         ProgressBar::hidden()

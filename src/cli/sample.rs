@@ -51,7 +51,7 @@ struct Report<'a> {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let spinner = if args.json { ProgressBar::hidden() } else { ProgressBar::new_spinner() };
+    let spinner = if args.json { ProgressBar::hidden() } else { super::progress::spinner() };
     spinner.enable_steady_tick(Duration::from_millis(100));
 
     spinner.set_message(format!("loading {}", args.mesh.display()));

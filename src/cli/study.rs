@@ -2,7 +2,7 @@
 //! integral (`translucent::study`).
 
 use anyhow::{Context, Result, bail};
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressStyle;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use translucent::gpu::Gpu;
@@ -445,7 +445,7 @@ fn check_error_image(chosen: Option<(Method, usize, Gather)>, config: &StudyConf
 
 /// `study::run` behind a progress bar (cleared when done).
 fn run_with_progress(gpu: &Arc<Gpu>, scene: &Scene, config: &StudyConfig, cache: &Path) -> Result<study::Study> {
-    let bar = ProgressBar::new(config.runs() as u64);
+    let bar = super::progress::bar(config.runs() as u64);
     bar.set_style(
         ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} eta {eta} {msg}")
             .expect("a valid template"),
