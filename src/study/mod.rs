@@ -443,7 +443,8 @@ pub fn run(
     let physics = match &config.physics {
         Some(options) => {
             let (base, truth) = (&first.0, &first.1);
-            Some(physics::Physics::measure(base, (truth, &single), options, &config.models, truth_dir, progress)?)
+            let own = (truth, dipole.exitance.as_slice(), &single);
+            Some(physics::Physics::measure(base, own, options, &config.models, truth_dir, progress)?)
         }
         None => None,
     };
