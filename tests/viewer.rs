@@ -30,8 +30,12 @@ struct Display {
 
 impl Display {
     /// A server on the first free display from `first` (each test its own range: the tests of
-    /// this file run in parallel).
+    /// this file run in parallel). One server starts at a time: on a fresh machine two Xvfb
+    /// starting at once race to create `/tmp/.X11-unix`, and the loser runs without its socket
+    /// file (reproduced). Ready when a client connects, through whichever socket it has.
     fn start(first: u32) -> Display {
+        static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+        let _starting = ONE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         let number =
             (first..first + 100).find(|n| !Path::new(&format!("/tmp/.X{n}-lock")).exists()).expect("a free display");
         let name = format!(":{number}");
@@ -41,13 +45,28 @@ impl Display {
             .stderr(Stdio::null())
             .spawn()
             .unwrap_or_else(|e| panic!("cannot start Xvfb ({e}): {INSTALL}"));
-        let socket = format!("/tmp/.X11-unix/X{number}");
+        // Owned from here, so a failed start still kills the server.
+        let mut display = Display { server, name };
         let started = Instant::now();
-        while !Path::new(&socket).exists() {
-            assert!(started.elapsed() < Duration::from_secs(20), "Xvfb {name} did not start");
-            sleep(Duration::from_millis(50));
+        while !display.accepts() {
+            let exited = display.server.try_wait().expect("waiting on Xvfb");
+            assert!(exited.is_none(), "Xvfb {} exited at start: {exited:?}", display.name);
+            assert!(started.elapsed() < Duration::from_secs(30), "Xvfb {} took no client in 30 s", display.name);
+            sleep(Duration::from_millis(100));
         }
-        Display { server, name }
+        display
+    }
+
+    /// Whether the server takes a client.
+    fn accepts(&self) -> bool {
+        Command::new("xdotool")
+            .arg("getdisplaygeometry")
+            .env("DISPLAY", &self.name)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .status()
+            .unwrap_or_else(|e| panic!("cannot run xdotool ({e}): {INSTALL}"))
+            .success()
     }
 
     fn xdotool(&self, args: &[&str]) -> String {
