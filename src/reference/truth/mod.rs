@@ -255,8 +255,6 @@ fn level_exitance(
     let eta = 0.4 * 0.5f64.powf(f64::from(level) / 2.0);
     let mut points = 0;
     let total: usize = scene.objects.iter().map(|o| receiver_subset(o.mesh.positions().len(), receivers).len()).sum();
-    // Heard before the sources are ray cast, which at a fine level takes minutes of its own.
-    progress(level, 0, total);
     let done = AtomicUsize::new(0);
     let tick = |n| {
         let d = done.fetch_add(n, Ordering::Relaxed) + n;
