@@ -42,6 +42,15 @@ fn run_quick_study(scene: &str, out: &Path, cache: &Path) {
     }
 }
 
+/// `study --quick --physics` of `scene` into `out` against a 256-walk adjoint reference, the
+/// truth and the reference cached under `cache`, with `models` (a `--models` or
+/// `--render-models` flag and its list).
+fn quick_physics_study(scene: &Path, out: &Path, cache: &Path, models: [&str; 2]) -> std::process::Output {
+    let (scene, out, cache) = (scene.to_str().unwrap(), out.to_str().unwrap(), cache.to_str().unwrap());
+    let args = ["study", scene, "-o", out, "--quick", "--physics", "--rte-walk", "adjoint", "--rte-photons", "256"];
+    translucent(&[&args[..], &models, &["--truth-cache", cache]].concat(), &[])
+}
+
 /// The study's CSV, checked to have the documented header, the scene's own row (labelled
 /// `default`, first) then the quick sweep's six rows, and no empty cell (but epsilon, which
 /// only some gathers have).
@@ -477,24 +486,7 @@ fn study_with_physics_splits_each_rows_error_into_model_discretisation_and_total
     let mut csvs = Vec::new();
     for pass in ["walked", "cached"] {
         let out = dir.join(format!("out-{pass}"));
-        let (scene, out_s, cache_s) = (scene.to_str().unwrap(), out.to_str().unwrap(), cache.to_str().unwrap());
-        let args = [
-            "study",
-            scene,
-            "-o",
-            out_s,
-            "--quick",
-            "--physics",
-            "--rte-walk",
-            "adjoint",
-            "--rte-photons",
-            "256",
-            "--models",
-            "between,per-channel,transport",
-            "--truth-cache",
-            cache_s,
-        ];
-        let run = translucent(&args, &[]);
+        let run = quick_physics_study(&scene, &out, &cache, ["--models", "between,per-channel,transport"]);
         assert!(run.status.success(), "{pass}: {}", text(&run.stderr));
         let md = std::fs::read_to_string(out.join("study.md")).unwrap();
         assert!(md.contains("Against the physics") && md.contains("stop paying"), "{md}");
@@ -552,23 +544,7 @@ fn the_kernel_beside_a_scene_that_takes_it_is_applied_once_and_the_dipole_is_rep
     let scene = dir.join("tiny-transport.toml");
     std::fs::write(&scene, tiny.replace("model = \"dipole\"", "model = \"transport\"")).unwrap();
     let (out, cache) = (dir.join("out"), dir.join("cache"));
-    let args = [
-        "study",
-        scene.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--quick",
-        "--physics",
-        "--rte-walk",
-        "adjoint",
-        "--rte-photons",
-        "256",
-        "--models",
-        "kernel",
-        "--truth-cache",
-        cache.to_str().unwrap(),
-    ];
-    let run = translucent(&args, &[]);
+    let run = quick_physics_study(&scene, &out, &cache, ["--models", "kernel"]);
     assert!(run.status.success(), "{}", text(&run.stderr));
     let md = std::fs::read_to_string(out.join("study.md")).unwrap();
     // The cells of the first table row of that name: the models' table comes before the bands'.
@@ -594,23 +570,7 @@ fn the_kernel_beside_a_scene_that_takes_it_is_applied_once_and_the_dipole_is_rep
 fn study_render_models_sweeps_each_model_against_the_one_reference_with_its_precompute() {
     let dir = temp_dir("study-render-models");
     let (scene, out, cache) = (repo_path("tests/scenes/study-tiny.toml"), dir.join("out"), dir.join("cache"));
-    let args = [
-        "study",
-        scene.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--quick",
-        "--physics",
-        "--rte-walk",
-        "adjoint",
-        "--rte-photons",
-        "256",
-        "--render-models",
-        "dipole,transport",
-        "--truth-cache",
-        cache.to_str().unwrap(),
-    ];
-    let run = translucent(&args, &[]);
+    let run = quick_physics_study(&scene, &out, &cache, ["--render-models", "dipole,transport"]);
     assert!(run.status.success(), "{}", text(&run.stderr));
     let (w, h) = image::image_dimensions(out.join("light.png")).expect("light.png");
     assert_eq!((w, h), (960, 640));
