@@ -100,13 +100,20 @@ pub(crate) fn read_cached<T: serde::de::DeserializeOwned>(
     None
 }
 
-/// `bytes` written to `path` through a hidden temporary beside it (`.NAME.tmp`), renamed into
-/// place, so a run cut short never leaves half a file behind.
+/// `bytes` written to `path` through a hidden temporary beside it (`.NAME.PID-N.tmp`), renamed
+/// into place, so a run cut short never leaves half a file behind. The temporary is this
+/// writer's own: two processes storing the same result at once each rename a whole file of
+/// their own (the last one wins), where a shared name let one rename the other's away.
 pub(crate) fn write_replacing(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    static WRITES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = WRITES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let name = path.file_name().map_or_else(Default::default, |n| n.to_string_lossy().into_owned());
-    let tmp = path.with_file_name(format!(".{name}.tmp"));
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(&tmp, path)
+    let tmp = path.with_file_name(format!(".{name}.{}-{n}.tmp", std::process::id()));
+    let written = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, path));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
 }
 
 /// What keeps `dir` (made if missing) from being a folder a file can be written in, if
@@ -211,5 +218,38 @@ impl Fnv {
     }
     pub(crate) fn f64(&mut self, v: f64) {
         self.u64(v.to_bits());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::write_replacing;
+
+    /// Many writers storing the same file at once (the tests' parallel renders of one scene)
+    /// all succeed, and the file left is one writer's whole file, not a mix.
+    #[test]
+    fn writers_storing_one_file_at_once_all_succeed_and_leave_one_whole_file() {
+        let dir = std::env::temp_dir().join(format!("translucent-write-race-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("kernel.json");
+        let writers: Vec<_> = (0..8u8)
+            .map(|k| {
+                let path = path.clone();
+                std::thread::spawn(move || {
+                    (0..50).map(|_| write_replacing(&path, &vec![b'a' + k; 100_000])).collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        for writer in writers {
+            for result in writer.join().unwrap() {
+                result.unwrap();
+            }
+        }
+        let left = std::fs::read(&path).unwrap();
+        assert_eq!(left.len(), 100_000);
+        assert!(left.iter().all(|&b| b == left[0]), "the file mixes two writers' bytes");
+        let others = std::fs::read_dir(&dir).unwrap().count();
+        assert_eq!(others, 1, "temporaries left beside the file");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
