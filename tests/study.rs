@@ -560,6 +560,38 @@ fn the_kernel_beside_a_scene_that_takes_it_is_applied_once_and_the_dipole_is_rep
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A study's long silent steps are reported: the kernel's walk patch by patch under the
+/// object's name up to its last patch, and the truth's image before the first configuration.
+#[test]
+fn a_study_reports_its_kernel_walk_and_each_long_step_before_the_configurations() {
+    use translucent::study::{Event, Step};
+    let dir = temp_dir("study-steps");
+    let tiny = std::fs::read_to_string(repo_path("tests/scenes/study-tiny.toml")).unwrap();
+    let path = dir.join("tiny-transport.toml");
+    std::fs::write(&path, tiny.replace("model = \"dipole\"", "model = \"transport\"")).unwrap();
+    let scene = translucent::Scene::load(&path).unwrap();
+    let config = translucent::study::StudyConfig {
+        frames: 1,
+        own: true,
+        sweep: false,
+        ..translucent::study::StudyConfig::quick()
+    };
+    let events = std::sync::Mutex::new(Vec::new());
+    let record = |e: Event| events.lock().unwrap().push(e);
+    common::with_gpu(|gpu| translucent::study::run(gpu, &scene, &config, &dir.join("cache"), &record).unwrap());
+    let events = events.into_inner().unwrap();
+    let kernel: Vec<_> =
+        events.iter().filter_map(|e| if let Event::Kernel(n, d, of) = e { Some((n, *d, *of)) } else { None }).collect();
+    let &(name, done, of) = kernel.last().expect("no kernel walk reported");
+    assert!(of > 0 && done == of && kernel.len() >= of, "{kernel:?}");
+    let prepared = translucent::PreparedScene::new(&scene, &Default::default()).unwrap();
+    assert_eq!(name, &prepared.objects[0].name, "the walk names another object");
+    let at = |want: &dyn Fn(&Event) -> bool| events.iter().position(want).unwrap_or_else(|| panic!("{events:?}"));
+    let image = at(&|e| matches!(e, Event::Step(Step::TruthImage)));
+    assert!(at(&|e| matches!(e, Event::Kernel(..))) < image && image < at(&|e| matches!(e, Event::Run(..))));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Issue 49, part 4: `--render-models dipole,transport` sweeps the renderer once per model.
 /// Each model's rows are measured against its own exact exitance and all against the one
 /// reference: the dipole's rows need no precompute and the transport rows carry their kernel's

@@ -185,20 +185,22 @@ count = {count}
     assert!(ta.exitance[0].iter().any(|m| m[0] > 0.0));
 }
 
-/// A long level is not silent: progress is reported after every receiver (not once per chunk of
-/// receivers, which left a small mesh's whole level without a word), counting up to the level's
-/// receivers, so a progress bar moves and can estimate the rest.
+/// A long level is not silent: progress is reported as it starts, before its sources are built,
+/// and after every receiver (not once per chunk of receivers, which left a small mesh's whole
+/// level without a word), counting up to the level's receivers, so a progress bar moves and can
+/// estimate the rest.
 #[test]
-fn truth_progress_is_reported_after_every_receiver_of_a_level() {
+fn truth_progress_is_reported_as_a_level_starts_and_after_every_receiver() {
     let scene = prepare(&lit_marble_sphere(0.3));
     let receivers = scene.objects[0].mesh.positions().len();
     let calls = std::sync::Mutex::new(Vec::new());
     let options = truth::TruthOptions { max_level: 0, ..Default::default() };
     truth::compute(&scene, &options, &|level, done, of| calls.lock().unwrap().push((level, done, of))).unwrap();
     let mut calls = calls.into_inner().unwrap();
-    assert_eq!(calls.len(), receivers, "one report per receiver: {calls:?}");
+    assert_eq!(calls.len(), receivers + 1, "one report at the start and one per receiver: {calls:?}");
+    assert_eq!(calls[0], (0, 0, receivers), "the first report is the level's start");
     calls.sort_unstable();
-    assert!(calls.iter().enumerate().all(|(i, &c)| c == (0, i + 1, receivers)), "{calls:?}");
+    assert!(calls.iter().enumerate().all(|(i, &c)| c == (0, i, receivers)), "{calls:?}");
 }
 
 /// A cached truth is read back instead of recomputed, and a changed scene gets a new key.

@@ -447,8 +447,9 @@ fn check_error_image(chosen: Option<(Method, usize, Gather)>, config: &StudyConf
 fn run_with_progress(gpu: &Arc<Gpu>, scene: &Scene, config: &StudyConfig, cache: &Path) -> Result<study::Study> {
     let bar = super::progress::bar(config.runs() as u64);
     bar.set_style(
-        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} eta {eta} {msg}")
-            .expect("a valid template"),
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {runs_eta} {msg}")
+            .expect("a valid template")
+            .with_key("runs_eta", runs_eta),
     );
     // The clock and spinner move while one long step (a truth level, a walk) reports nothing.
     bar.enable_steady_tick(std::time::Duration::from_millis(250));
@@ -460,7 +461,11 @@ fn run_with_progress(gpu: &Arc<Gpu>, scene: &Scene, config: &StudyConfig, cache:
                 bar.println(warning);
             }
             let left = left.map_or(String::new(), |s| format!(", about {} left", human_duration(s)));
-            bar.set_message(format!("exact integral, level {level}: {done}/{of} receivers{left}"));
+            bar.set_message(if done == 0 {
+                format!("exact integral, level {level}: placing and ray casting its sources")
+            } else {
+                format!("exact integral, level {level}: {done}/{of} receivers{left}")
+            });
         }
         Event::TruthCached => bar.set_message("exact integral from the cache".to_string()),
         Event::Rte(p) => bar.set_message(format!(
@@ -469,12 +474,37 @@ fn run_with_progress(gpu: &Arc<Gpu>, scene: &Scene, config: &StudyConfig, cache:
         )),
         Event::RteCached => bar.set_message("radiative transfer from the cache".to_string()),
         Event::Run(i, _, label) => {
+            if i == 0 {
+                // The rate of configurations, not of the truth and reference before them.
+                bar.reset_eta();
+            }
             bar.set_position(i as u64);
             bar.set_message(label);
         }
+        Event::Kernel(object, done, of) => {
+            bar.set_message(format!("transport kernel of {object}: {done}/{of} patches walked"));
+        }
+        Event::Step(step) => bar.set_message(step_message(step)),
     })?;
     bar.finish_and_clear();
     Ok(study)
+}
+
+/// The configurations' time left, once one has run: before, the bar stands at 0 through the
+/// truth and the reference, and a rate from nothing would read "0s".
+fn runs_eta(state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write) {
+    if state.pos() > 0 {
+        let _ = write!(w, "eta {}", indicatif::HumanDuration(state.eta()));
+    }
+}
+
+/// What the bar says while `step` runs.
+fn step_message(step: study::Step) -> String {
+    match step {
+        study::Step::BetweenPoints => "single scattering between points over the scene".to_string(),
+        study::Step::Model(m) => format!("model {} against the radiative transfer", m.name()),
+        study::Step::TruthImage => "the exact exitance's image".to_string(),
+    }
 }
 
 /// When the exact integral's current level started, to estimate what is left of it from the
@@ -489,13 +519,18 @@ const LONG_TRUTH_LEVEL_SECONDS: f64 = 600.0;
 
 impl TruthClock {
     /// Seconds left in `level` with `done` of `of` receivers finished (None before the first).
+    /// The clock starts at the first receiver, not at the level's start: the sources placed
+    /// before it are a fixed cost, which a rate per receiver would multiply.
     fn left(&self, level: u32, done: usize, of: usize) -> Option<f64> {
+        if done == 0 {
+            return None;
+        }
         let mut state = self.state.lock().unwrap_or_else(|e| e.into_inner());
         if state.is_none_or(|(l, _, _)| l != level) {
             *state = Some((level, std::time::Instant::now(), false));
         }
         let (_, start, _) = state.expect("set above");
-        (done > 0).then(|| start.elapsed().as_secs_f64() / done as f64 * of.saturating_sub(done) as f64)
+        Some(start.elapsed().as_secs_f64() / done as f64 * of.saturating_sub(done) as f64)
     }
 
     /// The one line saying that `level` will take long, the first time its estimate says so.
@@ -646,4 +681,20 @@ fn write_outputs(
 
 fn report_plot(summaries: &[report::Summary], title: &str) -> Result<Vec<u8>> {
     translucent::study::plot::error_vs_time(summaries, title, 960, 640).map_err(anyhow::Error::msg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::TruthClock;
+
+    /// The sources placed at a level's start are not a receiver's cost: an estimate taken
+    /// right after the first receiver is near zero however long the start took.
+    #[test]
+    fn the_truth_clock_starts_at_the_first_receiver_not_at_the_levels_start() {
+        let clock = TruthClock::default();
+        assert!(clock.left(2, 0, 100).is_none(), "an estimate before any receiver");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+        let left = clock.left(2, 1, 100).expect("an estimate after the first receiver");
+        assert!(left < 1.0, "{left} s left: the sources' time was counted per receiver");
+    }
 }

@@ -170,6 +170,7 @@ pub fn model_exitance(
     base: &PreparedScene,
     truth: &[Vec<[f64; 3]>],
     dir: &Path,
+    progress: &(dyn Fn(usize, usize, usize) + Sync),
 ) -> Result<Vec<Vec<[f64; 3]>>, RteCacheError> {
     use super::{occluders, ray_offset, transmitted_entry};
     use crate::optics::transport::SampleFlux;
@@ -182,7 +183,7 @@ pub fn model_exitance(
             out.push(truth.clone());
             continue;
         };
-        let (k, _) = cached(o, &KernelSettings::default(), dir, &|_, _| {})?;
+        let (k, _) = cached(o, &KernelSettings::default(), dir, &|done, of| progress(index, done, of))?;
         let (positions, normals) = (o.mesh.positions(), o.mesh.vertex_normals());
         let eps = ray_offset(base);
         let points = positions.iter().zip(normals).enumerate().map(|(v, (p, n))| {

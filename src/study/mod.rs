@@ -181,6 +181,22 @@ pub enum Event {
     RteCached,
     /// A configuration starts: `(index, of, label)`.
     Run(usize, usize, String),
+    /// An object's transport kernel is walked: `(object's name, patches done, patches)`.
+    Kernel(String, usize, usize),
+    /// A long step that counts nothing of its own starts.
+    Step(Step),
+}
+
+/// The long steps of a study that report no count, named so a progress bar can say which one
+/// the study is in.
+#[derive(Clone, Copy, Debug)]
+pub enum Step {
+    /// Single scattering between points over the scene (`reference::single::between_points`).
+    BetweenPoints,
+    /// One of `--models`, beside the scene's own model against the radiative transfer.
+    Model(physics::Model),
+    /// The truth's image (the exact exitance rendered through the camera).
+    TruthImage,
 }
 
 /// Per-vertex error against the truth, per channel, over the receivers lit in the truth
@@ -437,8 +453,8 @@ pub fn run(
         [] => vec![None],
         list => list.iter().copied().map(Some).collect(),
     };
-    let single = models::BetweenPoints::new(&base);
-    let models = models::prepare(&base, &forced, (&dipole, &single), truth_dir)?;
+    let single = models::BetweenPoints::new(&base, progress);
+    let models = models::prepare(&base, &forced, (&dipole, &single), truth_dir, progress)?;
     let first = (models[0].base.clone(), models[0].truth.clone());
     let physics = match &config.physics {
         Some(options) => {
@@ -449,6 +465,7 @@ pub fn run(
         None => None,
     };
     let (base, truth) = first;
+    progress(Event::Step(Step::TruthImage));
     let images = models.iter().map(|m| truth_image(gpu, &m.base, &m.truth)).collect::<Result<Vec<_>, _>>()?;
     let (mut rows, mut exitances) = (Vec::new(), Vec::new());
     let total = config.runs();

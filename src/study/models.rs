@@ -5,8 +5,8 @@
 //! radiative-transfer reference (the total error, against the light), so the Pareto front
 //! against the light spans the models, each with its precompute.
 
-use super::StudyError;
 use super::report::Summary;
+use super::{Event, Step, StudyError};
 use crate::reference::directional::FINENESS;
 use crate::reference::rte_mesh::KernelSettings;
 use crate::reference::transport_cache;
@@ -46,28 +46,33 @@ impl RenderModel {
 pub struct BetweenPoints<'a> {
     base: &'a PreparedScene,
     exitance: std::cell::OnceCell<Vec<Vec<[f64; 3]>>>,
+    progress: &'a (dyn Fn(Event) + Sync),
 }
 
 impl<'a> BetweenPoints<'a> {
-    /// Over `base`, not computed yet.
-    pub fn new(base: &'a PreparedScene) -> BetweenPoints<'a> {
-        BetweenPoints { base, exitance: std::cell::OnceCell::new() }
+    /// Over `base`, not computed yet; `progress` hears when it starts.
+    pub fn new(base: &'a PreparedScene, progress: &'a (dyn Fn(Event) + Sync)) -> BetweenPoints<'a> {
+        BetweenPoints { base, exitance: std::cell::OnceCell::new(), progress }
     }
 
     /// Per object, vertex and channel; computed on the first call.
     pub fn get(&self) -> &[Vec<[f64; 3]>] {
-        self.exitance.get_or_init(|| crate::reference::single::between_points(self.base, FINENESS))
+        self.exitance.get_or_init(|| {
+            (self.progress)(Event::Step(Step::BetweenPoints));
+            crate::reference::single::between_points(self.base, FINENESS)
+        })
     }
 }
 
 /// `base` under each of `forced` (`None`: as its materials say), against `dipole`, the
 /// dipole's exact integral over it, and `single`, single scattering between points over it;
-/// kernels are read from or walked into `dir`.
+/// kernels are read from or walked into `dir`, and `progress` hears of their walks.
 pub fn prepare(
     base: &PreparedScene,
     forced: &[Option<ScatteringModel>],
     (dipole, single): (&Truth, &BetweenPoints<'_>),
     dir: &Path,
+    progress: &(dyn Fn(Event) + Sync),
 ) -> Result<Vec<RenderModel>, StudyError> {
     let mut out = Vec::new();
     for &forced in forced {
@@ -80,8 +85,11 @@ pub fn prepare(
                 o.choose_model(target);
             }
         }
-        let precompute_s = transport_cache::attach(&mut base.objects, &KernelSettings::default(), dir, &|_, _, _| {})?;
-        let truth = Truth { exitance: exact_exitance(&base, &dipole.exitance, single, dir)?, ..dipole.clone() };
+        let names: Vec<String> = base.objects.iter().map(|o| o.name.clone()).collect();
+        let walk = |o: usize, done, of| progress(Event::Kernel(names[o].clone(), done, of));
+        let precompute_s = transport_cache::attach(&mut base.objects, &KernelSettings::default(), dir, &walk)?;
+        let truth =
+            Truth { exitance: exact_exitance(&base, &dipole.exitance, single, dir, progress)?, ..dipole.clone() };
         out.push(RenderModel { forced, base, truth, precompute_s });
     }
     Ok(out)
@@ -95,12 +103,14 @@ fn exact_exitance(
     dipole: &[Vec<[f64; 3]>],
     single: &BetweenPoints<'_>,
     dir: &Path,
+    progress: &(dyn Fn(Event) + Sync),
 ) -> Result<Vec<Vec<[f64; 3]>>, StudyError> {
     let takes = |o: &crate::scene::build::PreparedObject, m: ChannelModel| {
         o.model.as_ref().is_some_and(|c| c.channels.iter().any(|ch| ch.takes == m))
     };
     let kernel = if base.objects.iter().any(|o| takes(o, ChannelModel::Kernel)) {
-        Some(transport_cache::model_exitance(base, dipole, dir)?)
+        let walk = |o: usize, done, of| progress(Event::Kernel(base.objects[o].name.clone(), done, of));
+        Some(transport_cache::model_exitance(base, dipole, dir, &walk)?)
     } else {
         None
     };

@@ -126,7 +126,7 @@ impl Physics {
         let walks = reference.objects.iter().flatten().map(|o| o.photons).max().unwrap_or(1);
         let model_name = own_model_name(base, &truth.exitance, dipole);
         let own = (model_name, truth.exitance.as_slice(), dipole, single);
-        let models = alternative_models(base, own, models, (options, walks), dir)?;
+        let models = alternative_models(base, own, models, (options, walks), dir, progress)?;
         let alternatives =
             models.iter().skip(1).map(|(name, m)| (name.clone(), vertex_error_f64(&exitance, m))).collect();
         let cosines = light_cosines(base);
@@ -255,6 +255,7 @@ fn alternative_models(
     models: &[Model],
     reference: (&MeshOptions, u64),
     dir: &Path,
+    progress: &(dyn Fn(Event) + Sync),
 ) -> Result<Vec<(String, Vec<Exitance>)>, StudyError> {
     use crate::optics::directional_dipole::{Diffusion, Strength};
     use crate::reference::directional;
@@ -266,6 +267,7 @@ fn alternative_models(
         out.push(("dipole".to_string(), truth.to_vec()));
     }
     for &m in models {
+        progress(Event::Step(super::Step::Model(m)));
         let exitance = match m {
             Model::Between => between.get().to_vec(),
             Model::PerChannel => per_channel_choice(base, truth, between.get()),
@@ -281,7 +283,8 @@ fn alternative_models(
             Model::Transport => transport(base, reference, ModelEntry::Normal)?,
             Model::TransportSlanted => transport(base, reference, ModelEntry::Slanted)?,
             Model::Kernel => {
-                let scaled = crate::reference::transport_cache::model_exitance(base, truth, dir)?;
+                let walk = |o: usize, done, of| progress(Event::Kernel(base.objects[o].name.clone(), done, of));
+                let scaled = crate::reference::transport_cache::model_exitance(base, truth, dir, &walk)?;
                 with_single_between_points(base, scaled, between)
             }
         };

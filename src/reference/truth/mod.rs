@@ -186,7 +186,8 @@ impl Default for TruthOptions {
 }
 
 /// Progress of a truth computation, for a progress bar: `(level, receivers done, receivers in
-/// the level)`.
+/// the level)`, once with none done as a level starts (its sources are then placed and ray
+/// cast, which on a large mesh takes a while) and after every receiver.
 pub type Progress<'a> = &'a (dyn Fn(u32, usize, usize) + Sync);
 
 /// Compute the truth for every translucent object of `scene`, level after level until it
@@ -260,6 +261,7 @@ fn level_exitance(
         let d = done.fetch_add(n, Ordering::Relaxed) + n;
         progress(level, d, total);
     };
+    progress(level, 0, total);
     let exitance = scene
         .objects
         .iter()
