@@ -532,6 +532,14 @@ fn study_with_physics_splits_each_rows_error_into_model_discretisation_and_total
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The CI sphere (`tests/scenes/study-tiny.toml`) with `model = "transport"`, written into `dir`.
+fn tiny_transport_scene(dir: &Path) -> std::path::PathBuf {
+    let tiny = std::fs::read_to_string(repo_path("tests/scenes/study-tiny.toml")).unwrap();
+    let scene = dir.join("tiny-transport.toml");
+    std::fs::write(&scene, tiny.replace("model = \"dipole\"", "model = \"transport\"")).unwrap();
+    scene
+}
+
 /// In a scene whose own model is the transport kernel, `--models kernel` applies the kernel
 /// once, to the dipole's integral: its row reads what the scene's own row reads, and the dipole
 /// is reported beside them (a kernel applied to the kernel's exitance read 8.7 to 14% on the
@@ -540,9 +548,7 @@ fn study_with_physics_splits_each_rows_error_into_model_discretisation_and_total
 #[test]
 fn the_kernel_beside_a_scene_that_takes_it_is_applied_once_and_the_dipole_is_reported_beside_it() {
     let dir = temp_dir("study-kernel-once");
-    let tiny = std::fs::read_to_string(repo_path("tests/scenes/study-tiny.toml")).unwrap();
-    let scene = dir.join("tiny-transport.toml");
-    std::fs::write(&scene, tiny.replace("model = \"dipole\"", "model = \"transport\"")).unwrap();
+    let scene = tiny_transport_scene(&dir);
     let (out, cache) = (dir.join("out"), dir.join("cache"));
     let run = quick_physics_study(&scene, &out, &cache, ["--models", "kernel"]);
     assert!(run.status.success(), "{}", text(&run.stderr));
@@ -566,10 +572,7 @@ fn the_kernel_beside_a_scene_that_takes_it_is_applied_once_and_the_dipole_is_rep
 fn a_study_reports_its_kernel_walk_and_each_long_step_before_the_configurations() {
     use translucent::study::{Event, Step};
     let dir = temp_dir("study-steps");
-    let tiny = std::fs::read_to_string(repo_path("tests/scenes/study-tiny.toml")).unwrap();
-    let path = dir.join("tiny-transport.toml");
-    std::fs::write(&path, tiny.replace("model = \"dipole\"", "model = \"transport\"")).unwrap();
-    let scene = translucent::Scene::load(&path).unwrap();
+    let scene = translucent::Scene::load(&tiny_transport_scene(&dir)).unwrap();
     let config = translucent::study::StudyConfig {
         frames: 1,
         own: true,
