@@ -22,6 +22,8 @@ fn main() {
     let c = 1;
     let max = o.exitance.iter().map(|m| m[c]).fold(0.0, f64::max);
     println!("{} walks per receiver, {:.1} s, precision {:.4}", o.photons, o.seconds, o.relative_stderr);
+    let mean = [0, 1, 2].map(|c| o.exitance.iter().map(|m| m[c]).sum::<f64>() / o.exitance.len() as f64);
+    println!("mean exitance over the receivers (r, g, b): {:.5e} {:.5e} {:.5e}", mean[0], mean[1], mean[2]);
     for (lo, hi) in [(0.5, 1.01), (0.2, 0.5), (0.0, 0.2), (-0.2, 0.0), (-0.6, -0.2), (-1.01, -0.6)] {
         let mut rel: Vec<(f64, f64)> = o
             .receivers

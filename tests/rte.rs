@@ -505,7 +505,7 @@ fn the_adjoint_walk_agrees_with_the_photon_walk_on_the_lit_side_of_a_sphere() {
         let options = MeshOptions { budget: Budget::photons(n), seed: 3, walk };
         rte_mesh::exitance(&scene, &options, &quiet).unwrap().remove(0).unwrap()
     };
-    let adjoint = run(Walk::Adjoint { receivers: Some(200) }, 2000);
+    let adjoint = run(Walk::Adjoint { receivers: Some(200) }, 3000);
     let photons = run(Walk::Photons, 3_000_000);
     let count = scene.objects[0].mesh.positions().len();
     let (a, sa) = adjoint.per_vertex(count);

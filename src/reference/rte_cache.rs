@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 
 /// The version of the walk: a change to what `rte_mesh` computes bumps it, so older files are
 /// walked anew.
-pub const VERSION: u32 = 5;
+pub const VERSION: u32 = 6;
 
 /// The reference of every object of a scene, as cached.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -27,13 +27,13 @@ use super::beam::{Beam, Beams, Entry, Way};
 use super::geometry::Geometry;
 use super::sources::Lighting;
 use super::walk::scatter;
+use super::{MeshOptions, ObjectExitance};
 use crate::mesh::Mesh;
 use crate::optics::fresnel;
 use crate::optics::single_scatter::henyey_greenstein;
+use crate::reference::light_incidence;
 use crate::reference::rte::{Medium, Progress, RteError, RteProgress, after_collision, after_reflection, chunk_rng};
 use crate::reference::truth::LIT_FLOOR;
-use super::{MeshOptions, ObjectExitance};
-use crate::reference::light_incidence;
 use crate::scene::lights::PreparedLight;
 use glam::DVec3;
 use rand::RngExt;
@@ -45,9 +45,15 @@ use std::f64::consts::PI;
 const FIRST_ROUND: u64 = 16;
 /// The most walks per receiver and channel in one round.
 const MAX_ROUND: u64 = 1024;
-/// Within this many mean free paths of the surface (by the clearance grid's bound) every
-/// collision takes a next event; deeper, a chance of it (see `Adjoint::next_event`).
-const NEAR_FREE_PATHS: f64 = 2.0;
+/// The chance that a collision at the surface takes a next event; `c` mean free paths deeper
+/// (by the clearance grid's bound) the chance is `e^-c` times this (see `Adjoint::next_event`).
+/// Measured by the noise at equal time (`examples/adjoint_noise.rs`, 100 walks per receiver,
+/// lavapipe's 2-core VM): on the built-in scene every next event within two free paths gave
+/// a per-vertex noise of 26.9% in 41.9 s of walks, a quarter at the surface 31.8% in 11.6 s
+/// (2.6 times as much precision per second); on the 2 cm marble sphere 34.3% in 3.4 s and
+/// 35.8% in 1.2 s. The walk's flights cost the same either way; the next events' beams were
+/// four fifths of the walk.
+const SURFACE_CHANCE: f64 = 0.25;
 
 /// Where a receiver's walks start: just inside its vertex, with the vertex's outward shading
 /// normal; the light that reaches it without scattering (per channel, exitance); and per light
@@ -312,18 +318,18 @@ impl Adjoint<'_> {
     fn next_event(&self, q: DVec3, d: DVec3, (c, chances): (usize, &[f64]), rng: &mut Pcg64) -> f64 {
         let medium = &self.media[c];
         // Every beam reaching q has crossed at least the clearance: its attenuation is at most
-        // exp(-sigma_t clearance). Deep inside, the next event is taken with that chance (times
-        // e^NEAR_FREE_PATHS) and weighted by its inverse, which keeps it unbiased and spares
-        // the root-finding where it would find almost nothing.
-        let bound = (NEAR_FREE_PATHS - medium.sigma_t() * self.geometry.clearance_at(q)).exp();
-        if bound < 1.0 && rng.random::<f64>() >= bound {
+        // exp(-sigma_t clearance). The next event is taken with that bound's chance (times
+        // SURFACE_CHANCE) and weighted by its inverse: unbiased, each taken event worth at most
+        // 1 / SURFACE_CHANCE of its beam, and the search for beams spared where they are dim.
+        let chance = SURFACE_CHANCE * (-medium.sigma_t() * self.geometry.clearance_at(q)).exp();
+        if rng.random::<f64>() >= chance {
             return 0.0;
         }
-        let chance = bound.min(1.0);
         let Some(l) = pick(chances, rng.random::<f64>()) else { return 0.0 };
         let way = Way { eta: medium.eta, entry: self.entry };
         let Some(Beam { irradiance, s, d: along }) = self.beams.at(&self.lights[l], q, way) else { return 0.0 };
-        irradiance[c] * (-medium.sigma_t() * s).exp() * henyey_greenstein(along.dot(-d), medium.g) / (chances[l] * chance)
+        irradiance[c] * (-medium.sigma_t() * s).exp() * henyey_greenstein(along.dot(-d), medium.g)
+            / (chances[l] * chance)
     }
 }
 
@@ -409,19 +415,24 @@ mod tests {
     }
 
     /// The exitance at the centre of the top of a wide, deep slab (lengths in mean free paths)
-    /// of three media under one directional light towards `towards`.
+    /// of three media under one directional light towards `towards`. Each face is cut 32 times
+    /// along each side, so the shading normals tilt only in the outer 2.5 free paths.
     fn top_centre(media: [Medium; 3], towards: DVec3, walks: u64) -> ObjectExitance {
         top_centre_entering(media, towards, walks, Entry::Refracted)
     }
 
     fn top_centre_entering(media: [Medium; 3], towards: DVec3, walks: u64, entry: Entry) -> ObjectExitance {
         let half = DVec3::new(40.0, 40.0, 25.0);
-        let mesh = slab(half, 8);
+        let mesh = slab(half, 32);
         let lights = [directional(towards)];
         let occluders = crate::mesh::bvh::Bvh::new(Vec::new());
         let lighting = Lighting { lights: &lights, occluders: &occluders, eps: 1e-6 };
         let receiver = vertex_at(&mesh, DVec3::new(0.0, 0.0, half.z));
-        let options = MeshOptions { budget: Budget::photons(walks), seed: 7, walk: super::super::Walk::Adjoint { receivers: None } };
+        let options = MeshOptions {
+            budget: Budget::photons(walks),
+            seed: 7,
+            walk: super::super::Walk::Adjoint { receivers: None },
+        };
         object_adjoint(&mesh, &media, &lighting, vec![receiver], (&options, entry), &quiet).unwrap()
     }
 
@@ -455,23 +466,29 @@ mod tests {
             let (expected, se_f) = (entering * forward.mean, entering * forward.stderr);
             let (m, se) = (result.exitance[0][c], result.stderr[0][c]);
             let combined = (se * se + se_f * se_f).sqrt();
-            assert!(combined < 0.01 * expected, "channel {c}: the test must measure something ({se}, {se_f} of {expected})");
-            assert!((m - expected).abs() < 4.0 * combined, "channel {c}: adjoint {m} ± {se}, photons {expected} ± {se_f}");
+            assert!(
+                combined < 0.01 * expected,
+                "channel {c}: the test must measure something ({se}, {se_f} of {expected})"
+            );
+            assert!(
+                (m - expected).abs() < 4.0 * combined,
+                "channel {c}: adjoint {m} ± {se}, photons {expected} ± {se_f}"
+            );
         }
     }
 
     #[test]
     fn light_entering_along_the_normal_is_the_refracted_light_at_normal_incidence_and_at_its_depth_on_a_slab() {
         // The same walks: at normal incidence on a flat face the two entries are one beam, so
-        // the scores agree (to 1e-5: under the slab's rim, tens of free paths away, the shading
-        // normals tilt and the two beams part); at cosine 0.6 the refracted beam runs shallower and
+        // the scores agree (to 2e-4: under the slab's rim, 37.5 to 40 free paths away, the
+        // shading normals tilt and the two beams part); at cosine 0.6 the refracted beam runs shallower and
         // leaves more light near the entry (eta 1.3: cos_t 0.79), which the normal entry misses.
         let media = [0.5, 0.9, 0.99].map(|a| Medium::new(1.0 - a, a, 0.0, 1.3).unwrap());
         let run = |towards, entry| top_centre_entering(media, towards, 2000, entry);
         let (refracted, normal) = (run(DVec3::Z, Entry::Refracted), run(DVec3::Z, Entry::Normal));
         for c in 0..3 {
             let (a, b) = (refracted.exitance[0][c], normal.exitance[0][c]);
-            assert!((a - b).abs() <= 1e-5 * a, "channel {c}: {a} against {b}");
+            assert!((a - b).abs() <= 2e-4 * a, "channel {c}: {a} against {b}");
         }
         let towards = DVec3::new(0.8, 0.0, 0.6);
         let (refracted, normal) = (run(towards, Entry::Refracted), run(towards, Entry::Normal));
@@ -482,7 +499,7 @@ mod tests {
         let slanted = run(towards, Entry::Slanted);
         for c in 0..3 {
             let (a, b) = (refracted.exitance[0][c], slanted.exitance[0][c]);
-            assert!((a - b).abs() <= 1e-5 * a, "channel {c}: refracted {a}, slanted {b}");
+            assert!((a - b).abs() <= 2e-4 * a, "channel {c}: refracted {a}, slanted {b}");
         }
     }
 

@@ -76,6 +76,11 @@ impl<'a> Geometry<'a> {
         best
     }
 
+    /// The first face a ray from `p` along `d` meets within `s`, by the BVH alone.
+    pub(super) fn first_hit_within(&self, p: DVec3, d: DVec3, s: f64) -> Option<Hit> {
+        self.bvh.closest_hit(p, d, 0.0, s, None)
+    }
+
     /// The first face a ray from `p` along `d` meets, however far.
     pub(super) fn first_hit(&self, p: DVec3, d: DVec3) -> Option<Hit> {
         self.bvh.closest_hit(p, d, 0.0, f64::INFINITY, None)
@@ -87,11 +92,8 @@ impl<'a> Geometry<'a> {
     /// the face normal where they cancel.
     pub(super) fn shading_normal(&self, triangle: usize, bary: [f64; 3]) -> DVec3 {
         let normals = self.mesh.vertex_normals();
-        let n: DVec3 = self.mesh.triangles()[triangle]
-            .iter()
-            .zip(bary)
-            .map(|(&v, b)| normals[v as usize].as_dvec3() * b)
-            .sum();
+        let n: DVec3 =
+            self.mesh.triangles()[triangle].iter().zip(bary).map(|(&v, b)| normals[v as usize].as_dvec3() * b).sum();
         let len = n.length();
         let face = self.normals[triangle];
         if len <= 1e-9 {
