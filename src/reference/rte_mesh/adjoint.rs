@@ -49,10 +49,10 @@ const MAX_ROUND: u64 = 1024;
 /// (by the clearance grid's bound) the chance is `e^-c` times this (see `Adjoint::next_event`).
 /// Measured by the noise at equal time (`examples/adjoint_noise.rs`, 100 walks per receiver,
 /// lavapipe's 2-core VM): on the built-in scene every next event within two free paths gave
-/// a per-vertex noise of 26.9% in 41.9 s of walks, a quarter at the surface 31.8% in 11.6 s
-/// (2.6 times as much precision per second); on the 2 cm marble sphere 34.3% in 3.4 s and
-/// 35.8% in 1.2 s. The walk's flights cost the same either way; the next events' beams were
-/// four fifths of the walk.
+/// a per-vertex noise of 26.9% in 41.9 s of walks, this quarter 30.5% in 11 to 12 s (2.8
+/// times as much precision per second), `e^-1.5` 31.8% in 11.6 s; on the 2 cm marble sphere
+/// the first 34.3% in 3.4 s, the last 35.8% in 1.2 s. The walk's flights cost the same either
+/// way; the next events' beams were four fifths of the walk.
 const SURFACE_CHANCE: f64 = 0.25;
 
 /// Where a receiver's walks start: just inside its vertex, with the vertex's outward shading
