@@ -83,7 +83,7 @@ impl<'a> Geometry<'a> {
 
     /// The first face a ray from `p` along `d` meets, however far.
     pub(super) fn first_hit(&self, p: DVec3, d: DVec3) -> Option<Hit> {
-        self.bvh.closest_hit(p, d, 0.0, f64::INFINITY, None)
+        self.first_hit_within(p, d, f64::INFINITY)
     }
 
     /// The outward unit shading normal at barycentric coordinates `bary` of `triangle`: the
