@@ -46,7 +46,7 @@ layout(std430, set = 0, binding = 8) readonly buffer TransportDipole { vec4 dipo
 #define ALWAYS 2.0     // mesh::facing::ALWAYS
 #define GATHER 1u      // state.y: stage 1 of the gather computes its dipole exitance
 #define FINISH 2u      // state.y: glsl/transport.comp scales it this frame
-#define PATCH_UVEC4S 5u // TransportPatchRecord's size; its first uvec4 is `items`
+#define PATCH_UVEC4S 6u // TransportPatchRecord's size; its first uvec4 is `items`
 
 struct ReceiverViewPush {
     mat4 view_proj;       // world -> clip (Vulkan depth 0..1)

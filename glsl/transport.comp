@@ -2,17 +2,20 @@
 // The transport kernel (src/optics/transport.rs, its f64 twin): the dipole's exitance at the
 // vertices of an object with material.model = "transport" (those of its level of detail this
 // frame), scaled per patch of its surface to the radiative transfer through its own mesh, the
-// entry direction carried in the kernel's basis (1, mu - mu_bar, t . u_JI):
-//     F_I = max(0, sum_J (W0_IJ Phi_J + Wmu_IJ Phimu_J + Wt_IJ T_J . u_JI)) / A_I
-//     Phi_J = sum_(samples s in J) A_s E_t(s), Phimu_J and T_J alike weighted by the sample's
-//     mu_s - mu_bar and t_s (SampleFlux::from_splat), u_JI the unit direction in J's tangent
-//     plane towards I's centre (Patches::toward); Wmu and Wt are 0 beyond ENTRY_REACH patch
-//     radii, so each patch lists the J within it (TransportKernel::near)
+// entry direction and point carried in the kernel's basis (1, mu - mu_bar, t . u_JI,
+// (x - x_J) . u_JI):
+//     F_I = max(0, sum_J (W0_IJ Phi_J exp(g_IJ X_J . u_JI / Phi_J) + Wmu_IJ Phimu_J
+//           + Wt_IJ T_J . u_JI)) / A_I,   g_IJ = Wx_IJ / W0_IJ (optics::transport::offset_factor)
+//     Phi_J = sum_(samples s in J) A_s E_t(s), Phimu_J, T_J and X_J alike weighted by the
+//     sample's mu_s - mu_bar, t_s (SampleFlux::from_splat) and x_s - x_J (x_J the entries'
+//     mean, Patches::entry_centres), u_JI the unit direction in J's tangent plane towards I's
+//     centre (Patches::toward); Wmu and Wt are 0 beyond ENTRY_REACH patch radii, so each patch
+//     lists the J within it (TransportKernel::near)
 //     D_I = sum_(level's vertices v in I) a_v M_d(v) / sum a_v   (a_v: the level's dual cells)
 //     M(v) = M_d(v) sum_I w_vI F_I / sum_I w_vI D_I   (its eight nearest patches)
 // Each level of detail has its own patch records (its vertices, its D), sharing the object's W.
 // Three stages (push `stage.x`), each one dispatch per object, a barrier between them:
-//   0: one invocation per patch: Phi, Phimu, T and D, summed over its items;
+//   0: one invocation per patch: Phi, Phimu, T, X and D, summed over its items;
 //   1: one invocation per patch: F, its rows of W against every patch's fluxes;
 //   2: one invocation per vertex: the scale, in the channels push.stage.w names (the others
 //      take single scattering between points, which the pass before wrote), where the blended
@@ -24,9 +27,10 @@
 // every vertex was gathered and is scaled (a scope of every receiver).
 // Bindings: 0 = splat (SplatRecord[], read), 1 = exitance (vec4 per vertex, read by stage 0,
 // written by stage 2), 2 = patches (TransportPatchRecord[]), 3 = items (uvec2: index, area
-// bits), 4 = the kernels' rows (W0: a vec4 per pair, rgb; then per patch its near list, two
-// vec4 per J: Wmu rgb with J in w, exact as a float; Wt rgb), 5 = sums (SUMS vec4 per patch:
-// Phi, D, F, Phimu, T_r, T_g, T_b; written by stages 0 and 1), 6 = neighbours (four
+// bits), 4 = the kernels' rows (W0: a vec4 per pair, rgb; Wx alike after them; then per patch
+// its near list, two vec4 per J: Wmu rgb with J in w, exact as a float; Wt rgb), 5 = sums
+// (SUMS vec4 per patch: Phi, D, F, Phimu, T_r, T_g, T_b, X_r, X_g, X_b; written by stages 0
+// and 1), 6 = neighbours (four
 // uvec4 per vertex: (patch relative to the level's first record, weight bits) pairs), 7 = level
 // vertices (uint[], object-relative), 8 = samples (SampleRecord[]: the normals), 9 = receiver
 // state (uvec2 per vertex: generation, GATHER | FINISH), 10 = transport dipole (vec4 per vertex:
@@ -41,9 +45,11 @@ struct TransportPatchRecord {
     vec4 centre;    // xyz: centre
     vec4 normal;    // xyz: unit mean normal (0 where the patch's normals cancel)
     uvec4 near;     // x: its near list's first entry in the rows; y: its length
+    vec4 entry;     // xyz: the entries' mean x_J
 };
 
-const uint SUMS = 7u;
+const uint SUMS = 10u;
+const float OFFSET_EXPONENT_LIMIT = 2.0;  // optics::transport::OFFSET_EXPONENT_LIMIT
 
 layout(std430, set = 0, binding = 0) readonly buffer Splat { SplatRecord splat[]; };
 layout(std430, set = 0, binding = 1) buffer Exitance { vec4 exitance[]; };
@@ -70,11 +76,13 @@ struct TransportPush {
 layout(push_constant) uniform Push { TransportPush push; };
 
 // Sample item `it`'s weighted irradiance into the lane's sums: A_s E_t, and that times
-// mu_s - mu_bar and times t_s (SampleFlux::from_splat).
-void add_sample(uvec2 it, float mu_bar, inout vec3 phi, inout vec3 phi_mu, inout vec3 t[3]) {
+// mu_s - mu_bar, t_s (SampleFlux::from_splat) and x_s - x_J (`entry`).
+void add_sample(uvec2 it, vec4 at, inout vec3 phi, inout vec3 phi_mu, inout vec3 t[3], inout vec3 x[3]) {
     SplatRecord r = splat[it.x];
     vec3 e = r.irradiance_area.rgb;
-    vec3 n = samples[it.x].normal;
+    SampleRecord s = samples[it.x];
+    vec3 n = s.normal, offset = s.position_area.xyz - at.xyz;
+    float mu_bar = at.w;
     float w = e.r + e.g + e.b;
     float mu = mu_bar;
     vec3 tilt = vec3(0.0);
@@ -87,7 +95,10 @@ void add_sample(uvec2 it, float mu_bar, inout vec3 phi, inout vec3 phi_mu, inout
     vec3 f = uintBitsToFloat(it.y) * e;
     phi += f;
     phi_mu += f * (mu - mu_bar);
-    for (int c = 0; c < 3; ++c) t[c] += tilt * f[c];
+    for (int c = 0; c < 3; ++c) {
+        t[c] += tilt * f[c];
+        x[c] += offset * f[c];
+    }
 }
 
 // Vertex v's dipole exitance this generation; kept in `dipole` where this frame gathered it
@@ -99,13 +110,14 @@ vec3 dipole_value(uint v) {
     return m;
 }
 
-// Stage 0: patch `p`'s Phi, Phimu, T and D, one invocation walking its items (a patch has a
+// Stage 0: patch `p`'s Phi, Phimu, T, X and D, one invocation walking its items (a patch has a
 // few hundred; a workgroup per patch summing six arrays through shared memory and six barriers
 // was no faster on lavapipe).
 void patch_sums(uint p) {
     TransportPatchRecord r = patches[p];
     vec3 phi = vec3(0.0), phi_mu = vec3(0.0);
     vec3 t[3] = vec3[3](vec3(0.0), vec3(0.0), vec3(0.0));
+    vec3 x[3] = vec3[3](vec3(0.0), vec3(0.0), vec3(0.0));
     vec4 d = vec4(0.0);
     for (uint k = 0u; k < r.items.y; ++k) {
         uvec2 it = items[r.items.x + k];
@@ -113,13 +125,16 @@ void patch_sums(uint p) {
         d += vec4(a * dipole_value(it.x), a);
     }
     for (uint k = 0u; k < r.items.z; ++k) {
-        add_sample(items[r.items.x + r.items.y + k], r.area.y, phi, phi_mu, t);
+        add_sample(items[r.items.x + r.items.y + k], vec4(r.entry.xyz, r.area.y), phi, phi_mu, t, x);
     }
     sums[SUMS * p] = vec4(phi, 0.0);
     // The dipole's mean over the level's vertices in the patch (0 where it has none).
     sums[SUMS * p + 1u] = vec4(d.w > 0.0 ? d.rgb / d.w : vec3(0.0), 0.0);
     sums[SUMS * p + 3u] = vec4(phi_mu, 0.0);
-    for (uint c = 0u; c < 3u; ++c) sums[SUMS * p + 4u + c] = vec4(t[c], 0.0);
+    for (uint c = 0u; c < 3u; ++c) {
+        sums[SUMS * p + 4u + c] = vec4(t[c], 0.0);
+        sums[SUMS * p + 7u + c] = vec4(x[c], 0.0);
+    }
 }
 
 // The unit direction in patch `from`'s tangent plane towards `to`'s centre (Patches::toward).
@@ -130,13 +145,32 @@ vec3 toward(TransportPatchRecord from, vec3 to) {
     return l2 > 0.0 ? u * inversesqrt(l2) : vec3(0.0);
 }
 
+// optics::transport::offset_factor per channel: exp(Wx X.u / (W0 Phi)), limited; 1 where
+// W0 Phi is not positive.
+vec3 offset_factor(vec3 w0, vec3 wx, vec3 x_u, vec3 phi) {
+    vec3 s = vec3(1.0);
+    for (int c = 0; c < 3; ++c) {
+        float den = w0[c] * phi[c];
+        if (den > 0.0) s[c] = exp(clamp(wx[c] * x_u[c] / den, -OFFSET_EXPONENT_LIMIT, OFFSET_EXPONENT_LIMIT));
+    }
+    return s;
+}
+
 // Stage 1: patch `p`'s F from its rows of the kernel.
 void patch_transport(uint p) {
     TransportPatchRecord r = patches[p];
-    uint first = push.stage.y;
+    uint first = push.stage.y, k = push.stage.z;
     vec3 f = vec3(0.0);
-    for (uint j = 0u; j < push.stage.z; ++j) {
-        f += matrix[r.items.w + j].rgb * sums[SUMS * (first + j)].rgb;
+    for (uint j = 0u; j < k; ++j) {
+        uint q = SUMS * (first + j);
+        // Only the two vectors `toward` needs: llvmpipe loads a whole record otherwise.
+        vec3 n = patches[first + j].normal.xyz, d = r.centre.xyz - patches[first + j].centre.xyz;
+        vec3 u = d - n * dot(d, n);
+        float l2 = dot(u, u);
+        u = l2 > 0.0 ? u * inversesqrt(l2) : vec3(0.0);
+        vec3 xu = vec3(dot(sums[q + 7u].xyz, u), dot(sums[q + 8u].xyz, u), dot(sums[q + 9u].xyz, u));
+        vec3 w0 = matrix[r.items.w + j].rgb, phi = sums[q].rgb;
+        f += w0 * phi * offset_factor(w0, matrix[r.items.w + k * k + j].rgb, xu, phi);
     }
     for (uint k = 0u; k < r.near.y; ++k) {
         vec4 mu = matrix[r.near.x + 2u * k], tilt = matrix[r.near.x + 2u * k + 1u];

@@ -156,6 +156,50 @@ fn tilting_the_entry_towards_a_nearby_patch_sends_it_more_light_and_the_entry_ro
 }
 
 #[test]
+fn light_entering_a_patch_on_its_side_towards_a_far_patch_sends_it_more_and_a_uniform_entry_no_offset() {
+    // The 2 cm marble sphere: the flux reaching a patch I falls with the distance it runs, so
+    // light entering J on its side towards I sends I more than light entering on the far side:
+    // Wx_IJ, summed over the pairs beyond the entry rows' reach, is positive in every channel
+    // and, times a patch radius, a sizeable share of their W0. And where every vertex's cell
+    // is lit alike, the offsets from each patch's entry centre cancel: X_J = 0 and the row adds
+    // nothing to what W0 says.
+    use translucent::mesh::patches::cell_centroids;
+    use translucent::optics::transport::ENTRY_REACH;
+    let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
+    let kernel =
+        object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 24 * 2000, seed: 4 }, &quiet).unwrap();
+    let (k, p) = (kernel.patches.len(), &kernel.patches);
+    for c in 0..3 {
+        let (mut shift, mut flux) = (0.0, 0.0);
+        for i in 0..k {
+            for j in (0..k).filter(|&j| p.centre(i).distance(p.centre(j)) > ENTRY_REACH * p.radius) {
+                shift += kernel.shift[c][i * k + j] * p.radius;
+                flux += kernel.flux[c][i * k + j];
+            }
+        }
+        assert!(shift > 0.1 * flux, "channel {c}: Wx times a radius {shift:.4} against W0 {flux:.4} beyond the reach");
+    }
+    let mesh = &scene.objects[0].mesh;
+    let centroids = cell_centroids(mesh);
+    let uniform = (0..mesh.positions().len()).map(|v| {
+        let n = mesh.vertex_normals()[v].as_dvec3();
+        SampleFlux::from_splat(
+            (p.of_vertex[v], centroids[v]),
+            p.cells[v],
+            [1.0; 3],
+            (DVec3::ZERO, 0.0),
+            n,
+            kernel.mu_mean,
+        )
+    });
+    let flux = kernel.patch_flux(uniform, &p.entry_centres(mesh));
+    for j in 0..k {
+        let offset = flux.offset[j][0].length() / (flux.phi[j][0] * p.radius);
+        assert!(offset < 1e-9, "patch {j}: uniform light's offset {offset:.2e} of a radius");
+    }
+}
+
+#[test]
 fn the_kernel_is_reciprocal_flux_from_j_to_i_equals_flux_from_i_to_j_within_its_noise() {
     // The radiative transfer is reciprocal: under uniform irradiance, the flux that J sends out
     // through I equals what I sends through J, A_J W0_IJ = A_I W0_JI. The walks enter as
@@ -269,9 +313,10 @@ fn against_twin(mut scene: PreparedScene, kernel: &TransportKernel, level: usize
         let (d, w) = r.key_entry();
         let d = DVec3::from(d.map(f64::from));
         let patch = kernel.sample_patch(&o.mesh, s.triangle, s.barycentric);
-        SampleFlux::from_splat(patch, s.area, e, (d, f64::from(w)), s.normal.as_dvec3(), kernel.mu_mean)
+        let at = (patch, s.position.as_dvec3());
+        SampleFlux::from_splat(at, s.area, e, (d, f64::from(w)), s.normal.as_dvec3(), kernel.mu_mean)
     });
-    let phi = kernel.patch_flux(points);
+    let phi = kernel.patch_flux(points, &placed.entry_centres(&o.mesh));
     let dipole64: Vec<[f64; 3]> = dipole.iter().map(|m| m.map(f64::from)).collect();
     let near = TransportKernel::vertex_neighbours(&placed, &o.mesh);
     let cells = level_cells(o, &o.levels[level].triangles);

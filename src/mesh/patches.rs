@@ -44,6 +44,23 @@ pub fn cell_areas(mesh: &Mesh) -> Vec<f64> {
     cells
 }
 
+/// Each vertex's dual cell's centroid: in a triangle `(a, b, c)` the cell of `a` (the
+/// quadrilateral of `a`, the two edges' midpoints and the centroid) has its centroid at
+/// `(22 a + 7 b + 7 c) / 36`, a sixth of the triangle each side of the line to the centroid.
+pub fn cell_centroids(mesh: &Mesh) -> Vec<DVec3> {
+    let mut sum = vec![(DVec3::ZERO, 0.0); mesh.positions().len()];
+    for (t, tri) in mesh.triangles().iter().enumerate() {
+        let p = tri.map(|v| mesh.positions()[v as usize].as_dvec3());
+        let third = mesh.triangle_areas()[t] / 3.0;
+        for c in 0..3 {
+            let centroid = (22.0 * p[c] + 7.0 * (p[(c + 1) % 3] + p[(c + 2) % 3])) / 36.0;
+            let (s, w) = &mut sum[tri[c] as usize];
+            (*s, *w) = (*s + centroid * third, *w + third);
+        }
+    }
+    sum.iter().zip(mesh.positions()).map(|(&(s, w), p)| if w > 0.0 { s / w } else { p.as_dvec3() }).collect()
+}
+
 fn distance2(a: &Features, b: &Features) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
 }
@@ -97,6 +114,17 @@ impl Patches {
         let centres =
             sum.iter().zip(&self.centres).map(|((s, w), old)| if *w > 0.0 { s.map(|x| x / w) } else { *old }).collect();
         Patches { centres, ..self.clone() }
+    }
+
+    /// Each patch's entry centre on `mesh` (these patches' mesh, or a rigid move of it): the
+    /// mean of a point drawn uniformly over its vertices' cells, as the kernel's walks enter
+    /// (`cell_centroids`, weighted by the cells).
+    pub fn entry_centres(&self, mesh: &Mesh) -> Vec<DVec3> {
+        let mut sum = vec![DVec3::ZERO; self.len()];
+        for (v, c) in cell_centroids(mesh).into_iter().enumerate() {
+            sum[self.of_vertex[v] as usize] += c * self.cells[v];
+        }
+        sum.iter().zip(&self.area).map(|(&s, &a)| if a > 0.0 { s / a } else { s }).collect()
     }
 
     /// How many patches.

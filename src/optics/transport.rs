@@ -8,12 +8,16 @@
 //! low-order basis: per pair of patches, the flux that leaves through `I` per unit flux
 //! transmitted into `J` is
 //!
-//! `W_IJ(d) = W0_IJ + Wmu_IJ (mu - mu_bar) + Wt_IJ (t . u_JI)`,
+//! `W_IJ(d, x) = W0_IJ + Wmu_IJ (mu - mu_bar) + Wt_IJ (t . u_JI) + Wx_IJ ((x - x_J) . u_JI)`,
 //!
 //! `mu` the cosine of `d` with the inward normal, `t` its tangential part, `u_JI` the unit
 //! direction in `J`'s tangent plane towards `I` (`Patches::toward`) and `mu_bar` the mean cosine
 //! of the walks' entries ([`EntryBasis`]); `Wmu` and `Wt` are 0 between patches more than
-//! [`ENTRY_REACH`] patch radii apart ([`TransportKernel::near`] lists those within). The three
+//! [`ENTRY_REACH`] patch radii apart ([`TransportKernel::near`] lists those within). The last
+//! term carries where in `J` the light enters, `x` against the entries' mean `x_J`
+//! (`Patches::entry_centres`): at a terminator the light enters on a patch's lit side, and a
+//! kernel of uniform entry moved it towards the unlit side, 8 to 13% too bright there on a
+//! marble sphere in green and blue. The four
 //! rows are the least-squares projection of the walks' response on that basis, estimated once
 //! by random walks in the mesh
 //! (`reference::rte_mesh::kernel`) with entry directions drawn as diffuse light refracts in,
@@ -25,9 +29,11 @@
 //! lights' refracted cosine and tangential direction averaged by their flux, and `M_d` the
 //! dipole's exitance at the vertices:
 //!
-//! - `Phi_J = sum A_s E_t`, `Phimu_J = sum A_s E_t (mu_s - mu_bar)` and `T_J = sum A_s E_t t_s`
-//!   over the samples in `J` ([`PatchFlux`]);
-//! - `F_I = max(0, sum_J (W0_IJ Phi_J + Wmu_IJ Phimu_J + Wt_IJ T_J . u_JI)) / A_I`, the
+//! - `Phi_J = sum A_s E_t`, `Phimu_J = sum A_s E_t (mu_s - mu_bar)`, `T_J = sum A_s E_t t_s`
+//!   and `X_J = sum A_s E_t (x_s - x_J)` over the samples in `J` ([`PatchFlux`]);
+//! - `F_I = max(0, sum_J (W0_IJ Phi_J exp(g_IJ X_J . u_JI / Phi_J) + Wmu_IJ Phimu_J + Wt_IJ
+//!   T_J . u_JI)) / A_I` with `g_IJ = Wx_IJ / W0_IJ` (the offset's row read as an
+//!   exponential's rate, [`offset_factor`]), the
 //!   kernel's exitance averaged over `I` (the basis is linear in the entry, and may extrapolate
 //!   below zero);
 //! - `D_I = sum_(v in I) A_v M_d(v) / A_I`, the dipole's, alike (`A_v` the vertex's dual cell);
@@ -51,6 +57,24 @@ use glam::DVec3;
 /// to -3 to -5%, where unbounded rows added 3 to 7 points of noise and bias on the unlit side
 /// (docs/PHYSICS.md, "The transport kernel").
 pub const ENTRY_REACH: f64 = 3.0;
+
+/// The largest exponent [`offset_factor`] takes, either way: a factor of `e^2`. On the marble
+/// sphere the exponents stay under 1 (limits of 1, 2 and 4 gave the same figures); the limit
+/// only bounds a far pair whose few walks gave a noisy `Wx / W0`.
+pub const OFFSET_EXPONENT_LIMIT: f64 = 2.0;
+
+/// How `W0_IJ Phi_J` changes where the light enters `J` off its entry centre:
+/// `exp(g delta)` with the rate `g = Wx_IJ / W0_IJ` and `delta = X_J . u_JI / Phi_J` the light's
+/// mean offset towards `I` (`x_u` is `X_J . u_JI`, `phi` is `Phi_J`); 1 where `W0_IJ Phi_J` is
+/// not positive. The walks estimate `Wx` as a least-squares slope, and for a Gaussian spread
+/// of entries the slope over the mean is an exponential's rate exactly (Stein's lemma). The
+/// transport falls off exponentially with the distance the light runs, so the exponential
+/// follows a patch whose light sits at its edge where the line falls short (the marble sphere:
+/// 4.69, 4.95, 5.00% with the line, 4.28, 4.56, 4.11% with the exponential, docs/PHYSICS.md).
+pub fn offset_factor(w0: f64, wx: f64, x_u: f64, phi: f64) -> f64 {
+    let den = w0 * phi;
+    if den > 0.0 { ((wx * x_u) / den).clamp(-OFFSET_EXPONENT_LIMIT, OFFSET_EXPONENT_LIMIT).exp() } else { 1.0 }
+}
 
 /// How the kernel's walks enter, and the moments of that entry the basis needs: directions
 /// refracted from diffuse light, `sin^2 theta_t` uniform on `[0, S]` with `S = min(1,
@@ -99,6 +123,8 @@ pub struct PatchFlux {
     pub phi_mu: PerPatch,
     /// `T_J`, per channel a tangential vector.
     pub tilt: Vec<[DVec3; 3]>,
+    /// `X_J`, per channel a vector from the entries' mean.
+    pub offset: Vec<[DVec3; 3]>,
 }
 
 /// One sample's part of [`PatchFlux`]: its patch, its area, its transmitted irradiance per
@@ -116,6 +142,9 @@ pub struct SampleFlux {
     pub mu: f64,
     /// `t_s`.
     pub tilt: DVec3,
+    /// `x_s`, where it lies (for a vertex standing for its cell, the cell's centroid,
+    /// `patches::cell_centroids`).
+    pub position: DVec3,
 }
 
 impl SampleFlux {
@@ -126,7 +155,7 @@ impl SampleFlux {
     /// walks do, diffusely: at `mu_bar`, without tilt. So, with `w` the flux of every light,
     /// `mu_s = (-d_key . n + (w - w_key) mu_bar) / w` and `t_s = (d_key - (d_key . n) n) / w`.
     pub fn from_splat(
-        patch: u32,
+        (patch, position): (u32, DVec3),
         area: f64,
         e: [f64; 3],
         (d_key, w_key): (DVec3, f64),
@@ -140,7 +169,7 @@ impl SampleFlux {
         } else {
             (mu_bar, DVec3::ZERO)
         };
-        SampleFlux { patch, area, e, mu, tilt }
+        SampleFlux { patch, area, e, mu, tilt, position }
     }
 }
 
@@ -155,6 +184,8 @@ pub struct TransportKernel {
     pub depth: [Vec<f64>; 3],
     /// Per channel, `Wt_IJ`, alike.
     pub sideways: [Vec<f64>; 3],
+    /// Per channel, `Wx_IJ` (per unit length), alike.
+    pub shift: [Vec<f64>; 3],
     /// `mu_bar` of the walks' entry ([`EntryBasis::mu_mean`]).
     pub mu_mean: f64,
     /// Walks per patch and channel it was estimated with.
@@ -165,10 +196,12 @@ pub struct TransportKernel {
 pub type PerPatch = Vec<[f64; 3]>;
 
 impl TransportKernel {
-    /// The fluxes of `points` per patch ([`PatchFlux`]).
-    pub fn patch_flux(&self, points: impl Iterator<Item = SampleFlux>) -> PatchFlux {
+    /// The fluxes of `points` per patch ([`PatchFlux`]), their offsets taken from `entry`,
+    /// the entries' means where the object stands now (`Patches::entry_centres`).
+    pub fn patch_flux(&self, points: impl Iterator<Item = SampleFlux>, entry: &[DVec3]) -> PatchFlux {
         let k = self.patches.len();
-        let mut flux = PatchFlux { phi: vec![[0.0; 3]; k], phi_mu: vec![[0.0; 3]; k], tilt: vec![[DVec3::ZERO; 3]; k] };
+        let zero = || vec![[DVec3::ZERO; 3]; k];
+        let mut flux = PatchFlux { phi: vec![[0.0; 3]; k], phi_mu: vec![[0.0; 3]; k], tilt: zero(), offset: zero() };
         for s in points {
             let j = s.patch as usize;
             for c in 0..3 {
@@ -176,6 +209,7 @@ impl TransportKernel {
                 flux.phi[j][c] += f;
                 flux.phi_mu[j][c] += f * (s.mu - self.mu_mean);
                 flux.tilt[j][c] += s.tilt * f;
+                flux.offset[j][c] += (s.position - entry[j]) * f;
             }
         }
         flux
@@ -192,7 +226,11 @@ impl TransportKernel {
             .map(|i| {
                 let mut f = [0.0; 3];
                 for j in 0..k {
-                    (0..3).for_each(|c| f[c] += self.flux[c][i * k + j] * flux.phi[j][c]);
+                    let (at, u) = (i * k + j, placed.toward(j, i));
+                    for (c, f) in f.iter_mut().enumerate() {
+                        let (w0, phi) = (self.flux[c][at], flux.phi[j][c]);
+                        *f += w0 * phi * offset_factor(w0, self.shift[c][at], flux.offset[j][c].dot(u), phi);
+                    }
                 }
                 for &j in &near[i] {
                     let (j, at) = (j as usize, i * k + j as usize);
@@ -214,7 +252,7 @@ impl TransportKernel {
     /// refracts in and leave through the same Fresnel boundary). The walks entering `J` and
     /// those entering `I` estimate that one number on independent streams, so their mean has
     /// about half the variance of either; the far pairs, which a few walks reach, gain most.
-    /// `Wmu` and `Wt` have no such partner and are kept.
+    /// `Wmu`, `Wt` and `Wx` have no such partner and are kept.
     pub fn reciprocal(mut self) -> TransportKernel {
         let (k, area) = (self.patches.len(), &self.patches.area);
         for w in &mut self.flux {
@@ -238,9 +276,9 @@ impl TransportKernel {
         (0..k).map(|i| (0..k).filter(|&j| nonzero(i * k + j)).map(|j| j as u32).collect()).collect()
     }
 
-    /// Its three rows, `W0`, `Wmu` and `Wt`, each per channel.
+    /// Its four rows, `W0`, `Wmu`, `Wt` and `Wx`, each per channel.
     pub fn rows(&self) -> impl Iterator<Item = &[Vec<f64>; 3]> {
-        [&self.flux, &self.depth, &self.sideways].into_iter()
+        [&self.flux, &self.depth, &self.sideways, &self.shift].into_iter()
     }
 
     /// `D_I`: per patch, the dipole's exitance `dipole` (per vertex) averaged over it by the
@@ -321,17 +359,31 @@ impl TransportKernel {
         self.patches.of_vertex[mesh.triangles()[triangle as usize][corner] as usize]
     }
 
-    /// Bytes of device memory the kernel takes: `W0` as f32 RGBA per pair of patches, and
-    /// two RGBA per pair within the reach ([`TransportKernel::near`]).
+    /// Bytes of device memory the kernel takes: `W0` and `Wx` as f32 RGBA per pair of
+    /// patches, and two RGBA per pair within the reach ([`TransportKernel::near`]).
     pub fn device_bytes(&self) -> u64 {
         let near: usize = self.near().iter().map(Vec::len).sum();
-        (self.patches.len() as u64).pow(2) * 16 + near as u64 * 32
+        (self.patches.len() as u64).pow(2) * 32 + near as u64 * 32
     }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::EntryBasis;
+    use super::{EntryBasis, OFFSET_EXPONENT_LIMIT, offset_factor};
+
+    #[test]
+    fn the_offset_factor_is_the_rows_exponential_and_one_where_no_light_or_no_pair() {
+        // g = Wx / W0 = 50 per unit length, the light's mean 4 mm towards I: e^0.2.
+        let (w0, wx, phi) = (0.02, 1.0, 3.0);
+        let f = offset_factor(w0, wx, 0.004 * phi, phi);
+        assert!((f - 0.2f64.exp()).abs() < 1e-12, "{f}");
+        // A slope close to the line's near 0, and the exponent held at its limit far out.
+        assert!((offset_factor(w0, wx, 1e-5 * phi, phi) - (1.0 + 50.0 * 1e-5)).abs() < 1e-6);
+        assert_eq!(offset_factor(w0, wx, -phi, phi), (-OFFSET_EXPONENT_LIMIT).exp());
+        // No light in J, or no pair: W0 Phi stands as it is (and is 0).
+        assert_eq!(offset_factor(w0, wx, 0.0, 0.0), 1.0);
+        assert_eq!(offset_factor(0.0, wx, 0.01, phi), 1.0);
+    }
 
     #[test]
     fn the_entrys_closed_form_moments_are_those_of_its_samples() {

@@ -18,8 +18,9 @@ use std::path::Path;
 /// The version of the kernel's walk: a change to what it computes bumps it (4: the entry
 /// direction's basis, `optics::transport::EntryBasis`, within `ENTRY_REACH`; 5: the channels
 /// walk on common random numbers; 6: the walk's wall time is kept, [`CachedKernel::walk_seconds`];
-/// 7: `W0` averaged with its reciprocal estimate, `TransportKernel::reciprocal`).
-pub const VERSION: u32 = 7;
+/// 7: `W0` averaged with its reciprocal estimate, `TransportKernel::reciprocal`; 8: the entry
+/// point's offset row `Wx`).
+pub const VERSION: u32 = 8;
 
 /// One object's kernel, as cached.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -186,13 +187,15 @@ pub fn model_exitance(
         let (k, _) = cached(o, &KernelSettings::default(), dir, &|done, of| progress(index, done, of))?;
         let (positions, normals) = (o.mesh.positions(), o.mesh.vertex_normals());
         let eps = ray_offset(base);
+        // Each vertex stands for its cell, which the kernel's walks enter uniformly.
+        let centroids = crate::mesh::patches::cell_centroids(&o.mesh);
         let points = positions.iter().zip(normals).enumerate().map(|(v, (p, n))| {
             let (p, n) = (p.as_dvec3(), n.as_dvec3().normalize());
             let (e, d_key, w_key) = transmitted_entry(base, &casters, (p, n), material.eta, eps);
             let (patch, area) = (k.patches.of_vertex[v], k.patches.cells[v]);
-            SampleFlux::from_splat(patch, area, e.to_array(), (d_key, w_key), n, k.mu_mean)
+            SampleFlux::from_splat((patch, centroids[v]), area, e.to_array(), (d_key, w_key), n, k.mu_mean)
         });
-        let phi = k.patch_flux(points);
+        let phi = k.patch_flux(points, &k.patches.entry_centres(&o.mesh));
         let whole = gathered.as_ref().map_or(truth.as_slice(), |g| g[index].as_slice());
         let placed = k.placed(&o.mesh);
         let (f, d) = (k.transport_exitance(&phi, &placed), k.dipole_exitance(whole, &k.patches.cells));

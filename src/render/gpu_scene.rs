@@ -469,7 +469,7 @@ impl GpuScene {
                 transport_patches: upload(gpu, "transport patches", &t.patches, none)?,
                 transport_items: upload(gpu, "transport items", &t.items, none)?,
                 transport_matrix: upload(gpu, "transport matrix", &t.matrix, none)?,
-                transport_sums: sized("transport sums", 16 * 7, t.patches.len().max(1))?,
+                transport_sums: sized("transport sums", 16 * 10, t.patches.len().max(1))?,
                 transport_neighbours: upload(gpu, "transport neighbours", &t.neighbours, none)?,
                 // Generation 0 everywhere: no patch needed, no dipole value current.
                 transport_needed: upload(gpu, "transport needed", &vec![0u32; t.patches.len()], none)?,

@@ -22,7 +22,12 @@ pub struct TransportPatchRecord {
     /// x: its first entry-row entry in the matrix; y: their count (`TransportKernel::near`);
     /// z, w: 0.
     pub near: [u32; 4],
+    /// xyz: the entries' mean (`Patches::entry_centres`); w: 0.
+    pub entry: [f32; 4],
 }
+
+// glsl/receiver_view.comp reads the records as `PATCH_UVEC4S` = 6 uvec4s each: change both.
+const _: () = assert!(std::mem::size_of::<TransportPatchRecord>() == 6 * 16);
 
 /// Where one level of detail of an object's kernel lies in the packed buffers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,7 +52,7 @@ pub struct PackedTransport {
     pub patches: Vec<TransportPatchRecord>,
     /// Per patch record, its level's vertices then its samples: (absolute index, area bits).
     pub items: Vec<[u32; 2]>,
-    /// Each kernel's `W0` row by row (`[I K + J]`), RGB and 0; then per patch `I` its entry
+    /// Each kernel's `W0` row by row (`[I K + J]`), RGB and 0; `Wx` alike; then per patch `I` its entry
     /// rows within the reach, two entries per `J`: `Wmu_IJ` RGB with `J` (exact as an f32),
     /// `Wt_IJ` RGB and 0.
     pub matrix: Vec<[f32; 4]>,
@@ -87,8 +92,11 @@ impl PackedTransport {
             samples[i as usize].push([first_sample + s as u32, (sample.area as f32).to_bits()]);
         }
         let first_row = self.matrix.len() as u32;
-        self.matrix
-            .extend((0..k * k).map(|ij| [0, 1, 2].map(|c| kernel.flux[c][ij] as f32)).map(|[r, g, b]| [r, g, b, 0.0]));
+        for row in [&kernel.flux, &kernel.shift] {
+            self.matrix
+                .extend((0..k * k).map(|ij| [0, 1, 2].map(|c| row[c][ij] as f32)).map(|[r, g, b]| [r, g, b, 0.0]));
+        }
+        let entry = placed.entry_centres(&o.mesh);
         let mut near_rows = Vec::with_capacity(k);
         for (i, near) in kernel.near().iter().enumerate() {
             near_rows.push([self.matrix.len() as u32, near.len() as u32]);
@@ -132,6 +140,7 @@ impl PackedTransport {
                         centre: [c.x as f32, c.y as f32, c.z as f32, 0.0],
                         normal: [n.x as f32, n.y as f32, n.z as f32, 0.0],
                         near: [near_rows[i][0], near_rows[i][1], 0, 0],
+                        entry: [entry[i].x as f32, entry[i].y as f32, entry[i].z as f32, 0.0],
                     });
                 }
                 LevelTransport {

@@ -5,10 +5,12 @@
 //! (`walk`, expected-value splitting at the boundary). The flux `O_I` each leaves through patch
 //! `I`'s cells, weighted by the entry's basis function over its variance and averaged over the
 //! walks, is the least-squares coefficient of that basis: `W0_IJ = E[O_I]`,
-//! `Wmu_IJ = E[O_I (mu - mu_bar)] / Var mu` and `Wt_IJ = E[O_I (t . u_JI)] / E[(t . u)^2]` (the
-//! basis functions are orthogonal under the entry's distribution: the tilt is odd in the
-//! azimuth), `Wmu` and `Wt` only within `ENTRY_REACH` patch radii. Each patch has its own
-//! random stream, so the kernel does not depend on the threads.
+//! `Wmu_IJ = E[O_I (mu - mu_bar)] / Var mu`, `Wt_IJ = E[O_I (t . u_JI)] / E[(t . u)^2]` and
+//! `Wx_IJ = E[O_I s] / E[s^2]` with `s = (x - x_J) . u_JI` the entry point's offset towards `I`
+//! (the basis functions are orthogonal under the entry's distribution: the tilt is odd in the
+//! azimuth, and the point is drawn independently of the direction about its mean `x_J`; `E[s^2]`
+//! is the cells' exact second moment), `Wmu` and `Wt` only within `ENTRY_REACH` patch radii.
+//! Each patch has its own random stream, so the kernel does not depend on the threads.
 
 use super::geometry::Geometry;
 use super::tally::Exit;
@@ -17,7 +19,7 @@ use crate::mesh::Mesh;
 use crate::mesh::patches::Patches;
 use crate::optics::transport::{ENTRY_REACH, EntryBasis, TransportKernel};
 use crate::reference::rte::{Medium, chunk_rng};
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use rand::RngExt;
 use rand::SeedableRng as _;
 use rand_pcg::Pcg64;
@@ -44,39 +46,65 @@ pub fn transport_kernel(
     }
     let done = AtomicUsize::new(0);
     let entry = EntryBasis::new(media[0].eta);
+    let centres = patches.entry_centres(mesh);
     let columns: Vec<Column> = corners
         .par_iter()
         .enumerate()
         .map(|(j, list)| {
-            let at = Entering { patch: j, corners: list, entry };
+            let spread = second_moment(mesh, list, centres[j]);
+            let at = Entering { patch: j, corners: list, entry, centre: centres[j], spread };
             let col = column(&geometry, media, &patches, &at, walks, chunk_rng(seed, j as u64));
             progress(done.fetch_add(1, Ordering::Relaxed) + 1, k);
             col
         })
         .collect();
     let table = || [vec![0.0; k * k], vec![0.0; k * k], vec![0.0; k * k]];
-    let (mut flux, mut depth, mut sideways) = (table(), table(), table());
+    let mut rows = [table(), table(), table(), table()];
     for (j, col) in columns.iter().enumerate() {
-        for c in 0..3 {
-            for i in 0..k {
-                flux[c][i * k + j] = col[0][c][i];
-                depth[c][i * k + j] = col[1][c][i];
-                sideways[c][i * k + j] = col[2][c][i];
+        for (row, col) in rows.iter_mut().zip(col) {
+            for c in 0..3 {
+                (0..k).for_each(|i| row[c][i * k + j] = col[c][i]);
             }
         }
     }
-    TransportKernel { patches, flux, depth, sideways, mu_mean: entry.mu_mean(), walks }
+    let [flux, depth, sideways, shift] = rows;
+    TransportKernel { patches, flux, depth, sideways, shift, mu_mean: entry.mu_mean(), walks }
 }
 
-/// One patch's column of the kernel's three rows (`W0`, `Wmu`, `Wt`), per channel and patch.
-type Column = [[Vec<f64>; 3]; 3];
+/// One patch's column of the kernel's four rows (`W0`, `Wmu`, `Wt`, `Wx`), per channel and
+/// patch.
+type Column = [[Vec<f64>; 3]; 4];
 
 /// Where one patch's walks enter: the patch, its vertices' corners (triangle, corner, area of
-/// its cell there) and the entry's directions.
+/// its cell there), the entry's directions, the entry points' mean and their second moment
+/// about it (per unit area).
 struct Entering<'a> {
     patch: usize,
     corners: &'a [(usize, usize, f64)],
     entry: EntryBasis,
+    centre: DVec3,
+    spread: DMat3,
+}
+
+/// The second moment about `about` of a point drawn uniformly over the cells `corners`: each
+/// cell is two triangles of a sixth of its triangle (the corner, an edge's midpoint, the
+/// centroid), and a triangle of area `A` with corners `q_i` (from `about`) has
+/// `int q q^T dA = A / 12 (sum q_i q_i^T + s s^T)`, `s = sum q_i`.
+fn second_moment(mesh: &Mesh, corners: &[(usize, usize, f64)], about: DVec3) -> DMat3 {
+    let outer = |q: DVec3| DMat3::from_cols(q * q.x, q * q.y, q * q.z);
+    let triangle = |q: [DVec3; 3], area: f64| {
+        let s = q[0] + q[1] + q[2];
+        (outer(q[0]) + outer(q[1]) + outer(q[2]) + outer(s)) * (area / 12.0)
+    };
+    let (mut m, mut total) = (DMat3::ZERO, 0.0);
+    for &(t, c, third) in corners {
+        let p = mesh.triangles()[t].map(|v| mesh.positions()[v as usize].as_dvec3() - about);
+        let (a, b, e) = (p[c], p[(c + 1) % 3], p[(c + 2) % 3]);
+        let g = (a + b + e) / 3.0;
+        m += triangle([a, (a + b) * 0.5, g], third * 0.5) + triangle([a, g, (a + e) * 0.5], third * 0.5);
+        total += third;
+    }
+    if total > 0.0 { m * (1.0 / total) } else { m }
 }
 
 /// A patch's column of the kernel: per row of the basis and channel, the flux out of each patch
@@ -104,7 +132,9 @@ fn column(
         .collect();
     let total = cdf[cdf.len() - 1];
     let near: Vec<bool> = (0..k).map(|i| within_reach(patches, at.patch, i)).collect();
-    let toward: Vec<DVec3> = (0..k).map(|i| if near[i] { patches.toward(at.patch, i) } else { DVec3::ZERO }).collect();
+    let toward: Vec<DVec3> = (0..k).map(|i| patches.toward(at.patch, i)).collect();
+    // Each basis function over its variance; the offset's along `u_JI` is `u^T S u`.
+    let offset_var: Vec<f64> = toward.iter().map(|u| u.dot(at.spread * *u)).collect();
     let (mu_bar, mu_var, tilt_var) = (at.entry.mu_mean(), at.entry.mu_variance(), at.entry.tilt_variance());
     let mut exits: Vec<Exit> = Vec::new();
     for _ in 0..walks {
@@ -115,6 +145,7 @@ fn column(
         let inward = -geometry.shading_normal(t, bary);
         let (d, tilt) = entry_direction(inward, -geometry.normals[t], &at.entry, &mut rng);
         let depth = if mu_var > 0.0 { (d.dot(inward) - mu_bar) / mu_var } else { 0.0 };
+        let offset = p - at.centre;
         // The three channels walk on the same random numbers, so that their noise is alike
         // and a patch's scale errs in brightness rather than in hue.
         let shared = rng.random::<u64>();
@@ -127,8 +158,11 @@ fn column(
                 out[0][channel][i] += e.weight;
                 if near[i] {
                     out[1][channel][i] += e.weight * depth;
+                    out[2][channel][i] += e.weight * tilt.dot(toward[i]) / tilt_var;
                 }
-                out[2][channel][i] += e.weight * tilt.dot(toward[i]) / tilt_var;
+                if offset_var[i] > 0.0 {
+                    out[3][channel][i] += e.weight * offset.dot(toward[i]) / offset_var[i];
+                }
             }
         }
     }
