@@ -13,7 +13,7 @@
 //! `mu` the cosine of `d` with the inward normal, `t` its tangential part, `u_JI` the unit
 //! direction in `J`'s tangent plane towards `I` (`Patches::toward`) and `mu_bar` the mean cosine
 //! of the walks' entries ([`EntryBasis`]); `Wmu` and `Wt` are 0 between patches more than
-//! [`ENTRY_REACH`] patch radii apart ([`TransportKernel::near`] lists those within). The last
+//! [`entry_reach`] apart ([`TransportKernel::near`] lists those within). The last
 //! term carries where in `J` the light enters, `x` against the entries' mean `x_J`
 //! (`Patches::entry_centres`): at a terminator the light enters on a patch's lit side, and a
 //! kernel of uniform entry moved it towards the unlit side, 8 to 13% too bright there on a
@@ -49,14 +49,24 @@ use crate::mesh::Mesh;
 use crate::mesh::patches::Patches;
 use glam::DVec3;
 
-/// How far the entry's rows reach, in patch radii (`Patches::radius`): `Wmu_IJ` and `Wt_IJ`
-/// are walked only between patches whose centres are closer, and are 0 beyond. Farther, the
-/// entry's depth and tilt move little light while their rows' estimates are the noisiest (their
-/// weights are the basis functions over their variances). On the 2 cm marble sphere, against
-/// the photon reference at 24 and 48 divisions, this reach took the terminator's bias from -10%
-/// to -3 to -5%, where unbounded rows added 3 to 7 points of noise and bias on the unlit side
-/// (docs/PHYSICS.md, "The transport kernel").
+/// How far the entry's rows reach, in patch radii (`Patches::radius`), at least
+/// ([`entry_reach`]): `Wmu_IJ` and `Wt_IJ` are walked only between patches whose centres are
+/// closer, and are 0 beyond. Farther, the entry's depth and tilt move little light while their
+/// rows' estimates are the noisiest (their weights are the basis functions over their
+/// variances). On the 2 cm marble sphere, against the photon reference at 24 and 48 divisions,
+/// this reach took the terminator's bias from -10% to -3 to -5%, where unbounded rows added 3 to
+/// 7 points of noise and bias on the unlit side (docs/PHYSICS.md, "The transport kernel").
 pub const ENTRY_REACH: f64 = 3.0;
+
+/// How far the entry's rows reach in a channel of diffusion length `diffusion_length`, between
+/// patches of radius `radius`: [`ENTRY_REACH`] radii, or one diffusion length where that is
+/// farther. Grazing light's tilt carries about a diffusion length: on the 2 cm skim milk sphere
+/// (18.4, 10.4, 3.5 mm) three radii (5 mm) left red and green 6 and 4% too dark, 10.1, 7.53% per
+/// vertex; a diffusion length took them to 5.45, 6.32%, and the marble sphere moved within 0.2
+/// points (docs/PHYSICS.md).
+pub fn entry_reach(radius: f64, diffusion_length: f64) -> f64 {
+    (ENTRY_REACH * radius).max(diffusion_length)
+}
 
 /// The largest exponent [`offset_factor`] takes, either way: a factor of `e^2`. On the marble
 /// sphere the exponents stay under 1 (limits of 1, 2 and 4 gave the same figures); the limit
@@ -269,7 +279,7 @@ impl TransportKernel {
     }
 
     /// Per patch `I`, the patches `J` whose `Wmu_IJ` or `Wt_IJ` is not 0 in some channel (those
-    /// within [`ENTRY_REACH`]), ascending.
+    /// within a channel's [`entry_reach`]), ascending.
     pub fn near(&self) -> Vec<Vec<u32>> {
         let k = self.patches.len();
         let nonzero = |at: usize| (0..3).any(|c| self.depth[c][at] != 0.0 || self.sideways[c][at] != 0.0);

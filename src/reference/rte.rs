@@ -69,6 +69,13 @@ impl Medium {
         self.sigma_a + self.sigma_s
     }
 
+    /// Diffusion length `1 / sigma_tr`, `sigma_tr = sqrt(3 sigma_a sigma_t')` with the reduced
+    /// extinction `sigma_t' = sigma_a + sigma_s (1 - g)`: how far diffuse light runs before it
+    /// falls by `e` (infinite without absorption).
+    pub fn diffusion_length(&self) -> f64 {
+        1.0 / (3.0 * self.sigma_a * (self.sigma_a + self.sigma_s * (1.0 - self.g))).sqrt()
+    }
+
     /// Single-scattering albedo `sigma_s / sigma_t`.
     pub fn albedo(&self) -> f64 {
         self.sigma_s / self.sigma_t()

@@ -19,8 +19,8 @@ use std::path::Path;
 /// direction's basis, `optics::transport::EntryBasis`, within `ENTRY_REACH`; 5: the channels
 /// walk on common random numbers; 6: the walk's wall time is kept, [`CachedKernel::walk_seconds`];
 /// 7: `W0` averaged with its reciprocal estimate, `TransportKernel::reciprocal`; 8: the entry
-/// point's offset row `Wx`).
-pub const VERSION: u32 = 8;
+/// point's offset row `Wx`; 9: the entry's rows reach a diffusion length, `entry_reach`).
+pub const VERSION: u32 = 9;
 
 /// One object's kernel, as cached.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

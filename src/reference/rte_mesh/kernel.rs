@@ -9,7 +9,7 @@
 //! `Wx_IJ = E[O_I s] / E[s^2]` with `s = (x - x_J) . u_JI` the entry point's offset towards `I`
 //! (the basis functions are orthogonal under the entry's distribution: the tilt is odd in the
 //! azimuth, and the point is drawn independently of the direction about its mean `x_J`; `E[s^2]`
-//! is the cells' exact second moment), `Wmu` and `Wt` only within `ENTRY_REACH` patch radii.
+//! is the cells' exact second moment), `Wmu` and `Wt` only within each channel's `entry_reach`.
 //! Each patch has its own random stream, so the kernel does not depend on the threads.
 
 use super::geometry::Geometry;
@@ -17,7 +17,7 @@ use super::tally::Exit;
 use super::walk::{Start, walk};
 use crate::mesh::Mesh;
 use crate::mesh::patches::Patches;
-use crate::optics::transport::{ENTRY_REACH, EntryBasis, TransportKernel};
+use crate::optics::transport::{EntryBasis, TransportKernel, entry_reach};
 use crate::reference::rte::{Medium, chunk_rng};
 use glam::{DMat3, DVec3};
 use rand::RngExt;
@@ -131,7 +131,13 @@ fn column(
         })
         .collect();
     let total = cdf[cdf.len() - 1];
-    let near: Vec<bool> = (0..k).map(|i| within_reach(patches, at.patch, i)).collect();
+    let near: Vec<Vec<bool>> = media
+        .iter()
+        .map(|m| {
+            let reach = entry_reach(patches.radius, m.diffusion_length());
+            (0..k).map(|i| patches.centre(at.patch).distance(patches.centre(i)) <= reach).collect()
+        })
+        .collect();
     let toward: Vec<DVec3> = (0..k).map(|i| patches.toward(at.patch, i)).collect();
     // Each basis function over its variance; the offset's along `u_JI` is `u^T S u`.
     let offset_var: Vec<f64> = toward.iter().map(|u| u.dot(at.spread * *u)).collect();
@@ -156,7 +162,7 @@ fn column(
             for e in &exits {
                 let i = patches.of_vertex[e.vertex] as usize;
                 out[0][channel][i] += e.weight;
-                if near[i] {
+                if near[channel][i] {
                     out[1][channel][i] += e.weight * depth;
                     out[2][channel][i] += e.weight * tilt.dot(toward[i]) / tilt_var;
                 }
@@ -169,12 +175,6 @@ fn column(
     let n = walks as f64;
     out.iter_mut().flatten().for_each(|col| col.iter_mut().for_each(|w| *w /= n));
     out
-}
-
-/// Whether patches `j` and `i` are within `ENTRY_REACH` patch radii: the entry's depth and
-/// tilt rows are walked only there.
-fn within_reach(patches: &Patches, j: usize, i: usize) -> bool {
-    patches.centre(j).distance_squared(patches.centre(i)) <= (ENTRY_REACH * patches.radius).powi(2)
 }
 
 /// An entry direction about the inward shading normal `inward` drawn from `entry`, and its
