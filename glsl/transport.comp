@@ -9,8 +9,9 @@
 //     Phi_J = sum_(samples s in J) A_s E_t(s), Phimu_J, T_J and X_J alike weighted by the
 //     sample's mu_s - mu_bar, t_s (SampleFlux::from_splat) and x_s - x_J (x_J the entries'
 //     mean, Patches::entry_centres), u_JI the unit direction in J's tangent plane towards I's
-//     centre (Patches::toward); Wmu and Wt are 0 beyond ENTRY_REACH patch radii, so each patch
-//     lists the J within it (TransportKernel::near)
+//     centre (Patches::toward); Wmu and Wt are 0 beyond each channel's reach
+//     (optics::transport::entry_reach), so each patch lists the J within it
+//     (TransportKernel::near)
 //     D_I = sum_(level's vertices v in I) a_v M_d(v) / sum a_v   (a_v: the level's dual cells)
 //     M(v) = M_d(v) sum_I w_vI F_I / sum_I w_vI D_I   (its eight nearest patches)
 // Each level of detail has its own patch records (its vertices, its D), sharing the object's W.
@@ -137,10 +138,11 @@ void patch_sums(uint p) {
     }
 }
 
-// The unit direction in patch `from`'s tangent plane towards `to`'s centre (Patches::toward).
-vec3 toward(TransportPatchRecord from, vec3 to) {
-    vec3 d = to - from.centre.xyz;
-    vec3 u = d - from.normal.xyz * dot(d, from.normal.xyz);
+// The unit direction in patch `j`'s tangent plane towards `to` (Patches::toward), its record read
+// only for its centre and normal (llvmpipe loads a whole record passed by value).
+vec3 toward(uint j, vec3 to) {
+    vec3 n = patches[j].normal.xyz, d = to - patches[j].centre.xyz;
+    vec3 u = d - n * dot(d, n);
     float l2 = dot(u, u);
     return l2 > 0.0 ? u * inversesqrt(l2) : vec3(0.0);
 }
@@ -163,11 +165,7 @@ void patch_transport(uint p) {
     vec3 f = vec3(0.0);
     for (uint j = 0u; j < k; ++j) {
         uint q = SUMS * (first + j);
-        // Only the two vectors `toward` needs: llvmpipe loads a whole record otherwise.
-        vec3 n = patches[first + j].normal.xyz, d = r.centre.xyz - patches[first + j].centre.xyz;
-        vec3 u = d - n * dot(d, n);
-        float l2 = dot(u, u);
-        u = l2 > 0.0 ? u * inversesqrt(l2) : vec3(0.0);
+        vec3 u = toward(first + j, r.centre.xyz);
         vec3 xu = vec3(dot(sums[q + 7u].xyz, u), dot(sums[q + 8u].xyz, u), dot(sums[q + 9u].xyz, u));
         vec3 w0 = matrix[r.items.w + j].rgb, phi = sums[q].rgb;
         f += w0 * phi * offset_factor(w0, matrix[r.items.w + k * k + j].rgb, xu, phi);
@@ -175,7 +173,7 @@ void patch_transport(uint p) {
     for (uint k = 0u; k < r.near.y; ++k) {
         vec4 mu = matrix[r.near.x + 2u * k], tilt = matrix[r.near.x + 2u * k + 1u];
         uint j = uint(mu.w), q = SUMS * (first + j);
-        vec3 u = toward(patches[first + j], r.centre.xyz);
+        vec3 u = toward(first + j, r.centre.xyz);
         vec3 tu = vec3(dot(sums[q + 4u].xyz, u), dot(sums[q + 5u].xyz, u), dot(sums[q + 6u].xyz, u));
         f += mu.rgb * sums[q + 3u].rgb + tilt.rgb * tu;
     }
