@@ -126,20 +126,30 @@ fn the_channels_share_their_walks_so_a_patchs_noise_is_alike_in_every_channel() 
     assert!(correlation > 0.5, "red and green per patch correlate {correlation:.3}");
 }
 
+/// The 2 cm marble sphere (12 divisions) and its kernel of 24 patches and 2,000 walks each,
+/// walked once for the tests that read its rows.
+fn marble_kernel_of_24_patches() -> &'static (PreparedScene, TransportKernel) {
+    static KERNEL: std::sync::OnceLock<(PreparedScene, TransportKernel)> = std::sync::OnceLock::new();
+    KERNEL.get_or_init(|| {
+        let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
+        let settings = KernelSettings { patches: 24, walks: 24 * 2000, seed: 4 };
+        let kernel = object_kernel(&scene.objects[0], &settings, &quiet).unwrap();
+        (scene, kernel)
+    })
+}
+
 #[test]
 fn tilting_the_entry_towards_a_nearby_patch_sends_it_more_light_and_the_entry_rows_end_at_their_reach() {
     // The 2 cm marble sphere: light entering patch J tilted towards a neighbour I runs towards
     // it under the surface, so Wt_IJ, summed over J's neighbours within the reach, is positive
     // in every channel; beyond each channel's reach the row is not walked.
     use translucent::optics::transport::entry_reach;
-    let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
-    let kernel =
-        object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 24 * 2000, seed: 4 }, &quiet).unwrap();
+    let (scene, kernel) = marble_kernel_of_24_patches();
     let (k, p) = (kernel.patches.len(), &kernel.patches);
     let distance = |i: usize, j: usize| p.centre(i).distance(p.centre(j));
     let ResolvedMaterial::Translucent { dipoles, .. } = &scene.objects[0].material else { panic!("translucent") };
     for (c, dipole) in dipoles.iter().enumerate() {
-        let reach = entry_reach(p.radius, Medium::reduced(dipole).diffusion_length());
+        let reach = entry_reach(p.radius, dipole.diffusion_length());
         let (mut near, mut out_of_reach) = (0.0, 0usize);
         for i in 0..k {
             for j in (0..k).filter(|&j| j != i) {
@@ -167,9 +177,7 @@ fn light_entering_a_patch_on_its_side_towards_a_far_patch_sends_it_more_and_a_un
     // nothing to what W0 says.
     use translucent::mesh::patches::cell_centroids;
     use translucent::optics::transport::ENTRY_REACH;
-    let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
-    let kernel =
-        object_kernel(&scene.objects[0], &KernelSettings { patches: 24, walks: 24 * 2000, seed: 4 }, &quiet).unwrap();
+    let (scene, kernel) = marble_kernel_of_24_patches();
     let (k, p) = (kernel.patches.len(), &kernel.patches);
     for c in 0..3 {
         let (mut shift, mut flux) = (0.0, 0.0);
