@@ -17,7 +17,8 @@
 // Each level of detail has its own patch records (its vertices, its D), sharing the object's W.
 // Three stages (push `stage.x`), each one dispatch per object, a barrier between them:
 //   0: one invocation per patch: Phi, Phimu, T, X and D, summed over its items;
-//   1: one invocation per patch: F, its rows of W against every patch's fluxes;
+//   1: one invocation per patch: F, its rows of W against every patch's fluxes (kept where
+//      it was made under this frame's splat generation);
 //   2: one invocation per vertex: the scale, in the channels push.stage.w names (the others
 //      take single scattering between points, which the pass before wrote), where the blended
 //      D is positive and the scaled value finite (else the dipole's value stays).
@@ -30,7 +31,7 @@
 // written by stage 2), 2 = patches (TransportPatchRecord[]), 3 = items (uvec2: index, area
 // bits), 4 = the kernels' rows (W0: a vec4 per pair, rgb; Wx alike after them; then per patch
 // its near list, two vec4 per J: Wmu rgb with J in w, exact as a float; Wt rgb), 5 = sums
-// (SUMS vec4 per patch: Phi, D, F, Phimu, T_r, T_g, T_b, X_r, X_g, X_b; written by stages 0
+// (SUMS vec4 per patch: Phi, D, F (w: its generation's bits), Phimu, T_r, T_g, T_b, X_r, X_g, X_b; written by stages 0
 // and 1), 6 = neighbours (four
 // uvec4 per vertex: (patch relative to the level's first record, weight bits) pairs), 7 = level
 // vertices (uint[], object-relative), 8 = samples (SampleRecord[]: the normals), 9 = receiver
@@ -158,8 +159,13 @@ vec3 offset_factor(vec3 w0, vec3 wx, vec3 x_u, vec3 phi) {
     return s;
 }
 
-// Stage 1: patch `p`'s F from its rows of the kernel.
+// Stage 1: patch `p`'s F from its rows of the kernel, w the splat generation it was made under.
+// F depends on the splat alone (its Phi, Phimu, T and X): a visible-first frame that keeps the
+// generation (a camera frame's newly seen receivers, a sweep's chunk) keeps F, and only stage 0's
+// D and stage 2 run. Every-receiver frames (generation 0, which no visible-first frame has)
+// always make it.
 void patch_transport(uint p) {
+    if (push.frame.y == 0u && floatBitsToUint(sums[SUMS * p + 2u].w) == push.frame.x) return;
     TransportPatchRecord r = patches[p];
     uint first = push.stage.y, k = push.stage.z;
     vec3 f = vec3(0.0);
@@ -178,7 +184,7 @@ void patch_transport(uint p) {
         f += mu.rgb * sums[q + 3u].rgb + tilt.rgb * tu;
     }
     // Linear in the entry: never below zero (TransportKernel::transport_exitance).
-    sums[SUMS * p + 2u] = vec4(max(f / r.area.x, vec3(0.0)), 0.0);
+    sums[SUMS * p + 2u] = vec4(max(f / r.area.x, vec3(0.0)), uintBitsToFloat(push.frame.x));
 }
 
 // Stage 2: vertex `i` of the level scaled by its neighbours' blend.

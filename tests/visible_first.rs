@@ -93,7 +93,7 @@ fn marked(renderer: &Renderer) -> (Vec<u32>, Vec<u32>) {
 #[test]
 fn with_a_transport_kernel_every_image_and_readback_visible_first_equals_a_gather_of_every_receiver() {
     // A small kernel: what is tested is which vertices are gathered and scaled, not its noise.
-    let settings = KernelSettings { patches: 128, walks: 128 * 20, seed: 3 };
+    let settings = KernelSettings { patches: 128, walks: 128 * 20, seed: 3, more_on_small_meshes: false };
     let kernel = Arc::new(object_kernel(&prepared(ReceiverPolicy::Every).objects[0], &settings, &|_, _| {}).unwrap());
     with_gpu(|gpu| {
         let with_kernel = |policy| {

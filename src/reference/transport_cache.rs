@@ -91,7 +91,7 @@ pub fn content_key(o: &PreparedObject, settings: &KernelSettings) -> String {
     let mut h = Fnv::new();
     h.u64(u64::from(VERSION));
     h.u64(settings.patches_for(o.mesh.positions().len()) as u64);
-    h.u64(settings.walks);
+    h.u64(settings.walks_for(o.mesh.positions().len()));
     h.u64(settings.seed);
     o.mesh.positions().iter().for_each(|p| p.to_array().iter().for_each(|c| h.u64(u64::from(c.to_bits()))));
     o.mesh.vertex_normals().iter().for_each(|p| p.to_array().iter().for_each(|c| h.u64(u64::from(c.to_bits()))));
@@ -173,6 +173,18 @@ pub fn model_exitance(
     dir: &Path,
     progress: &(dyn Fn(usize, usize, usize) + Sync),
 ) -> Result<Vec<Vec<[f64; 3]>>, RteCacheError> {
+    model_exitance_with(base, truth, &KernelSettings::default(), dir, progress)
+}
+
+/// [`model_exitance`] with kernels of other `settings` (more walks, other patches, another
+/// seed): how the model converges in the kernel's own walks.
+pub fn model_exitance_with(
+    base: &PreparedScene,
+    truth: &[Vec<[f64; 3]>],
+    settings: &KernelSettings,
+    dir: &Path,
+    progress: &(dyn Fn(usize, usize, usize) + Sync),
+) -> Result<Vec<Vec<[f64; 3]>>, RteCacheError> {
     use super::{occluders, ray_offset, transmitted_entry};
     use crate::optics::transport::SampleFlux;
     let casters = occluders(base);
@@ -184,7 +196,7 @@ pub fn model_exitance(
             out.push(truth.clone());
             continue;
         };
-        let (k, _) = cached(o, &KernelSettings::default(), dir, &|done, of| progress(index, done, of))?;
+        let (k, _) = cached(o, settings, dir, &|done, of| progress(index, done, of))?;
         let (positions, normals) = (o.mesh.positions(), o.mesh.vertex_normals());
         let eps = ray_offset(base);
         // Each vertex stands for its cell, which the kernel's walks enter uniformly.

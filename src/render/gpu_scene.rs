@@ -469,7 +469,8 @@ impl GpuScene {
                 transport_patches: upload(gpu, "transport patches", &t.patches, none)?,
                 transport_items: upload(gpu, "transport items", &t.items, none)?,
                 transport_matrix: upload(gpu, "transport matrix", &t.matrix, none)?,
-                transport_sums: sized("transport sums", 16 * 10, t.patches.len().max(1))?,
+                // Generation 0 in every F: none made under a visible-first frame's splat.
+                transport_sums: upload(gpu, "transport sums", &vec![[0f32; 4]; 10 * t.patches.len().max(1)], none)?,
                 transport_neighbours: upload(gpu, "transport neighbours", &t.neighbours, none)?,
                 // Generation 0 everywhere: no patch needed, no dipole value current.
                 transport_needed: upload(gpu, "transport needed", &vec![0u32; t.patches.len()], none)?,

@@ -6,7 +6,9 @@
 //! transmitted flux and dipole exitance, stage 1 applies the kernel, stage 2 scales each vertex.
 //!
 //! Gathered visible-first, a frame scales only the vertices `receiver_view` marked, from the
-//! dipole values stage 0 keeps per vertex (`Resource::TransportDipole`).
+//! dipole values stage 0 keeps per vertex (`Resource::TransportDipole`), and a frame that keeps
+//! the splat's generation (a camera frame, a sweep's chunk) keeps each patch's `F`: stage 1
+//! finds it stamped with the generation and returns.
 //!
 //! Bindings: `BINDINGS`, in binding order. Push: `TransportPush`.
 
