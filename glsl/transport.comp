@@ -13,15 +13,15 @@
 //     (optics::transport::entry_reach), so each patch lists the J within it
 //     (TransportKernel::near)
 //     D_I = sum_(level's vertices v in I) a_v M_d(v) / sum a_v   (a_v: the level's dual cells)
-//     M(v) = M_d(v) sum_I w_vI F_I / sum_I w_vI D_I   (its eight nearest patches)
+//     M(v) = M_d(v) sum_I w_vI (F_I / D_I) / sum_I w_vI   (its eight nearest patches, D_I > 0)
 // Each level of detail has its own patch records (its vertices, its D), sharing the object's W.
 // Three stages (push `stage.x`), each one dispatch per object, a barrier between them:
 //   0: one invocation per patch: Phi, Phimu, T, X and D, summed over its items;
 //   1: one invocation per patch: F, its rows of W against every patch's fluxes (kept where
 //      it was made under this frame's splat generation);
 //   2: one invocation per vertex: the scale, in the channels push.stage.w names (the others
-//      take single scattering between points, which the pass before wrote), where the blended
-//      D is positive and the scaled value finite (else the dipole's value stays).
+//      take single scattering between points, which the pass before wrote), where some
+//      neighbour's D is positive and the scaled value finite (else the dipole's value stays).
 // Gathered visible-first (glsl/receiver_view.comp), a frame gathers (state GATHER) and scales
 // (FINISH) only some vertices, and D needs every vertex of a patch: so stage 0 keeps each
 // vertex's dipole value, as the gather left it, in `dipole` (w: the generation, push.frame.x),
@@ -187,6 +187,20 @@ void patch_transport(uint p) {
     sums[SUMS * p + 2u] = vec4(max(f / r.area.x, vec3(0.0)), uintBitsToFloat(push.frame.x));
 }
 
+// One neighbour (patch relative to the level's first record, weight bits) into the blend of
+// the ratios F / D, in the channels where its D is positive.
+void add_ratio(uvec2 pair, uint first, inout vec3 ratio, inout vec3 weight) {
+    float w = uintBitsToFloat(pair.y);
+    uint q = SUMS * (first + pair.x);
+    vec3 f = sums[q + 2u].rgb, d = sums[q + 1u].rgb;
+    for (int c = 0; c < 3; ++c) {
+        if (d[c] > 0.0) {
+            ratio[c] += w * (f[c] / d[c]);
+            weight[c] += w;
+        }
+    }
+}
+
 // Stage 2: vertex `i` of the level scaled by its neighbours' blend.
 void scale_vertex(uint i) {
     uint rel = level_vertices[push.vertices.w + i];
@@ -195,20 +209,18 @@ void scale_vertex(uint i) {
     // generation's).
     if (push.frame.y == 0u && (receiver_state[v].y & FINISH) == 0u) return;
     uint first = push.stage.y;
-    vec3 f = vec3(0.0), d = vec3(0.0);
+    vec3 ratio = vec3(0.0), weight = vec3(0.0);
     for (uint k = 0u; k < 4u; ++k) {
-        uvec4 pair = neighbours[push.vertices.z + 4u * rel + k];
-        float w0 = uintBitsToFloat(pair.y), w1 = uintBitsToFloat(pair.w);
-        uint p0 = SUMS * (first + pair.x), p1 = SUMS * (first + pair.z);
-        f += w0 * sums[p0 + 2u].rgb + w1 * sums[p1 + 2u].rgb;
-        d += w0 * sums[p0 + 1u].rgb + w1 * sums[p1 + 1u].rgb;
+        uvec4 pairs = neighbours[push.vertices.z + 4u * rel + k];
+        add_ratio(pairs.xy, first, ratio, weight);
+        add_ratio(pairs.zw, first, ratio, weight);
     }
     vec4 m = vec4(dipole[v].rgb, exitance[v].w);
     for (int c = 0; c < 3; ++c) {
-        // An overflowed dipole exitance times a zero ratio would be NaN: keep the dipole's.
-        float s = m[c] * (f[c] / d[c]);
+        // An overflowed dipole exitance or ratio would be Inf or NaN: keep the dipole's.
+        float s = m[c] * (ratio[c] / weight[c]);
         bool scaled = (push.stage.w & (1u << uint(c))) != 0u;
-        if (scaled && d[c] > 0.0 && !isinf(s) && !isnan(s)) m[c] = s;
+        if (scaled && weight[c] > 0.0 && !isinf(s) && !isnan(s)) m[c] = s;
     }
     exitance[v] = m;
 }

@@ -37,13 +37,14 @@
 //!   kernel's exitance averaged over `I` (the basis is linear in the entry, and may extrapolate
 //!   below zero);
 //! - `D_I = sum_(v in I) A_v M_d(v) / A_I`, the dipole's, alike (`A_v` the vertex's dual cell);
-//! - `M(v) = M_d(v) sum_I w_vI F_I / sum_I w_vI D_I` over the vertex's nearest patches with
-//!   the weights of `Patches::neighbours`.
+//! - `M(v) = M_d(v) sum_I w_vI (F_I / D_I) / sum_I w_vI` over the vertex's nearest patches
+//!   with `D_I > 0`, with the weights of `Patches::neighbours`.
 //!
 //! The dipole keeps the detail under a patch (it follows the irradiance at every sample), the
-//! kernel sets each patch's level. Blending the two fluxes before dividing (rather than
-//! blending the patches' ratios) keeps a dark patch's large ratio from brightening its lit
-//! neighbours. The f32 twin is `glsl/transport.comp`.
+//! kernel sets each patch's level. The patches' ratios are blended, not their fluxes: a blend of
+//! fluxes leans on the brightest patch, and at a terminator that is the lit one, whose ratio is
+//! the lowest (docs/PHYSICS.md, "Blending the patches' ratios"). The f32 twin is
+//! `glsl/transport.comp`.
 
 use crate::mesh::Mesh;
 use crate::mesh::patches::Patches;
@@ -306,18 +307,21 @@ impl TransportKernel {
         d
     }
 
-    /// `M(v)`: the dipole's `m` at a point with patch neighbours `near` scaled by the ratio of
-    /// the blended `F` and `D`; `m` itself where the dipole's blend is not positive or the
-    /// scaled value is not finite (an overflowed `m` or `D` stays the dipole's, never NaN).
+    /// `M(v)`: the dipole's `m` at a point with patch neighbours `near` scaled by the blend of
+    /// their ratios `F / D` over those with `D > 0`; `m` itself where none has, or where the
+    /// scaled value is not finite (an overflowed `m` or ratio stays the dipole's, never NaN).
     pub fn scaled(m: [f64; 3], near: &[(u32, f64)], f: &[[f64; 3]], d: &[[f64; 3]]) -> [f64; 3] {
         [0, 1, 2].map(|c| {
-            let (mut sf, mut sd) = (0.0, 0.0);
+            let (mut ratio, mut weight) = (0.0, 0.0);
             for &(i, w) in near {
-                sf += w * f[i as usize][c];
-                sd += w * d[i as usize][c];
+                let (f, d) = (f[i as usize][c], d[i as usize][c]);
+                if d > 0.0 {
+                    ratio += w * (f / d);
+                    weight += w;
+                }
             }
-            let scaled = m[c] * (sf / sd);
-            if sd > 0.0 && scaled.is_finite() { scaled } else { m[c] }
+            let scaled = m[c] * (ratio / weight);
+            if weight > 0.0 && scaled.is_finite() { scaled } else { m[c] }
         })
     }
 
@@ -379,7 +383,23 @@ impl TransportKernel {
 
 #[cfg(test)]
 mod tests {
-    use super::{EntryBasis, OFFSET_EXPONENT_LIMIT, offset_factor};
+    use super::{EntryBasis, OFFSET_EXPONENT_LIMIT, TransportKernel, offset_factor};
+
+    #[test]
+    fn a_vertex_blends_its_patches_ratios_so_a_lit_patch_does_not_set_a_terminators_scale() {
+        // A lit patch (ratio 1.1) and a dark one (ratio 2) weighed alike: the scale is their mean,
+        // where a blend of fluxes would give 13 / 11, the lit patch's nearly.
+        let (f, d) = ([[11.0; 3], [2.0; 3]], [[10.0; 3], [1.0; 3]]);
+        let near = [(0u32, 1.0), (1, 1.0)];
+        assert!(TransportKernel::scaled([1.0; 3], &near, &f, &d).iter().all(|m| (m - 1.55).abs() < 1e-12));
+        // A patch the dipole leaves dark has no ratio; with none the dipole's value stays.
+        let dark = [[0.0; 3], [1.0; 3]];
+        assert!(TransportKernel::scaled([1.0; 3], &near, &f, &dark).iter().all(|m| (m - 2.0).abs() < 1e-12));
+        assert_eq!(TransportKernel::scaled([3.0; 3], &near, &f, &[[0.0; 3]; 2]), [3.0; 3]);
+        // An overflowed ratio leaves the dipole's value, never Inf.
+        let tiny = [[1e-310; 3], [1.0; 3]];
+        assert_eq!(TransportKernel::scaled([3.0; 3], &near, &[[1e10; 3], [1.0; 3]], &tiny), [3.0; 3]);
+    }
 
     #[test]
     fn the_offset_factor_is_the_rows_exponential_and_one_where_no_light_or_no_pair() {
