@@ -31,10 +31,10 @@
 // written by stage 2), 2 = patches (TransportPatchRecord[]), 3 = items (uvec2: index, area
 // bits), 4 = the kernels' rows (W0: a vec4 per pair, rgb; Wx alike after them; then per patch
 // its near list, two vec4 per J: Wmu rgb with J in w, exact as a float; Wt rgb), 5 = sums
-// (SUMS vec4 per patch: Phi, D, F (w: its generation's bits), Phimu, T_r, T_g, T_b, X_r, X_g, X_b; written by stages 0
-// and 1), 6 = neighbours (four
-// uvec4 per vertex: (patch relative to the level's first record, weight bits) pairs), 7 = level
-// vertices (uint[], object-relative), 8 = samples (SampleRecord[]: the normals), 9 = receiver
+// (SUMS vec4 per patch: Phi, D, F (w: its generation's bits), Phimu, T_r, T_g, T_b, X_r, X_g,
+// X_b; written by stages 0 and 1), 6 = neighbours (four uvec4 per vertex: (patch relative to
+// the level's first record, weight bits) pairs), 7 = level vertices (uint[], object-relative),
+// 8 = samples (SampleRecord[]: the normals), 9 = receiver
 // state (uvec2 per vertex: generation, GATHER | FINISH), 10 = transport dipole (vec4 per vertex:
 // the dipole's exitance, w the generation's bits). Push: TransportPush.
 #include "scene.glsl"
