@@ -338,7 +338,7 @@ impl KernelSettings {
 pub const LARGE_MESH: usize = 30_000;
 
 /// The most times [`KernelSettings::walks`] a small mesh takes.
-pub const SMALL_MESH_WALKS: f64 = 3.0;
+pub const SMALL_MESH_WALKS: f64 = 5.0;
 
 /// The fewest vertices per patch: a patch's dipole exitance is averaged over its vertices.
 pub const VERTICES_PER_PATCH: usize = 8;
