@@ -50,6 +50,12 @@ count = 1500
 
 fn quiet(_: usize, _: usize) {}
 
+/// Kernel settings of exactly `walks` walks per channel, whatever the mesh's size (the tests'
+/// figures were set for these counts, not for `KernelSettings::walks_for`'s small-mesh rule).
+fn fixed(patches: usize, walks: u64, seed: u64) -> KernelSettings {
+    KernelSettings { patches, walks, seed, more_on_small_meshes: false }
+}
+
 /// The half-space's albedo for light entering as the kernel's walks do at eta 1 (`sin^2` of
 /// the entry uniform: `mu^2` uniform), `2 int R(mu) mu dmu`, by four-point Gauss-Legendre in
 /// `mu^2` over `rte::half_space_reflectance` at each node.
@@ -75,7 +81,7 @@ fn a_kernel_on_a_sphere_far_wider_than_its_diffusion_length_reflects_what_the_ha
     let scene =
         sphere(100.0, 24, "sigma_a = [1.0, 2.0, 0.5], sigma_s_prime = [10.0, 10.0, 10.0], eta = 1.0", "transport");
     let o = &scene.objects[0];
-    let settings = KernelSettings { patches: 16, walks: 16 * 8000, seed: 3, more_on_small_meshes: false };
+    let settings = fixed(16, 16 * 8000, 3);
     let kernel = object_kernel(o, &settings, &quiet).unwrap();
     let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else { unreachable!() };
     let k = kernel.patches.len();
@@ -97,12 +103,7 @@ fn a_kernel_brightens_a_marble_sphere_the_dipole_leaves_too_dark_and_keeps_energ
     // each patch sends out more than the dipole's R_d,total, and never more than came in.
     let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
     let o = &scene.objects[0];
-    let kernel = object_kernel(
-        o,
-        &KernelSettings { patches: 24, walks: 16 * 400, seed: 1, more_on_small_meshes: false },
-        &quiet,
-    )
-    .unwrap();
+    let kernel = object_kernel(o, &fixed(24, 16 * 400, 1), &quiet).unwrap();
     let ResolvedMaterial::Translucent { dipoles, .. } = &o.material else { unreachable!() };
     let k = kernel.patches.len();
     for (c, dipole) in dipoles.iter().enumerate() {
@@ -118,12 +119,7 @@ fn a_kernel_brightens_a_marble_sphere_the_dipole_leaves_too_dark_and_keeps_energ
 #[test]
 fn the_channels_share_their_walks_so_a_patchs_noise_is_alike_in_every_channel() {
     let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
-    let kernel = object_kernel(
-        &scene.objects[0],
-        &KernelSettings { patches: 24, walks: 24 * 200, seed: 7, more_on_small_meshes: false },
-        &quiet,
-    )
-    .unwrap();
+    let kernel = object_kernel(&scene.objects[0], &fixed(24, 24 * 200, 7), &quiet).unwrap();
     let k = kernel.patches.len();
     let sent = |c: usize| (0..k).map(|j| (0..k).map(|i| kernel.flux[c][i * k + j]).sum::<f64>()).collect::<Vec<_>>();
     let (r, g) = (sent(0), sent(1));
@@ -141,7 +137,7 @@ fn marble_kernel_of_24_patches() -> &'static (PreparedScene, TransportKernel) {
     static KERNEL: std::sync::OnceLock<(PreparedScene, TransportKernel)> = std::sync::OnceLock::new();
     KERNEL.get_or_init(|| {
         let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
-        let settings = KernelSettings { patches: 24, walks: 24 * 2000, seed: 4, more_on_small_meshes: false };
+        let settings = fixed(24, 24 * 2000, 4);
         let kernel = object_kernel(&scene.objects[0], &settings, &quiet).unwrap();
         (scene, kernel)
     })
@@ -223,12 +219,7 @@ fn in_skim_milk_the_entry_rows_reach_a_diffusion_length_farther_in_red_than_in_b
     // Skim milk's red runs 18.4 mm, its blue 3.5 mm: on a 2 cm sphere of 24 patches (radius
     // about 4 mm) red's rows reach past three radii, blue's stop there.
     let scene = sphere(10.0, 12, "preset = \"skimmilk\"", "transport");
-    let kernel = object_kernel(
-        &scene.objects[0],
-        &KernelSettings { patches: 24, walks: 24 * 200, seed: 4, more_on_small_meshes: false },
-        &quiet,
-    )
-    .unwrap();
+    let kernel = object_kernel(&scene.objects[0], &fixed(24, 24 * 200, 4), &quiet).unwrap();
     let k = kernel.patches.len();
     let pairs = |c: usize| (0..k * k).filter(|&at| kernel.depth[c][at] != 0.0).count();
     let (red, blue) = (pairs(0), pairs(2));
@@ -242,12 +233,7 @@ fn the_kernel_is_reciprocal_flux_from_j_to_i_equals_flux_from_i_to_j_within_its_
     // diffuse light refracts in and leave through the Fresnel boundary, the same angular weight
     // both ways up to Fresnel's transmittance, which the sphere's patches share.
     let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
-    let kernel = object_kernel_walks(
-        &scene.objects[0],
-        &KernelSettings { patches: 24, walks: 24 * 4000, seed: 5, more_on_small_meshes: false },
-        &quiet,
-    )
-    .unwrap();
+    let kernel = object_kernel_walks(&scene.objects[0], &fixed(24, 24 * 4000, 5), &quiet).unwrap();
     let (k, area) = (kernel.patches.len(), &kernel.patches.area);
     for c in 0..3 {
         let w = &kernel.flux[c];
@@ -276,7 +262,7 @@ fn averaging_each_pair_with_its_reciprocal_brings_the_kernel_closer_to_one_of_tw
     // The walks entering J and those entering I estimate A_J W0_IJ = A_I W0_JI independently:
     // their mean should have about half the variance, an RMS error about 0.7 times either's.
     let scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
-    let at = |walks: u64, seed| KernelSettings { patches: 24, walks: 24 * walks, seed, more_on_small_meshes: false };
+    let at = |walks: u64, seed| fixed(24, 24 * walks, seed);
     let fine = object_kernel(&scene.objects[0], &at(12_000, 9), &quiet).unwrap();
     let raw = object_kernel_walks(&scene.objects[0], &at(1_000, 5), &quiet).unwrap();
     let averaged = raw.clone().reciprocal();
@@ -376,12 +362,7 @@ fn against_twin(mut scene: PreparedScene, kernel: &TransportKernel, level: usize
 fn the_gpu_transport_pass_matches_its_f64_twin_at_each_level_and_after_a_rigid_move() {
     let scene = sphere(10.0, 24, "preset = \"marble\"", "transport");
     assert!(scene.objects[0].levels.len() > 1, "the test needs a coarser level of detail");
-    let kernel = object_kernel(
-        &scene.objects[0],
-        &KernelSettings { patches: 48, walks: 48 * 300, seed: 2, more_on_small_meshes: false },
-        &quiet,
-    )
-    .unwrap();
+    let kernel = object_kernel(&scene.objects[0], &fixed(48, 48 * 300, 2), &quiet).unwrap();
     for level in [0, scene.objects[0].levels.len() - 1] {
         let (worst, changed) = against_twin(scene.clone(), &kernel, level);
         assert!(worst < 1e-4, "level {level}: GPU against its f64 twin, {worst:.2e} of the brightest vertex");
@@ -402,7 +383,7 @@ fn the_gpu_transport_pass_matches_its_f64_twin_at_each_level_and_after_a_rigid_m
 fn in_ketchup_the_kernel_scales_red_and_leaves_green_and_blue_to_single_scattering_between_points() {
     let scene = sphere(10.0, 24, "preset = \"ketchup\"", "transport");
     assert_eq!(scene.objects[0].single_channels(), [false, true, true], "ketchup's reduced albedos");
-    let settings = KernelSettings { patches: 48, walks: 48 * 300, seed: 2, more_on_small_meshes: false };
+    let settings = fixed(48, 48 * 300, 2);
     let kernel = object_kernel(&scene.objects[0], &settings, &quiet).unwrap();
     let mut with = scene.clone();
     with.objects[0].transport = Some(std::sync::Arc::new(kernel));
@@ -419,12 +400,7 @@ fn in_ketchup_the_kernel_scales_red_and_leaves_green_and_blue_to_single_scatteri
 #[test]
 fn a_scale_or_a_material_edit_drops_the_kernel_with_its_reason_and_the_dipole_takes_over() {
     let mut scene = sphere(10.0, 12, "preset = \"marble\"", "transport");
-    let kernel = object_kernel(
-        &scene.objects[0],
-        &KernelSettings { patches: 24, walks: 16 * 100, seed: 2, more_on_small_meshes: false },
-        &quiet,
-    )
-    .unwrap();
+    let kernel = object_kernel(&scene.objects[0], &fixed(24, 16 * 100, 2), &quiet).unwrap();
     scene.objects[0].transport = Some(std::sync::Arc::new(kernel));
     let mut scaled = scene.clone();
     scaled.set_transform(0, Transform { scale: Some(1.5), ..Transform::default() }).unwrap();
@@ -468,7 +444,7 @@ fn a_damaged_or_foreign_kernel_cache_file_is_walked_anew_never_used() {
     let dir = common::temp_dir("transport-cache");
     let scene = sphere(10.0, 8, "preset = \"marble\"", "transport");
     let o = &scene.objects[0];
-    let settings = KernelSettings { patches: 8, walks: 7 * 50, seed: 4, more_on_small_meshes: false };
+    let settings = fixed(8, 7 * 50, 4);
     let (first, cached) = transport_cache::cached(o, &settings, &dir, &quiet).unwrap();
     assert!(!cached);
     let (again, cached) = transport_cache::cached(o, &settings, &dir, &quiet).unwrap();
@@ -520,7 +496,7 @@ fn a_cached_kernel_follows_a_moving_light_as_the_rte_does_where_the_dipole_does_
     // from it, and the RTE's walks are short.
     let scene = sphere(3.0, 24, "preset = \"marble\"", "transport");
     let dir = std::env::temp_dir().join(format!("translucent-kernel-light-{}", std::process::id()));
-    let settings = KernelSettings { patches: 48, walks: 48 * 400, seed: 6, more_on_small_meshes: false };
+    let settings = fixed(48, 48 * 400, 6);
     let (kernel, cached) = transport_cache::cached(&scene.objects[0], &settings, &dir, &quiet).unwrap();
     assert!(!cached, "a fresh folder holds no kernel");
     let count = scene.objects[0].mesh.positions().len();
